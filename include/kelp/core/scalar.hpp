@@ -1,0 +1,68 @@
+/// \file
+/// \brief Scalar policy: how kelp reads the value of a `double`, a `float` or a `ceres::Jet`, and
+/// the finiteness / positivity checks used on user input.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "kelp/core/error.hpp"
+
+namespace kelp {
+
+/// \brief The value part of a scalar as a double: the number itself for arithmetic types, the
+/// real part `x.a` (recursively) for automatic-differentiation types such as `ceres::Jet`.
+template <typename Scalar>
+constexpr double value_of(const Scalar& x) {
+  if constexpr (std::is_arithmetic_v<Scalar>) {
+    return static_cast<double>(x);
+  } else {
+    return value_of(x.a);
+  }
+}
+
+/// \brief True when the value part of `x` is finite (neither NaN nor ±Inf).
+template <typename Scalar>
+bool is_finite(const Scalar& x) {
+  return std::isfinite(value_of(x));
+}
+
+/// \brief True when every coefficient of an Eigen expression has a finite value part.
+template <typename Derived>
+bool all_finite(const Derived& m) {
+  for (Eigen::Index j = 0; j < m.cols(); ++j)
+    for (Eigen::Index i = 0; i < m.rows(); ++i)
+      if (!is_finite(m(i, j))) return false;
+  return true;
+}
+
+/// \brief Throws `kelp::invalid_argument` naming `field` unless `x` is finite.
+template <typename Scalar>
+void check_finite(const Scalar& x, const char* field) {
+  if (!is_finite(x)) detail::throw_invalid_argument(std::string(field) + " must be finite");
+}
+
+/// \brief Throws `kelp::invalid_argument` naming `field` unless every coefficient is finite.
+template <typename Derived>
+void check_all_finite(const Derived& m, const char* field) {
+  if (!all_finite(m)) detail::throw_invalid_argument(std::string(field) + " must be finite");
+}
+
+/// \brief Throws `kelp::invalid_argument` naming `field` unless `x` is finite and > 0.
+template <typename Scalar>
+void check_positive(const Scalar& x, const char* field) {
+  if (!(is_finite(x) && value_of(x) > 0.0))
+    detail::throw_invalid_argument(std::string(field) + " must be finite and > 0");
+}
+
+/// \brief Throws `kelp::invalid_argument` naming `field` unless `x` is finite and >= 0.
+template <typename Scalar>
+void check_non_negative(const Scalar& x, const char* field) {
+  if (!(is_finite(x) && value_of(x) >= 0.0))
+    detail::throw_invalid_argument(std::string(field) + " must be finite and >= 0");
+}
+
+}  // namespace kelp

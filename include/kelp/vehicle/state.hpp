@@ -1,0 +1,43 @@
+/// \file
+/// \brief The 6-DOF state of a rigid marine vehicle, shared by vehicle dynamics and by the
+/// system layer that attaches tethers to vehicles.
+#pragma once
+
+#include "kelp/core/rotation.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp::vehicle {
+
+/// \brief Vehicle state: position and attitude in NED, generalized velocity in body axes.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct VehicleState {
+  /// Position of the body-frame origin (CO) in NED [m].
+  Vector3<Scalar> position = Vector3<Scalar>::Zero();
+  /// Unit quaternion rotating body vectors into NED (Eigen's w, x, y, z).
+  Quaternion<Scalar> attitude = Quaternion<Scalar>::Identity();
+  /// ν = (u, v, w, p, q, r): body-frame linear [m/s] and angular [rad/s] velocity.
+  Vector6<Scalar> nu = Vector6<Scalar>::Zero();
+
+  /// \brief Rotation matrix body → NED.
+  Matrix3<Scalar> rotation() const { return attitude.toRotationMatrix(); }
+
+  /// \brief NED position [m] of a point given in body coordinates `r_body` [m] relative to the CO.
+  template <typename Derived>
+  Vector3<Scalar> point_position(const Eigen::MatrixBase<Derived>& r_body) const {
+    return position + attitude * Vector3<Scalar>(r_body);
+  }
+
+  /// \brief NED velocity [m/s] of a body-fixed point `r_body`: R (v + ω × r).
+  template <typename Derived>
+  Vector3<Scalar> point_velocity(const Eigen::MatrixBase<Derived>& r_body) const {
+    const Vector3<Scalar> r(r_body);
+    const Vector3<Scalar> v = nu.template head<3>() + nu.template tail<3>().cross(r);
+    return attitude * v;
+  }
+};
+
+using VehicleStated = VehicleState<double>;
+using VehicleStatef = VehicleState<float>;
+
+}  // namespace kelp::vehicle

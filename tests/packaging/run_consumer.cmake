@@ -1,0 +1,34 @@
+# Driver for one packaging test (see CMakeLists.txt). Fails with FATAL_ERROR on any step.
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "packaging: command failed (${rc}): ${ARGN}")
+  endif()
+endfunction()
+
+if(MODE STREQUAL "install")
+  run(${CMAKE_COMMAND} --install ${KELP_BINARY_DIR} --prefix ${WORK_DIR}/prefix)
+  set(prefix_args -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+  if(NOT EXISTS ${WORK_DIR}/prefix/share/cmake/kelp/kelpConfigVersion.cmake)
+    message(FATAL_ERROR "packaging: kelpConfigVersion.cmake was not installed")
+  endif()
+else()
+  set(prefix_args -Dkelp_DIR=${KELP_BINARY_DIR})
+endif()
+
+# 1. Without the ceres component: kelp::kelp only, and Ceres must not be pulled in.
+run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/plain -DCMAKE_BUILD_TYPE=Release
+    -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DKELP_CONSUMER_WITH_CERES=OFF ${prefix_args})
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/plain -j 2)
+run(${WORK_DIR}/plain/hello_kelp)
+
+# 2. With the ceres component: kelp::ceres and every header, the Ceres ones included.
+if(WITH_CERES)
+  run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/ceres -DCMAKE_BUILD_TYPE=Release
+      -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DKELP_CONSUMER_WITH_CERES=ON ${prefix_args})
+  run(${CMAKE_COMMAND} --build ${WORK_DIR}/ceres -j 2)
+  run(${WORK_DIR}/ceres/hello_kelp)
+endif()
