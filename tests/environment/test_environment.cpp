@@ -1,0 +1,68 @@
+// The environment facade: the calm default is still water, a constant current is returned
+// everywhere, the batch query agrees with the point query and allocates nothing, and bad input is
+// rejected naming the field.
+#include <catch2/catch.hpp>
+#include <limits>
+
+#include "kelp/environment/environment.hpp"
+
+using kelp::Matrix3X;
+using kelp::Vector3;
+using kelp::environment::Environment;
+
+TEMPLATE_TEST_CASE("a default environment is still seawater with standard gravity", "[environment]",
+                   double, float) {
+  using S = TestType;
+  const Environment<S> env = Environment<S>::calm();
+  CHECK(env.water_density() == S(1025));
+  CHECK(env.air_density() == S(1.225));
+  CHECK(env.gravity() == S(kelp::standard_gravity));
+  CHECK(env.seabed_depth() == std::numeric_limits<S>::infinity());
+  for (const S z : {S(-1), S(0), S(3), S(50)}) {
+    const auto s = env.sample(Vector3<S>(S(2), S(-4), z), S(12.5));
+    CHECK(s.current.norm() == S(0));
+    CHECK(s.wave_velocity.norm() == S(0));
+    CHECK(s.wave_acceleration.norm() == S(0));
+    CHECK(s.surface_elevation == S(0));
+    CHECK(s.wind.norm() == S(0));
+  }
+  CHECK(env.surface_elevation(S(1), S(2), S(3)) == S(0));
+}
+
+TEMPLATE_TEST_CASE("a constant current is seen at every point, alone and in the batch query",
+                   "[environment]", double, float) {
+  using S = TestType;
+  Environment<S> env;
+  env.set_current(Vector3<S>(S(0.5), S(-0.2), S(0.01)));
+  Matrix3X<S> pts(3, 5), vel(3, 5), acc(3, 5);
+  pts << 0, 1, 2, 3, 4,  //
+      0, 0, 1, 1, 2,     //
+      0.5, 2, 4, 8, 16;
+  vel.setConstant(S(99));
+  acc.setConstant(S(99));
+  Eigen::internal::set_is_malloc_allowed(false);
+  env.sample_water(pts, S(3), vel, acc);
+  Eigen::internal::set_is_malloc_allowed(true);
+  for (Eigen::Index i = 0; i < pts.cols(); ++i) {
+    const Vector3<S> p = pts.col(i);
+    const auto s = env.sample(p, S(3));
+    CHECK((s.current - Vector3<S>(S(0.5), S(-0.2), S(0.01))).norm() == S(0));
+    CHECK((vel.col(i) - s.current - s.wave_velocity).norm() == S(0));
+    CHECK(acc.col(i).norm() == S(0));
+  }
+}
+
+TEST_CASE("bad environment input throws kelp::invalid_argument naming the field", "[environment]") {
+  Environment<double> env;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(env.set_water_density(-1.0), kelp::invalid_argument);
+  CHECK_THROWS_WITH(env.set_water_density(0.0), Catch::Contains("water_density"));
+  CHECK_THROWS_WITH(env.set_air_density(nan), Catch::Contains("air_density"));
+  CHECK_THROWS_WITH(env.set_gravity(-9.8), Catch::Contains("gravity"));
+  CHECK_THROWS_WITH(env.set_seabed_depth(-5.0), Catch::Contains("seabed_depth"));
+  CHECK_THROWS_WITH(env.set_seabed_depth(nan), Catch::Contains("seabed_depth"));
+  CHECK_THROWS_WITH(env.set_current(Vector3<double>(nan, 0, 0)), Catch::Contains("current"));
+  CHECK_NOTHROW(env.set_seabed_depth(std::numeric_limits<double>::infinity()));
+  env.set_seabed_depth(30.0);
+  CHECK(env.seabed_depth() == 30.0);
+}
