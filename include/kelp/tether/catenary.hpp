@@ -1,0 +1,593 @@
+/// \file
+/// \brief The elastic-free catenary between two tether ends: a fast analytic solver for the paper's
+/// two equations, physical statuses instead of exceptions, and a 3-D helper (shape, lowest point,
+/// tensions) in world NED.
+///
+/// **The paper's plane.** x is horizontal from the start (ASV) end, z points up; D ≥ 0 is the
+/// horizontal distance between the ends, Δz = z_end − z_start and L the tether length. The shape is
+/// \f$ z(x) = a\cosh((x-c)/a) - a\cosh(c/a) \f$ with a, c from
+/// \f[ a[\cosh((D-c)/a) - \cosh(c/a)] = \Delta z, \qquad a[\sinh((D-c)/a) + \sinh(c/a)] = L. \f]
+/// Subtracting the squares gives \f$ \sqrt{L^2 - \Delta z^2} = 2a\sinh(D/(2a)) \f$ and dividing
+/// them \f$ \Delta z / L = \tanh((D-2c)/(2a)) \f$, so with \f$ u = D/(2a) \f$ the problem is the
+/// 1-D equation \f$ \sinh(u)/u = \sqrt{L^2-\Delta z^2}/D \f$ and
+/// \f$ c = D/2 - a\,\mathrm{atanh}(\Delta z/L) \f$ (see `reference/tether.md`).
+///
+/// **How it is solved.** The 1-D equation is solved in its logarithmic form
+/// \f$ h(u) = \ln(\sinh(u)/u) = \lambda \f$, which never overflows and keeps full relative
+/// precision near taut (u → 0, where h ≈ u²/6) and for very slack lines (h ≈ u − ln 2u). The
+/// initial guess is a series inversion for small λ and the asymptotic form for large λ; safeguarded
+/// Halley steps (h is increasing and convex) finish in 1–3 iterations. The work is done in double
+/// for every Scalar; for automatic-differentiation scalars (`ceres::Jet`) the derivative parts of a
+/// and c are added by the implicit function theorem (du/dλ = 1/h'(u)), so no derivative is taken
+/// through the iterations.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+#include <Eigen/Core>
+
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp {
+namespace tether {
+
+/// \brief Outcome of a catenary solve. Physically possible geometry never throws; it is reported
+/// here.
+enum class CatenaryStatus {
+  converged,  ///< Slack line: a, c solve the paper's two equations.
+  taut,       ///< L ≤ chord: the line is straight (stretched when L < chord); a = +∞, c = NaN.
+  vertical,   ///< D ≤ vertical_tolerance·L: the ends are vertically aligned; a = 0, c = 0.
+  invalid_input,   ///< NaN or ±Inf input, L ≤ 0 or D < 0 (for the 3-D helper: non-finite w).
+  max_iterations,  ///< The iteration limit was hit; a, c hold the last iterate.
+};
+
+/// \brief A short lower-case name of a status ("converged", "taut", ...), for logs and messages.
+inline const char* to_string(CatenaryStatus status) {
+  switch (status) {
+    case CatenaryStatus::converged:
+      return "converged";
+    case CatenaryStatus::taut:
+      return "taut";
+    case CatenaryStatus::vertical:
+      return "vertical";
+    case CatenaryStatus::invalid_input:
+      return "invalid_input";
+    case CatenaryStatus::max_iterations:
+      return "max_iterations";
+  }
+  return "unknown";
+}
+
+/// \brief Controls of the catenary solvers (the fast path here and `kelp::ceres::solve_catenary`).
+/// \tparam Scalar double, float or `ceres::Jet` (EA may carry derivative parts).
+template <typename Scalar>
+struct CatenaryOptions {
+  /// Stop when a Halley step changes u = D/(2a) by at most `tolerance`·u (dimensionless). The step
+  /// that meets the test is applied, so the final error is far below it (cubic convergence).
+  double tolerance = 1e-12;
+  /// Iteration limit of the 1-D solve (the Ceres path uses it as its own iteration limit).
+  int max_iterations = 30;
+  /// Ends closer horizontally than `vertical_tolerance`·L are treated as vertically aligned
+  /// (status `vertical`). Must be ≥ 0; the default keeps D/L = 1e-6 on the regular path.
+  double vertical_tolerance = 1e-12;
+  /// Axial stiffness EA [N] used only for the tension of a taut (stretched) line:
+  /// T = EA·(chord − L)/L. 0 (the default) means inextensible: a taut line then reports T = 0
+  /// because statics alone cannot determine it.
+  Scalar EA = Scalar(0);
+};
+
+/// \brief Result of a catenary solve in the paper's plane (x horizontal from the start, z up).
+/// \tparam Scalar double, float or `ceres::Jet`.
+template <typename Scalar>
+struct CatenaryResult {
+  /// Catenary parameter a = H/w [m]: the radius of curvature at the vertex. +∞ when taut, 0 when
+  /// vertical, NaN when invalid.
+  Scalar a = Scalar(std::numeric_limits<double>::quiet_NaN());
+  /// Horizontal position of the vertex from the start end [m]; may lie outside [0, D] (then the
+  /// vertex is on the virtual extension of the cable). NaN when taut or invalid, 0 when vertical.
+  Scalar c = Scalar(std::numeric_limits<double>::quiet_NaN());
+  /// What happened; see CatenaryStatus.
+  CatenaryStatus status = CatenaryStatus::invalid_input;
+  /// Iterations used by the solver (0 for taut, vertical and invalid input).
+  int iterations = 0;
+  /// max(|R1|, |R2|)/L with R1, R2 the paper's two equations written as residuals and evaluated in
+  /// double at the returned a, c (dimensionless). 0 for taut and vertical, NaN for invalid input.
+  Scalar residual = Scalar(std::numeric_limits<double>::quiet_NaN());
+  /// Axial tension of a taut line, EA·(chord − L)/L [N] (0 when not taut or EA = 0).
+  Scalar taut_tension = Scalar(0);
+
+  /// \brief True when a, c describe the line (converged or vertical).
+  bool ok() const {
+    return status == CatenaryStatus::converged || status == CatenaryStatus::vertical;
+  }
+};
+
+namespace detail {
+
+/// sinh(u)/u − 1 for u ≥ 0 with full relative precision (Taylor series below 0.5).
+inline double sinhc_minus_one(double u) {
+  if (u < 0.5) {
+    const double v = u * u;
+    return v * (1.0 / 6.0 +
+                v * (1.0 / 120.0 +
+                     v * (1.0 / 5040.0 +
+                          v * (1.0 / 362880.0 + v * (1.0 / 39916800.0 + v / 6227020800.0)))));
+  }
+  return std::sinh(u) / u - 1.0;
+}
+
+/// h(u) = ln(sinh(u)/u), u ≥ 0, without overflow: for u > 1 it uses ln sinh u = u − ln 2 +
+/// ln(1 − e^{−2u}).
+inline double log_sinhc(double u) {
+  if (u <= 1.0) return std::log1p(sinhc_minus_one(u));
+  return u - std::log(2.0 * u) + std::log1p(-std::exp(-2.0 * u));
+}
+
+/// h'(u) = coth(u) − 1/u (the Langevin function), u > 0; series below 0.25.
+inline double log_sinhc_d1(double u) {
+  if (u < 0.25) {
+    const double v = u * u;
+    return u * (1.0 / 3.0 +
+                v * (-1.0 / 45.0 + v * (2.0 / 945.0 + v * (-1.0 / 4725.0 + v * (2.0 / 93555.0)))));
+  }
+  return 1.0 / std::tanh(u) - 1.0 / u;
+}
+
+/// h''(u) = 1/u² − 1/sinh²(u), u > 0; series below 0.5 (only used to shape Halley steps).
+inline double log_sinhc_d2(double u) {
+  const double v = u * u;
+  if (u < 0.5) {
+    return 1.0 / 3.0 +
+           v * (-1.0 / 15.0 + v * (2.0 / 189.0 + v * (-7.0 / 4725.0 + v * (18.0 / 93555.0))));
+  }
+  if (u > 300.0) return 1.0 / v;
+  const double s = std::sinh(u);
+  return 1.0 / v - 1.0 / (s * s);
+}
+
+/// Initial guess of u for h(u) = λ: for small λ the inverted series h = u²/6 − u⁴/180 + u⁶/2835
+/// (u² = 6λ + 1.2λ² + 0.0229λ³); for large λ two fixed-point steps of u = λ + ln(2u).
+inline double log_sinhc_inverse_guess(double lambda) {
+  if (lambda < 2.5) {
+    return std::sqrt(lambda * (6.0 + lambda * (1.2 + 0.0229 * lambda)));
+  }
+  double u = lambda + std::log(2.0 * lambda);
+  u = lambda + std::log(2.0 * u);
+  return lambda + std::log(2.0 * u);
+}
+
+/// Result of the double-precision 1-D solve.
+struct ReducedSolution {
+  double u = 0.0;       ///< D/(2a)
+  double lambda = 0.0;  ///< ln(√(L²−Δz²)/D)
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// ρ = √(L²−Δz²)/D − 1 ≥ 0 without cancellation near taut: L² − Δz² − D² = (L − chord)(L + chord).
+template <typename T>
+T sinhc_target_minus_one(const T& D, const T& dz, const T& L) {
+  using std::sqrt;
+  const T chord = sqrt(D * D + dz * dz);
+  const T excess = (L - chord) * (L + chord);
+  return excess / (D * (sqrt(D * D + excess) + D));
+}
+
+/// Solves h(u) = λ by safeguarded Halley steps (h is increasing and convex on u > 0).
+inline ReducedSolution solve_reduced(double lambda, double tolerance, int max_iterations) {
+  ReducedSolution out;
+  out.lambda = lambda;
+  double u = log_sinhc_inverse_guess(lambda);
+  for (int it = 1; it <= max_iterations; ++it) {
+    const double f = log_sinhc(u) - lambda;
+    const double d1 = log_sinhc_d1(u);
+    const double d2 = log_sinhc_d2(u);
+    const double newton = f / d1;
+    double denom = 1.0 - 0.5 * newton * d2 / d1;
+    // Halley's correction is only trusted while it is moderate; otherwise take the Newton step.
+    if (!(denom > 0.5 && denom < 2.0)) denom = 1.0;
+    const double step = newton / denom;
+    double next = u - step;
+    if (!(next > 0.0)) next = 0.5 * u;  // keep u > 0 (a > 0)
+    const bool small = std::abs(next - u) <= tolerance * next;
+    u = next;
+    out.iterations = it;
+    if (small || f == 0.0) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.u = u;
+  return out;
+}
+
+/// The paper's residuals a[cosh((D−c)/a) − cosh(c/a)] − Δz and a[sinh((D−c)/a) + sinh(c/a)] − L,
+/// as written, in double; returns max(|R1|, |R2|)/L.
+inline double paper_residual(double a, double c, double D, double dz, double L) {
+  const double p = (D - c) / a;
+  const double q = c / a;
+  const double ep = std::exp(p), eq = std::exp(q);
+  const double cosh_p = 0.5 * (ep + 1.0 / ep), sinh_p = 0.5 * (ep - 1.0 / ep);
+  const double cosh_q = 0.5 * (eq + 1.0 / eq), sinh_q = 0.5 * (eq - 1.0 / eq);
+  const double r1 = a * (cosh_p - cosh_q) - dz;
+  const double r2 = a * (sinh_p + sinh_q) - L;
+  return std::max(std::abs(r1), std::abs(r2)) / L;
+}
+
+/// atanh(t) = ½ ln((1+t)/(1−t)) written with log1p (ceres::Jet has no atanh).
+template <typename T>
+T atanh_via_log(const T& t) {
+  using std::log1p;
+  return T(0.5) * log1p(T(2.0) * t / (T(1.0) - t));
+}
+
+/// asinh(y) via log1p/sqrt (ceres::Jet has no asinh); odd-symmetric and exact near 0.
+template <typename T>
+T asinh_via_log(const T& y) {
+  using std::log1p;
+  using std::sqrt;
+  if (y < T(0.0)) return -asinh_via_log(T(-y));
+  return log1p(y + y * y / (T(1.0) + sqrt(T(1.0) + y * y)));
+}
+
+/// Classification shared by the fast and the Ceres paths, on the value parts.
+/// Returns `converged` when the geometry needs a solve.
+inline CatenaryStatus classify_catenary(double D, double dz, double L, double vertical_tolerance) {
+  if (!(std::isfinite(D) && std::isfinite(dz) && std::isfinite(L)) || !(L > 0.0) || D < 0.0 ||
+      !(vertical_tolerance >= 0.0))
+    return CatenaryStatus::invalid_input;
+  if (L <= std::hypot(D, dz)) return CatenaryStatus::taut;
+  if (D <= vertical_tolerance * L) return CatenaryStatus::vertical;
+  return CatenaryStatus::converged;
+}
+
+/// Fills the result for the statuses that need no solve (taut, vertical, invalid input).
+template <typename Scalar>
+void fill_unsolved(CatenaryStatus status, const Scalar& D, const Scalar& dz, const Scalar& L,
+                   const CatenaryOptions<Scalar>& options, CatenaryResult<Scalar>& result) {
+  using std::sqrt;
+  result.status = status;
+  result.iterations = 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (status == CatenaryStatus::taut) {
+    result.a = Scalar(std::numeric_limits<double>::infinity());
+    result.c = Scalar(nan);
+    result.residual = Scalar(0.0);
+    if (value_of(options.EA) > 0.0) {
+      const Scalar chord = sqrt(D * D + dz * dz);
+      result.taut_tension = options.EA * (chord - L) / L;
+    }
+  } else if (status == CatenaryStatus::vertical) {
+    result.a = Scalar(0.0);
+    result.c = Scalar(0.0);
+    result.residual = Scalar(0.0);
+  } else {
+    result.a = Scalar(nan);
+    result.c = Scalar(nan);
+    result.residual = Scalar(nan);
+  }
+}
+
+/// Turns the double solution u into a, c (and, for autodiff scalars, their derivative parts by the
+/// implicit function theorem: δu = δλ / h'(u)).
+template <typename Scalar>
+void finish_from_u(const ReducedSolution& sol, const Scalar& D, const Scalar& dz, const Scalar& L,
+                   CatenaryResult<Scalar>& result) {
+  using std::log1p;
+  const double Dd = value_of(D), dzd = value_of(dz), Ld = value_of(L);
+  if constexpr (std::is_arithmetic_v<Scalar>) {
+    const double a = Dd / (2.0 * sol.u);
+    const double c = 0.5 * Dd - a * atanh_via_log(dzd / Ld);
+    result.a = static_cast<Scalar>(a);
+    result.c = static_cast<Scalar>(c);
+  } else {
+    // λ with its derivative parts, then one exact linearisation about the double root.
+    const Scalar lambda = log1p(sinhc_target_minus_one(D, dz, L));
+    const Scalar u = Scalar(sol.u) + (lambda - Scalar(sol.lambda)) / log_sinhc_d1(sol.u);
+    result.a = D / (Scalar(2.0) * u);
+    result.c = Scalar(0.5) * D - result.a * atanh_via_log(dz / L);
+  }
+  result.iterations = sol.iterations;
+  result.residual = Scalar(paper_residual(value_of(result.a), value_of(result.c), Dd, dzd, Ld));
+}
+
+}  // namespace detail
+
+/// \brief Solves the paper's catenary equations for a and c by the analytic reduction (fast path).
+///
+/// Solves \f$ a[\cosh((D-c)/a) - \cosh(c/a)] = \Delta z \f$ and
+/// \f$ a[\sinh((D-c)/a) + \sinh(c/a)] = L \f$ through \f$ \sqrt{L^2-\Delta z^2} = 2a\sinh(D/(2a))
+/// \f$ and \f$ c = D/2 - a\,\mathrm{atanh}(\Delta z/L) \f$ (paper; `reference/tether.md`).
+/// Never throws and never allocates.
+/// \tparam Scalar double, float or `ceres::Jet<double, N>` (derivatives of a, c with respect to
+///   D, Δz and L by the implicit function theorem).
+/// \param[in] D horizontal distance between the ends [m], ≥ 0.
+/// \param[in] dz height of the end above the start, z_end − z_start with z up [m].
+/// \param[in] L unstretched tether length [m], > 0.
+/// \param[in] options tolerance, iteration limit, vertical threshold, EA for the taut tension.
+/// \return a, c, status (converged / taut / vertical / invalid_input / max_iterations),
+///   iterations and the paper's residual. Vertical (D ≤ vertical_tolerance·L): a = 0, c = 0 — the
+///   slack L − |Δz| hangs as a doubled vertical loop below the lower end (for a weighted line),
+///   see CatenaryShape.
+template <typename Scalar>
+CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
+                                      const CatenaryOptions<Scalar>& options = {}) {
+  CatenaryResult<Scalar> result;
+  const double Dd = value_of(D), dzd = value_of(dz), Ld = value_of(L);
+  const CatenaryStatus kind = detail::classify_catenary(Dd, dzd, Ld, options.vertical_tolerance);
+  if (kind != CatenaryStatus::converged) {
+    detail::fill_unsolved(kind, D, dz, L, options, result);
+    return result;
+  }
+  const double lambda = std::log1p(detail::sinhc_target_minus_one(Dd, dzd, Ld));
+  const detail::ReducedSolution sol =
+      detail::solve_reduced(lambda, options.tolerance, options.max_iterations);
+  detail::finish_from_u(sol, D, dz, L, result);
+  result.status = sol.converged ? CatenaryStatus::converged : CatenaryStatus::max_iterations;
+  return result;
+}
+
+/// \brief The static catenary between two 3-D attachment points, in world NED.
+///
+/// Built by catenary_between(): the vertical plane through both ends, the paper's solve, then the
+/// shape by arc length, the lowest point, the horizontal tension H = a·|w| and the 3-D forces
+/// the cable exerts on its two attachment points. A buoyant line (w < 0) is the mirror image of a
+/// hanging one (inverted catenary: it arches upwards).
+///
+/// Status-specific behaviour: `taut` — the straight segment from start to end; each end carries the
+/// axial tension EA·(chord − L)/L (0 when EA = 0) plus half the weight w·L (the limit of a
+/// vanishing sag). `vertical` — the ends are vertically aligned: the line runs from the start to
+/// the vertex (lowest point for w ≥ 0, highest for w < 0) and back to the end along the vertical,
+/// s_start = (L − Δz')/2 from the start (Δz' the height difference in the mirrored plane), H = 0,
+/// each end carries the weight of its own branch. `invalid_input` — every query returns NaN.
+/// \tparam Scalar double, float or `ceres::Jet<double, N>`.
+template <typename Scalar>
+class CatenaryShape {
+ public:
+  using Vector3S = Vector3<Scalar>;
+
+  /// \brief An invalid shape (status invalid_input); use catenary_between() to build one.
+  CatenaryShape() = default;
+
+  /// \brief Solves the catenary between `start_ned` and `end_ned`; see catenary_between().
+  CatenaryShape(const Vector3S& start_ned, const Vector3S& end_ned, Scalar L, Scalar w,
+                const CatenaryOptions<Scalar>& options = {})
+      : start_(start_ned), end_(end_ned), L_(L), w_(w) {
+    using std::abs;
+    using std::sqrt;
+    horizontal_dir_ = Vector3S(Scalar(1.0), Scalar(0.0), Scalar(0.0));
+    if (!(all_finite(start_ned) && all_finite(end_ned) && is_finite(w))) {
+      detail::fill_unsolved(CatenaryStatus::invalid_input, Scalar(0.0), Scalar(0.0), L, options,
+                            result_);
+      return;
+    }
+    const Scalar dn = end_.x() - start_.x();
+    const Scalar de = end_.y() - start_.y();
+    D_ = sqrt(dn * dn + de * de);
+    if (value_of(D_) > 0.0) horizontal_dir_ = Vector3S(dn / D_, de / D_, Scalar(0.0));
+    buoyant_ = value_of(w_) < 0.0;
+    // z up = −z_NED; the mirrored plane flips z for a buoyant line so that it always hangs.
+    const Scalar dz_up = start_.z() - end_.z();
+    dz_ = buoyant_ ? Scalar(-dz_up) : dz_up;
+    weight_ = abs(w_);
+    result_ = solve_catenary(D_, dz_, L_, options);
+    if (result_.ok() && result_.status == CatenaryStatus::converged) {
+      H_ = result_.a * weight_;
+    } else {
+      H_ = Scalar(0.0);
+    }
+  }
+
+  /// \brief The solver's status (see CatenaryStatus).
+  CatenaryStatus status() const { return result_.status; }
+  /// \brief The full solve result in the (mirrored, for w < 0) paper plane: a, c, iterations,
+  /// residual, taut tension.
+  const CatenaryResult<Scalar>& result() const { return result_; }
+  /// \brief Horizontal tension H = a·|w| [N], the same all along the line (0 when vertical, taut or
+  /// invalid).
+  Scalar horizontal_tension() const { return H_; }
+  /// \brief Horizontal distance between the ends D [m].
+  Scalar horizontal_distance() const { return D_; }
+  /// \brief Unstretched length L [m].
+  Scalar length() const { return L_; }
+  /// \brief Submerged weight per length w [N/m] (< 0: buoyant).
+  Scalar weight_per_length() const { return w_; }
+
+  /// \brief The NED point [m] at unstretched arc length s ∈ [0, L] from the start end.
+  ///
+  /// Slack line (paper plane, mirrored when buoyant): with σ₀ = −a sinh(c/a) the arc length of the
+  /// start from the vertex, x(s) = c + a·asinh((σ₀ + s)/a) and
+  /// z(x) = a cosh((x−c)/a) − a cosh(c/a) = 2a sinh(x/(2a)) sinh((x−2c)/(2a)).
+  /// Taut: linear interpolation. Values of s outside [0, L] extrapolate the same curve.
+  Vector3S point_at(Scalar s) const {
+    using std::sinh;
+    const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
+    switch (result_.status) {
+      case CatenaryStatus::taut:
+        return start_ + (s / L_) * (end_ - start_);
+      case CatenaryStatus::vertical: {
+        const Scalar s1 = start_branch_length();
+        const Scalar z_plane = s <= s1 ? Scalar(-s) : Scalar(s - Scalar(2.0) * s1);
+        return from_plane(D_ * s / L_, z_plane);
+      }
+      case CatenaryStatus::converged:
+      case CatenaryStatus::max_iterations: {
+        const Scalar a = result_.a, c = result_.c;
+        const Scalar sigma0 = -a * sinh(c / a);
+        const Scalar x = c + a * detail::asinh_via_log((sigma0 + s) / a);
+        return from_plane(x, plane_height(x));
+      }
+      case CatenaryStatus::invalid_input:
+        break;
+    }
+    return Vector3S(nan, nan, nan);
+  }
+
+  /// \brief The vertex of the catenary in NED [m]: the lowest point of the curve for w ≥ 0, the
+  /// highest for w < 0. It may lie beyond the ends (then it is not on the cable). NaN when taut
+  /// or invalid.
+  Vector3S vertex() const {
+    const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
+    if (result_.status == CatenaryStatus::vertical) return point_at(start_branch_length());
+    if (result_.status == CatenaryStatus::converged ||
+        result_.status == CatenaryStatus::max_iterations)
+      return from_plane(result_.c, plane_height(result_.c));
+    return Vector3S(nan, nan, nan);
+  }
+
+  /// \brief The deepest point of the cable itself, NED [m]: the vertex when it lies between the
+  /// ends of a hanging line, otherwise the deeper end (always an end for a buoyant or taut line).
+  Vector3S lowest_point() const {
+    const Vector3S deeper_end = end_.z() > start_.z() ? end_ : start_;
+    switch (result_.status) {
+      case CatenaryStatus::converged:
+      case CatenaryStatus::max_iterations:
+        if (!buoyant_ && result_.c >= Scalar(0.0) && result_.c <= D_) return vertex();
+        return deeper_end;
+      case CatenaryStatus::vertical:
+        return buoyant_ ? deeper_end : vertex();
+      case CatenaryStatus::taut:
+        return deeper_end;
+      case CatenaryStatus::invalid_input:
+        break;
+    }
+    return vertex();
+  }
+
+  /// \brief Force the cable exerts on the start attachment point, NED [N].
+  ///
+  /// Slack line: H toward the end horizontally and H·sinh(c/a) = |w|·(arc length from the start to
+  /// the vertex) downwards (upwards for a buoyant line), i.e. the cable tension T = H cosh(c/a)
+  /// along the tangent. Taut and vertical: see the class description.
+  Vector3S force_on_start() const { return end_force(true); }
+
+  /// \brief Force the cable exerts on the end attachment point, NED [N] (see force_on_start()).
+  Vector3S force_on_end() const { return end_force(false); }
+
+  /// \brief Tension magnitude [N] at arc length s: H cosh((x(s) − c)/a) for a slack line.
+  Scalar tension_at(Scalar s) const {
+    using std::sqrt;
+    switch (result_.status) {
+      case CatenaryStatus::converged:
+      case CatenaryStatus::max_iterations: {
+        const Scalar a = result_.a, c = result_.c;
+        using std::sinh;
+        const Scalar sigma = s - a * sinh(c / a);  // arc length from the vertex
+        return weight_ * sqrt(a * a + sigma * sigma);
+      }
+      case CatenaryStatus::vertical: {
+        const Scalar s1 = start_branch_length();
+        return weight_ * (s <= s1 ? Scalar(s1 - s) : Scalar(s - s1));
+      }
+      case CatenaryStatus::taut:
+        return result_.taut_tension;
+      case CatenaryStatus::invalid_input:
+        break;
+    }
+    return Scalar(std::numeric_limits<double>::quiet_NaN());
+  }
+
+ private:
+  /// Arc length from the start to the vertex of a vertical line, (L − Δz')/2.
+  Scalar start_branch_length() const { return Scalar(0.5) * (L_ - dz_); }
+
+  /// z of the (mirrored) paper plane at horizontal position x: 2a sinh(x/2a) sinh((x−2c)/2a).
+  Scalar plane_height(const Scalar& x) const {
+    using std::sinh;
+    const Scalar a = result_.a, c = result_.c;
+    return Scalar(2.0) * a * sinh(x / (Scalar(2.0) * a)) *
+           sinh((x - Scalar(2.0) * c) / (Scalar(2.0) * a));
+  }
+
+  /// NED point of the (mirrored) plane coordinates (x, z).
+  Vector3S from_plane(const Scalar& x, const Scalar& z_plane) const {
+    const Scalar z_up = buoyant_ ? Scalar(-z_plane) : z_plane;
+    Vector3S p = start_ + x * horizontal_dir_;
+    p.z() = start_.z() - z_up;
+    return p;
+  }
+
+  /// NED vector of a (mirrored) plane vector (horizontal, vertical-up).
+  Vector3S plane_vector(const Scalar& fx, const Scalar& fz_plane) const {
+    const Scalar fz_up = buoyant_ ? Scalar(-fz_plane) : fz_plane;
+    Vector3S f = fx * horizontal_dir_;
+    f.z() = -fz_up;
+    return f;
+  }
+
+  Vector3S end_force(bool at_start) const {
+    using std::sinh;
+    using std::sqrt;
+    const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
+    switch (result_.status) {
+      case CatenaryStatus::converged:
+      case CatenaryStatus::max_iterations: {
+        const Scalar a = result_.a, c = result_.c;
+        // Vertical components from the arc lengths to the vertex: w·a·sinh(·).
+        if (at_start) return plane_vector(H_, -weight_ * a * sinh(c / a));
+        return plane_vector(Scalar(-H_), -weight_ * a * sinh((D_ - c) / a));
+      }
+      case CatenaryStatus::vertical: {
+        const Scalar s1 = start_branch_length();
+        const Scalar branch = at_start ? s1 : Scalar(L_ - s1);
+        return plane_vector(Scalar(0.0), -weight_ * branch);
+      }
+      case CatenaryStatus::taut: {
+        const Vector3S chord = end_ - start_;
+        const Scalar n = sqrt(chord.squaredNorm());
+        Vector3S f = (at_start ? result_.taut_tension : Scalar(-result_.taut_tension)) / n * chord;
+        f.z() += Scalar(0.5) * w_ * L_;
+        return f;
+      }
+      case CatenaryStatus::invalid_input:
+        break;
+    }
+    return Vector3S(nan, nan, nan);
+  }
+
+  Vector3S start_ = Vector3S::Zero();
+  Vector3S end_ = Vector3S::Zero();
+  Vector3S horizontal_dir_ = Vector3S(Scalar(1.0), Scalar(0.0), Scalar(0.0));
+  Scalar L_ = Scalar(0.0);
+  Scalar w_ = Scalar(0.0);
+  Scalar weight_ = Scalar(0.0);  // |w|
+  Scalar D_ = Scalar(0.0);
+  Scalar dz_ = Scalar(0.0);  // height difference in the (mirrored) plane, z up
+  Scalar H_ = Scalar(0.0);
+  bool buoyant_ = false;
+  CatenaryResult<Scalar> result_{};
+};
+
+/// \brief The static catenary between two attachment points given in world NED (z down, sea
+/// surface at z = 0).
+///
+/// Builds the vertical plane through both points (x along the horizontal projection of
+/// end − start, z up), solves the paper's equations with solve_catenary() and returns the shape
+/// with its tensions. Never throws; non-finite inputs give status `invalid_input`.
+/// \tparam Scalar double, float or `ceres::Jet<double, N>`.
+/// \param[in] start_ned start attachment point (the ASV end in the paper), NED [m].
+/// \param[in] end_ned end attachment point, NED [m].
+/// \param[in] L unstretched tether length [m].
+/// \param[in] w submerged weight per length [N/m]: weight minus buoyancy, w = (m' − ρ A) g
+///   (w > 0 hangs, w < 0 is buoyant and arches upwards, w = 0 gives the shape with zero tension).
+/// \param[in] options solver options (EA sets the tension of a taut line).
+template <typename Scalar>
+CatenaryShape<Scalar> catenary_between(const Vector3<Scalar>& start_ned,
+                                       const Vector3<Scalar>& end_ned, Scalar L, Scalar w,
+                                       const CatenaryOptions<Scalar>& options = {}) {
+  return CatenaryShape<Scalar>(start_ned, end_ned, L, w, options);
+}
+
+using CatenaryOptionsd = CatenaryOptions<double>;  ///< CatenaryOptions<double>
+using CatenaryOptionsf = CatenaryOptions<float>;   ///< CatenaryOptions<float>
+using CatenaryResultd = CatenaryResult<double>;    ///< CatenaryResult<double>
+using CatenaryResultf = CatenaryResult<float>;     ///< CatenaryResult<float>
+using CatenaryShaped = CatenaryShape<double>;      ///< CatenaryShape<double>
+using CatenaryShapef = CatenaryShape<float>;       ///< CatenaryShape<float>
+
+}  // namespace tether
+}  // namespace kelp
