@@ -78,6 +78,12 @@ struct CatenaryOptions {
   /// T = EA·(chord − L)/L. 0 (the default) means inextensible: a taut line then reports T = 0
   /// because statics alone cannot determine it.
   Scalar EA = Scalar(0);
+  /// Ceres path only (kelp/ceres/catenary_solver.hpp): the solution is accepted (status converged)
+  /// when max(|R1|, |R2|)/L ≤ residual_tolerance, otherwise the status is max_iterations.
+  double residual_tolerance = 1e-10;
+  /// Ceres path only: Levenberg–Marquardt stops once max |R_i| is about target_residual·L
+  /// (0.5‖R‖² < 0.5 (target_residual·L)²).
+  double target_residual = 1e-14;
 };
 
 /// \brief Result of a catenary solve in the paper's plane (x horizontal from the start, z up).
@@ -168,13 +174,31 @@ struct ReducedSolution {
   bool converged = false;
 };
 
-/// ρ = √(L²−Δz²)/D − 1 ≥ 0 without cancellation near taut: L² − Δz² − D² = (L − chord)(L + chord).
-template <typename T>
-T sinhc_target_minus_one(const T& D, const T& dz, const T& L) {
-  using std::sqrt;
-  const T chord = sqrt(D * D + dz * dz);
-  const T excess = (L - chord) * (L + chord);
-  return excess / (D * (sqrt(D * D + excess) + D));
+/// L² − Δz² − D² (= L² − chord², > 0 exactly when the line is slack) with error-free products
+/// (fma) and two-sums, so that it keeps its relative precision when L is within 1e-9 of the chord:
+/// a plain evaluation loses all digits there, and so does (L − chord)(L + chord) because the
+/// rounded chord carries an error of eps·chord.
+inline double slack_excess(double D, double dz, double L) {
+  const double p1 = L * L, e1 = std::fma(L, L, -p1);
+  const double p2 = dz * dz, e2 = std::fma(dz, dz, -p2);
+  const double p3 = D * D, e3 = std::fma(D, D, -p3);
+  // Knuth's two-sum: s + t == x + y exactly.
+  const auto two_sum = [](double x, double y, double& t) {
+    const double s = x + y;
+    const double yy = s - x;
+    t = (x - (s - yy)) + (y - yy);
+    return s;
+  };
+  double t1 = 0.0, t2 = 0.0;
+  const double s1 = two_sum(p1, -p2, t1);
+  const double s2 = two_sum(s1, -p3, t2);
+  return s2 + (((t1 + t2) + e1) - e2 - e3);
+}
+
+/// λ = ln(√(L²−Δz²)/D) = log1p(ρ) with ρ = E/(D(√(D²+E) + D)), E = L² − Δz² − D² (no cancellation
+/// near taut).
+inline double reduced_target(double D, double excess) {
+  return std::log1p(excess / (D * (std::sqrt(D * D + excess) + D)));
 }
 
 /// Solves h(u) = λ by safeguarded Halley steps (h is increasing and convex on u > 0).
@@ -218,11 +242,13 @@ inline double paper_residual(double a, double c, double D, double dz, double L) 
   return std::max(std::abs(r1), std::abs(r2)) / L;
 }
 
-/// atanh(t) = ½ ln((1+t)/(1−t)) written with log1p (ceres::Jet has no atanh).
+/// atanh(dz/L) = ½ ln((L+dz)/(L−dz)) from dz and L themselves, written with log1p (ceres::Jet has
+/// no atanh). Forming t = dz/L first would lose the digits of 1 − |t| for steep, nearly taut lines.
 template <typename T>
-T atanh_via_log(const T& t) {
+T atanh_ratio(const T& dz, const T& L) {
   using std::log1p;
-  return T(0.5) * log1p(T(2.0) * t / (T(1.0) - t));
+  if (dz < T(0.0)) return -atanh_ratio(T(-dz), L);
+  return T(0.5) * log1p(T(2.0) * dz / (L - dz));
 }
 
 /// asinh(y) via log1p/sqrt (ceres::Jet has no asinh); odd-symmetric and exact near 0.
@@ -236,11 +262,15 @@ T asinh_via_log(const T& y) {
 
 /// Classification shared by the fast and the Ceres paths, on the value parts.
 /// Returns `converged` when the geometry needs a solve.
-inline CatenaryStatus classify_catenary(double D, double dz, double L, double vertical_tolerance) {
+/// `excess` receives L² − Δz² − D² (see slack_excess) for valid input.
+inline CatenaryStatus classify_catenary(double D, double dz, double L, double vertical_tolerance,
+                                        double& excess) {
+  excess = 0.0;
   if (!(std::isfinite(D) && std::isfinite(dz) && std::isfinite(L)) || !(L > 0.0) || D < 0.0 ||
       !(vertical_tolerance >= 0.0))
     return CatenaryStatus::invalid_input;
-  if (L <= std::hypot(D, dz)) return CatenaryStatus::taut;
+  excess = slack_excess(D, dz, L);
+  if (!(excess > 0.0)) return CatenaryStatus::taut;
   if (D <= vertical_tolerance * L) return CatenaryStatus::vertical;
   return CatenaryStatus::converged;
 }
@@ -281,15 +311,21 @@ void finish_from_u(const ReducedSolution& sol, const Scalar& D, const Scalar& dz
   const double Dd = value_of(D), dzd = value_of(dz), Ld = value_of(L);
   if constexpr (std::is_arithmetic_v<Scalar>) {
     const double a = Dd / (2.0 * sol.u);
-    const double c = 0.5 * Dd - a * atanh_via_log(dzd / Ld);
+    const double c = 0.5 * Dd - a * atanh_ratio(dzd, Ld);
     result.a = static_cast<Scalar>(a);
     result.c = static_cast<Scalar>(c);
   } else {
     // λ with its derivative parts, then one exact linearisation about the double root.
-    const Scalar lambda = log1p(sinhc_target_minus_one(D, dz, L));
+    using std::sqrt;
+    const Scalar excess = L * L - dz * dz - D * D;  // only its derivative parts are used
+    const Scalar lambda = log1p(excess / (D * (sqrt(D * D + excess) + D)));
     const Scalar u = Scalar(sol.u) + (lambda - Scalar(sol.lambda)) / log_sinhc_d1(sol.u);
     result.a = D / (Scalar(2.0) * u);
-    result.c = Scalar(0.5) * D - result.a * atanh_via_log(dz / L);
+    result.c = Scalar(0.5) * D - result.a * atanh_ratio(dz, L);
+    // The value parts are exactly those of the double solve (Jet division rounds differently).
+    const double a = Dd / (2.0 * sol.u);
+    result.a.a = a;
+    result.c.a = 0.5 * Dd - a * atanh_ratio(dzd, Ld);
   }
   result.iterations = sol.iterations;
   result.residual = Scalar(paper_residual(value_of(result.a), value_of(result.c), Dd, dzd, Ld));
@@ -318,12 +354,14 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
                                       const CatenaryOptions<Scalar>& options = {}) {
   CatenaryResult<Scalar> result;
   const double Dd = value_of(D), dzd = value_of(dz), Ld = value_of(L);
-  const CatenaryStatus kind = detail::classify_catenary(Dd, dzd, Ld, options.vertical_tolerance);
+  double excess = 0.0;
+  const CatenaryStatus kind =
+      detail::classify_catenary(Dd, dzd, Ld, options.vertical_tolerance, excess);
   if (kind != CatenaryStatus::converged) {
     detail::fill_unsolved(kind, D, dz, L, options, result);
     return result;
   }
-  const double lambda = std::log1p(detail::sinhc_target_minus_one(Dd, dzd, Ld));
+  const double lambda = detail::reduced_target(Dd, excess);
   const detail::ReducedSolution sol =
       detail::solve_reduced(lambda, options.tolerance, options.max_iterations);
   detail::finish_from_u(sol, D, dz, L, result);
