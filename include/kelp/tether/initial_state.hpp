@@ -1,0 +1,66 @@
+/// \file
+/// \brief Initial lumped-mass tether states from the analytic catenary, optionally refined to
+/// the lumped-mass static equilibrium.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/catenary.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+
+namespace kelp::tether {
+
+/// \brief Nodes placed on the analytic catenary between two NED end points, at rest.
+///
+/// Node i sits at unstretched arc length s_i = i·L/N on `catenary_between(start, end, L, w)`,
+/// with w = (μ − ρA) g the submerged weight per length from the environment's water density and
+/// gravity (a buoyant line, w < 0, gives the inverted catenary). A taut geometry gives the straight
+/// line; if the catenary solve fails (`invalid_input`, `max_iterations`) the straight line is used
+/// as well. The status is reported through `status` when non-null.
+/// \param[in] model the tether \param[in] env environment (water_density(), gravity())
+/// \param[in] start_ned node 0, NED [m] \param[in] end_ned node N, NED [m]
+/// \param[out] status catenary status (optional)
+/// \throws kelp::invalid_argument naming `start_ned` / `end_ned` when not finite.
+template <typename Scalar, typename Env>
+TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, const Env& env,
+                                           const Vector3<Scalar>& start_ned,
+                                           const Vector3<Scalar>& end_ned,
+                                           CatenaryStatus* status = nullptr) {
+  check_all_finite(start_ned, "start_ned");
+  check_all_finite(end_ned, "end_ned");
+  const Scalar w =
+      model.submerged_weight_per_length(Scalar(env.water_density()), Scalar(env.gravity()));
+  const Scalar L = model.parameters().length;
+  const CatenaryShape<Scalar> shape = catenary_between(start_ned, end_ned, L, w);
+  const CatenaryStatus st = shape.status();
+  if (status) *status = st;
+  if (!(shape.result().ok() || st == CatenaryStatus::taut))
+    return straight_line_state(model, start_ned, end_ned);
+  TetherState<Scalar> s(model);
+  const int n = model.segments();
+  for (int i = 0; i <= n; ++i) s.position.col(i) = shape.point_at(L * Scalar(i) / Scalar(n));
+  s.position.col(0) = start_ned;
+  s.position.col(n) = end_ned;
+  if (!all_finite(s.position)) return straight_line_state(model, start_ned, end_ned);
+  return s;
+}
+
+/// \brief Catenary initial state refined by `solve_static_equilibrium` with both ends fixed at
+/// `start_ned`, `end_ned` (free ends of the model stay free). Returns the solve's result; the
+/// state is written to `state`.
+template <typename Scalar, typename Env>
+StaticResult<Scalar> static_initial_state(const TetherModel<Scalar>& model,
+                                          TetherWorkspace<Scalar>& ws, const Env& env,
+                                          const Vector3<Scalar>& start_ned,
+                                          const Vector3<Scalar>& end_ned,
+                                          TetherState<Scalar>& state,
+                                          const StaticOptions<Scalar>& options = {}) {
+  state = catenary_initial_state(model, env, start_ned, end_ned);
+  return solve_static_equilibrium(model, ws, env, state,
+                                  TetherBoundary<Scalar>::fixed(start_ned, end_ned), options);
+}
+
+}  // namespace kelp::tether

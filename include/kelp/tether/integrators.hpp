@@ -1,0 +1,546 @@
+/// \file
+/// \brief Time integration of the lumped-mass tether: semi-implicit (symplectic) Euler, RK2
+/// (midpoint), RK4, and implicit backward Euler / BDF2 solved by Newton's method with the
+/// analytic block-tridiagonal Jacobian (O(N) block-Thomas solve); an explicit stable-dt estimate,
+/// a sub-stepping driver and a static-equilibrium solve.
+///
+/// Every step works in preallocated workspace buffers (no heap allocation) and commits the new
+/// state only when it is finite: a failed step throws `kelp::numerical_error` and leaves the state
+/// as it was.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+
+namespace kelp::tether {
+
+/// \brief Time-stepping scheme.
+enum class Integrator {
+  symplectic_euler,  ///< v ← v + h a(x, v); x ← x + h v (first order, symplectic)
+  rk2,               ///< explicit midpoint (MoorDyn's default RK2)
+  rk4,               ///< classical fourth-order Runge–Kutta
+  implicit_euler,    ///< backward Euler, Newton with the block-tridiagonal Jacobian
+  bdf2               ///< second-order BDF (backward Euler on the first step or after a dt change)
+};
+
+/// \brief Name of an integrator ("symplectic_euler", "rk2", "rk4", "implicit_euler", "bdf2").
+inline const char* integrator_name(Integrator i) {
+  switch (i) {
+    case Integrator::symplectic_euler:
+      return "symplectic_euler";
+    case Integrator::rk2:
+      return "rk2";
+    case Integrator::rk4:
+      return "rk4";
+    case Integrator::implicit_euler:
+      return "implicit_euler";
+    case Integrator::bdf2:
+      return "bdf2";
+  }
+  return "unknown";
+}
+
+/// \brief True for the Newton-solved schemes.
+inline bool is_implicit(Integrator i) {
+  return i == Integrator::implicit_euler || i == Integrator::bdf2;
+}
+
+/// \brief Newton settings of the implicit schemes.
+template <typename Scalar>
+struct ImplicitOptions {
+  /// Maximum Newton corrections per step (each: one Jacobian factorisation and solve).
+  int max_iterations = 4;
+  /// Convergence when max_i |R_i| / a_i ≤ this [m/s], R_i the momentum residual of node i and
+  /// a_i its isotropic mass; default ≈ 100·√ε (1.5e-6 m/s in double, 0.03 m/s in float).
+  Scalar velocity_tolerance = Scalar(100) * std::sqrt(std::numeric_limits<Scalar>::epsilon());
+};
+
+/// \brief What one step did.
+template <typename Scalar>
+struct StepReport {
+  /// Force evaluations used.
+  int force_evaluations = 0;
+  /// Newton corrections (0 for explicit schemes).
+  int newton_iterations = 0;
+  /// Final scaled Newton residual max_i |R_i|/a_i [m/s] (0 for explicit schemes).
+  Scalar residual = Scalar(0);
+  /// False when an implicit step hit `max_iterations` before meeting the tolerance (the step is
+  /// still taken).
+  bool converged = true;
+};
+
+namespace detail {
+
+template <typename Scalar>
+Matrix3<Scalar> node_mass_matrix(const TetherWorkspace<Scalar>& ws, int i) {
+  const Vector3<Scalar> q = ws.tangent.col(i);
+  Matrix3<Scalar> m = (ws.mass_tan(i) * q) * q.transpose();
+  m.diagonal().array() += ws.mass_iso(i);
+  return m;
+}
+
+/// A_s = c_v·(−∂F/∂v) + c_x·(−∂F/∂x) coupling block of segment s (symmetric PSD).
+template <typename Scalar>
+Matrix3<Scalar> segment_block(const TetherWorkspace<Scalar>& ws, int s, Scalar c_v, Scalar c_x) {
+  const Vector3<Scalar> u = ws.direction.col(s);
+  Matrix3<Scalar> a = ((c_v * ws.seg_c_uu(s) + c_x * ws.seg_k_uu(s)) * u) * u.transpose();
+  a.diagonal().array() += c_x * ws.seg_k_perp(s);
+  return a;
+}
+
+/// Solves J δ = rhs over the free nodes, J = c_m M + c_v (−∂F/∂v) + c_x (−∂F/∂x), block
+/// tridiagonal and symmetric positive definite, by block-Thomas elimination with a 3×3 Cholesky
+/// factorisation per block. Reads the Jacobian ingredients of the last compute_forces<true>;
+/// writes ws.delta. O(N), no heap allocation.
+template <typename Scalar>
+void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                             Scalar c_m, Scalar c_v, Scalar c_x) {
+  const int n = model.segments();
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  Eigen::LLT<Matrix3<Scalar>> llt;
+  Matrix3<Scalar> a_prev = Matrix3<Scalar>::Zero();
+  for (int i = f0; i <= f1; ++i) {
+    Matrix3<Scalar> d = c_m * node_mass_matrix(ws, i) + c_v * ws.node_dv[i];
+    d(2, 2) += c_x * ws.node_kz(i);
+    Vector3<Scalar> r = ws.rhs.col(i);
+    if (i > 0) {
+      const Matrix3<Scalar> a = segment_block(ws, i - 1, c_v, c_x);
+      d += a;
+      if (i > f0) {
+        d.noalias() -= a_prev * ws.block_g[i - 1];
+        r.noalias() += a_prev * ws.delta.col(i - 1);
+      }
+    }
+    if (i < n) {
+      a_prev = segment_block(ws, i, c_v, c_x);
+      d += a_prev;
+    }
+    llt.compute(d);
+    if (llt.info() != Eigen::Success)
+      ::kelp::detail::throw_numerical_error(
+          "tether Newton step: Jacobian block not positive "
+          "definite");
+    ws.delta.col(i) = llt.solve(r);
+    if (i < f1) ws.block_g[i] = llt.solve(a_prev);
+  }
+  for (int i = f1 - 1; i >= f0; --i)
+    ws.delta.col(i).noalias() += ws.block_g[i] * ws.delta.col(i + 1);
+}
+
+template <typename Scalar>
+bool all_finite_fast(const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v) {
+  using std::isfinite;
+  return isfinite(value_of(x.sum() + v.sum()));
+}
+
+template <typename Scalar>
+void commit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+            TetherState<Scalar>& state, const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v,
+            Scalar dt, const char* who) {
+  (void)model;
+  if (!all_finite_fast(x, v))
+    ::kelp::detail::throw_numerical_error(std::string(who) +
+                                          ": non-finite node state; the state is unchanged");
+  ws.x_prev = state.position;
+  ws.v_prev = state.velocity;
+  ws.previous_dt = dt;
+  ws.has_previous = true;
+  state.position = x;
+  state.velocity = v;
+  state.time += dt;
+}
+
+template <typename Scalar>
+void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
+                       const TetherState<Scalar>& state, const TetherBoundary<Scalar>& b,
+                       Scalar dt) {
+  check_positive(dt, "dt");
+  KELP_CHECK(ws.force.cols() == model.nodes(), "workspace was built for a different tether");
+  KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
+             "state.position and state.velocity must have segments + 1 columns");
+  check_boundary(b);
+}
+
+/// Acceleration of every node at (x, v) [boundary already applied] into `acc`.
+template <typename Scalar, typename Env>
+void derivative(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                Scalar t, const TetherBoundary<Scalar>& b, const Matrix3X<Scalar>& x,
+                const Matrix3X<Scalar>& v, Matrix3X<Scalar>& acc) {
+  compute_forces<false>(model, ws, env, t, x, v);
+  accelerations_from_forces(model, ws, b.start.acceleration, b.end.acceleration, acc);
+}
+
+}  // namespace detail
+
+/// \brief One semi-implicit (symplectic) Euler step of length `dt` [s]:
+/// v_{n+1} = v_n + h M⁻¹F(x_n, v_n), x_{n+1} = x_n + h v_{n+1}. Stable for h ω_max < 2.
+/// End forces (`ws.end_forces`) are those at the start of the step.
+/// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
+/// the result is not finite.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
+                                         TetherWorkspace<Scalar>& ws, const Env& env,
+                                         TetherState<Scalar>& state,
+                                         const TetherBoundary<Scalar>& boundary, Scalar dt) {
+  detail::check_step_inputs(model, ws, state, boundary, dt);
+  const Scalar t = state.time;
+  ws.x0 = state.position;
+  ws.v0 = state.velocity;
+  detail::apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
+  detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
+  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
+  ws.x1.noalias() = ws.x0 + dt * ws.v1;
+  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
+  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_symplectic_euler");
+  StepReport<Scalar> r;
+  r.force_evaluations = 1;
+  return r;
+}
+
+/// \brief One explicit-midpoint (RK2) step of length `dt` [s]. End forces are those at the start
+/// of the step. \throws as step_symplectic_euler.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                            const Env& env, TetherState<Scalar>& state,
+                            const TetherBoundary<Scalar>& boundary, Scalar dt) {
+  detail::check_step_inputs(model, ws, state, boundary, dt);
+  const Scalar t = state.time, h2 = Scalar(0.5) * dt;
+  ws.x0 = state.position;
+  ws.v0 = state.velocity;
+  detail::apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
+  detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
+  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  ws.xs.noalias() = ws.x0 + h2 * ws.v0;
+  ws.vs.noalias() = ws.v0 + h2 * ws.acceleration;
+  detail::apply_boundary(model, boundary, h2, ws.xs, ws.vs);
+  detail::derivative(model, ws, env, t + h2, boundary, ws.xs, ws.vs, ws.acceleration);
+  ws.x1.noalias() = ws.x0 + dt * ws.vs;
+  ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
+  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
+  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_rk2");
+  StepReport<Scalar> r;
+  r.force_evaluations = 2;
+  return r;
+}
+
+/// \brief One classical RK4 step of length `dt` [s]. End forces are those at the start of the
+/// step. \throws as step_symplectic_euler.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                            const Env& env, TetherState<Scalar>& state,
+                            const TetherBoundary<Scalar>& boundary, Scalar dt) {
+  detail::check_step_inputs(model, ws, state, boundary, dt);
+  const Scalar t = state.time;
+  ws.x0 = state.position;
+  ws.v0 = state.velocity;
+  detail::apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
+  ws.xs = ws.x0;
+  ws.vs = ws.v0;
+  ws.x1 = ws.x0;
+  ws.v1 = ws.v0;
+  const Scalar c[4] = {Scalar(0), Scalar(0.5), Scalar(0.5), Scalar(1)};
+  const Scalar w[4] = {dt / Scalar(6), dt / Scalar(3), dt / Scalar(3), dt / Scalar(6)};
+  for (int k = 0; k < 4; ++k) {
+    detail::derivative(model, ws, env, t + c[k] * dt, boundary, ws.xs, ws.vs, ws.acceleration);
+    if (k == 0) ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+    ws.x1.noalias() += w[k] * ws.vs;
+    ws.v1.noalias() += w[k] * ws.acceleration;
+    if (k < 3) {
+      const Scalar ch = c[k + 1] * dt;
+      ws.xs.noalias() = ws.x0 + ch * ws.vs;
+      ws.vs.noalias() = ws.v0 + ch * ws.acceleration;
+      detail::apply_boundary(model, boundary, ch, ws.xs, ws.vs);
+    }
+  }
+  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
+  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_rk4");
+  StepReport<Scalar> r;
+  r.force_evaluations = 4;
+  return r;
+}
+
+/// \brief One implicit step (backward Euler, or BDF2 when `bdf2` is true and the previous step
+/// had the same dt) solved by Newton's method.
+///
+/// With x = x̂ + γh v (backward Euler: γ = 1, x̂ = x_n, v̂ = v_n; BDF2: γ = 2/3,
+/// x̂ = (4x_n − x_{n−1})/3, v̂ = (4v_n − v_{n−1})/3) the unknown node velocities solve
+/// R(v) = M (v − v̂) − γh F(x̂ + γh v, v) = 0. The Jacobian J = M + γh D_v + (γh)² D_x
+/// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
+/// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness) is block
+/// tridiagonal, symmetric positive definite, and solved in O(N) by block-Thomas elimination
+/// (no dense N×N). End forces are those of the final iterate, at t + dt.
+/// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
+/// the result is not finite.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                                 const Env& env, TetherState<Scalar>& state,
+                                 const TetherBoundary<Scalar>& boundary, Scalar dt,
+                                 bool bdf2 = false, const ImplicitOptions<Scalar>& options = {}) {
+  using std::abs;
+  detail::check_step_inputs(model, ws, state, boundary, dt);
+  const Scalar t1 = state.time + dt;
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  const bool use_bdf2 = bdf2 && ws.has_previous && ws.previous_dt == dt;
+  const Scalar gamma = use_bdf2 ? Scalar(2) / Scalar(3) : Scalar(1);
+  const Scalar gh = gamma * dt;
+  // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
+  if (use_bdf2) {
+    const Scalar third = Scalar(1) / Scalar(3);
+    ws.x0.noalias() = (Scalar(4) * third) * state.position - third * ws.x_prev;
+    ws.v0.noalias() = (Scalar(4) * third) * state.velocity - third * ws.v_prev;
+    ws.v1.noalias() = Scalar(2) * state.velocity - ws.v_prev;
+  } else {
+    ws.x0 = state.position;
+    ws.v0 = state.velocity;
+    ws.v1 = state.velocity;
+  }
+  ws.x1.noalias() = ws.x0 + gh * ws.v1;
+  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
+
+  StepReport<Scalar> report;
+  report.converged = false;
+  for (int it = 0;; ++it) {
+    compute_forces<true>(model, ws, env, t1, ws.x1, ws.v1);
+    ++report.force_evaluations;
+    // rhs = −R = γh F − M (v − v̂) on the free nodes; scaled residual max |R_i| / a_i.
+    Scalar res(0);
+    for (int i = f0; i <= f1; ++i) {
+      const Vector3<Scalar> dvel = ws.v1.col(i) - ws.v0.col(i);
+      const Vector3<Scalar> q = ws.tangent.col(i);
+      const Vector3<Scalar> r =
+          gh * ws.force.col(i) - (ws.mass_iso(i) * dvel + (ws.mass_tan(i) * q.dot(dvel)) * q);
+      ws.rhs.col(i) = r;
+      res = std::max(res, Scalar(r.cwiseAbs().maxCoeff() / ws.mass_iso(i)));
+    }
+    report.residual = res;
+    if (!(res == res))
+      ::kelp::detail::throw_numerical_error(
+          "step_implicit: non-finite residual; the state is "
+          "unchanged");
+    if (res <= options.velocity_tolerance) {
+      report.converged = true;
+      break;
+    }
+    if (it >= options.max_iterations) break;
+    detail::solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+    ++report.newton_iterations;
+    for (int i = f0; i <= f1; ++i) {
+      ws.v1.col(i) += ws.delta.col(i);
+      ws.x1.col(i) = ws.x0.col(i) + gh * ws.v1.col(i);
+    }
+  }
+  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  // commit() stores the pre-step state as BDF2 history.
+  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_implicit");
+  return report;
+}
+
+/// \brief One step with the chosen integrator (dispatch). \throws as the individual steps.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                        const Env& env, TetherState<Scalar>& state,
+                        const TetherBoundary<Scalar>& boundary, Scalar dt, Integrator integrator,
+                        const ImplicitOptions<Scalar>& options = {}) {
+  switch (integrator) {
+    case Integrator::symplectic_euler:
+      return step_symplectic_euler(model, ws, env, state, boundary, dt);
+    case Integrator::rk2:
+      return step_rk2(model, ws, env, state, boundary, dt);
+    case Integrator::rk4:
+      return step_rk4(model, ws, env, state, boundary, dt);
+    case Integrator::implicit_euler:
+      return step_implicit(model, ws, env, state, boundary, dt, false, options);
+    case Integrator::bdf2:
+      return step_implicit(model, ws, env, state, boundary, dt, true, options);
+  }
+  return {};
+}
+
+/// \brief Largest angular frequency of the axial node–spring chain [rad/s], bounded by
+/// Gershgorin's theorem: ω²_max ≤ max_i Σ_j |K_ij| / m_i = max_i 2 k_i / m_i, with k_i the sum of
+/// the segment spring constants EA/l acting on free node i and m_i its axial mass (structural
+/// plus tangential added mass, nodes taken as submerged).
+template <typename Scalar>
+Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_density) {
+  using std::sqrt;
+  const int n = model.segments();
+  const TetherParameters<Scalar>& p = model.parameters();
+  Scalar w2(0);
+  for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
+    const int springs = (i > 0 ? 1 : 0) + (i < n ? 1 : 0);
+    const Scalar m =
+        model.node_mass(i) + water_density * model.node_volume(i) * p.tangential_added_mass;
+    w2 = std::max(w2, Scalar(2) * Scalar(springs) * model.axial_spring() / m);
+  }
+  return sqrt(w2);
+}
+
+/// \brief Estimated largest stable explicit time step [s]: `safety` × h_max with
+/// h_max ω_max = 2 (symplectic Euler), 1 (RK2, which is only stabilised by damping on the
+/// imaginary axis; MoorDyn's CFL rule), 2√2 (RK4). Implicit schemes: +infinity (unconditionally
+/// stable for the linearised line; choose dt for accuracy, e.g. 10 ms).
+/// \param[in] water_density ρ [kg/m³] for the tangential added mass.
+template <typename Scalar>
+Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrator,
+                          Scalar water_density = Scalar(kelp::seawater_density),
+                          Scalar safety = Scalar(0.8)) {
+  check_positive(safety, "safety");
+  if (is_implicit(integrator)) return std::numeric_limits<Scalar>::infinity();
+  const Scalar w = highest_axial_frequency(model, water_density);
+  if (!(w > Scalar(0))) return std::numeric_limits<Scalar>::infinity();
+  Scalar limit(2);
+  if (integrator == Integrator::rk2) limit = Scalar(1);
+  if (integrator == Integrator::rk4) limit = Scalar(2.8284271247461903);
+  return safety * limit / w;
+}
+
+/// \brief Sub-stepping driver: advances `state` by `duration` [s] in n = ⌈duration/max_dt⌉ equal
+/// steps of the chosen integrator; the kinematic ends follow `boundary` (given at the current
+/// time) through the interval. `ws.end_forces` holds the forces of the last sub-step. If any
+/// sub-step fails the state is restored to its value at entry. No heap allocation.
+/// \returns the number of sub-steps taken.
+template <typename Scalar, typename Env>
+int advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+            TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, Scalar duration,
+            Scalar max_dt, Integrator integrator, const ImplicitOptions<Scalar>& options = {}) {
+  using std::ceil;
+  check_positive(duration, "duration");
+  check_positive(max_dt, "max_dt");
+  const int n = std::max(1, static_cast<int>(ceil(value_of(duration / max_dt))));
+  const Scalar h = duration / Scalar(n);
+  // Backup in the (otherwise per-step) stage buffers kx/kv.
+  ws.kx = state.position;
+  ws.kv = state.velocity;
+  const Scalar t_entry = state.time;
+  try {
+    for (int k = 0; k < n; ++k) {
+      const Scalar tau = Scalar(k) * h;
+      TetherBoundary<Scalar> b = boundary;
+      b.start.position = boundary.start.position_at(tau);
+      b.start.velocity = boundary.start.velocity_at(tau);
+      b.end.position = boundary.end.position_at(tau);
+      b.end.velocity = boundary.end.velocity_at(tau);
+      step(model, ws, env, state, b, h, integrator, options);
+    }
+  } catch (const kelp::numerical_error&) {
+    state.position = ws.kx;
+    state.velocity = ws.kv;
+    state.time = t_entry;
+    ws.has_previous = false;
+    throw;
+  }
+  return n;
+}
+
+/// \brief Settings of the static-equilibrium solve.
+template <typename Scalar>
+struct StaticOptions {
+  /// Converged when max_i |F_i| ≤ this [N]; ≤ 0 selects 1e-7 × the line's weight in air.
+  Scalar force_tolerance = Scalar(0);
+  /// Maximum (pseudo-transient) Newton iterations.
+  int max_iterations = 200;
+  /// First pseudo time step h [s] of the regularisation M/h² (grows as the residual falls).
+  Scalar initial_pseudo_dt = Scalar(0.05);
+};
+
+/// \brief Outcome of the static-equilibrium solve.
+template <typename Scalar>
+struct StaticResult {
+  bool converged = false;       ///< residual below tolerance
+  int iterations = 0;           ///< Newton iterations used
+  Scalar residual = Scalar(0);  ///< final max_i |F_i| over free nodes [N]
+};
+
+/// \brief Static equilibrium F(x) = 0 of the free nodes (velocities zero, ends held at the
+/// boundary positions) by pseudo-transient continuation: repeated backward-Euler steps (each
+/// solved by Newton with the analytic block-tridiagonal Jacobian) with the velocities reset to
+/// zero after every step, so that each step solves (M/h² + D_x + D_v/h) Δx = F(x + Δx) — the
+/// mass term regularises slack and contact nonlinearities while h is small, and the iteration
+/// becomes Newton's method on F(x) = 0 as h grows (doubling after every easy step, quartered and
+/// retried after a step whose Newton solve did not converge). Drag from a current enters F.
+/// Starts from `state` (e.g. the catenary); `state` ends at the last iterate with zero velocity
+/// and unchanged time; `ws.end_forces` holds the static end forces.
+/// \throws kelp::invalid_argument for bad input; kelp::numerical_error if the iteration produces
+/// non-finite values (state unchanged).
+template <typename Scalar, typename Env>
+StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
+                                              TetherWorkspace<Scalar>& ws, const Env& env,
+                                              TetherState<Scalar>& state,
+                                              const TetherBoundary<Scalar>& boundary,
+                                              const StaticOptions<Scalar>& options = {}) {
+  check_state(model, state);
+  check_boundary(boundary);
+  check_positive(options.initial_pseudo_dt, "initial_pseudo_dt");
+  KELP_CHECK(options.max_iterations >= 1, "max_iterations must be >= 1");
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  Scalar tol = options.force_tolerance;
+  if (!(tol > Scalar(0)))
+    tol = Scalar(1e-7) * model.parameters().mass_per_length * model.parameters().length *
+          Scalar(env.gravity());
+  TetherBoundary<Scalar> b = boundary;
+  b.start.velocity.setZero();
+  b.end.velocity.setZero();
+  b.start.acceleration.setZero();
+  b.end.acceleration.setZero();
+  // Work on a copy in the workspace (kx/kv are free outside a step) so that a failure leaves
+  // `state` as it was; iterate on `state` itself and restore on error.
+  ws.kx = state.position;
+  ws.kv = state.velocity;
+  const Scalar t_entry = state.time;
+  state.velocity.setZero();
+  detail::apply_boundary(model, b, Scalar(0), state.position, state.velocity);
+  ImplicitOptions<Scalar> inner;
+  inner.max_iterations = 6;
+  inner.velocity_tolerance = tol / (Scalar(100) * model.node_mass(model.segments() / 2));
+  StaticResult<Scalar> result;
+  Scalar h = options.initial_pseudo_dt;
+  const Scalar h_max(1e6);
+  try {
+    for (int it = 0;; ++it) {
+      compute_forces<false>(model, ws, env, t_entry, state.position, state.velocity);
+      Scalar res(0);
+      for (int i = f0; i <= f1; ++i) res = std::max(res, ws.force.col(i).cwiseAbs().maxCoeff());
+      if (!(res == res))
+        ::kelp::detail::throw_numerical_error("solve_static_equilibrium: non-finite force");
+      result.residual = res;
+      result.iterations = it;
+      if (res <= tol) {
+        result.converged = true;
+        break;
+      }
+      if (it >= options.max_iterations) break;
+      ws.xs = state.position;  // undo point
+      inner.velocity_tolerance = std::max(inner.velocity_tolerance, Scalar(0));
+      const StepReport<Scalar> r = step_implicit(model, ws, env, state, b, h, false, inner);
+      state.time = t_entry;
+      state.velocity.setZero();
+      if (!r.converged && h > options.initial_pseudo_dt * Scalar(1e-6)) {
+        state.position = ws.xs;
+        h *= Scalar(0.25);
+      } else if (r.newton_iterations <= 3) {
+        h = std::min(h_max, h * Scalar(2));
+      }
+    }
+  } catch (const kelp::numerical_error&) {
+    state.position = ws.kx;
+    state.velocity = ws.kv;
+    state.time = t_entry;
+    ws.has_previous = false;
+    throw;
+  }
+  ws.end_forces = end_forces_from_workspace(model, ws, b);
+  ws.has_previous = false;
+  return result;
+}
+
+}  // namespace kelp::tether

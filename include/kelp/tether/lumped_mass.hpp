@@ -1,0 +1,595 @@
+/// \file
+/// \brief Lumped-mass tether model: parameters, workspace, state, end conditions and the force
+/// evaluation (axial tension, internal damping, weight and buoyancy, Morison drag, added mass,
+/// fluid-inertia forcing, seabed contact).
+///
+/// The line of unstretched length L is cut into N segments of length l = L/N joined at N+1 nodes
+/// (node 0 = start end, e.g. the ASV; node N = far end, e.g. the AUV). The model follows the
+/// lumped-mass formulation of Hall & Goupee (2015, "Validation of a lumped-mass mooring line
+/// model with DeepCwind semisubmersible model test data", Ocean Engineering 104) as implemented
+/// in MoorDyn v2 (source/Line.cpp; facts in shared/reference/tether.md); the code is kelp's own.
+///
+/// Frames and units: world NED (z down, mean sea surface at z = 0, free surface at z = −ζ), SI.
+/// Environments are duck-typed (`Env`): anything with `water_density()`, `gravity()`,
+/// `seabed_depth()`, `surface_elevation(x, y, t)` and `sample_water(points, t, vel, acc)` as
+/// `kelp::environment::Environment` has.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp::tether {
+
+/// \brief How a tether end moves.
+enum class EndMode {
+  /// Position and velocity prescribed each step (a fixed anchor or a point on a vehicle); the
+  /// tether reports the force it exerts on that point.
+  kinematic,
+  /// The end node moves freely under the tether forces (optionally carrying a point mass).
+  free
+};
+
+/// \brief User-facing physical description of a lumped-mass tether (all magnitudes positive).
+///
+/// Defaults are the benchmark line of shared/reference/tether.md (20 m, d 8 mm, 0.07 kg/m,
+/// EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1) with 100 segments and MoorDyn's seabed constants.
+/// \tparam Scalar double or float.
+template <typename Scalar>
+struct TetherParameters {
+  /// Number of segments N (≥ 1); the line has N + 1 nodes.
+  int segments = 100;
+  /// Unstretched length L [m].
+  Scalar length = Scalar(20);
+  /// Hydrodynamic (and volume-equivalent) diameter d [m].
+  Scalar diameter = Scalar(0.008);
+  /// Mass per unit unstretched length in air μ [kg/m].
+  Scalar mass_per_length = Scalar(0.07);
+  /// Axial stiffness EA [N].
+  Scalar axial_stiffness = Scalar(1e5);
+  /// Internal (axial) damping BA [N s]: the damping tension is BA · ε̇ (ε the strain).
+  Scalar internal_damping = Scalar(0);
+  /// Normal drag coefficient Cdn [-] (on the projected area d·l).
+  Scalar normal_drag = Scalar(1.2);
+  /// Tangential drag coefficient Cdt [-] (on the wetted surface π·d·l, as MoorDyn does).
+  Scalar tangential_drag = Scalar(0.008);
+  /// Normal added-mass coefficient Can [-].
+  Scalar normal_added_mass = Scalar(1);
+  /// Tangential added-mass coefficient Cat [-].
+  Scalar tangential_added_mass = Scalar(0);
+  /// Seabed stiffness kb [Pa/m] = [N/m³]: contact force per node (z − h)·kb·d·l_i
+  /// (MoorDyn's default 3e6).
+  Scalar seabed_stiffness = Scalar(3e6);
+  /// Seabed damping cb [Pa s/m]: contact damping ż·cb·d·l_i while in contact (MoorDyn's 3e5).
+  Scalar seabed_damping = Scalar(3e5);
+  /// Seabed Coulomb friction coefficient μ_f [-] (0 disables friction).
+  Scalar seabed_friction = Scalar(0);
+  /// Horizontal speed [m/s] below which seabed friction is viscous (saturated-viscous model).
+  Scalar friction_velocity = Scalar(0.01);
+  /// Motion of the start end (node 0).
+  EndMode start_mode = EndMode::kinematic;
+  /// Motion of the far end (node N).
+  EndMode end_mode = EndMode::kinematic;
+  /// Extra point mass lumped at node 0 [kg] (used when the start end is free).
+  Scalar start_point_mass = Scalar(0);
+  /// Extra point mass lumped at node N [kg] (used when the far end is free).
+  Scalar end_point_mass = Scalar(0);
+};
+
+/// \brief Validated tether parameters with the per-step constants precomputed.
+///
+/// Build once from `TetherParameters`; constant afterwards.
+/// \tparam Scalar double or float.
+template <typename Scalar>
+class TetherModel {
+ public:
+  /// \brief Validates `p` and precomputes constants.
+  /// \throws kelp::invalid_argument naming the offending field (segments ≥ 1; length, diameter,
+  /// mass_per_length, axial_stiffness > 0; the rest finite and ≥ 0).
+  explicit TetherModel(const TetherParameters<Scalar>& p) : p_(p) {
+    KELP_CHECK(p.segments >= 1, "segments must be >= 1");
+    check_positive(p.length, "length");
+    check_positive(p.diameter, "diameter");
+    check_positive(p.mass_per_length, "mass_per_length");
+    check_positive(p.axial_stiffness, "axial_stiffness");
+    check_non_negative(p.internal_damping, "internal_damping");
+    check_non_negative(p.normal_drag, "normal_drag");
+    check_non_negative(p.tangential_drag, "tangential_drag");
+    check_non_negative(p.normal_added_mass, "normal_added_mass");
+    check_non_negative(p.tangential_added_mass, "tangential_added_mass");
+    check_non_negative(p.seabed_stiffness, "seabed_stiffness");
+    check_non_negative(p.seabed_damping, "seabed_damping");
+    check_non_negative(p.seabed_friction, "seabed_friction");
+    check_positive(p.friction_velocity, "friction_velocity");
+    check_non_negative(p.start_point_mass, "start_point_mass");
+    check_non_negative(p.end_point_mass, "end_point_mass");
+    const int n = p.segments;
+    const Scalar N = Scalar(n);
+    l_ = p.length / N;
+    inv_l_ = Scalar(1) / l_;
+    ea_over_l_ = p.axial_stiffness / l_;
+    ba_over_l_ = p.internal_damping / l_;
+    area_ = Scalar(kelp::pi) * p.diameter * p.diameter / Scalar(4);
+    node_mass_.resize(n + 1);
+    node_volume_.resize(n + 1);
+    node_length_.resize(n + 1);
+    for (int i = 0; i <= n; ++i) {
+      const Scalar li = (i == 0 || i == n) ? l_ / Scalar(2) : l_;
+      node_length_(i) = li;
+      node_mass_(i) = p.mass_per_length * li;
+      node_volume_(i) = area_ * li;
+    }
+    node_mass_(0) += p.start_point_mass;
+    node_mass_(n) += p.end_point_mass;
+    first_free_ = p.start_mode == EndMode::kinematic ? 1 : 0;
+    last_free_ = p.end_mode == EndMode::kinematic ? n - 1 : n;
+  }
+
+  /// \brief The parameters the model was built from.
+  const TetherParameters<Scalar>& parameters() const { return p_; }
+  /// \brief Number of segments N.
+  int segments() const { return p_.segments; }
+  /// \brief Number of nodes N + 1.
+  int nodes() const { return p_.segments + 1; }
+  /// \brief Unstretched segment length l = L/N [m].
+  Scalar segment_length() const { return l_; }
+  /// \brief 1/l [1/m].
+  Scalar inverse_segment_length() const { return inv_l_; }
+  /// \brief EA/l [N/m]: the axial spring constant of one segment.
+  Scalar axial_spring() const { return ea_over_l_; }
+  /// \brief BA/l [N s/m]: the axial damper constant of one segment.
+  Scalar axial_damper() const { return ba_over_l_; }
+  /// \brief Cross-section area A = π d²/4 [m²].
+  Scalar area() const { return area_; }
+  /// \brief Structural mass of node i [kg] (μ times its share of length, plus any point mass).
+  Scalar node_mass(int i) const { return node_mass_(i); }
+  /// \brief Displaced volume of node i [m³] (A times its share of length).
+  Scalar node_volume(int i) const { return node_volume_(i); }
+  /// \brief Length of line lumped at node i [m] (l, or l/2 at the ends).
+  Scalar node_length(int i) const { return node_length_(i); }
+  /// \brief Index of the first node integrated (0 if the start end is free, else 1).
+  int first_free_node() const { return first_free_; }
+  /// \brief Index of the last node integrated (N if the far end is free, else N − 1).
+  int last_free_node() const { return last_free_; }
+  /// \brief Submerged weight per unit length w = (μ − ρA) g [N/m] (negative: buoyant line).
+  Scalar submerged_weight_per_length(Scalar water_density, Scalar gravity) const {
+    return (p_.mass_per_length - water_density * area_) * gravity;
+  }
+
+ private:
+  TetherParameters<Scalar> p_;
+  Scalar l_, inv_l_, ea_over_l_, ba_over_l_, area_;
+  VectorX<Scalar> node_mass_, node_volume_, node_length_;
+  int first_free_ = 1, last_free_ = 0;
+};
+
+/// \brief Positions and velocities of all N + 1 nodes, NED.
+/// \tparam Scalar double or float.
+template <typename Scalar>
+struct TetherState {
+  /// Node positions, 3 × (N+1), NED [m].
+  Matrix3X<Scalar> position;
+  /// Node velocities, 3 × (N+1), NED [m/s].
+  Matrix3X<Scalar> velocity;
+  /// Simulation time [s].
+  Scalar time = Scalar(0);
+
+  TetherState() = default;
+  /// \brief Zero state sized for `model`.
+  explicit TetherState(const TetherModel<Scalar>& model)
+      : position(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {}
+};
+
+/// \brief Motion of a kinematic end point over a step, NED.
+///
+/// Within a step of length h starting at t₀ the end is taken at p + v τ + ½ a τ², with velocity
+/// v + a τ (τ = t − t₀).
+template <typename Scalar>
+struct EndMotion {
+  /// Position at the start of the step, NED [m].
+  Vector3<Scalar> position = Vector3<Scalar>::Zero();
+  /// Velocity, NED [m/s].
+  Vector3<Scalar> velocity = Vector3<Scalar>::Zero();
+  /// Acceleration, NED [m/s²] (also enters the end force through the end node's inertia).
+  Vector3<Scalar> acceleration = Vector3<Scalar>::Zero();
+
+  /// \brief Position τ seconds into the step.
+  Vector3<Scalar> position_at(Scalar tau) const {
+    return position + tau * velocity + (Scalar(0.5) * tau * tau) * acceleration;
+  }
+  /// \brief Velocity τ seconds into the step.
+  Vector3<Scalar> velocity_at(Scalar tau) const { return velocity + tau * acceleration; }
+};
+
+/// \brief Prescribed motion of both ends (an entry is ignored when that end is free).
+template <typename Scalar>
+struct TetherBoundary {
+  /// Node 0 (start, e.g. the ASV attachment point).
+  EndMotion<Scalar> start;
+  /// Node N (far end, e.g. the AUV attachment point).
+  EndMotion<Scalar> end;
+
+  /// \brief Both ends fixed at the given NED points [m].
+  template <typename D1, typename D2>
+  static TetherBoundary fixed(const Eigen::MatrixBase<D1>& start_ned,
+                              const Eigen::MatrixBase<D2>& end_ned) {
+    TetherBoundary b;
+    b.start.position = start_ned;
+    b.end.position = end_ned;
+    return b;
+  }
+};
+
+/// \brief Forces the tether exerts on its two attachment points, NED [N] (zero for a free end).
+template <typename Scalar>
+struct EndForces {
+  /// On the start attachment point (node 0).
+  Vector3<Scalar> on_start = Vector3<Scalar>::Zero();
+  /// On the far attachment point (node N).
+  Vector3<Scalar> on_end = Vector3<Scalar>::Zero();
+};
+
+/// \brief Preallocated mutable buffers for force evaluation and integration (Pinocchio's `Data`).
+///
+/// Built from a model; every step reuses these buffers, so no heap allocation happens in a step.
+/// Fields are public so that tests and diagnostics can read intermediate quantities; their
+/// content is valid after the last force evaluation.
+template <typename Scalar>
+struct TetherWorkspace {
+  using Mat3 = Matrix3<Scalar>;
+  using Mat3Vector = std::vector<Mat3, Eigen::aligned_allocator<Mat3>>;
+
+  // --- per evaluation, per node -------------------------------------------------------------
+  Matrix3X<Scalar> force;               ///< net force on each node (no constraint force), NED [N]
+  Matrix3X<Scalar> acceleration;        ///< node accelerations, NED [m/s²]
+  Matrix3X<Scalar> tangent;             ///< unit node tangent q_i (zero if degenerate)
+  Matrix3X<Scalar> water_velocity;      ///< current + wave orbital velocity at each node [m/s]
+  Matrix3X<Scalar> water_acceleration;  ///< water acceleration at each node [m/s²]
+  VectorX<Scalar> mass_iso;             ///< a_i: M_i = a_i I + b_i q qᵀ [kg]
+  VectorX<Scalar> mass_tan;             ///< b_i [kg]
+  VectorX<Scalar> seabed_force;         ///< upward normal seabed contact force on node i [N]
+  VectorX<Scalar> submerged;            ///< 1 if node i is below the free surface, else 0
+  // --- per evaluation, per segment ------------------------------------------------------------
+  Matrix3X<Scalar> direction;        ///< unit vector u_s from node s to s+1 (0 if zero length)
+  VectorX<Scalar> tension;           ///< segment tension T_s ≥ 0 [N]
+  VectorX<Scalar> stretched_length;  ///< segment length l_s [m]
+  // --- Jacobian ingredients (filled when requested) --------------------------------------------
+  VectorX<Scalar> seg_k_uu;    ///< ∂F/∂x along u: EA/l − T/l_s (active segments)
+  VectorX<Scalar> seg_k_perp;  ///< geometric stiffness T/l_s [N/m]
+  VectorX<Scalar> seg_c_uu;    ///< BA/l on active segments [N s/m]
+  Mat3Vector node_dv;          ///< −∂F_i/∂v_i from drag and seabed [N s/m]
+  VectorX<Scalar> node_kz;     ///< −∂F_z/∂z from the seabed [N/m]
+  // --- linear solver and integrator buffers ----------------------------------------------------
+  Mat3Vector block_g;           ///< block-Thomas multipliers D'^{-1} B
+  Matrix3X<Scalar> rhs, delta;  ///< Newton right-hand side and correction
+  Matrix3X<Scalar> x0, v0, x1, v1, xs, vs, kx, kv, x_prev, v_prev;  ///< integrator stages
+  bool has_previous = false;                                        ///< BDF2 history valid
+  Scalar previous_dt = Scalar(0);  ///< step of the stored history [s]
+  EndForces<Scalar> end_forces;    ///< forces on the attachment points after the last step
+
+  TetherWorkspace() = default;
+  /// \brief Buffers sized for `model`.
+  explicit TetherWorkspace(const TetherModel<Scalar>& model) { resize(model.nodes()); }
+
+  /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
+  void resize(int nodes) {
+    const int n = nodes, s = nodes - 1;
+    for (Matrix3X<Scalar>* m :
+         {&force, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs, &delta, &x0,
+          &v0, &x1, &v1, &xs, &vs, &kx, &kv, &x_prev, &v_prev})
+      m->setZero(3, n);
+    for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &submerged, &node_kz})
+      v->setZero(n);
+    direction.setZero(3, s);
+    for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu})
+      v->setZero(s);
+    node_dv.assign(n, Mat3::Zero());
+    block_g.assign(n, Mat3::Zero());
+    has_previous = false;
+  }
+};
+
+namespace detail {
+
+/// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.
+template <typename Scalar, typename DX, typename DV>
+void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scalar>& b, Scalar tau,
+                    Eigen::MatrixBase<DX>& x, Eigen::MatrixBase<DV>& v) {
+  const int n = model.segments();
+  if (model.parameters().start_mode == EndMode::kinematic) {
+    x.col(0) = b.start.position_at(tau);
+    v.col(0) = b.start.velocity_at(tau);
+  }
+  if (model.parameters().end_mode == EndMode::kinematic) {
+    x.col(n) = b.end.position_at(tau);
+    v.col(n) = b.end.velocity_at(tau);
+  }
+}
+
+}  // namespace detail
+
+/// \brief Net force on every node of the tether at positions `x`, velocities `v`, time `t`.
+///
+/// Fills `ws.force` (NED [N]) and the per-node mass matrices M_i = a_i I + b_i q_i q_iᵀ
+/// (`ws.mass_iso`, `ws.mass_tan`), plus tensions, tangents and seabed forces. Per node i:
+/// \f[ F_i = T_i u_i − T_{i−1} u_{i−1} + (m_i − ρ V_i) g e_z + F^{drag}_i + F^{FK}_i + F^{bed}_i
+/// \f]
+/// - axial: T_s = max(0, EA ε_s + BA ε̇_s) when l_s > l, else 0 (no compression);
+/// - drag (Morison, on v_r = u_water − v_i): ½ρ d l_i Cdn |v_rn| v_rn + ½ρ π d l_i Cdt |v_rt| v_rt;
+/// - fluid inertia: ρ V_i [(1 + Can)(I − q qᵀ) + (1 + Cat) q qᵀ] a_water;
+/// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force);
+/// - seabed (z_i > h): upward (z_i − h) kb d l_i + ż_i cb d l_i (≥ 0), and saturated-viscous
+///   friction −μ_f N v_h / max(|v_h|, v_f);
+/// - nodes above the free surface (z_i < −ζ) get no buoyancy, drag, fluid inertia or added mass.
+/// No heap allocation.
+/// \tparam WithJacobian also fill the Jacobian ingredients (`ws.seg_*`, `ws.node_dv`,
+/// `ws.node_kz`). \param[in] model the tether \param[in,out] ws workspace \param[in] env
+/// environment \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v
+/// velocities [m/s]
+template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
+void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                    Scalar t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
+  using std::abs;
+  using std::sqrt;
+  using V3 = Vector3<Scalar>;
+  const TetherParameters<Scalar>& p = model.parameters();
+  const int n = model.segments();
+  const Scalar rho = Scalar(env.water_density());
+  const Scalar g = Scalar(env.gravity());
+  const Scalar bed = Scalar(env.seabed_depth());
+  const Scalar l = model.segment_length(), l2 = l * l, inv_l = model.inverse_segment_length();
+  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
+  const Scalar ea = p.axial_stiffness, ba = p.internal_damping;
+
+  env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
+
+  // Segments: tension along u_s (zero when slack).
+  for (int s = 0; s < n; ++s) {
+    const V3 d = x.col(s + 1) - x.col(s);
+    const Scalar ls2 = d.squaredNorm();
+    Scalar tension(0), k_uu(0), k_perp(0), c_uu(0);
+    if (ls2 > l2) {
+      const Scalar ls = sqrt(ls2), inv_ls = Scalar(1) / ls;
+      const V3 u = d * inv_ls;
+      const Scalar strain_rate = u.dot(v.col(s + 1) - v.col(s)) * inv_l;
+      tension = ea * (ls - l) * inv_l + ba * strain_rate;
+      ws.direction.col(s) = u;
+      ws.stretched_length(s) = ls;
+      if (tension > Scalar(0)) {
+        k_perp = tension * inv_ls;
+        k_uu = ea_l - k_perp;
+        c_uu = ba_l;
+      } else {
+        tension = Scalar(0);
+      }
+    } else {
+      const Scalar ls = sqrt(ls2);
+      ws.stretched_length(s) = ls;
+      // The direction of a slack segment is kept for diagnostics and the static solve's Jacobian.
+      if (ls > Scalar(0))
+        ws.direction.col(s) = d / ls;
+      else
+        ws.direction.col(s).setZero();
+    }
+    ws.tension(s) = tension;
+    if constexpr (WithJacobian) {
+      ws.seg_k_uu(s) = k_uu;
+      ws.seg_k_perp(s) = k_perp;
+      ws.seg_c_uu(s) = c_uu;
+    }
+  }
+
+  // Nodes.
+  const Scalar half_rho_d = Scalar(0.5) * rho * p.diameter;
+  const Scalar kn_per_l = half_rho_d * p.normal_drag;
+  const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
+  const Scalar can = p.normal_added_mass, cat = p.tangential_added_mass;
+  const Scalar bed_k = p.seabed_stiffness * p.diameter, bed_c = p.seabed_damping * p.diameter;
+  for (int i = 0; i <= n; ++i) {
+    // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends.
+    const V3 chord = x.col(i < n ? i + 1 : n) - x.col(i > 0 ? i - 1 : 0);
+    const Scalar c2 = chord.squaredNorm();
+    const V3 q = c2 > Scalar(0) ? V3(chord / sqrt(c2)) : V3::Zero();
+    ws.tangent.col(i) = q;
+
+    V3 f = V3::Zero();
+    if (i < n) f += ws.tension(i) * ws.direction.col(i);
+    if (i > 0) f -= ws.tension(i - 1) * ws.direction.col(i - 1);
+
+    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
+    const Scalar zeta = Scalar(env.surface_elevation(x(0, i), x(1, i), t));
+    const bool wet = !(x(2, i) < -zeta);
+    ws.submerged(i) = wet ? Scalar(1) : Scalar(0);
+    Eigen::Matrix<Scalar, 3, 3> dv;
+    if constexpr (WithJacobian) dv.setZero();
+    if (wet) {
+      f(2) += (m - rho * vol) * g;
+      // Morison drag on the relative velocity, split along q.
+      const V3 vr = ws.water_velocity.col(i) - v.col(i);
+      const Scalar vq = vr.dot(q);
+      const V3 vn = vr - vq * q;
+      const Scalar vn_abs = sqrt(vn.squaredNorm());
+      const Scalar kn = kn_per_l * li, kt = kt_per_l * li;
+      f += (kn * vn_abs) * vn + (kt * abs(vq) * vq) * q;
+      // Froude–Krylov plus added-mass forcing from the water acceleration.
+      const V3& aw = ws.water_acceleration.col(i);
+      f += (rho * vol) * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
+      ws.mass_iso(i) = m + rho * vol * can;
+      ws.mass_tan(i) = rho * vol * (cat - can);
+      if constexpr (WithJacobian) {
+        // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ.
+        dv.noalias() = (kn * vn_abs) * (Matrix3<Scalar>::Identity() - q * q.transpose());
+        if (vn_abs > Scalar(0)) dv.noalias() += (kn / vn_abs) * (vn * vn.transpose());
+        dv.noalias() += (Scalar(2) * kt * abs(vq)) * (q * q.transpose());
+      }
+    } else {
+      f(2) += m * g;
+      ws.mass_iso(i) = m;
+      ws.mass_tan(i) = Scalar(0);
+    }
+    // Seabed: spring–damper normal force (never pulling) and saturated-viscous friction.
+    Scalar normal(0), kz(0);
+    const Scalar pen = x(2, i) - bed;
+    if (pen > Scalar(0)) {
+      normal = (pen * bed_k + v(2, i) * bed_c) * li;
+      if (normal > Scalar(0)) {
+        f(2) -= normal;
+        kz = bed_k * li;
+        if constexpr (WithJacobian) dv(2, 2) += bed_c * li;
+        if (p.seabed_friction > Scalar(0)) {
+          const Scalar vh2 = v(0, i) * v(0, i) + v(1, i) * v(1, i);
+          const Scalar vf = p.friction_velocity;
+          const Scalar fmax = p.seabed_friction * normal;
+          const Scalar coef = vh2 > vf * vf ? fmax / sqrt(vh2) : fmax / vf;
+          f(0) -= coef * v(0, i);
+          f(1) -= coef * v(1, i);
+          if constexpr (WithJacobian) {
+            dv(0, 0) += coef;
+            dv(1, 1) += coef;
+          }
+        }
+      } else {
+        normal = Scalar(0);
+      }
+    }
+    ws.seabed_force(i) = normal;
+    if constexpr (WithJacobian) {
+      ws.node_dv[i] = dv;
+      ws.node_kz(i) = kz;
+    }
+    ws.force.col(i) = f;
+  }
+}
+
+/// \brief Node accelerations a_i = M_i⁻¹ F_i from the last `compute_forces` (free nodes only;
+/// kinematic ends get the prescribed acceleration `a_start`, `a_end`).
+///
+/// M_i = a I + b q qᵀ is inverted in closed form: M⁻¹ F = (F − b/(a+b) q (q·F)) / a.
+template <typename Scalar, typename DA>
+void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                               const Vector3<Scalar>& a_start, const Vector3<Scalar>& a_end,
+                               Eigen::MatrixBase<DA>& acc) {
+  const int n = model.segments();
+  for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
+    const Scalar a = ws.mass_iso(i), b = ws.mass_tan(i);
+    const auto q = ws.tangent.col(i);
+    const auto f = ws.force.col(i);
+    acc.col(i) = (f - (b / (a + b) * q.dot(f)) * q) / a;
+  }
+  if (model.first_free_node() == 1) acc.col(0) = a_start;
+  if (model.last_free_node() == n - 1) acc.col(n) = a_end;
+}
+
+/// \brief Forces the tether exerts on its kinematic attachment points from the last
+/// `compute_forces`: F_end = F_node − M_node a_end (the negative of the constraint force that
+/// holds the end node on its prescribed path), NED [N]. Zero for a free end.
+template <typename Scalar>
+EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
+                                            const TetherWorkspace<Scalar>& ws,
+                                            const TetherBoundary<Scalar>& boundary) {
+  EndForces<Scalar> out;
+  const int n = model.segments();
+  const auto inertia = [&](int i, const Vector3<Scalar>& a) -> Vector3<Scalar> {
+    const Vector3<Scalar> q = ws.tangent.col(i);
+    return ws.mass_iso(i) * a + ws.mass_tan(i) * q.dot(a) * q;
+  };
+  if (model.parameters().start_mode == EndMode::kinematic)
+    out.on_start = ws.force.col(0) - inertia(0, boundary.start.acceleration);
+  if (model.parameters().end_mode == EndMode::kinematic)
+    out.on_end = ws.force.col(n) - inertia(n, boundary.end.acceleration);
+  return out;
+}
+
+/// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
+/// the submerged weight −Σ (mᵢ − ρVᵢ) g zᵢ (NED z down) + elastic ½ EA/l Σ (l_s − l)² over
+/// stretched segments. Ignores the seabed spring. Recomputes the tangents and wetness itself.
+template <typename Scalar, typename Env>
+Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
+                     const TetherState<Scalar>& state) {
+  using std::sqrt;
+  const TetherParameters<Scalar>& p = model.parameters();
+  const int n = model.segments();
+  const Scalar rho = Scalar(env.water_density()), g = Scalar(env.gravity());
+  const Scalar l = model.segment_length();
+  Scalar e(0);
+  for (int s = 0; s < n; ++s) {
+    const Scalar ls = (state.position.col(s + 1) - state.position.col(s)).norm();
+    if (ls > l) e += Scalar(0.5) * model.axial_spring() * (ls - l) * (ls - l);
+  }
+  for (int i = 0; i <= n; ++i) {
+    const Vector3<Scalar> chord =
+        state.position.col(i < n ? i + 1 : n) - state.position.col(i > 0 ? i - 1 : 0);
+    const Scalar c = chord.norm();
+    const Vector3<Scalar> q = c > Scalar(0) ? Vector3<Scalar>(chord / c) : Vector3<Scalar>::Zero();
+    const Scalar zeta =
+        Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
+    const bool wet = !(state.position(2, i) < -zeta);
+    const Scalar m = model.node_mass(i), rv = wet ? rho * model.node_volume(i) : Scalar(0);
+    const Vector3<Scalar> vi = state.velocity.col(i);
+    const Scalar vq = vi.dot(q);
+    e += Scalar(0.5) * ((m + rv * p.normal_added_mass) * vi.squaredNorm() +
+                        rv * (p.tangential_added_mass - p.normal_added_mass) * vq * vq);
+    e -= (m - rv) * g * state.position(2, i);
+  }
+  return e;
+}
+
+/// \brief Checks that a state fits the model and is finite.
+/// \throws kelp::invalid_argument naming `state.position` / `state.velocity`.
+template <typename Scalar>
+void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
+             "state.position and state.velocity must have segments + 1 columns");
+  check_all_finite(state.position, "state.position");
+  check_all_finite(state.velocity, "state.velocity");
+  check_finite(state.time, "state.time");
+}
+
+/// \brief Checks that the boundary motion is finite.
+/// \throws kelp::invalid_argument naming the field.
+template <typename Scalar>
+void check_boundary(const TetherBoundary<Scalar>& b) {
+  check_all_finite(b.start.position, "boundary.start.position");
+  check_all_finite(b.start.velocity, "boundary.start.velocity");
+  check_all_finite(b.start.acceleration, "boundary.start.acceleration");
+  check_all_finite(b.end.position, "boundary.end.position");
+  check_all_finite(b.end.velocity, "boundary.end.velocity");
+  check_all_finite(b.end.acceleration, "boundary.end.acceleration");
+}
+
+/// \brief Straight-line state: nodes evenly spaced from `start_ned` to `end_ned`, at rest.
+template <typename Scalar, typename D1, typename D2>
+TetherState<Scalar> straight_line_state(const TetherModel<Scalar>& model,
+                                        const Eigen::MatrixBase<D1>& start_ned,
+                                        const Eigen::MatrixBase<D2>& end_ned) {
+  check_all_finite(start_ned, "start_ned");
+  check_all_finite(end_ned, "end_ned");
+  TetherState<Scalar> s(model);
+  const int n = model.segments();
+  const Vector3<Scalar> a(start_ned), b(end_ned);
+  for (int i = 0; i <= n; ++i) s.position.col(i) = a + (Scalar(i) / Scalar(n)) * (b - a);
+  return s;
+}
+
+/// \brief Double-precision aliases.
+using TetherParametersd = TetherParameters<double>;
+using TetherModeld = TetherModel<double>;
+using TetherStated = TetherState<double>;
+using TetherWorkspaced = TetherWorkspace<double>;
+using TetherBoundaryd = TetherBoundary<double>;
+/// \brief Single-precision aliases.
+using TetherParametersf = TetherParameters<float>;
+using TetherModelf = TetherModel<float>;
+using TetherStatef = TetherState<float>;
+using TetherWorkspacef = TetherWorkspace<float>;
+using TetherBoundaryf = TetherBoundary<float>;
+
+}  // namespace kelp::tether
