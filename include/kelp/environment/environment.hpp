@@ -14,6 +14,9 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/current.hpp"
+#include "kelp/environment/waves.hpp"
+#include "kelp/environment/wind.hpp"
 
 namespace kelp {
 namespace environment {
@@ -39,7 +42,9 @@ struct EnvironmentSample {
 ///
 /// A default-constructed environment is still water (`calm()`): seawater of 1025 kg/m³, air of
 /// 1.225 kg/m³, g = kelp::standard_gravity, no seabed, no current, no waves, no wind.
-/// All queries are `const` and allocate nothing.
+/// All queries are `const` and allocate nothing; in still water they only copy zeros.
+/// The parts are built separately (`CurrentModel`, `WaveField`, `WindField`) and set here; see
+/// `sea_state.hpp` for presets. The wave field's `depth` should be the seabed depth.
 /// \tparam Scalar double, float or an automatic-differentiation type.
 template <typename Scalar>
 class Environment {
@@ -92,26 +97,56 @@ class Environment {
   /// \throws kelp::invalid_argument naming `current` when not finite.
   template <typename Derived>
   Environment& set_current(const Eigen::MatrixBase<Derived>& v_ned) {
-    check_all_finite(v_ned, "current");
-    current_ = v_ned.template cast<Scalar>();
+    current_ = CurrentModel<Scalar>::constant(v_ned);
     return *this;
   }
 
-  /// \brief Everything at NED point `p_ned` and time `t` [s].
+  /// \brief Sets the current model (speed, direction, depth profile, variation).
+  Environment& set_current(const CurrentModel<Scalar>& current) {
+    current_ = current;
+    return *this;
+  }
+  /// \brief Sets the wave field (a default-constructed `WaveField` is a calm sea).
+  Environment& set_waves(const WaveField<Scalar>& waves) {
+    waves_ = waves;
+    return *this;
+  }
+  /// \brief Sets the wind field (a default-constructed `WindField` is no wind).
+  Environment& set_wind(const WindField<Scalar>& wind) {
+    wind_ = wind;
+    return *this;
+  }
+  /// \brief The current model.
+  const CurrentModel<Scalar>& current() const { return current_; }
+  /// \brief The wave field.
+  const WaveField<Scalar>& waves() const { return waves_; }
+  /// \brief The wind field.
+  const WindField<Scalar>& wind() const { return wind_; }
+
+  /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
+  /// and acceleration (zero above the free surface), surface elevation at (x, y), wind at 10 m.
   EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, Scalar t) const {
-    (void)p_ned;
-    (void)t;
     EnvironmentSample<Scalar> s;
-    s.current = current_;
+    if (!current_.is_zero()) s.current = current_.velocity(p_ned, t);
+    if (!waves_.empty()) {
+      const WaveKinematics<Scalar> k = waves_.kinematics(p_ned, t);
+      s.wave_velocity = k.velocity;
+      s.wave_acceleration = k.acceleration;
+      s.surface_elevation = k.elevation;
+    }
+    s.wind = wind_.velocity(t);
     return s;
   }
 
-  /// \brief Free-surface elevation ζ(x, y, t) [m], positive up.
+  /// \brief Free-surface elevation ζ(x, y, t) [m], positive up (x north, y east [m], t [s]).
   Scalar surface_elevation(Scalar x, Scalar y, Scalar t) const {
-    (void)x;
-    (void)y;
-    (void)t;
-    return Scalar(0);
+    if (waves_.empty()) return Scalar(0);
+    return waves_.elevation(x, y, t);
+  }
+
+  /// \brief Free-surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t).
+  Eigen::Matrix<Scalar, 2, 1> surface_slope(Scalar x, Scalar y, Scalar t) const {
+    return waves_.slope(x, y, t);
   }
 
   /// \brief Water velocity and acceleration at many NED points at once (e.g. all tether nodes);
@@ -124,11 +159,17 @@ class Environment {
   void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, Scalar t,
                     Eigen::Ref<Matrix3X<Scalar>> velocity,
                     Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
-    (void)t;
     KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
                "sample_water: velocity and acceleration must have as many columns as points");
-    for (Eigen::Index i = 0; i < points.cols(); ++i) velocity.col(i) = current_;
-    acceleration.setZero();
+    waves_.kinematics(points, t, velocity, acceleration);
+    if (current_.is_zero()) return;
+    const Vector3<Scalar> vs = current_.surface_velocity(t);
+    if (current_.parameters().profile.kind == CurrentProfileKind::uniform) {
+      velocity.colwise() += vs;
+      return;
+    }
+    for (Eigen::Index i = 0; i < points.cols(); ++i)
+      velocity.col(i) += vs * profile_factor(current_.parameters().profile, points(2, i));
   }
 
  private:
@@ -136,7 +177,9 @@ class Environment {
   Scalar air_density_ = Scalar(kelp::air_density);
   Scalar gravity_ = Scalar(kelp::standard_gravity);
   Scalar seabed_depth_ = Scalar(std::numeric_limits<double>::infinity());
-  Vector3<Scalar> current_ = Vector3<Scalar>::Zero();
+  CurrentModel<Scalar> current_;
+  WaveField<Scalar> waves_;
+  WindField<Scalar> wind_;
 };
 
 /// \brief Double-precision environment.

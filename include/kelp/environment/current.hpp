@@ -1,0 +1,237 @@
+/// \file
+/// \brief Ocean current: the paper's formula, Fossen's 3-D current vector, depth profiles
+/// (uniform, power-law, linear) and a seeded, bounded first-order Gauss–Markov variation of speed
+/// and direction.
+///
+/// Frames: world NED, z down, mean sea surface at z = 0. Angles: β_c is the horizontal direction
+/// the current flows TOWARDS (NED azimuth from north, clockwise) and α_c the vertical angle of
+/// Fossen's 3-D current (positive: flowing downwards). Units SI.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp {
+namespace environment {
+
+/// \brief The paper's current formula (eq:current): v_c = V_c cos α_c cos β_c [m/s].
+///
+/// The paper writes this one component only. It is the first (north, x) component of Fossen's 3-D
+/// current vector (`current_velocity_ned`); with α_c = β_c = 0 it is the whole current, flowing
+/// north. \param[in] speed V_c [m/s] \param[in] alpha α_c vertical angle [rad]
+/// \param[in] beta β_c horizontal direction [rad]
+template <typename Scalar>
+Scalar paper_current(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
+  using std::cos;
+  return speed * cos(alpha) * cos(beta);
+}
+
+/// \brief Fossen's 3-D current velocity in NED [m/s] from speed and direction angles:
+/// \f$ \mathbf v_c^n = V_c [\cos\alpha_c\cos\beta_c,\ \sin\beta_c,\ \sin\alpha_c\cos\beta_c]^T \f$
+/// (Fossen 2021, §8.3, 3-D irrotational current). With α_c = 0 the current is horizontal and
+/// flows towards the azimuth β_c. \param[in] speed V_c [m/s] \param[in] alpha α_c [rad]
+/// \param[in] beta β_c [rad]
+template <typename Scalar>
+Vector3<Scalar> current_velocity_ned(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
+  using std::cos;
+  using std::sin;
+  return Vector3<Scalar>(speed * cos(alpha) * cos(beta), speed * sin(beta),
+                         speed * sin(alpha) * cos(beta));
+}
+
+/// \brief How the current speed varies with depth.
+enum class CurrentProfileKind {
+  uniform,    ///< the same speed at every depth
+  power_law,  ///< V(z) = V_s ((h − z)/h)^p: zero at the seabed (p = 1/7 typical for tidal flow)
+  linear      ///< V(z) = V_s (1 − (1 − r) z/h): from V_s at the surface to r V_s at the seabed
+};
+
+/// \brief A current depth profile; the factor multiplies the surface speed.
+struct CurrentProfile {
+  CurrentProfileKind kind = CurrentProfileKind::uniform;  ///< profile shape
+  /// Depth h [m] of the seabed the profile decays to (needed by power_law and linear).
+  double depth = std::numeric_limits<double>::infinity();
+  /// Exponent p of the power law (> 0). 1/7 after DNV-RP-C205 (2010) eq. 4.1.2 (tidal current).
+  double exponent = 1.0 / 7.0;
+  /// Ratio r of the seabed speed to the surface speed for the linear profile (≥ 0).
+  double bottom_ratio = 0.0;
+};
+
+/// \brief Throws `kelp::invalid_argument` naming the bad field of a profile.
+inline void validate(const CurrentProfile& p) {
+  if (p.kind != CurrentProfileKind::uniform) check_positive(p.depth, "profile.depth");
+  check_positive(p.exponent, "profile.exponent");
+  check_non_negative(p.bottom_ratio, "profile.bottom_ratio");
+}
+
+/// \brief Profile factor f(z) ∈ [0, 1] at NED depth z [m]: 1 above the surface (z ≤ 0),
+/// the profile in between, and its seabed value at and below z = h.
+template <typename Scalar>
+Scalar profile_factor(const CurrentProfile& p, const Scalar& z) {
+  using std::pow;
+  if (p.kind == CurrentProfileKind::uniform || value_of(z) <= 0.0) return Scalar(1);
+  if (value_of(z) >= p.depth)
+    return p.kind == CurrentProfileKind::power_law ? Scalar(0) : Scalar(p.bottom_ratio);
+  const Scalar s = z / Scalar(p.depth);
+  if (p.kind == CurrentProfileKind::power_law) return pow(Scalar(1) - s, p.exponent);
+  return Scalar(1) - Scalar(1.0 - p.bottom_ratio) * s;
+}
+
+/// \brief A first-order Gauss–Markov process x with bounds (Fossen 2021, §8.3.1:
+/// V̇_c + μ V_c = w with V_min ≤ V_c ≤ V_max), written about its nominal value x̄:
+/// \f$ \dot x = -\mu (x - \bar x) + w \f$, w white noise of intensity σ².
+struct GaussMarkov {
+  double time_constant = 600.0;  ///< 1/μ [s] (> 0)
+  double sigma = 0.0;            ///< σ [unit/√s] (≥ 0; 0 disables the variation)
+  double lower = -std::numeric_limits<double>::infinity();  ///< lower bound (≤ nominal)
+  double upper = std::numeric_limits<double>::infinity();   ///< upper bound (≥ nominal)
+};
+
+/// \brief Everything that defines a current.
+struct CurrentParameters {
+  double speed = 0.0;               ///< nominal surface speed V_c [m/s] (≥ 0)
+  double direction = 0.0;           ///< β_c: NED azimuth the current flows towards [rad]
+  double vertical_angle = 0.0;      ///< α_c [rad]
+  CurrentProfile profile;           ///< depth profile
+  GaussMarkov speed_variation;      ///< slow variation of V_c (bounds in m/s)
+  GaussMarkov direction_variation;  ///< slow variation of β_c (bounds in rad, absolute)
+  double duration = 3600.0;         ///< length of the precomputed variation [s] (held after)
+  double time_step = 1.0;           ///< sampling step of the variation [s]
+  std::uint64_t seed = 1;           ///< seed of the variation (std::mt19937_64, portable)
+};
+
+/// \brief Throws `kelp::invalid_argument` naming the bad field of `p`.
+inline void validate(const CurrentParameters& p) {
+  check_non_negative(p.speed, "speed");
+  check_finite(p.direction, "direction");
+  check_finite(p.vertical_angle, "vertical_angle");
+  validate(p.profile);
+  for (const GaussMarkov* g : {&p.speed_variation, &p.direction_variation}) {
+    const bool is_speed = g == &p.speed_variation;
+    const double nominal = is_speed ? p.speed : p.direction;
+    check_positive(g->time_constant, is_speed ? "speed_variation.time_constant"
+                                              : "direction_variation.time_constant");
+    check_non_negative(g->sigma, is_speed ? "speed_variation.sigma" : "direction_variation.sigma");
+    KELP_CHECK(!std::isnan(g->lower) && !std::isnan(g->upper) && g->lower <= nominal &&
+                   nominal <= g->upper,
+               is_speed ? "speed_variation bounds must satisfy lower <= speed <= upper"
+                        : "direction_variation bounds must satisfy lower <= direction <= upper");
+  }
+  check_positive(p.duration, "duration");
+  check_positive(p.time_step, "time_step");
+}
+
+/// \brief A current evaluable at any NED point and time: nominal speed and direction, depth
+/// profile and an optional slow, bounded Gauss–Markov variation.
+///
+/// The variation is simulated once at construction (exact discretisation of the
+/// Ornstein–Uhlenbeck process at `time_step`, clamped to the bounds after each step) and
+/// linearly interpolated in time, so queries are `const`, deterministic and allocation-free;
+/// after `duration` the last value is held. The current is treated as quasi-steady: its slow
+/// time derivative is not reported as a fluid acceleration.
+/// \tparam Scalar double, float or ceres::Jet (derivatives flow through position; the time
+/// interpolation uses the value part of t).
+template <typename Scalar>
+class CurrentModel {
+ public:
+  /// \brief No current.
+  CurrentModel() = default;
+
+  /// \brief Builds the current (and its variation record). \throws kelp::invalid_argument
+  explicit CurrentModel(const CurrentParameters& p) : params_(p) {
+    validate(p);
+    varying_ = p.speed_variation.sigma > 0.0 || p.direction_variation.sigma > 0.0;
+    if (!varying_) return;
+    const auto n = static_cast<std::size_t>(std::ceil(p.duration / p.time_step)) + 1;
+    speed_.resize(n);
+    direction_.resize(n);
+    std::mt19937_64 rng(p.seed);
+    auto uniform = [&rng]() { return (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53; };
+    auto normal = [&uniform]() {  // Box–Muller: portable, unlike std::normal_distribution
+      return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * kelp::pi * uniform());
+    };
+    auto step = [&](const GaussMarkov& g, double nominal, double x) {
+      const double mu = 1.0 / g.time_constant;
+      const double decay = std::exp(-mu * p.time_step);
+      const double sd = g.sigma * std::sqrt((1.0 - decay * decay) / (2.0 * mu));
+      x = nominal + (x - nominal) * decay + sd * normal();
+      return std::min(std::max(x, g.lower), g.upper);
+    };
+    speed_[0] = p.speed;
+    direction_[0] = p.direction;
+    for (std::size_t i = 1; i < n; ++i) {
+      speed_[i] = step(p.speed_variation, p.speed, speed_[i - 1]);
+      direction_[i] = step(p.direction_variation, p.direction, direction_[i - 1]);
+    }
+  }
+
+  /// \brief A constant current of the given NED velocity [m/s], uniform in depth.
+  /// \throws kelp::invalid_argument naming `current` when not finite.
+  template <typename Derived>
+  static CurrentModel constant(const Eigen::MatrixBase<Derived>& v_ned) {
+    check_all_finite(v_ned, "current");
+    const double u = value_of(v_ned(0)), v = value_of(v_ned(1)), w = value_of(v_ned(2));
+    CurrentParameters p;
+    p.speed = std::sqrt(u * u + v * v + w * w);
+    // Invert Fossen's parametrisation: sin β = v/V, tan α = w/u.
+    p.direction = std::atan2(v, std::sqrt(u * u + w * w));
+    p.vertical_angle = std::atan2(w, u);
+    return CurrentModel(p);
+  }
+
+  /// \brief The parameters the current was built from.
+  const CurrentParameters& parameters() const { return params_; }
+  /// \brief True when the current is zero everywhere and always.
+  bool is_zero() const { return params_.speed == 0.0 && !varying_; }
+
+  /// \brief Surface speed V_c(t) [m/s].
+  double speed_at(double t) const { return varying_ ? interpolate(speed_, t) : params_.speed; }
+  /// \brief Direction β_c(t) [rad].
+  double direction_at(double t) const {
+    return varying_ ? interpolate(direction_, t) : params_.direction;
+  }
+  /// \brief Current velocity at the surface, NED [m/s], at time t [s].
+  Vector3<Scalar> surface_velocity(const Scalar& t) const {
+    const double tv = value_of(t);
+    return current_velocity_ned(Scalar(speed_at(tv)), Scalar(params_.vertical_angle),
+                                Scalar(direction_at(tv)));
+  }
+  /// \brief Current velocity at NED point p [m] and time t [s], NED [m/s]. Above the surface
+  /// (z < 0) the surface value is returned.
+  template <typename Derived>
+  Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, const Scalar& t) const {
+    return surface_velocity(t) * profile_factor(params_.profile, Scalar(p(2)));
+  }
+
+ private:
+  double interpolate(const std::vector<double>& v, double t) const {
+    if (!(t > 0.0)) return v.front();
+    const double s = t / params_.time_step;
+    const auto i = static_cast<std::size_t>(s);
+    if (i + 1 >= v.size()) return v.back();
+    const double f = s - static_cast<double>(i);
+    return v[i] + f * (v[i + 1] - v[i]);
+  }
+
+  CurrentParameters params_;
+  bool varying_ = false;
+  std::vector<double> speed_, direction_;
+};
+
+/// \brief Double-precision current model.
+using CurrentModeld = CurrentModel<double>;
+/// \brief Single-precision current model.
+using CurrentModelf = CurrentModel<float>;
+
+}  // namespace environment
+}  // namespace kelp

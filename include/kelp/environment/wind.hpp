@@ -1,0 +1,258 @@
+/// \file
+/// \brief Wind: the paper's force formula, a mean wind with gusts from a wind spectrum (Harris or
+/// NORSEPP) with seeded phases, and the wind forces and yaw moment on a surface vessel from
+/// coefficients (constant-coefficient model by default, an Isherwood-style table as option).
+///
+/// Frames: world NED; body x forward, y starboard, z down. The wind velocity is the velocity of
+/// the air (the direction it blows TOWARDS), horizontal, at 10 m above the sea. Units SI.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp {
+namespace environment {
+
+/// \brief The paper's wind force (eq:wind): F_wind = ½ ρ_air V_w² C_x A_w [N].
+///
+/// Implicit in the paper: V_w is the wind speed relative to the vessel, the force acts along the
+/// wind, C_x is the drag coefficient for the frontal (transverse) projected area A_w, and both
+/// are constant (independent of the wind's angle to the hull).
+/// \param[in] rho_air air density [kg/m³] \param[in] wind_speed V_w [m/s]
+/// \param[in] cx C_x [-] \param[in] frontal_area A_w [m²]
+template <typename Scalar>
+Scalar paper_wind_force(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cx,
+                        const Scalar& frontal_area) {
+  return Scalar(0.5) * rho_air * wind_speed * wind_speed * cx * frontal_area;
+}
+
+/// \brief The lateral twin of the paper's wind force: F = ½ ρ_air V_w² C_y A_lw [N], with the
+/// lateral coefficient C_y and the lateral projected area A_lw (paper, text after eq:wind).
+template <typename Scalar>
+Scalar paper_wind_force_lateral(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cy,
+                                const Scalar& lateral_area) {
+  return Scalar(0.5) * rho_air * wind_speed * wind_speed * cy * lateral_area;
+}
+
+/// \brief Harris wind-gust spectrum S(f) [(m/s)²/Hz] at frequency f [Hz]:
+/// \f$ S(f) = \frac{4\kappa L U_{10}}{(2 + \tilde f^2)^{5/6}},\ \tilde f = L f / U_{10} \f$
+/// with L = 1800 m and the surface drag coefficient κ = 0.0026 (Harris 1971, as given in
+/// Fossen 2021 §10.1.3). Its integral over f ∈ (0, ∞) is ≈ 0.01736 U₁₀² (σ_u ≈ 0.13 U₁₀).
+inline double harris_spectrum(double f, double u10, double length = 1800.0, double kappa = 0.0026) {
+  if (!(f > 0.0) || !(u10 > 0.0)) return 0.0;
+  const double ft = length * f / u10;
+  return 4.0 * kappa * length * u10 / std::pow(2.0 + ft * ft, 5.0 / 6.0);
+}
+
+/// \brief NORSEPP (Norwegian Petroleum Directorate / NORSOK N-003) wind spectrum
+/// S(f) [(m/s)²/Hz] at height z [m]:
+/// \f$ S(f) = \frac{320 (U_{10}/10)^2 (z/10)^{0.45}}{(1 + \tilde f^n)^{5/(3n)}},\quad
+/// \tilde f = 172 f (z/10)^{2/3} (U_{10}/10)^{-3/4},\ n = 0.468 \f$
+/// (NORSOK N-003 (2007) §6.3; DNV-RP-C205 (2010) eq. 2.3.2.12).
+inline double norsepp_spectrum(double f, double u10, double z = 10.0) {
+  if (!(f > 0.0) || !(u10 > 0.0)) return 0.0;
+  constexpr double n = 0.468;
+  const double ft = 172.0 * f * std::pow(z / 10.0, 2.0 / 3.0) * std::pow(u10 / 10.0, -0.75);
+  return 320.0 * (u10 / 10.0) * (u10 / 10.0) * std::pow(z / 10.0, 0.45) /
+         std::pow(1.0 + std::pow(ft, n), 5.0 / (3.0 * n));
+}
+
+/// \brief Which gust spectrum a wind uses.
+enum class GustSpectrum {
+  none,    ///< steady mean wind
+  harris,  ///< `harris_spectrum`
+  norsepp  ///< `norsepp_spectrum` at 10 m
+};
+
+/// \brief A wind field: mean speed and direction plus longitudinal gusts.
+struct WindParameters {
+  double speed = 0.0;                      ///< mean speed U₁₀ at 10 m [m/s] (≥ 0)
+  double direction = 0.0;                  ///< NED azimuth the air moves TOWARDS [rad]
+  GustSpectrum gust = GustSpectrum::none;  ///< gust spectrum
+  int n_components = 64;                   ///< number of gust components (≥ 1)
+  double f_min = 1e-4;     ///< lower end of the gust band [Hz] (> 0); frequencies are log-spaced
+  double f_max = 1.0;      ///< upper end of the gust band [Hz] (> f_min)
+  std::uint64_t seed = 1;  ///< seed of the gust phases (std::mt19937_64)
+};
+
+/// \brief Throws `kelp::invalid_argument` naming the bad field of `p`.
+inline void validate(const WindParameters& p) {
+  check_non_negative(p.speed, "wind speed");
+  check_finite(p.direction, "wind direction");
+  KELP_CHECK(p.n_components >= 1, "wind n_components must be >= 1");
+  check_positive(p.f_min, "f_min");
+  KELP_CHECK(std::isfinite(p.f_max) && p.f_max > p.f_min, "f_max must be finite and > f_min");
+}
+
+/// \brief Mean wind plus gusts u_g(t) = Σ a_j cos(2π f_j t + φ_j) along the mean direction,
+/// a_j = √(2 ∫_bin S df) over log-spaced bins, φ_j seeded. Queries are `const` and
+/// allocation-free.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+class WindField {
+ public:
+  /// \brief No wind.
+  WindField() = default;
+  /// \brief Builds the gust components. \throws kelp::invalid_argument naming the bad field.
+  explicit WindField(const WindParameters& p) : params_(p) {
+    validate(p);
+    cos_dir_ = std::cos(p.direction);
+    sin_dir_ = std::sin(p.direction);
+    if (p.gust == GustSpectrum::none || p.speed == 0.0) return;
+    const auto n = static_cast<std::size_t>(p.n_components);
+    std::mt19937_64 rng(p.seed);
+    const double ratio = std::pow(p.f_max / p.f_min, 1.0 / static_cast<double>(n));
+    omega_.resize(n);
+    amp_.resize(n);
+    phase_.resize(n);
+    auto spectrum = [&p](double f) {
+      return p.gust == GustSpectrum::harris ? harris_spectrum(f, p.speed)
+                                            : norsepp_spectrum(f, p.speed);
+    };
+    for (std::size_t j = 0; j < n; ++j) {
+      const double f0 = p.f_min * std::pow(ratio, static_cast<double>(j)), f1 = f0 * ratio;
+      // Bin energy by Simpson's rule on 16 sub-intervals; the frequency sits at the geometric
+      // centre of the bin.
+      constexpr int m = 16;
+      const double h = (f1 - f0) / m;
+      double sum = spectrum(f0) + spectrum(f1);
+      for (int i = 1; i < m; ++i) sum += (i % 2 ? 4.0 : 2.0) * spectrum(f0 + i * h);
+      amp_[j] = std::sqrt(2.0 * sum * h / 3.0);
+      omega_[j] = 2.0 * kelp::pi * std::sqrt(f0 * f1);
+      phase_[j] = 2.0 * kelp::pi * static_cast<double>(rng() >> 11) * 0x1.0p-53;
+    }
+  }
+
+  /// \brief The parameters the field was built from.
+  const WindParameters& parameters() const { return params_; }
+  /// \brief Variance of the discretised gust Σ a_j²/2 [(m/s)²].
+  double gust_variance() const {
+    double v = 0.0;
+    for (double a : amp_) v += 0.5 * a * a;
+    return v;
+  }
+  /// \brief Wind speed U(t) = U₁₀ + u_g(t) [m/s] at time t [s].
+  Scalar speed(const Scalar& t) const {
+    using std::cos;
+    Scalar u(params_.speed);
+    for (std::size_t j = 0; j < amp_.size(); ++j)
+      u += Scalar(amp_[j]) * cos(Scalar(omega_[j]) * t + Scalar(phase_[j]));
+    return u;
+  }
+  /// \brief Wind velocity (air motion) at 10 m, NED [m/s], at time t [s]; horizontal.
+  Vector3<Scalar> velocity(const Scalar& t) const {
+    if (params_.speed == 0.0) return Vector3<Scalar>::Zero();
+    const Scalar u = speed(t);
+    return Vector3<Scalar>(u * Scalar(cos_dir_), u * Scalar(sin_dir_), Scalar(0));
+  }
+
+ private:
+  WindParameters params_;
+  double cos_dir_ = 1.0, sin_dir_ = 0.0;
+  std::vector<double> omega_, amp_, phase_;
+};
+
+/// \brief Double-precision wind field.
+using WindFieldd = WindField<double>;
+/// \brief Single-precision wind field.
+using WindFieldf = WindField<float>;
+
+/// \brief Projected areas and length of the hull above water.
+struct WindAreas {
+  double frontal_area = 0.0;    ///< A_Fw: frontal (transverse) projected area [m²]
+  double lateral_area = 0.0;    ///< A_Lw: lateral projected area [m²]
+  double length_overall = 0.0;  ///< L_oa [m], the yaw-moment arm
+};
+
+/// \brief The paper's constant coefficients resolved by the relative wind angle γ_rw
+/// (Fossen 2021 §10.1.1, coefficients for a port/starboard-symmetric hull):
+/// C_X = −c_x cos γ_rw, C_Y = c_y sin γ_rw, C_N = c_n sin 2γ_rw.
+/// With γ_rw = 0 (head wind) |X| reduces to the paper's eq:wind.
+struct ConstantWindCoefficients {
+  double cx = 0.0;  ///< c_x [-] (≥ 0)
+  double cy = 0.0;  ///< c_y [-] (≥ 0)
+  double cn = 0.0;  ///< c_n [-]
+  /// \brief (C_X, C_Y, C_N) at the relative wind angle γ_rw [rad].
+  Eigen::Vector3d operator()(double gamma) const {
+    return Eigen::Vector3d(-cx * std::cos(gamma), cy * std::sin(gamma), cn * std::sin(2 * gamma));
+  }
+};
+
+/// \brief Isherwood-style table of (C_X, C_Y, C_N) against the relative wind angle γ_rw ∈ [0, π],
+/// linearly interpolated, mirrored for γ_rw < 0 with C_X even and C_Y, C_N odd (port/starboard
+/// symmetry). Fill it from Isherwood (1972) or wind-tunnel data for the hull at hand; the values
+/// use the sign convention of `ConstantWindCoefficients` (C_X < 0 in a head wind).
+struct TabulatedWindCoefficients {
+  std::vector<double> angle;       ///< γ_rw [rad], strictly increasing, from 0 to π
+  std::vector<double> cx, cy, cn;  ///< coefficients at those angles [-]
+
+  /// \brief Throws `kelp::invalid_argument` unless the table is well formed.
+  void validate() const {
+    KELP_CHECK(angle.size() >= 2, "wind table angle needs at least 2 entries");
+    KELP_CHECK(cx.size() == angle.size() && cy.size() == angle.size() && cn.size() == angle.size(),
+               "wind table cx, cy, cn must have as many entries as angle");
+    KELP_CHECK(std::abs(angle.front()) < 1e-9 && std::abs(angle.back() - kelp::pi) < 1e-6,
+               "wind table angle must run from 0 to pi");
+    for (std::size_t i = 1; i < angle.size(); ++i)
+      KELP_CHECK(angle[i] > angle[i - 1], "wind table angle must be strictly increasing");
+  }
+  /// \brief (C_X, C_Y, C_N) at γ_rw [rad] (any value; wrapped to (−π, π]).
+  Eigen::Vector3d operator()(double gamma) const {
+    gamma = std::remainder(gamma, 2.0 * kelp::pi);
+    const double sign = gamma < 0.0 ? -1.0 : 1.0;
+    const double g = std::abs(gamma);
+    const auto it = std::upper_bound(angle.begin(), angle.end(), g);
+    std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, it - angle.begin()));
+    i = std::min(i, angle.size() - 1);
+    const double f = (g - angle[i - 1]) / (angle[i] - angle[i - 1]);
+    auto lerp = [&](const std::vector<double>& c) { return c[i - 1] + f * (c[i] - c[i - 1]); };
+    return Eigen::Vector3d(lerp(cx), sign * lerp(cy), sign * lerp(cn));
+  }
+};
+
+/// \brief Wind force and yaw moment (X, Y, N) on a surface vessel, body frame [N, N, N·m]
+/// (Fossen 2021 §10.1.1):
+/// \f$ X = \tfrac12\rho_a V_{rw}^2 C_X(\gamma_{rw}) A_{Fw},\quad
+///     Y = \tfrac12\rho_a V_{rw}^2 C_Y(\gamma_{rw}) A_{Lw},\quad
+///     N = \tfrac12\rho_a V_{rw}^2 C_N(\gamma_{rw}) A_{Lw} L_{oa} \f$
+/// with the relative velocity u_rw = u − u_w, v_rw = v − v_w (wind resolved in the body frame by
+/// the heading ψ), V_rw² = u_rw² + v_rw² and γ_rw = −atan2(v_rw, u_rw).
+/// Assumes a level hull (roll and pitch ignored) and wind at 10 m acting on the whole area.
+/// \tparam Coefficients `ConstantWindCoefficients`, `TabulatedWindCoefficients` or any callable
+/// γ ↦ Eigen::Vector3d (C_X, C_Y, C_N).
+/// \param[in] coefficients coefficient model \param[in] areas projected areas and length
+/// \param[in] rho_air [kg/m³] \param[in] wind_ned wind velocity (air motion) NED [m/s]
+/// \param[in] psi heading [rad] \param[in] u surge velocity [m/s] \param[in] v sway velocity [m/s]
+template <typename Scalar, typename Coefficients, typename Derived>
+Vector3<Scalar> wind_load(const Coefficients& coefficients, const WindAreas& areas,
+                          const Scalar& rho_air, const Eigen::MatrixBase<Derived>& wind_ned,
+                          const Scalar& psi, const Scalar& u, const Scalar& v) {
+  using std::atan2;
+  using std::cos;
+  using std::sin;
+  const Scalar cpsi = cos(psi), spsi = sin(psi);
+  const Scalar wx = Scalar(wind_ned(0)), wy = Scalar(wind_ned(1));
+  const Scalar u_rw = u - (cpsi * wx + spsi * wy);
+  const Scalar v_rw = v - (-spsi * wx + cpsi * wy);
+  const Scalar v2 = u_rw * u_rw + v_rw * v_rw;
+  if (value_of(v2) == 0.0) return Vector3<Scalar>::Zero();
+  const Scalar gamma = -atan2(v_rw, u_rw);
+  // Coefficients are read at the value of γ (tabulated data carry no derivative).
+  const Eigen::Vector3d c = coefficients(value_of(gamma));
+  const Scalar q = Scalar(0.5) * rho_air * v2;
+  return Vector3<Scalar>(q * Scalar(c(0) * areas.frontal_area),
+                         q * Scalar(c(1) * areas.lateral_area),
+                         q * Scalar(c(2) * areas.lateral_area * areas.length_overall));
+}
+
+}  // namespace environment
+}  // namespace kelp
