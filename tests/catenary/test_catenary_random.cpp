@@ -40,5 +40,7 @@ TEST_CASE("1e5 + 1e5 random geometries: zero failures, residual <= 1e-10", "[cat
   CHECK(failures == 0);
   CHECK(worst <= 1e-10L);
   CHECK(worst_reported <= 1e-10L);
-  CHECK(max_iterations_used <= 6);
+  CHECK(max_iterations_used <= 2);
+  // Regression guard far inside the requirement: the solver reaches ~1e-14 everywhere today.
+  CHECK(worst <= 1e-12L);
 }

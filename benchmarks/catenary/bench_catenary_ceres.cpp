@@ -1,0 +1,67 @@
+// Ceres path (TinySolver on the paper's residuals): warm-started from the fast path, from the
+// previous control step, and from a naive start, over the same grid as the fast path.
+#include <benchmark/benchmark.h>
+
+#include "grid.hpp"
+#include "kelp/ceres/catenary_solver.hpp"
+
+namespace {
+
+void BM_CeresWarmFastPath(benchmark::State& state) {
+  const auto grid = kelp_bench::catenary_grid();
+  kelp::ceres::CatenarySolver solver;
+  for (auto _ : state) {
+    for (const auto& g : grid) {
+      auto r = solver.solve(g.D, g.dz, g.L);
+      benchmark::DoNotOptimize(r);
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid.size()));
+}
+BENCHMARK(BM_CeresWarmFastPath);
+
+// A control loop: each geometry is solved from the solution of the geometry 1 ms earlier
+// (ends moving ~1 mm, i.e. D and dz changed by 1e-4 L).
+void BM_CeresWarmPreviousStep(benchmark::State& state) {
+  const auto grid = kelp_bench::catenary_grid();
+  std::vector<kelp::tether::CatenaryResult<double>> previous;
+  for (const auto& g : grid)
+    previous.push_back(kelp::tether::solve_catenary(g.D * (1 - 1e-4), g.dz - 1e-4 * g.L, g.L));
+  kelp::ceres::CatenarySolver solver;
+  int64_t iterations = 0;
+  for (auto _ : state) {
+    for (size_t i = 0; i < grid.size(); ++i) {
+      const auto& g = grid[i];
+      auto r = solver.solve(g.D, g.dz, g.L, previous[i].a, previous[i].c);
+      iterations += r.iterations;
+      benchmark::DoNotOptimize(r);
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid.size()));
+  state.counters["iterations"] =
+      static_cast<double>(iterations) / static_cast<double>(state.iterations() * grid.size());
+}
+BENCHMARK(BM_CeresWarmPreviousStep);
+
+// For scale: the paper's two-parameter solve from a naive start (a = L, c = D/2).
+void BM_CeresNaiveStart(benchmark::State& state) {
+  const auto grid = kelp_bench::catenary_grid();
+  kelp::ceres::CatenarySolver solver;
+  int64_t iterations = 0, failures = 0;
+  for (auto _ : state) {
+    for (const auto& g : grid) {
+      auto r = solver.solve(g.D, g.dz, g.L, g.L, 0.5 * g.D);
+      iterations += r.iterations;
+      failures += r.status != kelp::tether::CatenaryStatus::converged;
+      benchmark::DoNotOptimize(r);
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid.size()));
+  state.counters["iterations"] =
+      static_cast<double>(iterations) / static_cast<double>(state.iterations() * grid.size());
+  state.counters["failed_fraction"] =
+      static_cast<double>(failures) / static_cast<double>(state.iterations() * grid.size());
+}
+BENCHMARK(BM_CeresNaiveStart);
+
+}  // namespace
