@@ -1,1 +1,327 @@
+// The lumped-mass tether model: input validation, force terms checked against hand-computed
+// values, the analytic Jacobian against finite differences, float/double instantiation and
+// allocation-free steps.
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+#include "tether_test_support.hpp"
+
+namespace kt = kelp::tether;
+using kelp::Vector3;
+
+// Explicit instantiation for both supported scalars (every public class template).
+template struct kt::TetherParameters<double>;
+template struct kt::TetherParameters<float>;
+template class kt::TetherModel<double>;
+template class kt::TetherModel<float>;
+template struct kt::TetherState<double>;
+template struct kt::TetherState<float>;
+template struct kt::TetherWorkspace<double>;
+template struct kt::TetherWorkspace<float>;
+template struct kt::TetherBoundary<double>;
+template struct kt::TetherBoundary<float>;
+template struct kt::EndMotion<double>;
+template struct kt::EndMotion<float>;
+
+TEST_CASE("bad tether parameters throw invalid_argument naming the field", "[tether][errors]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto p = kelp_test::benchmark_line<double>(10);
+  const auto expect = [](kt::TetherParametersd q, const char* field) {
+    CHECK_THROWS_AS(kt::TetherModeld(q), kelp::invalid_argument);
+    CHECK_THROWS_WITH(kt::TetherModeld(q), Catch::Contains(field));
+  };
+  auto q = p;
+  q.segments = 0;
+  expect(q, "segments");
+  q = p;
+  q.length = 0;
+  expect(q, "length");
+  q = p;
+  q.length = -1;
+  expect(q, "length");
+  q = p;
+  q.axial_stiffness = 0;
+  expect(q, "axial_stiffness");
+  q = p;
+  q.diameter = -0.01;
+  expect(q, "diameter");
+  q = p;
+  q.diameter = nan;
+  expect(q, "diameter");
+  q = p;
+  q.mass_per_length = nan;
+  expect(q, "mass_per_length");
+  q = p;
+  q.normal_drag = -1;
+  expect(q, "normal_drag");
+  q = p;
+  q.internal_damping = nan;
+  expect(q, "internal_damping");
+  CHECK_NOTHROW(kt::TetherModeld(p));
+
+  // Steps: dt, boundary and state sizes are checked.
+  const kt::TetherModeld model(p);
+  kt::TetherWorkspaced ws(model);
+  kelp::environment::Environmentd env;
+  auto s = kt::straight_line_state(model, Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
+  auto b = kt::TetherBoundaryd::fixed(Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
+  CHECK_THROWS_WITH(kt::step_rk4(model, ws, env, s, b, 0.0), Catch::Contains("dt"));
+  CHECK_THROWS_WITH(kt::step_implicit(model, ws, env, s, b, -1e-3), Catch::Contains("dt"));
+  auto bad = b;
+  bad.end.velocity.x() = nan;
+  CHECK_THROWS_WITH(kt::step_symplectic_euler(model, ws, env, s, bad, 1e-4),
+                    Catch::Contains("boundary.end.velocity"));
+  kt::TetherStated wrong(kt::TetherModeld(kelp_test::benchmark_line<double>(5)));
+  CHECK_THROWS_AS(kt::step_rk2(model, ws, env, wrong, b, 1e-4), kelp::invalid_argument);
+  CHECK_THROWS_WITH(kt::straight_line_state(model, Vector3<double>(nan, 0, 0), Vector3<double>()),
+                    Catch::Contains("start_ned"));
+}
+
+TEST_CASE("node masses, volumes and lumped lengths", "[tether][model]") {
+  auto p = kelp_test::benchmark_line<double>(4);
+  p.end_point_mass = 2.0;
+  const kt::TetherModeld m(p);
+  CHECK(m.nodes() == 5);
+  CHECK(m.segment_length() == Approx(5.0));
+  CHECK(m.node_mass(0) == Approx(0.07 * 2.5));
+  CHECK(m.node_mass(2) == Approx(0.07 * 5.0));
+  CHECK(m.node_mass(4) == Approx(0.07 * 2.5 + 2.0));
+  double total_volume = 0;
+  for (int i = 0; i < 5; ++i) total_volume += m.node_volume(i);
+  CHECK(total_volume == Approx(kelp::pi * 0.008 * 0.008 / 4 * 20));
+  // w = (μ − ρA) g: tether.md gives 0.181268 N/m with g = 9.81.
+  CHECK(m.submerged_weight_per_length(1025.0, 9.81) == Approx(0.181268).epsilon(1e-5));
+  CHECK(m.first_free_node() == 1);
+  CHECK(m.last_free_node() == 3);
+}
+
+TEST_CASE("axial force: EA strain plus damping when stretched, nothing in compression",
+          "[tether][forces]") {
+  kelp_test::Vacuum<double> env;
+  env.g = 0;  // isolate the axial force
+  auto p = kelp_test::benchmark_line<double>(1);
+  p.length = 2.0;
+  p.internal_damping = 50.0;
+  const kt::TetherModeld m(p);
+  kt::TetherWorkspaced ws(m);
+  kelp::Matrix3X<double> x(3, 2), v = kelp::Matrix3X<double>::Zero(3, 2);
+  // Stretched by 1 mm along a diagonal direction: T = EA·(0.001/2) = 50 N.
+  const Vector3<double> u = Vector3<double>(1, 2, 2) / 3.0;
+  x.col(0).setZero();
+  x.col(1) = 2.001 * u;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(50.0).epsilon(1e-9));
+  CHECK((ws.force.col(0) - 50.0 * u).norm() < 1e-9);
+  CHECK((ws.force.col(1) + 50.0 * u).norm() < 1e-9);
+  // Separating at 0.2 m/s: damping adds BA·ε̇ = 50 · 0.2/2 = 5 N.
+  v.col(1) = 0.2 * u;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(55.0).epsilon(1e-9));
+  // Approaching fast: damping would make the tension negative → clamped at zero.
+  v.col(1) = -4.0 * u;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == 0.0);
+  CHECK(ws.force.col(0).norm() == 0.0);
+  // Compressed (shorter than l): slack, no force at all even when separating.
+  x.col(1) = 1.5 * u;
+  v.col(1) = 0.3 * u;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == 0.0);
+  CHECK(ws.force.norm() == 0.0);
+}
+
+TEST_CASE("weight, buoyancy, drag and fluid inertia on a node", "[tether][forces]") {
+  kelp_test::TestWater<double> env;
+  auto p = kelp_test::benchmark_line<double>(2);
+  p.length = 2.0;
+  const kt::TetherModeld m(p);
+  kt::TetherWorkspaced ws(m);
+  // Three nodes on the x axis at depth 10 m, segments slack (exactly l long: no tension).
+  kelp::Matrix3X<double> x(3, 3), v = kelp::Matrix3X<double>::Zero(3, 3);
+  x << 0, 1, 2, 0, 0, 0, 10, 10, 10;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  // Middle node: submerged weight (μ − ρA) l g downwards (+z), nothing else.
+  const double area = kelp::pi * 0.008 * 0.008 / 4;
+  const double w = (0.07 - 1025 * area) * kelp::standard_gravity;
+  CHECK(ws.force(2, 1) == Approx(w * 1.0).epsilon(1e-12));
+  CHECK(ws.force(0, 1) == 0.0);
+  // Mass matrix: a = m + ρV Can, b = ρV (Cat − Can) along the tangent (x axis).
+  CHECK(ws.mass_iso(1) == Approx(0.07 + 1025 * area * 1.0));
+  CHECK(ws.mass_tan(1) == Approx(-1025 * area * 1.0));
+  CHECK(ws.tangent.col(1).isApprox(Vector3<double>(1, 0, 0)));
+
+  // Node moving at (0.5, 0, 1) m/s in still water: normal drag on (0, 0, −1) relative velocity
+  // ½ρ d l Cdn |v_n| v_n and tangential ½ρ π d l Cdt |v_t| v_t on (−0.5, 0, 0).
+  v.col(1) = Vector3<double>(0.5, 0, 1);
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  const double fn = -0.5 * 1025 * 0.008 * 1.0 * 1.2 * 1.0 * 1.0;
+  const double ft = -0.5 * 1025 * kelp::pi * 0.008 * 1.0 * 0.008 * 0.5 * 0.5;
+  CHECK(ws.force(2, 1) == Approx(w + fn).epsilon(1e-12));
+  CHECK(ws.force(0, 1) == Approx(ft).epsilon(1e-12));
+  // A current equal to the node velocity removes the drag (relative velocity).
+  env.current = Vector3<double>(0.5, 0, 1);
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.force(2, 1) == Approx(w).epsilon(1e-12));
+  CHECK(std::abs(ws.force(0, 1)) < 1e-15);
+  // Water acceleration (1, 0, 1): ρV[(1 + Can) a_n + (1 + Cat) a_t] = ρV (0 + 1, 0, 2·1)... with
+  // Can = 1, Cat = 0: x (tangential) gets ρV·1, z (normal) gets ρV·2.
+  env.current.setZero();
+  v.setZero();
+  env.accel = Vector3<double>(1, 0, 1);
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  const double rv = 1025 * area * 1.0;
+  CHECK(ws.force(0, 1) == Approx(rv).epsilon(1e-12));
+  CHECK(ws.force(2, 1) == Approx(w + 2 * rv).epsilon(1e-12));
+
+  // Above the free surface: weight only, no buoyancy, drag, added mass.
+  env.accel.setZero();
+  env.surface_z = 20.0;  // surface below the nodes? No: NED z < surface_z means above it.
+  v.col(1) = Vector3<double>(0, 0, 1);
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.submerged(1) == 0.0);
+  CHECK(ws.force(2, 1) == Approx(0.07 * kelp::standard_gravity).epsilon(1e-12));
+  CHECK(ws.mass_iso(1) == Approx(0.07));
+  CHECK(ws.mass_tan(1) == 0.0);
+}
+
+TEST_CASE("analytic block-tridiagonal Jacobian agrees with finite differences",
+          "[tether][jacobian]") {
+  // J δ = c_m M δ − c_v ∂F/∂v δ − c_x ∂F/∂x δ, evaluated by central differences of F, must equal
+  // the right-hand side the block-Thomas solve was given. Exact when the Jacobian is exact:
+  // (1) no drag, no added mass (M constant), taut stretched line with internal damping (uniform
+  //     velocity, see below);
+  // (2) drag on, velocity part only (the drag's dependence on the tangent is not in D_x).
+  kelp_test::TestWater<double> env;
+  for (int variant = 0; variant < 2; ++variant) {
+    auto p = kelp_test::benchmark_line<double>(8);
+    p.length = 8.0;
+    p.internal_damping = 40.0;
+    p.normal_added_mass = 0.0;
+    if (variant == 0) p.normal_drag = p.tangential_drag = 0.0;
+    const kt::TetherModeld m(p);
+    kt::TetherWorkspaced ws(m);
+    kelp::Matrix3X<double> x(3, 9), v(3, 9);
+    for (int i = 0; i <= 8; ++i) {
+      x.col(i) = Vector3<double>(1.01 * i, 0.05 * std::sin(1.3 * i), 5 + 0.1 * std::cos(0.7 * i));
+      // Variant 1: arbitrary velocities. Variant 0: a uniform velocity, because D_x omits the
+      // (non-symmetric) dependence of the damping tension BA·u·Δv/l on the direction u, which
+      // vanishes when the nodes share one velocity.
+      v.col(i) = variant == 0
+                     ? Vector3<double>(0.3, -0.2, 0.1)
+                     : Vector3<double>(0.3 * std::sin(i), 0.2 * std::cos(2.0 * i), -0.1 * i);
+    }
+    const double cm = 1.0, cv = variant == 0 ? 0.01 : 0.05, cx = variant == 0 ? 1e-4 : 0.0;
+    kt::compute_forces<true>(m, ws, env, 0.0, x, v);
+    kelp::Matrix3X<double> r(3, 9);
+    for (int i = 0; i <= 8; ++i) r.col(i) = Vector3<double>(std::cos(i), 1.0, std::sin(0.5 * i));
+    ws.rhs = r;
+    kt::detail::solve_block_tridiagonal(m, ws, cm, cv, cx);
+    kelp::Matrix3X<double> d = ws.delta;
+    d.col(0).setZero();
+    d.col(8).setZero();
+    const double eps = 1e-6;
+    kelp::Matrix3X<double> fp(3, 9), fm(3, 9), jd(3, 9);
+    kt::compute_forces(m, ws, env, 0.0, x, v + eps * d);
+    fp = ws.force;
+    kt::compute_forces(m, ws, env, 0.0, x, v - eps * d);
+    fm = ws.force;
+    jd = -cv * (fp - fm) / (2 * eps);
+    kt::compute_forces(m, ws, env, 0.0, x + eps * d, v);
+    fp = ws.force;
+    kt::compute_forces(m, ws, env, 0.0, x - eps * d, v);
+    fm = ws.force;
+    jd -= cx * (fp - fm) / (2 * eps);
+    for (int i = 1; i <= 7; ++i) {
+      jd.col(i) += cm * m.node_mass(i) * d.col(i);
+      INFO("variant " << variant << " node " << i << ": " << jd.col(i).transpose() << " vs "
+                      << r.col(i).transpose());
+      CHECK((jd.col(i) - r.col(i)).norm() < 1e-6 * r.col(i).norm());
+    }
+  }
+}
+
+TEMPLATE_TEST_CASE("steps allocate nothing on the heap", "[tether][malloc]", double, float) {
+  using S = TestType;
+  kelp::environment::Environment<S> env;
+  env.set_current(Vector3<S>(S(0.3), S(0.1), S(0)));
+  env.set_seabed_depth(S(8));
+  auto p = kelp_test::benchmark_line<S>(20);
+  p.seabed_friction = S(0.5);
+  p.internal_damping = S(10);
+  const kt::TetherModel<S> model(p);
+  kt::TetherWorkspace<S> ws(model);
+  const Vector3<S> a(0, 0, 0), b(10, 0, 5);
+  auto state = kt::straight_line_state(model, a, b);
+  for (int i = 1; i < 20; ++i) state.position(2, i) += S(3) * std::sin(S(kelp::pi) * S(i) / S(20));
+  auto boundary = kt::TetherBoundary<S>::fixed(a, b);
+  boundary.end.velocity = Vector3<S>(S(0), S(0), S(0.2));
+  Eigen::internal::set_is_malloc_allowed(false);
+  for (auto integ : {kt::Integrator::symplectic_euler, kt::Integrator::rk2, kt::Integrator::rk4,
+                     kt::Integrator::implicit_euler, kt::Integrator::bdf2}) {
+    const S dt = kt::is_implicit(integ) ? S(0.01) : S(1e-5);
+    for (int k = 0; k < 3; ++k) kt::step(model, ws, env, state, boundary, dt, integ);
+  }
+  kt::advance(model, ws, env, state, boundary, S(0.02), S(0.01), kt::Integrator::bdf2);
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(kelp::all_finite(state.position));
+  CHECK(state.position.col(0).isApprox(a));
+}
+
+namespace {
+// Water whose velocity turns NaN after t = 0.5 s: a non-finite value during a step.
+struct PoisonedWater : kelp_test::TestWater<double> {
+  void sample_water(const Eigen::Ref<const kelp::Matrix3X<double>>& points, double t,
+                    Eigen::Ref<kelp::Matrix3X<double>> velocity,
+                    Eigen::Ref<kelp::Matrix3X<double>> acceleration) const {
+    kelp_test::TestWater<double>::sample_water(points, t, velocity, acceleration);
+    if (t > 0.5) velocity(0, points.cols() / 2) = std::numeric_limits<double>::quiet_NaN();
+  }
+};
+}  // namespace
+
+TEST_CASE("a non-finite value during a step throws and leaves the state unchanged",
+          "[tether][errors]") {
+  PoisonedWater env;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(10));
+  kt::TetherWorkspaced ws(model);
+  const Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  for (auto integ : {kt::Integrator::symplectic_euler, kt::Integrator::rk2, kt::Integrator::rk4,
+                     kt::Integrator::implicit_euler, kt::Integrator::bdf2}) {
+    INFO(kt::integrator_name(integ));
+    auto state = kt::straight_line_state(model, a, b);
+    state.velocity.col(4) = Vector3<double>(0.1, 0.2, 0.3);
+    state.time = 0.6;
+    const kt::TetherStated before = state;
+    CHECK_THROWS_AS(kt::step(model, ws, env, state, kt::TetherBoundaryd::fixed(a, b), 1e-4, integ),
+                    kelp::numerical_error);
+    CHECK(state.position == before.position);
+    CHECK(state.velocity == before.velocity);
+    CHECK(state.time == before.time);
+    // The sub-stepping driver restores the entry state even after successful sub-steps.
+    state.time = 0.4;
+    const kt::TetherStated before2 = state;
+    CHECK_THROWS_AS(kt::advance(model, ws, env, state, kt::TetherBoundaryd::fixed(a, b), 0.2,
+                                kt::is_implicit(integ) ? 0.01 : 1e-3, integ),
+                    kelp::numerical_error);
+    CHECK(state.position == before2.position);
+    CHECK(state.time == before2.time);
+  }
+}
+
+TEST_CASE("stable-dt estimate follows the axial frequency 2 sqrt(EA/(l m))", "[tether][dt]") {
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(100));
+  // Interior node: m = μ l = 0.014 kg, k = EA/l = 5e5 N/m → ω = 2 sqrt(k/m) = 11952 rad/s.
+  const double w = 2 * std::sqrt(5e5 / 0.014);
+  CHECK(kt::highest_axial_frequency(model, 1025.0) == Approx(w).epsilon(1e-12));
+  CHECK(kt::estimate_stable_dt(model, kt::Integrator::symplectic_euler, 1025.0, 1.0) ==
+        Approx(2 / w));
+  CHECK(kt::estimate_stable_dt(model, kt::Integrator::rk4, 1025.0, 1.0) ==
+        Approx(2 * std::sqrt(2.0) / w));
+  CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2)));
+  // tether.md: explicit schemes need dt ≲ 0.1 ms on this line.
+  CHECK(kt::estimate_stable_dt(model, kt::Integrator::rk4) < 2e-4);
+}
