@@ -2,11 +2,26 @@
 // (implicit function theorem inside the solvers) against central finite differences.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <type_traits>
 
 #include "kelp/ceres/catenary_solver.hpp"
 #include "kelp/tether/catenary.hpp"
 
 using J3 = ceres::Jet<double, 3>;
+
+// Every public class and solver instantiated for a Jet scalar.
+template class kelp::tether::CatenaryShape<J3>;
+template struct kelp::tether::CatenaryResult<J3>;
+template struct kelp::tether::CatenaryOptions<J3>;
+template kelp::tether::CatenaryResult<J3> kelp::tether::solve_catenary(
+    J3, J3, J3, const kelp::tether::CatenaryOptions<J3>&);
+template kelp::tether::CatenaryResult<J3> kelp::ceres::solve_catenary(
+    J3, J3, J3, double, double, const kelp::tether::CatenaryOptions<J3>&);
+
+namespace kelp {
+// Inside namespace kelp, `ceres::Jet` still names Ceres' Jet (re-exported by kelp::ceres).
+static_assert(std::is_same<ceres::Jet<double, 3>, ::ceres::Jet<double, 3>>::value, "");
+}  // namespace kelp
 using kelp::tether::CatenaryStatus;
 namespace kt = kelp::tether;
 

@@ -8,6 +8,13 @@ using kelp::tether::catenary_between;
 using kelp::tether::CatenaryStatus;
 using V3 = kelp::Vector3<double>;
 
+// Every public class for every supported plain scalar (the Jet instantiations are in
+// test_catenary_jet.cpp).
+template class kelp::tether::CatenaryShape<double>;
+template class kelp::tether::CatenaryShape<float>;
+template struct kelp::tether::CatenaryResult<float>;
+template struct kelp::tether::CatenaryOptions<float>;
+
 namespace {
 // tether.md: d = 8 mm, 0.07 kg/m, rho = 1025, g = 9.81 -> w = 0.181268 N/m.
 const double kPi = 3.14159265358979323846;

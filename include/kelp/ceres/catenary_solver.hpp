@@ -8,8 +8,9 @@
 /// warm-started from the fast analytic path (kelp/tether/catenary.hpp) by default or from a
 /// caller's guess (e.g. the previous control step). Geometry statuses (taut, vertical, invalid
 /// input) are decided exactly as on the fast path. This is the only kelp directory that includes
-/// Ceres; note that inside `namespace kelp` the name `ceres` means `kelp::ceres`, so kelp code
-/// spells Ceres' own namespace `::ceres`.
+/// Ceres. Inside `namespace kelp` the name `ceres` now means `kelp::ceres`: kelp code spells Ceres'
+/// namespace `::ceres`, and `Jet`, `TinySolver` and `TinySolverAutoDiffFunction` are re-exported
+/// into `kelp::ceres` so that `ceres::Jet<double, N>` written inside `namespace kelp` still works.
 #pragma once
 
 #include <cmath>
@@ -25,6 +26,12 @@
 
 namespace kelp {
 namespace ceres {
+
+/// \brief Ceres' own names re-exported, so that code inside `namespace kelp` that writes
+/// `ceres::Jet<double, N>` (which now finds `kelp::ceres` first) keeps meaning Ceres' types.
+using ::ceres::Jet;
+using ::ceres::TinySolver;
+using ::ceres::TinySolverAutoDiffFunction;
 
 using tether::CatenaryOptions;
 using tether::CatenaryResult;
