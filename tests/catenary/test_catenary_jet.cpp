@@ -107,3 +107,30 @@ TEST_CASE("Jet: 3-D end force derivatives match finite differences", "[catenary]
     for (int i = 0; i < 3; ++i) CHECK(f[i].v[k] == Approx(dfd[i]).epsilon(1e-5).margin(1e-7));
   }
 }
+
+TEST_CASE("Jet: grounded line's end force derivatives match finite differences",
+          "[catenary][jet]") {
+  // Seabed at 12 m, ends at 0.5 m and 3 m depth, 9 m apart, 25 m of tether (grounded, H > 0).
+  kelp::tether::CatenaryOptions<double> od;
+  od.seabed_depth = 12.0;
+  kelp::tether::CatenaryOptions<J3> oj;
+  oj.seabed_depth = 12.0;
+  const double w = 0.3, L = 25.0;
+  const Eigen::Vector3d start(1, -2, 0.5), end(8.2, 3.4, 3.0);
+  kelp::Vector3<J3> s = start.cast<J3>(), e;
+  for (int k = 0; k < 3; ++k) e[k] = J3(end[k], k);
+  const auto shape = kt::catenary_between(s, e, J3(L), J3(w), oj);
+  REQUIRE(shape.on_seabed());
+  REQUIRE(shape.horizontal_tension().a > 0);
+  const auto f = shape.force_on_end();
+  for (int k = 0; k < 3; ++k) {
+    const double h = 1e-6;
+    Eigen::Vector3d ep = end, em = end;
+    ep[k] += h;
+    em[k] -= h;
+    const Eigen::Vector3d fp = kt::catenary_between(start, ep, L, w, od).force_on_end();
+    const Eigen::Vector3d fm = kt::catenary_between(start, em, L, w, od).force_on_end();
+    const Eigen::Vector3d dfd = (fp - fm) / (2 * h);
+    for (int i = 0; i < 3; ++i) CHECK(f[i].v[k] == Approx(dfd[i]).epsilon(1e-5).margin(1e-7));
+  }
+}

@@ -79,6 +79,9 @@ struct CatenaryOptions {
   /// T = EA·(chord − L)/L. 0 (the default) means inextensible: a taut line then reports T = 0
   /// because statics alone cannot determine it.
   Scalar EA = Scalar(0);
+  /// 3-D helper only (CatenaryShape): NED z [m] of a flat, frictionless seabed (positive depth);
+  /// +∞ (the default) means no seabed. See CatenaryShape for the grounded shapes.
+  double seabed_depth = std::numeric_limits<double>::infinity();
   /// Ceres path only (kelp/ceres/catenary_solver.hpp): the solution is accepted (status converged)
   /// when max(|R1|, |R2|)/L ≤ residual_tolerance, otherwise the status is max_iterations.
   double residual_tolerance = 1e-10;
@@ -356,6 +359,93 @@ void finish_from_u(const ReducedSolution& sol, const Scalar& D, const Scalar& dz
   result.residual = Scalar(paper_residual(value_of(result.a), value_of(result.c), Dd, dzd, Ld));
 }
 
+/// acosh(1 + y) = log1p(y + √(y(2 + y))), y ≥ 0, exact near 0 (ceres::Jet has no acosh).
+template <typename T>
+T acosh1p_via_log(const T& y) {
+  using std::log1p;
+  using std::sqrt;
+  return log1p(y + sqrt(y * (T(2.0) + y)));
+}
+
+/// For a catenary whose vertex touches the seabed: the suspended arc length s = √(h² + 2ah) and
+/// horizontal span x = a·acosh(1 + h/a) from the touchdown point to an end at height h above the
+/// seabed; returns g = s − x ≥ 0 (the length the suspended part adds over its span) and dg/da.
+/// Series in y = h/a below 1e-3, where s and x agree to ~y/3 relative:
+/// g = a√(2y)·y·(1/3 − y/20 + 3y²/224 − 5y³/1152), dg/da = √(2y)·y·(−1/6 + 3y/40 − 15y²/448).
+inline double grounded_excess(double a, double h, double& dg_da) {
+  const double y = h / a;
+  if (y < 1e-3) {
+    const double ty = std::sqrt(2.0 * y) * y;
+    dg_da = ty * (-1.0 / 6.0 + y * (3.0 / 40.0 - y * (15.0 / 448.0)));
+    return a * ty * (1.0 / 3.0 + y * (-1.0 / 20.0 + y * (3.0 / 224.0 - y * (5.0 / 1152.0))));
+  }
+  const double r = std::sqrt(y * (y + 2.0));
+  const double phi = r - acosh1p_via_log(y);
+  dg_da = phi - y * y / r;
+  return a * phi;
+}
+
+/// Result of the seabed-contact solve.
+struct GroundedSolution {
+  double a = 0.0;
+  double residual = 0.0;  ///< |F(a)|/L
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// Solves g(a, h1) + g(a, h2) = L − D for a > 0 (two suspended catenaries with their vertices on
+/// the seabed and a straight grounded part between them; frictionless seabed, so H = a·w is the
+/// same on both sides). F(a) = g1 + g2 − (L − D) decreases from h1 + h2 − (L − D) > 0 (a → 0) to
+/// −(L − D) < 0 (a → ∞); Newton in ln a inside a maintained bracket, bisection as a fallback.
+inline GroundedSolution solve_grounded(double D, double L, double h1, double h2, double a0,
+                                       double tolerance, int max_iterations) {
+  GroundedSolution out;
+  const double target = L - D;
+  const auto F = [&](double b, double& dF_db) {
+    const double a = std::exp(b);
+    double d1 = 0.0, d2 = 0.0;
+    const double f = grounded_excess(a, h1, d1) + grounded_excess(a, h2, d2) - target;
+    dF_db = a * (d1 + d2);
+    return f;
+  };
+  double b = std::log(a0), dF = 0.0;
+  double f = F(b, dF);
+  // Bracket the root: F(lo) > 0 > F(hi).
+  double lo = b, hi = b;
+  double dummy = 0.0;
+  if (f > 0.0) {
+    while (F(hi, dummy) > 0.0 && hi < 700.0) hi += 2.302585092994046;  // ×10
+  } else {
+    while (F(lo, dummy) <= 0.0 && lo > -700.0) lo -= 2.302585092994046;
+  }
+  const double step_tolerance = std::sqrt(tolerance);
+  for (int it = 1; it <= max_iterations + 60; ++it) {
+    f = F(b, dF);
+    out.iterations = it;
+    if (f == 0.0) {
+      out.converged = true;
+      break;
+    }
+    if (f > 0.0)
+      lo = b;
+    else
+      hi = b;
+    double next = b - f / dF;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);  // Newton left the bracket: bisect
+    const double step = next - b;
+    b = next;
+    if (std::abs(step) <= step_tolerance * 1e-1 || hi - lo <= 4e-16 * std::abs(b) + 1e-300) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.a = std::exp(b);
+  double d = 0.0;
+  out.residual =
+      std::abs(grounded_excess(out.a, h1, d) + grounded_excess(out.a, h2, d) - target) / L;
+  return out;
+}
+
 }  // namespace detail
 
 /// \brief Solves the paper's catenary equations for a and c by the analytic reduction (fast path).
@@ -407,6 +497,18 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
 /// the vertex (lowest point for w ≥ 0, highest for w < 0) and back to the end along the vertical,
 /// s_start = (L − Δz')/2 from the start (Δz' the height difference in the mirrored plane), H = 0,
 /// each end carries the weight of its own branch. `invalid_input` — every query returns NaN.
+///
+/// **Seabed contact** (options.seabed_depth finite, w > 0, both ends at or above the seabed; an end
+/// below it gives `invalid_input`). When the free catenary's lowest point would lie below the
+/// seabed, the line is modelled as two catenaries whose vertices touch a flat frictionless seabed,
+/// joined by a straight grounded part of length L_b (on_seabed(), grounded_length()). With h₁, h₂
+/// the end heights above the seabed, each suspended part has arc length s = √(h² + 2ah) and span
+/// x = a·acosh(1 + h/a), and a solves s₁ − x₁ + s₂ − x₂ = L − D (so that L_b = L − s₁ − s₂ =
+/// D − x₁ − x₂). The seabed carries w·L_b; the ends carry H horizontally and w·s₁, w·s₂
+/// vertically. If even H = 0 leaves slack (L ≥ h₁ + h₂ + D) the line drops vertically from both
+/// ends and the grounded part, longer than D, is laid along the seabed between the touchdown points
+/// with its length spread uniformly (statics does not fix a slack shape on the seabed). result().a
+/// is then the grounded a, result().c the touchdown distance x₁ and result().residual |F(a)|/L.
 /// \tparam Scalar double, float or `ceres::Jet<double, N>`.
 template <typename Scalar>
 class CatenaryShape {
@@ -423,7 +525,10 @@ class CatenaryShape {
     using std::abs;
     using std::sqrt;
     horizontal_dir_ = Vector3S(Scalar(1.0), Scalar(0.0), Scalar(0.0));
-    if (!(all_finite(start_ned) && all_finite(end_ned) && is_finite(w))) {
+    const double seabed = options.seabed_depth;
+    const bool has_seabed = std::isfinite(seabed);
+    if (!(all_finite(start_ned) && all_finite(end_ned) && is_finite(w)) || std::isnan(seabed) ||
+        (has_seabed && (value_of(start_ned.z()) > seabed || value_of(end_ned.z()) > seabed))) {
       detail::fill_unsolved(CatenaryStatus::invalid_input, Scalar(0.0), Scalar(0.0), L, options,
                             result_);
       return;
@@ -438,17 +543,19 @@ class CatenaryShape {
     dz_ = buoyant_ ? Scalar(-dz_up) : dz_up;
     weight_ = abs(w_);
     result_ = solve_catenary(D_, dz_, L_, options);
-    if (result_.ok() && result_.status == CatenaryStatus::converged) {
-      H_ = result_.a * weight_;
-    } else {
-      H_ = Scalar(0.0);
+    H_ = result_.status == CatenaryStatus::converged ? Scalar(result_.a * weight_) : Scalar(0.0);
+    const bool slack =
+        result_.status == CatenaryStatus::converged || result_.status == CatenaryStatus::vertical;
+    if (has_seabed && !buoyant_ && value_of(w_) > 0.0 && slack &&
+        value_of(lowest_point().z()) > seabed) {
+      ground(seabed, options);
     }
   }
 
   /// \brief The solver's status (see CatenaryStatus).
   CatenaryStatus status() const { return result_.status; }
   /// \brief The full solve result in the (mirrored, for w < 0) paper plane: a, c, iterations,
-  /// residual, taut tension.
+  /// residual, taut tension (for a grounded line see the class description).
   const CatenaryResult<Scalar>& result() const { return result_; }
   /// \brief Horizontal tension H = a·|w| [N], the same all along the line (0 when vertical, taut or
   /// invalid).
@@ -459,16 +566,22 @@ class CatenaryShape {
   Scalar length() const { return L_; }
   /// \brief Submerged weight per length w [N/m] (< 0: buoyant).
   Scalar weight_per_length() const { return w_; }
+  /// \brief True when part of the line rests on the seabed (options.seabed_depth).
+  bool on_seabed() const { return grounded_; }
+  /// \brief Length resting on the seabed L_b [m] (0 when not on the seabed); the seabed carries
+  /// its weight w·L_b.
+  Scalar grounded_length() const { return grounded_ ? Lb_ : Scalar(0.0); }
 
   /// \brief The NED point [m] at unstretched arc length s ∈ [0, L] from the start end.
   ///
   /// Slack line (paper plane, mirrored when buoyant): with σ₀ = −a sinh(c/a) the arc length of the
   /// start from the vertex, x(s) = c + a·asinh((σ₀ + s)/a) and
   /// z(x) = a cosh((x−c)/a) − a cosh(c/a) = 2a sinh(x/(2a)) sinh((x−2c)/(2a)).
-  /// Taut: linear interpolation. Values of s outside [0, L] extrapolate the same curve.
+  /// Taut: linear interpolation. Grounded: see the class description.
   Vector3S point_at(Scalar s) const {
     using std::sinh;
     const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
+    if (grounded_) return grounded_point(s);
     switch (result_.status) {
       case CatenaryStatus::taut:
         return start_ + (s / L_) * (end_ - start_);
@@ -491,10 +604,11 @@ class CatenaryShape {
   }
 
   /// \brief The vertex of the catenary in NED [m]: the lowest point of the curve for w ≥ 0, the
-  /// highest for w < 0. It may lie beyond the ends (then it is not on the cable). NaN when taut
-  /// or invalid.
+  /// highest for w < 0. It may lie beyond the ends (then it is not on the cable). Grounded: the
+  /// first touchdown point. NaN when taut or invalid.
   Vector3S vertex() const {
     const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
+    if (grounded_) return grounded_point(s1_);
     if (result_.status == CatenaryStatus::vertical) return point_at(start_branch_length());
     if (result_.status == CatenaryStatus::converged ||
         result_.status == CatenaryStatus::max_iterations)
@@ -503,9 +617,11 @@ class CatenaryShape {
   }
 
   /// \brief The deepest point of the cable itself, NED [m]: the vertex when it lies between the
-  /// ends of a hanging line, otherwise the deeper end (always an end for a buoyant or taut line).
+  /// ends of a hanging line, otherwise the deeper end (always an end for a buoyant or taut line);
+  /// the first touchdown point when grounded.
   Vector3S lowest_point() const {
     const Vector3S deeper_end = end_.z() > start_.z() ? end_ : start_;
+    if (grounded_) return vertex();
     switch (result_.status) {
       case CatenaryStatus::converged:
       case CatenaryStatus::max_iterations:
@@ -525,20 +641,27 @@ class CatenaryShape {
   ///
   /// Slack line: H toward the end horizontally and H·sinh(c/a) = |w|·(arc length from the start to
   /// the vertex) downwards (upwards for a buoyant line), i.e. the cable tension T = H cosh(c/a)
-  /// along the tangent. Taut and vertical: see the class description.
+  /// along the tangent. Taut, vertical and grounded: see the class description.
   Vector3S force_on_start() const { return end_force(true); }
 
   /// \brief Force the cable exerts on the end attachment point, NED [N] (see force_on_start()).
   Vector3S force_on_end() const { return end_force(false); }
 
-  /// \brief Tension magnitude [N] at arc length s: H cosh((x(s) − c)/a) for a slack line.
+  /// \brief Tension magnitude [N] at arc length s: H cosh((x(s) − c)/a) = |w|√(a² + σ²) for a
+  /// slack line (σ the arc length from the vertex); H on the grounded part.
   Scalar tension_at(Scalar s) const {
+    using std::sinh;
     using std::sqrt;
+    if (grounded_) {
+      const Scalar a = result_.a;
+      if (s <= s1_) return weight_ * sqrt(a * a + (s1_ - s) * (s1_ - s));
+      if (s >= s1_ + Lb_) return weight_ * sqrt(a * a + (s - s1_ - Lb_) * (s - s1_ - Lb_));
+      return H_;
+    }
     switch (result_.status) {
       case CatenaryStatus::converged:
       case CatenaryStatus::max_iterations: {
         const Scalar a = result_.a, c = result_.c;
-        using std::sinh;
         const Scalar sigma = s - a * sinh(c / a);  // arc length from the vertex
         return weight_ * sqrt(a * a + sigma * sigma);
       }
@@ -555,6 +678,95 @@ class CatenaryShape {
   }
 
  private:
+  /// Switches to the seabed-contact shape (see the class description).
+  void ground(double seabed, const CatenaryOptions<Scalar>& options) {
+    using std::sqrt;
+    seabed_ = Scalar(seabed);
+    const Scalar h1 = seabed_ - start_.z(), h2 = seabed_ - end_.z();
+    const double D = value_of(D_), L = value_of(L_), h1d = value_of(h1), h2d = value_of(h2);
+    CatenaryResult<Scalar> r;
+    r.taut_tension = Scalar(0.0);
+    if (L >= h1d + h2d + D) {  // slack even with H = 0: vertical drops, slack on the seabed
+      r.a = Scalar(0.0);
+      r.status = result_.status == CatenaryStatus::vertical ? CatenaryStatus::vertical
+                                                            : CatenaryStatus::converged;
+      r.iterations = 0;
+      r.residual = Scalar(0.0);
+      s1_ = h1;
+      x1_ = Scalar(0.0);
+      x2_ = Scalar(0.0);
+      Lb_ = L_ - h1 - h2;
+      slack_on_seabed_ = true;
+    } else {
+      const double a0 = result_.status == CatenaryStatus::converged ? value_of(result_.a)
+                                                                    : 0.5 * (h1d + h2d + 1e-3 * L);
+      const detail::GroundedSolution g = detail::solve_grounded(
+          D, L, h1d, h2d, a0 > 0.0 ? a0 : 1e-3 * L, options.tolerance, options.max_iterations);
+      r.status = g.converged ? CatenaryStatus::converged : CatenaryStatus::max_iterations;
+      r.iterations = g.iterations;
+      r.residual = Scalar(g.residual);
+      if constexpr (std::is_arithmetic_v<Scalar>) {
+        r.a = static_cast<Scalar>(g.a);
+      } else {
+        // Implicit function theorem on F(a; D, L, h1, h2) = g1 + g2 − (L − D) = 0.
+        double d1 = 0.0, d2 = 0.0;
+        detail::grounded_excess(g.a, h1d, d1);
+        detail::grounded_excess(g.a, h2d, d2);
+        const Scalar as(g.a);
+        const Scalar F = suspended_excess(as, h1) + suspended_excess(as, h2) - (L_ - D_);
+        r.a = as - F / (d1 + d2);
+        r.a.a = g.a;
+      }
+      const Scalar a = r.a;
+      s1_ = sqrt(h1 * h1 + Scalar(2.0) * a * h1);
+      x1_ = a * detail::acosh1p_via_log(Scalar(h1 / a));
+      x2_ = a * detail::acosh1p_via_log(Scalar(h2 / a));
+      const Scalar s2 = sqrt(h2 * h2 + Scalar(2.0) * a * h2);
+      Lb_ = L_ - s1_ - s2;
+      slack_on_seabed_ = false;
+      // A (theoretically impossible) negative grounded length keeps the free solution.
+      if (r.status == CatenaryStatus::converged && !(value_of(Lb_) >= 0.0)) return;
+    }
+    r.c = x1_;
+    result_ = r;
+    H_ = r.a * weight_;
+    grounded_ = true;
+  }
+
+  /// s − x of a suspended part in Scalar arithmetic (for the implicit derivatives).
+  static Scalar suspended_excess(const Scalar& a, const Scalar& h) {
+    using std::sqrt;
+    return sqrt(h * h + Scalar(2.0) * a * h) - a * detail::acosh1p_via_log(Scalar(h / a));
+  }
+
+  /// Grounded shape by arc length (x from the start, η above the seabed).
+  Vector3S grounded_point(const Scalar& s) const {
+    using std::sqrt;
+    const Scalar a = result_.a;
+    Scalar x, eta;
+    const Scalar s_down = s1_ + Lb_;  // arc length where the end-side part leaves the seabed
+    if (s <= s1_ || s >= s_down) {
+      const bool first = s <= s1_;
+      const Scalar sigma = first ? Scalar(s1_ - s) : Scalar(s - s_down);
+      Scalar dx(0.0);
+      if (value_of(a) > 0.0) {
+        dx = a * detail::asinh_via_log(Scalar(sigma / a));
+        eta = sigma * sigma / (sqrt(a * a + sigma * sigma) + a);
+      } else {
+        eta = sigma;
+      }
+      x = first ? Scalar(x1_ - dx) : Scalar(D_ - x2_ + dx);
+    } else {
+      const Scalar along = s - s1_;
+      const Scalar span = D_ - x1_ - x2_;
+      x = x1_ + (slack_on_seabed_ ? Scalar(along * span / Lb_) : along);
+      eta = Scalar(0.0);
+    }
+    Vector3S p = start_ + x * horizontal_dir_;
+    p.z() = seabed_ - eta;
+    return p;
+  }
+
   /// Arc length from the start to the vertex of a vertical line, (L − Δz')/2.
   Scalar start_branch_length() const { return Scalar(0.5) * (L_ - dz_); }
 
@@ -586,6 +798,10 @@ class CatenaryShape {
     using std::sinh;
     using std::sqrt;
     const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
+    if (grounded_) {
+      const Scalar branch = at_start ? s1_ : Scalar(L_ - s1_ - Lb_);
+      return plane_vector(at_start ? H_ : Scalar(-H_), -weight_ * branch);
+    }
     switch (result_.status) {
       case CatenaryStatus::converged:
       case CatenaryStatus::max_iterations: {
@@ -622,6 +838,14 @@ class CatenaryShape {
   Scalar dz_ = Scalar(0.0);  // height difference in the (mirrored) plane, z up
   Scalar H_ = Scalar(0.0);
   bool buoyant_ = false;
+  // Seabed contact (valid when grounded_).
+  bool grounded_ = false;
+  bool slack_on_seabed_ = false;
+  Scalar seabed_ = Scalar(0.0);  // NED z of the seabed
+  Scalar s1_ = Scalar(0.0);      // arc length from the start to the first touchdown
+  Scalar x1_ = Scalar(0.0);      // horizontal span of the start-side suspended part
+  Scalar x2_ = Scalar(0.0);      // horizontal span of the end-side suspended part
+  Scalar Lb_ = Scalar(0.0);      // grounded length
   CatenaryResult<Scalar> result_{};
 };
 
