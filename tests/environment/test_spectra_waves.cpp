@@ -265,6 +265,28 @@ TEMPLATE_TEST_CASE("the batch query equals point queries and does not allocate",
   }
 }
 
+TEST_CASE("the run-time dispatched SIMD kernel agrees with the baseline kernel",
+          "[environment][waves]") {
+  // On a CPU with AVX2/AVX-512 the batch query runs a kernel compiled for it; it must give the
+  // baseline's numbers up to FMA rounding.
+  for (const double depth : {std::numeric_limits<double>::infinity(), 25.0}) {
+    auto p = sea(4.5, 9.5, SpectrumKind::jonswap);
+    p.spreading = 1.0;
+    p.depth = depth;
+    WaveField<double> fast(p), base(p);
+    base.set_force_baseline_kernel(true);
+    const int n = 70;
+    Matrix3X<double> pts(3, n), v1(3, n), a1(3, n), v2(3, n), a2(3, n);
+    for (int i = 0; i < n; ++i) pts.col(i) << 0.3 * i, 0.1 * i, -1.0 + 0.3 * i;
+    for (const double t : {0.0, 17.3, 1234.5}) {
+      fast.kinematics(pts, t, v1, a1);
+      base.kinematics(pts, t, v2, a2);
+      CHECK((v1 - v2).norm() <= 1e-12 * (1 + v2.norm()));
+      CHECK((a1 - a2).norm() <= 1e-12 * (1 + a2.norm()));
+    }
+  }
+}
+
 TEST_CASE("bad wave input throws kelp::invalid_argument naming the field", "[environment][waves]") {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto p = sea(2.0, 8.0, SpectrumKind::jonswap);

@@ -1,0 +1,94 @@
+// Environment queries: the batch water query for a tether's nodes (the target: 100 points,
+// 64 wave components, ≤ 10 µs), single-point samples, and the calm sea's cost.
+#include <benchmark/benchmark.h>
+
+#include <limits>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/environment/sea_state.hpp"
+
+using namespace kelp::environment;
+
+namespace {
+template <typename S>
+Environment<S> rough_sea(double seabed, int components) {
+  SeaStateOptions o;
+  o.wave_components = components;
+  o.spreading = 1.0;
+  o.seabed_depth = seabed;
+  return make_environment<S>(presets::rough(), o);
+}
+
+// 100 nodes of a 20 m tether hanging from the surface to 15 m depth.
+template <typename S>
+kelp::Matrix3X<S> tether_nodes(int n) {
+  kelp::Matrix3X<S> p(3, n);
+  for (int i = 0; i < n; ++i) p.col(i) << S(0.15 * i), S(0.05 * i), S(0.15 * i);
+  return p;
+}
+
+template <typename S>
+void sample_water(benchmark::State& state, double seabed) {
+  const int n = static_cast<int>(state.range(0)), nc = static_cast<int>(state.range(1));
+  const auto env = rough_sea<S>(seabed, nc);
+  const auto pts = tether_nodes<S>(n);
+  kelp::Matrix3X<S> vel(3, n), acc(3, n);
+  S t = S(0);
+  for (auto _ : state) {
+    env.sample_water(pts, t, vel, acc);
+    benchmark::DoNotOptimize(vel.data());
+    benchmark::DoNotOptimize(acc.data());
+    t += S(0.01);
+  }
+  state.SetItemsProcessed(state.iterations() * n * nc);
+}
+
+void BM_SampleWaterDeep(benchmark::State& s) {
+  sample_water<double>(s, std::numeric_limits<double>::infinity());
+}
+void BM_SampleWaterFiniteDepth(benchmark::State& s) { sample_water<double>(s, 40.0); }
+void BM_SampleWaterDeepFloat(benchmark::State& s) {
+  sample_water<float>(s, std::numeric_limits<double>::infinity());
+}
+
+void BM_SampleWaterCalm(benchmark::State& state) {
+  const Environment<double> env;
+  const auto pts = tether_nodes<double>(100);
+  kelp::Matrix3X<double> vel(3, 100), acc(3, 100);
+  double t = 0;
+  for (auto _ : state) {
+    env.sample_water(pts, t, vel, acc);
+    benchmark::DoNotOptimize(vel.data());
+    t += 0.01;
+  }
+}
+
+void BM_SamplePoint(benchmark::State& state) {
+  const auto env = rough_sea<double>(std::numeric_limits<double>::infinity(), 64);
+  kelp::Vector3<double> p(1.0, 2.0, 3.0);
+  double t = 0;
+  for (auto _ : state) {
+    auto s = env.sample(p, t);
+    benchmark::DoNotOptimize(s);
+    t += 0.01;
+  }
+}
+
+void BM_SamplePointCalm(benchmark::State& state) {
+  const Environment<double> env;
+  kelp::Vector3<double> p(1.0, 2.0, 3.0);
+  double t = 0;
+  for (auto _ : state) {
+    auto s = env.sample(p, t);
+    benchmark::DoNotOptimize(s);
+    t += 0.01;
+  }
+}
+}  // namespace
+
+BENCHMARK(BM_SampleWaterDeep)->Args({100, 64})->Args({10, 64})->Args({100, 16});
+BENCHMARK(BM_SampleWaterFiniteDepth)->Args({100, 64});
+BENCHMARK(BM_SampleWaterDeepFloat)->Args({100, 64});
+BENCHMARK(BM_SampleWaterCalm);
+BENCHMARK(BM_SamplePoint);
+BENCHMARK(BM_SamplePointCalm);
