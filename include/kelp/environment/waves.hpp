@@ -67,28 +67,54 @@ struct WaveBlock {
 template <bool kFinite>
 KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView& c, WaveBlock& b,
                                                         int m, double t) {
-  for (std::size_t j = 0; j < c.n; ++j) {
-    const double kx = c.kx[j], ky = c.ky[j], k = c.k[j], c0 = c.phase[j] - c.omega[j] * t;
-    const double a = c.amp[j], aw = c.aw[j], aw2 = c.aw2[j], cb = c.cosb[j], sb = c.sinb[j];
-    const double q = c.q[j], two_h = c.two_h;
-    for (int i = 0; i < m; ++i) {
-      double sn, cs;
-      fast_sincos(kx * b.x[i] + ky * b.y[i] + c0, sn, cs);
-      const double e = fast_exp_nonpositive(-k * b.ze[i]);
-      double fh = e, fv = e;
-      if constexpr (kFinite) {
-        const double e2 = fast_exp_nonpositive(-k * (two_h - b.ze[i]));
-        fh = (e + e2) * q;
-        fv = (e - e2) * q;
+  // Points go in lanes of kLanes (a compile-time width the compiler maps onto vector registers,
+  // padding the last lane group with copies of its first point); the accumulators of one lane
+  // group stay in registers across the loop over components.
+  constexpr int kLanes = 8;
+  const double two_h = c.two_h;
+  for (int i0 = 0; i0 < m; i0 += kLanes) {
+    double x[kLanes], y[kLanes], ze[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      const int i = i0 + l < m ? i0 + l : i0;
+      x[l] = b.x[i];
+      y[l] = b.y[i];
+      ze[l] = b.ze[i];
+    }
+    double zeta[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, ax[kLanes] = {},
+           ay[kLanes] = {}, az[kLanes] = {};
+    for (std::size_t j = 0; j < c.n; ++j) {
+      const double kx = c.kx[j], ky = c.ky[j], k = c.k[j], c0 = c.phase[j] - c.omega[j] * t;
+      const double a = c.amp[j], aw = c.aw[j], aw2 = c.aw2[j], cb = c.cosb[j], sb = c.sinb[j];
+      const double q = c.q[j];
+      for (int l = 0; l < kLanes; ++l) {
+        double sn, cs;
+        fast_sincos(kx * x[l] + ky * y[l] + c0, sn, cs);
+        const double e = fast_exp_nonpositive_unchecked(-k * ze[l]);  // k·ze ≤ 700
+        double fh = e, fv = e;
+        if constexpr (kFinite) {
+          const double e2 = fast_exp_nonpositive(-k * (two_h - ze[l]));
+          fh = (e + e2) * q;
+          fv = (e - e2) * q;
+        }
+        zeta[l] += a * cs;
+        const double hv = aw * fh * cs, ha = aw2 * fh * sn;
+        vx[l] += hv * cb;
+        vy[l] += hv * sb;
+        vz[l] -= aw * fv * sn;
+        ax[l] += ha * cb;
+        ay[l] += ha * sb;
+        az[l] += aw2 * fv * cs;
       }
-      b.zeta[i] += a * cs;
-      const double hv = aw * fh * cs, ha = aw2 * fh * sn;
-      b.vx[i] += hv * cb;
-      b.vy[i] += hv * sb;
-      b.vz[i] -= aw * fv * sn;
-      b.ax[i] += ha * cb;
-      b.ay[i] += ha * sb;
-      b.az[i] += aw2 * fv * cs;
+    }
+    for (int l = 0; l < kLanes && i0 + l < m; ++l) {
+      const int i = i0 + l;
+      b.zeta[i] += zeta[l];
+      b.vx[i] += vx[l];
+      b.vy[i] += vy[l];
+      b.vz[i] += vz[l];
+      b.ax[i] += ax[l];
+      b.ay[i] += ay[l];
+      b.az[i] += az[l];
     }
   }
 }
@@ -262,6 +288,7 @@ class WaveField {
       q_[j] = std::isinf(p.depth) ? 1.0 : 1.0 / (-std::expm1(-2.0 * k * p.depth));
     }
     finite_depth_ = !std::isinf(p.depth);
+    z_exp_limit_ = 700.0 / k_.back();  // k grows with j: k_.back() is the largest
   }
 
   /// \brief True for a calm sea (no components).
@@ -414,6 +441,7 @@ class WaveField {
     for (int i = 0; i < m; ++i) {
       double z = b.z[i] < 0.0 ? 0.0 : b.z[i];  // crest region: kinematics of z = 0
       if (finite_depth_ && z > h) z = h;       // below the seabed: those at the seabed
+      if (z > z_exp_limit_) z = z_exp_limit_;  // e^{−k z} < 1e-304 beyond: keeps k z ≤ 700
       b.ze[i] = z;
       b.zeta[i] = b.vx[i] = b.vy[i] = b.vz[i] = b.ax[i] = b.ay[i] = b.az[i] = 0.0;
     }
@@ -471,6 +499,7 @@ class WaveField {
   WaveFieldParameters params_;
   bool finite_depth_ = false;
   bool force_baseline_ = false;
+  double z_exp_limit_ = std::numeric_limits<double>::infinity();
   std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, q_;
 };
 
