@@ -38,7 +38,7 @@ void BM_CeresWarmPreviousStep(benchmark::State& state) {
     }
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid.size()));
-  state.counters["iterations"] =
+  state.counters["lm_iterations"] =
       static_cast<double>(iterations) / static_cast<double>(state.iterations() * grid.size());
 }
 BENCHMARK(BM_CeresWarmPreviousStep);
@@ -61,7 +61,7 @@ void BM_CeresPoorGuess(benchmark::State& state) {
     }
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(grid.size()));
-  state.counters["iterations"] =
+  state.counters["lm_iterations"] =
       static_cast<double>(iterations) / static_cast<double>(state.iterations() * grid.size());
   state.counters["failed_fraction"] =
       static_cast<double>(failures) / static_cast<double>(state.iterations() * grid.size());
@@ -76,7 +76,7 @@ void BM_CeresNaiveStartReferenceCase(benchmark::State& state) {
     iterations = r.iterations;
     benchmark::DoNotOptimize(r);
   }
-  state.counters["iterations"] = iterations;
+  state.counters["lm_iterations"] = iterations;
 }
 BENCHMARK(BM_CeresNaiveStartReferenceCase);
 

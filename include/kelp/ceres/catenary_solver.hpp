@@ -96,6 +96,7 @@ class CatenarySolver {
   CatenaryResult<Scalar> solve(Scalar D, Scalar dz, Scalar L,
                                const CatenaryOptions<Scalar>& options = {}) {
     CatenaryResult<Scalar> result;
+    restarted_ = false;
     if (!classify(D, dz, L, options, result)) return result;
     const auto fast =
         tether::solve_catenary(value_of(D), value_of(dz), value_of(L), plain_options(options));
@@ -103,15 +104,31 @@ class CatenarySolver {
   }
 
   /// \brief Solves from a caller's guess (a0, c0) [m], e.g. the previous control step's solution.
-  /// An unusable guess (a0 ≤ 0 or non-finite) falls back to the fast path's start.
+  ///
+  /// An unusable guess (a0 ≤ 0 or non-finite) starts from the fast path instead. When Ceres does
+  /// not reach options.residual_tolerance from the guess — it happens within ~1e-3 of taut, where
+  /// the (a, c) problem is badly conditioned — and options.restart_from_fast_path is set (default),
+  /// the solve is repeated from the fast path's solution; restarted() tells, and `iterations`
+  /// counts both runs.
   template <typename Scalar>
   CatenaryResult<Scalar> solve(Scalar D, Scalar dz, Scalar L, double a0, double c0,
                                const CatenaryOptions<Scalar>& options = {}) {
     CatenaryResult<Scalar> result;
+    restarted_ = false;
     if (!classify(D, dz, L, options, result)) return result;
     if (!(std::isfinite(a0) && std::isfinite(c0) && a0 > 0.0)) return solve(D, dz, L, options);
-    return run(D, dz, L, Parameters(a0, c0), options);
+    result = run(D, dz, L, Parameters(a0, c0), options);
+    if (result.status == CatenaryStatus::converged || !options.restart_from_fast_path)
+      return result;
+    const int first_run = result.iterations;
+    result = solve(D, dz, L, options);
+    result.iterations += first_run;
+    restarted_ = true;
+    return result;
   }
+
+  /// \brief True when the last solve from a caller's guess had to restart from the fast path.
+  bool restarted() const { return restarted_; }
 
   /// \brief Solves warm-started from this solver's previous converged solution (the fast path on
   /// the first call or after a failure).
@@ -215,6 +232,7 @@ class CatenarySolver {
   Solver solver_{};
   Parameters previous_ = Parameters::Zero();
   bool has_previous_ = false;
+  bool restarted_ = false;
 };
 
 /// \brief Solves the paper's catenary equations for a and c with Ceres, warm-started from the fast
