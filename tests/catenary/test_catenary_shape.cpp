@@ -138,3 +138,17 @@ TEST_CASE("CatenaryShape works in float", "[catenary][shape]") {
   CHECK(s.force_on_end().norm() == Approx(2.318855).epsilon(1e-5));
   CHECK((s.point_at(20.0f) - end).norm() < 1e-4f);
 }
+
+TEST_CASE("the 3-D helper does not allocate", "[catenary][shape]") {
+  kelp::tether::CatenaryOptions<double> opt;
+  opt.seabed_depth = 6.0;
+  const V3 start(0, 0, 0), end(10, 0, 4);
+  Eigen::internal::set_is_malloc_allowed(false);
+  const auto free_line = catenary_between(start, end, 20.0, kW);
+  const auto grounded = catenary_between(start, end, 20.0, kW, opt);
+  const V3 f = free_line.force_on_end() + grounded.force_on_start() + grounded.point_at(7.0) +
+               free_line.point_at(3.0) + free_line.lowest_point();
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(grounded.on_seabed());
+  CHECK(std::isfinite(f.sum()));
+}
