@@ -238,9 +238,10 @@ inline double reduced_target(double D, double excess) {
 /// Solves h(u) = λ by safeguarded Halley steps (h is increasing and convex on u > 0).
 ///
 /// Stopping rule: after a step δ the remaining error is about (h''/2h')δ² for a Newton step and
-/// (h''/2h')²δ³ for a Halley step; relative to u both constants are ≤ 1/2 (h ≈ u²/6 near 0, h'' → 0
-/// for large u). The loop therefore stops after a Halley step with |δ/u|³ ≤ tolerance or a Newton
-/// step with (δ/u)² ≤ tolerance, leaving a relative error of u below ~tolerance.
+/// [(h''/2h')² − h'''/6h']δ³ for a Halley step. In units of u these constants are ≤ 1/2 and ≈ 1/4
+/// (h ≈ u²/6 − u⁴/180 near 0; h'' → 0 for large u; u·h''/2h' = 0.44 at u = 1). The loop therefore
+/// stops after a Halley step with |δ/u|³ ≤ tolerance or a Newton step with (δ/u)² ≤ tolerance,
+/// leaving a relative error of u below ~tolerance.
 inline ReducedSolution solve_reduced(double lambda, double tolerance, int max_iterations) {
   ReducedSolution out;
   out.lambda = lambda;
