@@ -1,0 +1,45 @@
+/// \file
+/// \brief Input checks shared by the vehicle models: symmetry and (semi-)definiteness of the
+/// matrices a user supplies (inertia, added mass, linear damping).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+
+namespace kelp::vehicle {
+
+/// \brief Throws `kelp::invalid_argument` naming `field` unless the square matrix `m` is finite,
+/// symmetric (to 1e-9 relative to its largest entry) and positive definite (`semi = false`, every
+/// eigenvalue > 0) or positive semi-definite (`semi = true`, every eigenvalue ≥ −1e-12·‖m‖).
+///
+/// Only the value part of each coefficient is inspected (so the check also runs for
+/// `ceres::Jet`); the eigenvalues are computed once, at parameter-set construction, never per step.
+/// \tparam Derived an Eigen square matrix expression.
+/// \param[in] m the matrix. \param[in] field its name for the message.
+/// \param[in] semi accept a singular (positive semi-definite) matrix.
+template <typename Derived>
+void check_symmetric_definite(const Eigen::MatrixBase<Derived>& m, const char* field, bool semi) {
+  check_all_finite(m, field);
+  KELP_CHECK(m.rows() == m.cols(), std::string(field) + " must be square");
+  const Eigen::Index n = m.rows();
+  Eigen::MatrixXd v(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i) v(i, j) = value_of(m(i, j));
+  const double scale = v.cwiseAbs().maxCoeff();
+  KELP_CHECK((v - v.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale,
+             std::string(field) + " must be symmetric");
+  if (n == 0) return;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(v, Eigen::EigenvaluesOnly);
+  const double lowest = eig.eigenvalues().minCoeff();
+  if (semi) {
+    KELP_CHECK(lowest >= -1e-12 * scale, std::string(field) + " must be positive semi-definite");
+  } else {
+    KELP_CHECK(lowest > 0.0, std::string(field) + " must be positive definite");
+  }
+}
+
+}  // namespace kelp::vehicle

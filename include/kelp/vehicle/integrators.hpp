@@ -1,0 +1,181 @@
+/// \file
+/// \brief Fixed-step integrators for a VehicleState: classical RK4 and semi-implicit
+/// (symplectic) Euler. Both are allocation-free, renormalise the attitude quaternion and leave the
+/// state unchanged (throwing kelp::numerical_error) when a step produces a non-finite value.
+///
+/// The external wrench is either held constant over the step (zero-order hold: the usual coupling
+/// with a controller or a tether solved once per step) or given as a callable evaluated at every
+/// RK4 stage.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/vehicle/kinematics.hpp"
+#include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/state.hpp"
+
+namespace kelp::vehicle {
+
+/// \brief Time derivative of a VehicleState.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct StateDerivative {
+  /// ṗ [m/s] NED and q̇ (Eigen coefficient order x, y, z, w).
+  PoseRate<Scalar> pose;
+  /// ν̇ [m/s², rad/s²], body axes.
+  Vector6<Scalar> nu_dot = Vector6<Scalar>::Zero();
+};
+
+/// \brief Full state derivative: kinematics (pose_rate()) and kinetics (forward_dynamics()).
+/// \param[in] model vehicle. \param[in,out] ws buffers. \param[in] state current state.
+/// \param[in] tau_total τ + τ_env [N, N m], body axes. \param[in] current_ned v_c^n [m/s], NED.
+template <typename Scalar, typename DT, typename DC>
+StateDerivative<Scalar> state_derivative(const VehicleModel<Scalar>& model,
+                                         VehicleWorkspace<Scalar>& ws,
+                                         const VehicleState<Scalar>& state,
+                                         const Eigen::MatrixBase<DT>& tau_total,
+                                         const Eigen::MatrixBase<DC>& current_ned) {
+  StateDerivative<Scalar> d;
+  d.pose = pose_rate(state.attitude, state.nu);
+  d.nu_dot = forward_dynamics(model, ws, state, tau_total, Vector6<Scalar>::Zero(), current_ned);
+  return d;
+}
+
+namespace detail {
+
+template <typename Scalar>
+VehicleState<Scalar> advance(const VehicleState<Scalar>& x, const StateDerivative<Scalar>& d,
+                             const Scalar& h) {
+  VehicleState<Scalar> y;
+  y.position = x.position + h * d.pose.position_dot;
+  y.attitude.coeffs() = x.attitude.coeffs() + h * d.pose.attitude_dot;
+  renormalize(y.attitude);
+  y.nu = x.nu + h * d.nu_dot;
+  return y;
+}
+
+template <typename Scalar>
+void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& next,
+                      const char* who) {
+  if (!(all_finite(next.position) && all_finite(next.attitude.coeffs()) && all_finite(next.nu)))
+    ::kelp::detail::throw_numerical_error(std::string(who) +
+                                          ": step produced a non-finite state; state unchanged");
+  state = next;
+}
+
+}  // namespace detail
+
+/// \brief One classical fourth-order Runge–Kutta step of length `dt` with a wrench evaluated at
+/// every stage: `wrench(stage_state, stage_time_offset)` must return τ + τ_env (Vector6, body axes,
+/// [N, N m]); stage offsets are 0, dt/2, dt/2, dt. The quaternion is renormalised at every stage
+/// and at the end.
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt on success, unchanged on failure.
+/// \param[in] dt step [s], > 0. \param[in] wrench callable as above.
+/// \param[in] current_ned v_c^n [m/s], NED, constant over the step.
+/// \throws kelp::invalid_argument naming `dt`; kelp::numerical_error on a non-finite result.
+template <typename Scalar, typename WrenchFn, typename DC>
+void rk4_step_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                   VehicleState<Scalar>& state, const Scalar& dt, WrenchFn&& wrench,
+                   const Eigen::MatrixBase<DC>& current_ned) {
+  check_positive(dt, "dt");
+  const Scalar half = Scalar(0.5) * dt;
+  const Vector3<Scalar> vc(current_ned);
+  const StateDerivative<Scalar> k1 =
+      state_derivative(model, ws, state, wrench(state, Scalar(0)), vc);
+  const VehicleState<Scalar> x2 = detail::advance(state, k1, half);
+  const StateDerivative<Scalar> k2 = state_derivative(model, ws, x2, wrench(x2, half), vc);
+  const VehicleState<Scalar> x3 = detail::advance(state, k2, half);
+  const StateDerivative<Scalar> k3 = state_derivative(model, ws, x3, wrench(x3, half), vc);
+  const VehicleState<Scalar> x4 = detail::advance(state, k3, dt);
+  const StateDerivative<Scalar> k4 = state_derivative(model, ws, x4, wrench(x4, dt), vc);
+  StateDerivative<Scalar> k;
+  const Scalar two(2), sixth = dt / Scalar(6);
+  k.pose.position_dot = k1.pose.position_dot + two * k2.pose.position_dot +
+                        two * k3.pose.position_dot + k4.pose.position_dot;
+  k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
+                        two * k3.pose.attitude_dot + k4.pose.attitude_dot;
+  k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
+  detail::commit_if_finite(state, detail::advance(state, k, sixth), "rk4_step");
+}
+
+/// \brief One RK4 step with τ and τ_env held constant over the step (zero-order hold).
+/// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
+/// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
+/// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
+/// \throws kelp::invalid_argument naming `dt`; kelp::numerical_error on a non-finite result.
+template <typename Scalar, typename DT, typename DE, typename DC>
+void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+              VehicleState<Scalar>& state, const Scalar& dt, const Eigen::MatrixBase<DT>& tau,
+              const Eigen::MatrixBase<DE>& tau_env, const Eigen::MatrixBase<DC>& current_ned) {
+  const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_env);
+  rk4_step_with(
+      model, ws, state, dt,
+      [&total](const VehicleState<Scalar>&, const Scalar&) -> const Vector6<Scalar>& {
+        return total;
+      },
+      current_ned);
+}
+
+/// \brief One RK4 step without current.
+template <typename Scalar, typename DT, typename DE>
+void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+              VehicleState<Scalar>& state, const Scalar& dt, const Eigen::MatrixBase<DT>& tau,
+              const Eigen::MatrixBase<DE>& tau_env) {
+  rk4_step(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+}
+
+/// \brief One semi-implicit (symplectic) Euler step: ν_{k+1} = ν_k + dt ν̇(x_k), then the pose is
+/// advanced with the *new* velocity: p_{k+1} = p_k + dt R(q_k) ν₁_{k+1} and
+/// q_{k+1} = q_k ⊗ exp(½ dt ν₂_{k+1}) (exact rotation for a constant rate, so the quaternion stays
+/// unit). First order; cheap and stable for stiff restoring/damping at small dt.
+/// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
+/// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
+/// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
+/// \throws kelp::invalid_argument naming `dt`; kelp::numerical_error on a non-finite result.
+template <typename Scalar, typename DT, typename DE, typename DC>
+void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                              VehicleState<Scalar>& state, const Scalar& dt,
+                              const Eigen::MatrixBase<DT>& tau,
+                              const Eigen::MatrixBase<DE>& tau_env,
+                              const Eigen::MatrixBase<DC>& current_ned) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  check_positive(dt, "dt");
+  VehicleState<Scalar> next;
+  next.nu = state.nu + dt * forward_dynamics(model, ws, state, tau, tau_env, current_ned);
+  next.position =
+      state.position + dt * (state.attitude * Vector3<Scalar>(next.nu.template head<3>()));
+  const Vector3<Scalar> rot = dt * next.nu.template tail<3>();
+  const Scalar angle2 = rot.squaredNorm();
+  Quaternion<Scalar> dq;
+  if (value_of(angle2) > 1e-24) {
+    const Scalar angle = sqrt(angle2);
+    const Scalar s = sin(Scalar(0.5) * angle) / angle;
+    dq = Quaternion<Scalar>(cos(Scalar(0.5) * angle), s * rot(0), s * rot(1), s * rot(2));
+  } else {
+    const Scalar h(0.5);
+    dq = Quaternion<Scalar>(Scalar(1), h * rot(0), h * rot(1), h * rot(2));
+  }
+  next.attitude = state.attitude * dq;
+  renormalize(next.attitude);
+  detail::commit_if_finite(state, next, "semi_implicit_euler_step");
+}
+
+/// \brief One semi-implicit Euler step without current.
+template <typename Scalar, typename DT, typename DE>
+void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                              VehicleState<Scalar>& state, const Scalar& dt,
+                              const Eigen::MatrixBase<DT>& tau,
+                              const Eigen::MatrixBase<DE>& tau_env) {
+  semi_implicit_euler_step(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+}
+
+}  // namespace kelp::vehicle

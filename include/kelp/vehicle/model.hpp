@@ -1,0 +1,260 @@
+/// \file
+/// \brief Fossen 6-DOF vehicle model: parameters, the model built from them once (mass matrix and
+/// its LDLT factorisation) and the allocation-free forward dynamics.
+///
+/// Equation of motion with an irrotational ocean current (Fossen 2021, §10.3; DESIGN.md):
+/// \f[ M_{RB}\dot\nu + C_{RB}(\nu)\nu + M_A\dot\nu_r + C_A(\nu_r)\nu_r + D(\nu_r)\nu_r + g(\eta)
+///     = \tau + \tau_{env}, \f]
+/// with ν_r = ν − ν_c, ν_c = (Rᵀ v_c^n, 0) and, for a current constant in NED,
+/// ν̇_c = (ν_{c,1} × ν₂, 0) (the body-frame rate of a fixed NED vector). Hence
+/// \f[ \dot\nu = M^{-1}\big(\tau + \tau_{env} - C_{RB}(\nu)\nu - C_A(\nu_r)\nu_r - D(\nu_r)\nu_r
+///     - g(\eta) + M_A \dot\nu_c\big), \quad M = M_{RB} + M_A, \f]
+/// where the last term is the irrotational-current correction. M is factored once (LDLT) when the
+/// model is built; no inverse is formed and nothing is allocated per step.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/vehicle/added_mass.hpp"
+#include "kelp/vehicle/coriolis.hpp"
+#include "kelp/vehicle/damping.hpp"
+#include "kelp/vehicle/restoring.hpp"
+#include "kelp/vehicle/rigid_body.hpp"
+#include "kelp/vehicle/state.hpp"
+
+namespace kelp::vehicle {
+
+/// \brief Which hydrostatic model gives g(η).
+enum class Hydrostatics {
+  /// Fully submerged: constant weight and buoyancy, restoring_force() (rotation-matrix form).
+  submerged,
+  /// Floating at the surface: heave stiffness and metacentric heights, restoring_force_surface().
+  surface
+};
+
+/// \brief Constant parameters of a rigid marine vehicle (Fossen 2021 notation, SI units, body axes
+/// x fwd / y stbd / z down about the body origin CO). Added mass and damping are positive
+/// magnitudes; the equations carry the signs.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct VehicleParameters {
+  /// m [kg], > 0.
+  Scalar mass = Scalar(0);
+  /// I_g [kg m²]: inertia tensor about the CG in body axes, symmetric positive definite.
+  Matrix3<Scalar> inertia = Matrix3<Scalar>::Zero();
+  /// r_g [m]: centre of gravity relative to the CO, body axes.
+  Vector3<Scalar> r_g = Vector3<Scalar>::Zero();
+  /// r_b [m]: centre of buoyancy relative to the CO, body axes (submerged model).
+  Vector3<Scalar> r_b = Vector3<Scalar>::Zero();
+  /// ∇ [m³]: displaced volume; B = ρ g ∇ (submerged) or the floating volume (surface).
+  Scalar displaced_volume = Scalar(0);
+  /// ρ [kg/m³]: water density.
+  Scalar density = Scalar(seawater_density);
+  /// g [m/s²]: gravitational acceleration.
+  Scalar gravity = Scalar(standard_gravity);
+  /// M_A [kg, kg m, kg m²]: added mass, symmetric positive semi-definite (−X_u̇ … magnitudes).
+  Matrix6<Scalar> added_mass = Matrix6<Scalar>::Zero();
+  /// Linear and quadratic damping magnitudes.
+  DampingParameters<Scalar> damping;
+  /// Restoring model.
+  Hydrostatics hydrostatics = Hydrostatics::submerged;
+  /// A_wp [m²]: waterplane area (surface model only).
+  Scalar waterplane_area = Scalar(0);
+  /// GM_T [m]: transverse metacentric height (surface model only).
+  Scalar gm_transverse = Scalar(0);
+  /// GM_L [m]: longitudinal metacentric height (surface model only).
+  Scalar gm_longitudinal = Scalar(0);
+
+  /// \brief W = m g [N].
+  Scalar weight() const { return mass * gravity; }
+  /// \brief B = ρ g ∇ [N].
+  Scalar buoyancy() const { return density * gravity * displaced_volume; }
+
+  /// \brief Throws kelp::invalid_argument naming the first offending field (`mass`, `inertia`,
+  /// `r_g`, `r_b`, `displaced_volume`, `density`, `gravity`, `added_mass`, `linear_damping`,
+  /// `quadratic_damping`, `waterplane_area`, `gm_transverse`, `gm_longitudinal`).
+  void validate() const {
+    check_positive(mass, "mass");
+    check_symmetric_definite(inertia, "inertia", false);
+    check_all_finite(r_g, "r_g");
+    check_all_finite(r_b, "r_b");
+    check_non_negative(displaced_volume, "displaced_volume");
+    check_positive(density, "density");
+    check_positive(gravity, "gravity");
+    check_added_mass(added_mass);
+    damping.validate();
+    if (hydrostatics == Hydrostatics::surface) {
+      check_positive(waterplane_area, "waterplane_area");
+      check_positive(displaced_volume, "displaced_volume");
+      check_finite(gm_transverse, "gm_transverse");
+      check_finite(gm_longitudinal, "gm_longitudinal");
+    }
+  }
+
+  /// \brief The same parameters in another scalar type (e.g. double → ceres::Jet).
+  template <typename T>
+  VehicleParameters<T> cast() const {
+    VehicleParameters<T> o;
+    o.mass = T(mass);
+    o.inertia = inertia.template cast<T>();
+    o.r_g = r_g.template cast<T>();
+    o.r_b = r_b.template cast<T>();
+    o.displaced_volume = T(displaced_volume);
+    o.density = T(density);
+    o.gravity = T(gravity);
+    o.added_mass = added_mass.template cast<T>();
+    o.damping = damping.template cast<T>();
+    o.hydrostatics = hydrostatics;
+    o.waterplane_area = T(waterplane_area);
+    o.gm_transverse = T(gm_transverse);
+    o.gm_longitudinal = T(gm_longitudinal);
+    return o;
+  }
+};
+
+/// \brief A vehicle model built once from VehicleParameters: validated parameters, M_RB, M_A
+/// (symmetrised), M = M_RB + M_A and its LDLT factorisation. Immutable after construction, so one
+/// model can be shared by many simulations (each with its own VehicleWorkspace).
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+class VehicleModel {
+ public:
+  /// \brief Validates `parameters` and factors the mass matrix.
+  /// \throws kelp::invalid_argument naming the offending field.
+  explicit VehicleModel(const VehicleParameters<Scalar>& parameters)
+      : parameters_((parameters.validate(), parameters)) {
+    const Scalar h(0.5);
+    rigid_body_mass_ =
+        rigid_body_mass_matrix(parameters_.mass, parameters_.inertia, parameters_.r_g);
+    added_mass_ = h * (parameters_.added_mass + parameters_.added_mass.transpose());
+    mass_ = rigid_body_mass_ + added_mass_;
+    ldlt_.compute(mass_);
+    // M_RB is positive definite and M_A positive semi-definite, so M is positive definite.
+    KELP_CHECK(ldlt_.info() == Eigen::Success && ldlt_.isPositive(),
+               "mass matrix M = M_RB + M_A must be positive definite");
+    weight_ = parameters_.weight();
+    buoyancy_ = parameters_.buoyancy();
+  }
+
+  /// \brief The validated parameters.
+  const VehicleParameters<Scalar>& parameters() const { return parameters_; }
+  /// \brief M_RB about the CO [kg, kg m, kg m²].
+  const Matrix6<Scalar>& rigid_body_mass() const { return rigid_body_mass_; }
+  /// \brief M_A (symmetric part of the given matrix).
+  const Matrix6<Scalar>& added_mass() const { return added_mass_; }
+  /// \brief M = M_RB + M_A.
+  const Matrix6<Scalar>& mass_matrix() const { return mass_; }
+  /// \brief LDLT factorisation of M, computed once.
+  const Eigen::LDLT<Matrix6<Scalar>>& mass_ldlt() const { return ldlt_; }
+  /// \brief W = m g [N].
+  const Scalar& weight() const { return weight_; }
+  /// \brief B = ρ g ∇ [N] (submerged model).
+  const Scalar& buoyancy() const { return buoyancy_; }
+
+  /// \brief Restoring vector g(η) [N, N m], body axes, for the pose in `state` (rotation-matrix
+  /// form; see restoring_force() and restoring_force_surface()).
+  /// \param[in] state vehicle state. \param[in] R its rotation matrix body → NED.
+  template <typename DerivedR>
+  Vector6<Scalar> restoring(const VehicleState<Scalar>& state,
+                            const Eigen::MatrixBase<DerivedR>& R) const {
+    if (parameters_.hydrostatics == Hydrostatics::surface) {
+      return restoring_force_surface(parameters_.density, parameters_.gravity,
+                                     parameters_.displaced_volume, parameters_.waterplane_area,
+                                     parameters_.gm_transverse, parameters_.gm_longitudinal,
+                                     state.position(2), R);
+    }
+    return restoring_force(weight_, buoyancy_, parameters_.r_g, parameters_.r_b, R);
+  }
+
+ private:
+  VehicleParameters<Scalar> parameters_;
+  Matrix6<Scalar> rigid_body_mass_;
+  Matrix6<Scalar> added_mass_;
+  Matrix6<Scalar> mass_;
+  Eigen::LDLT<Matrix6<Scalar>> ldlt_;
+  Scalar weight_;
+  Scalar buoyancy_;
+};
+
+/// \brief Mutable per-simulation buffers of the forward dynamics. After each call they hold the
+/// terms of the last evaluation (useful to log loads or to couple a tether in `system/`).
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct VehicleWorkspace {
+  /// R: rotation body → NED of the last evaluated state.
+  Matrix3<Scalar> rotation = Matrix3<Scalar>::Identity();
+  /// ν_c = (Rᵀ v_c^n, 0): current velocity in body axes [m/s].
+  Vector6<Scalar> nu_c = Vector6<Scalar>::Zero();
+  /// ν_r = ν − ν_c [m/s, rad/s].
+  Vector6<Scalar> nu_r = Vector6<Scalar>::Zero();
+  /// ν̇_c = (ν_{c,1} × ω, 0) [m/s²].
+  Vector6<Scalar> nu_c_dot = Vector6<Scalar>::Zero();
+  /// C_RB(ν) ν [N, N m].
+  Vector6<Scalar> coriolis_rigid_body = Vector6<Scalar>::Zero();
+  /// C_A(ν_r) ν_r [N, N m].
+  Vector6<Scalar> coriolis_added_mass = Vector6<Scalar>::Zero();
+  /// D(ν_r) ν_r [N, N m].
+  Vector6<Scalar> damping = Vector6<Scalar>::Zero();
+  /// g(η) [N, N m].
+  Vector6<Scalar> restoring = Vector6<Scalar>::Zero();
+  /// Right-hand side M ν̇ [N, N m].
+  Vector6<Scalar> rhs = Vector6<Scalar>::Zero();
+  /// ν̇ [m/s², rad/s²].
+  Vector6<Scalar> nu_dot = Vector6<Scalar>::Zero();
+};
+
+/// \brief Forward dynamics ν̇ = M⁻¹(τ + τ_env − C_RB(ν)ν − C_A(ν_r)ν_r − D(ν_r)ν_r − g + M_A ν̇_c)
+/// (see the file comment; Fossen 2021, eqs. of §6 and §10.3). Allocation-free.
+///
+/// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
+/// \param[in] state pose (NED, unit quaternion) and ν (body).
+/// \param[in] tau control wrench (thrusters) [N, N m], body axes about the CO.
+/// \param[in] tau_env other external wrench [N, N m], body axes about the CO (tether, wind,
+///   waves... added by the caller each step).
+/// \param[in] current_ned ocean current velocity v_c^n [m/s] in NED (irrotational, uniform).
+/// \return ν̇ [m/s², rad/s²], body axes.
+template <typename Scalar, typename DT, typename DE, typename DC>
+Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                                 const VehicleState<Scalar>& state,
+                                 const Eigen::MatrixBase<DT>& tau,
+                                 const Eigen::MatrixBase<DE>& tau_env,
+                                 const Eigen::MatrixBase<DC>& current_ned) {
+  ws.rotation = state.attitude.toRotationMatrix();
+  const Vector3<Scalar> vc = ws.rotation.transpose() * Vector3<Scalar>(current_ned);
+  ws.nu_c.template head<3>() = vc;
+  ws.nu_c.template tail<3>().setZero();
+  ws.nu_r = state.nu - ws.nu_c;
+  ws.nu_c_dot.template head<3>() = vc.cross(Vector3<Scalar>(state.nu.template tail<3>()));
+  ws.nu_c_dot.template tail<3>().setZero();
+  ws.coriolis_rigid_body = coriolis_force(model.rigid_body_mass(), state.nu);
+  ws.coriolis_added_mass = coriolis_force(model.added_mass(), ws.nu_r);
+  ws.damping = damping_force(model.parameters().damping, ws.nu_r);
+  ws.restoring = model.restoring(state, ws.rotation);
+  ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_env) - ws.coriolis_rigid_body -
+           ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot;
+  ws.nu_dot = model.mass_ldlt().solve(ws.rhs);
+  return ws.nu_dot;
+}
+
+/// \brief Forward dynamics without current: ν̇ = M⁻¹(τ + τ_env − C_RB ν − C_A ν − D ν − g).
+template <typename Scalar, typename DT, typename DE>
+Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                                 const VehicleState<Scalar>& state,
+                                 const Eigen::MatrixBase<DT>& tau,
+                                 const Eigen::MatrixBase<DE>& tau_env) {
+  return forward_dynamics(model, ws, state, tau, tau_env, Vector3<Scalar>::Zero());
+}
+
+using VehicleParametersd = VehicleParameters<double>;
+using VehicleParametersf = VehicleParameters<float>;
+using VehicleModeld = VehicleModel<double>;
+using VehicleModelf = VehicleModel<float>;
+using VehicleWorkspaced = VehicleWorkspace<double>;
+using VehicleWorkspacef = VehicleWorkspace<float>;
+
+}  // namespace kelp::vehicle

@@ -1,0 +1,219 @@
+/// \file
+/// \brief Thrusters: the allocation matrix from thruster positions and directions, the Blue
+/// Robotics T200 static thrust curve and its inverse, and the PWM ↔ normalised command mapping.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+#include <cmath>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp::vehicle {
+
+/// \brief Thrust-allocation matrix B (6×n): column i is (d_i, r_i × d_i), the wrench about the
+/// CO of a unit thrust along d_i applied at r_i (Fossen 2021, control-allocation chapter: τ = T f).
+/// \param[in] positions r_i [m], 3×n, body axes relative to the CO.
+/// \param[in] directions d_i, 3×n, body axes; normalised here (thrust of a positive command).
+/// \throws kelp::invalid_argument naming `thruster_positions` or `thruster_directions`.
+template <typename DP, typename DD>
+Eigen::Matrix<typename DP::Scalar, 6, Eigen::Dynamic> allocation_matrix(
+    const Eigen::MatrixBase<DP>& positions, const Eigen::MatrixBase<DD>& directions) {
+  using S = typename DP::Scalar;
+  KELP_CHECK(positions.rows() == 3 && positions.cols() >= 1,
+             "thruster_positions must be 3 x n with n >= 1");
+  KELP_CHECK(directions.rows() == 3 && directions.cols() == positions.cols(),
+             "thruster_directions must be 3 x n, one column per thruster position");
+  check_all_finite(positions, "thruster_positions");
+  check_all_finite(directions, "thruster_directions");
+  Eigen::Matrix<S, 6, Eigen::Dynamic> B(6, positions.cols());
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    const Vector3<S> d(directions.col(i));
+    using std::sqrt;
+    const S n = sqrt(d.squaredNorm());
+    KELP_CHECK(value_of(n) > 1e-12, "thruster_directions must be non-zero vectors");
+    const Vector3<S> u = d / n;
+    const Vector3<S> r(positions.col(i));
+    B.col(i).template head<3>() = u;
+    B.col(i).template tail<3>() = r.cross(u);
+  }
+  return B;
+}
+
+/// \brief A fixed set of thrusters: allocation matrix B and its Moore–Penrose pseudo-inverse B⁺,
+/// both computed once at construction. wrench() and distribute() are allocation-free.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+class ThrusterAllocation {
+ public:
+  /// \brief Builds B from positions and directions (see allocation_matrix()) and B⁺ by a complete
+  /// orthogonal decomposition (valid for any rank).
+  /// \param[in] positions r_i [m], 3×n, body. \param[in] directions d_i, 3×n, body.
+  template <typename DP, typename DD>
+  ThrusterAllocation(const Eigen::MatrixBase<DP>& positions,
+                     const Eigen::MatrixBase<DD>& directions)
+      : positions_(positions), matrix_(allocation_matrix(positions, directions)) {
+    directions_ = matrix_.template topRows<3>();
+    Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<Scalar, 6, Eigen::Dynamic>> cod(matrix_);
+    pseudo_inverse_ = cod.pseudoInverse();
+    rank_ = cod.rank();
+  }
+
+  /// \brief Number of thrusters n.
+  Eigen::Index size() const { return matrix_.cols(); }
+  /// \brief Rank of B (6 for a fully actuated vehicle).
+  Eigen::Index rank() const { return rank_; }
+  /// \brief r_i [m], 3×n, body.
+  const Matrix3X<Scalar>& positions() const { return positions_; }
+  /// \brief Unit d_i, 3×n, body.
+  const Matrix3X<Scalar>& directions() const { return directions_; }
+  /// \brief B, 6×n.
+  const Eigen::Matrix<Scalar, 6, Eigen::Dynamic>& matrix() const { return matrix_; }
+  /// \brief B⁺, n×6.
+  const Eigen::Matrix<Scalar, Eigen::Dynamic, 6>& pseudo_inverse() const { return pseudo_inverse_; }
+
+  /// \brief Body wrench τ = B f [N, N m] of the thruster forces f [N] (n-vector).
+  template <typename Derived>
+  Vector6<Scalar> wrench(const Eigen::MatrixBase<Derived>& forces) const {
+    KELP_ASSERT(forces.size() == size());
+    Vector6<Scalar> tau;
+    tau.noalias() = matrix_ * forces;
+    return tau;
+  }
+
+  /// \brief Minimum-norm thruster forces f = B⁺ τ [N] for a desired body wrench τ [N, N m]
+  /// (least-squares when τ is not reachable). `forces` must already have n rows.
+  template <typename DW, typename DF>
+  void distribute(const Eigen::MatrixBase<DW>& tau, Eigen::MatrixBase<DF>& forces) const {
+    KELP_ASSERT(forces.size() == size());
+    forces.noalias() = pseudo_inverse_ * tau;
+  }
+
+ private:
+  Matrix3X<Scalar> positions_;
+  Eigen::Matrix<Scalar, 6, Eigen::Dynamic> matrix_;
+  Matrix3X<Scalar> directions_;
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 6> pseudo_inverse_;
+  Eigen::Index rank_ = 0;
+};
+
+/// \brief Blue Robotics T200 static thrust [N] for a normalised command u ∈ [−1, 1] (clamped):
+/// F(u) = −140.3u⁹ + 389.9u⁷ − 404.1u⁵ + 176.0u³ + 8.9u, F(1) ≈ 30.4 N (von Benzon et al. 2022,
+/// J. Mar. Sci. Eng. 10(12):1898, fit to the Blue Robotics T200 data; odd, so reverse = forward).
+/// \param[in] u normalised command (positive: thrust along the thruster direction).
+template <typename Scalar>
+Scalar t200_thrust(const Scalar& u_in) {
+  Scalar u = u_in;
+  if (value_of(u) > 1.0) u = Scalar(1);
+  if (value_of(u) < -1.0) u = Scalar(-1);
+  const Scalar u2 = u * u;
+  return u *
+         (Scalar(8.9) + u2 * (Scalar(176.0) +
+                              u2 * (Scalar(-404.1) + u2 * (Scalar(389.9) + u2 * Scalar(-140.3)))));
+}
+
+/// \brief dF/du of t200_thrust() [N] (same clamping: 0 outside [−1, 1]).
+template <typename Scalar>
+Scalar t200_thrust_slope(const Scalar& u) {
+  if (value_of(u) > 1.0 || value_of(u) < -1.0) return Scalar(0);
+  const Scalar u2 = u * u;
+  return Scalar(8.9) +
+         u2 * (Scalar(3 * 176.0) +
+               u2 * (Scalar(-5 * 404.1) + u2 * (Scalar(7 * 389.9) + u2 * Scalar(-9 * 140.3))));
+}
+
+/// \brief Command at which the T200 curve peaks: the polynomial rises monotonically on
+/// [0, 0.971656] to 30.62 N and then falls slightly to 30.40 N at u = 1 (root of dF/du at
+/// 0.97165617, found by bisection in double and rounded down; the unit test re-checks it).
+inline constexpr double t200_peak_command = 0.971656;
+/// \brief Largest T200 thrust the curve gives, F(t200_peak_command) = 30.621753 N, rounded down
+/// [N].
+inline constexpr double t200_max_thrust = 30.62175;
+
+/// \brief Inverse of the T200 curve on its monotone branch: the command u ∈ [−u_peak, u_peak]
+/// with t200_thrust(u) = force; forces beyond ±t200_max_thrust saturate at ±u_peak.
+/// Bisection on the value, then one Newton correction so that ceres::Jet derivatives follow the
+/// implicit-function theorem (du/dF = 1/F'(u)).
+/// \param[in] force desired thrust [N] along the thruster direction.
+template <typename Scalar>
+Scalar t200_command(const Scalar& force) {
+  const double f = value_of(force);
+  if (f >= t200_max_thrust) return Scalar(t200_peak_command);
+  if (f <= -t200_max_thrust) return Scalar(-t200_peak_command);
+  const double target = f < 0 ? -f : f;
+  double lo = 0.0, hi = t200_peak_command;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (t200_thrust(mid) < target ? lo : hi) = mid;
+  }
+  const double u0 = (f < 0 ? -0.5 : 0.5) * (lo + hi);
+  const Scalar u(u0);
+  return u + (force - t200_thrust(u)) / t200_thrust_slope(u);
+}
+
+/// \brief PWM pulse-width ↔ normalised command mapping of a bidirectional ESC.
+///
+/// Defaults: 1100–1500–1900 µs (ArduSub `MOT_PWM_MIN`/`MOT_PWM_MAX`, sitl.md §1.7) and a ±25 µs
+/// deadband around neutral (1475…1525 µs, ArduPilot's SITL submarine, SIM_Submarine.cpp).
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct PwmMapping {
+  /// Full reverse [µs].
+  Scalar min_us = Scalar(1100);
+  /// Neutral (stop) [µs].
+  Scalar neutral_us = Scalar(1500);
+  /// Full forward [µs].
+  Scalar max_us = Scalar(1900);
+  /// Half-width of the dead band around neutral [µs]; |pwm − neutral| ≤ deadband gives 0.
+  Scalar deadband_us = Scalar(25);
+
+  /// \brief Throws kelp::invalid_argument naming the field unless min < neutral < max and
+  /// 0 ≤ deadband < min(max − neutral, neutral − min).
+  void validate() const {
+    check_finite(min_us, "min_us");
+    check_finite(neutral_us, "neutral_us");
+    check_finite(max_us, "max_us");
+    check_non_negative(deadband_us, "deadband_us");
+    KELP_CHECK(value_of(min_us) < value_of(neutral_us), "min_us must be < neutral_us");
+    KELP_CHECK(value_of(neutral_us) < value_of(max_us), "max_us must be > neutral_us");
+    KELP_CHECK(value_of(deadband_us) < value_of(max_us) - value_of(neutral_us) &&
+                   value_of(deadband_us) < value_of(neutral_us) - value_of(min_us),
+               "deadband_us must be smaller than both PWM half-ranges");
+  }
+};
+
+/// \brief Normalised command u ∈ [−1, 1] of a pulse width [µs]: 0 inside the dead band, else
+/// (pwm − neutral)/(max − neutral) above neutral and (pwm − neutral)/(neutral − min) below,
+/// clamped (as ArduPilot's SITL submarine does: no rescaling of the dead band).
+template <typename Scalar>
+Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
+  const Scalar d = pwm_us - m.neutral_us;
+  const double dv = value_of(d);
+  if (dv <= value_of(m.deadband_us) && dv >= -value_of(m.deadband_us)) return Scalar(0);
+  Scalar u = dv > 0 ? d / (m.max_us - m.neutral_us) : d / (m.neutral_us - m.min_us);
+  if (value_of(u) > 1.0) u = Scalar(1);
+  if (value_of(u) < -1.0) u = Scalar(-1);
+  return u;
+}
+
+/// \brief Pulse width [µs] for a normalised command u (clamped to [−1, 1]):
+/// neutral + u (max − neutral) for u > 0, neutral + u (neutral − min) otherwise (ArduSub's
+/// `AP_Motors6DOF::calc_thrust_to_pwm`, sitl.md §1.7). The dead band is not skipped.
+template <typename Scalar>
+Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
+  Scalar u = u_in;
+  if (value_of(u) > 1.0) u = Scalar(1);
+  if (value_of(u) < -1.0) u = Scalar(-1);
+  return value_of(u) > 0 ? m.neutral_us + u * (m.max_us - m.neutral_us)
+                         : m.neutral_us + u * (m.neutral_us - m.min_us);
+}
+
+using ThrusterAllocationd = ThrusterAllocation<double>;
+using ThrusterAllocationf = ThrusterAllocation<float>;
+using PwmMappingd = PwmMapping<double>;
+using PwmMappingf = PwmMapping<float>;
+
+}  // namespace kelp::vehicle

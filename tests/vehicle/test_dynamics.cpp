@@ -1,0 +1,280 @@
+// Forward dynamics and integrators (kelp/vehicle/model.hpp, integrators.hpp, kinematics.hpp):
+// energy conservation, steady speeds against the algebraic balance τ = D(u)u, heave settling,
+// current handling, failure semantics and the absence of heap allocation.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <type_traits>
+
+#include "kelp/core/rotation.hpp"
+#include "kelp/vehicle/integrators.hpp"
+#include "kelp/vehicle/kinematics.hpp"
+#include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/thrusters.hpp"
+
+using kelp::Matrix6;
+using kelp::Vector3;
+using kelp::Vector6;
+namespace kv = kelp::vehicle;
+
+namespace {
+
+// Positive root of a u + b u² = f (the steady speed where thrust balances damping).
+double steady_speed(double a, double b, double f) {
+  return (-a + std::sqrt(a * a + 4 * b * f)) / (2 * b);
+}
+
+template <typename S>
+kv::VehicleParameters<S> neutral_rov() {
+  auto p = kv::bluerov2_heavy<S>().parameters;
+  p.displaced_volume = p.mass / p.density;  // W = B
+  return p;
+}
+
+}  // namespace
+
+TEMPLATE_TEST_CASE("without damping or forcing, RK4 conserves the kinetic energy",
+                   "[vehicle][energy]", double, float) {
+  using S = TestType;
+  auto p = neutral_rov<S>();
+  p.damping = kv::DampingParameters<S>();
+  p.r_g = Vector3<S>(S(0.01), S(-0.02), S(0.03));
+  p.r_b = p.r_g;
+  // Full added mass with couplings, so that C_A has every term.
+  p.added_mass(0, 4) = p.added_mass(4, 0) = S(0.3);
+  p.added_mass(1, 5) = p.added_mass(5, 1) = S(-0.2);
+  p.added_mass(2, 3) = p.added_mass(3, 2) = S(0.1);
+  const kv::VehicleModel<S> model(p);
+  kv::VehicleWorkspace<S> ws;
+  kv::VehicleState<S> x;
+  x.attitude = kelp::quaternion_from_euler(S(0.1), S(-0.2), S(0.3));
+  x.nu << S(0.5), S(-0.3), S(0.2), S(0.4), S(-0.5), S(0.6);
+  const auto energy = [&](const kv::VehicleState<S>& s) {
+    return double(S(0.5) * s.nu.dot(model.mass_matrix() * s.nu));
+  };
+  const double e0 = energy(x);
+  const Vector6<S> zero = Vector6<S>::Zero();
+  double worst = 0;
+  for (int k = 0; k < 10000; ++k) {  // 10 s at 1 ms
+    kv::rk4_step(model, ws, x, S(0.001), zero, zero);
+    worst = std::max(worst, std::abs(energy(x) - e0) / e0);
+  }
+  // double: the 1e-6 (RK4 error at 1 ms is ~1e-12 here); float: rounding of 1e4 steps.
+  const double tol = std::is_same<S, float>::value ? 1e-3 : 1e-6;
+  CHECK(worst < tol);
+  CHECK(x.nu.norm() > S(0.1));  // it really moved and rotated
+}
+
+TEMPLATE_TEST_CASE("BlueROV2 Heavy at constant surge thrust reaches the speed where tau = D(u)u",
+                   "[vehicle][behaviour]", double, float) {
+  using S = TestType;
+  const kv::VehicleModel<S> model(neutral_rov<S>());
+  kv::VehicleWorkspace<S> ws;
+  kv::VehicleState<S> x;
+  Vector6<S> tau = Vector6<S>::Zero();
+  tau(0) = S(40);
+  // 40 = 13.7 u + 141 u² ⇒ u = 0.4862 m/s (von Benzon 2022 damping).
+  const double u_ss = steady_speed(13.7, 141, 40);
+  for (int k = 0; k < 2000; ++k) kv::rk4_step(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
+  CHECK(double(x.nu(0)) == Approx(u_ss).epsilon(0.01));
+  CHECK(double(x.position(0)) > 0.9 * u_ss * 19);
+  // The semi-implicit Euler integrator reaches the same steady state.
+  kv::VehicleState<S> y;
+  for (int k = 0; k < 20000; ++k)
+    kv::semi_implicit_euler_step(model, ws, y, S(0.001), tau, Vector6<S>::Zero());
+  CHECK(double(y.nu(0)) == Approx(u_ss).epsilon(0.01));
+  CHECK(double(y.attitude.norm()) == Approx(1.0).epsilon(1e-6));
+}
+
+TEMPLATE_TEST_CASE("BlueBoat at full thrust reaches its top speed near 3 m/s",
+                   "[vehicle][behaviour]", double, float) {
+  using S = TestType;
+  const auto preset = kv::blueboat<S>();
+  const kv::VehicleModel<S> model(preset.parameters);
+  const kv::ThrusterAllocation<S> thrusters(preset.thruster_positions, preset.thruster_directions);
+  kv::VehicleWorkspace<S> ws;
+  kv::VehicleState<S> x;
+  // Two T200 at full command: 2 × 30.4 N; surge damping 5 u + 5 u² (blueboat preset) ⇒ 3.02 m/s.
+  Eigen::Matrix<S, Eigen::Dynamic, 1> f(2);
+  f.setConstant(kv::t200_thrust(S(1)));
+  const Vector6<S> tau = thrusters.wrench(f);
+  CHECK(double(tau(0)) == Approx(60.8).epsilon(1e-6));
+  CHECK(std::abs(double(tau(5))) < 1e-6);
+  for (int k = 0; k < 6000; ++k) kv::rk4_step(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
+  // Pure surge balance: 5 u + 5 u² = 60.8 ⇒ 3.023 m/s. The thrusters sit 0.10 m below the CO, so
+  // the boat trims bow-up (≈ 0.03 rad) and the heave restoring force then has a surge component:
+  // the simulated top speed is ≈ 2 % lower (2.966 m/s when this test was written).
+  const double u_top = steady_speed(5, 5, 60.8);
+  CHECK(double(x.nu(0)) < u_top);
+  CHECK(double(x.nu(0)) == Approx(u_top).epsilon(0.03));
+  CHECK(double(x.nu(0)) == Approx(3.0).epsilon(0.03));
+  // Thrusters below the waterline trim the bow up slightly but the boat stays upright.
+  const Vector3<S> e = kelp::euler_from_quaternion(x.attitude);
+  CHECK(double(e(1)) > 0.01);  // bow up
+  CHECK(double(e(1)) < 0.1);
+  CHECK(std::abs(double(e(0))) < 1e-6);
+}
+
+TEMPLATE_TEST_CASE("a heave step settles", "[vehicle][behaviour]", double, float) {
+  using S = TestType;
+  // BlueBoat pushed down by a constant 50 N: z settles at 50 / (ρ g A_wp) = 50 / 1909.87 m.
+  const kv::VehicleModel<S> boat(kv::blueboat<S>().parameters);
+  kv::VehicleWorkspace<S> ws;
+  kv::VehicleState<S> x;
+  Vector6<S> tau = Vector6<S>::Zero();
+  tau(2) = S(50);
+  for (int k = 0; k < 2000; ++k) kv::rk4_step(boat, ws, x, S(0.005), tau, Vector6<S>::Zero());
+  CHECK(double(x.position(2)) == Approx(50 / (1025 * 9.80665 * 0.19)).epsilon(0.01));
+  CHECK(std::abs(double(x.nu(2))) < 1e-3);
+
+  // BlueROV2 Heavy (neutral) with a 20 N downward heave force: w settles where 33 w + 190 w² = 20.
+  const kv::VehicleModel<S> rov(neutral_rov<S>());
+  kv::VehicleState<S> y;
+  tau(2) = S(20);
+  for (int k = 0; k < 1000; ++k) kv::rk4_step(rov, ws, y, S(0.01), tau, Vector6<S>::Zero());
+  CHECK(double(y.nu(2)) == Approx(steady_speed(33, 190, 20)).epsilon(0.01));
+}
+
+TEMPLATE_TEST_CASE("a passive neutrally buoyant vehicle ends up moving with a uniform current",
+                   "[vehicle][current]", double, float) {
+  using S = TestType;
+  auto p = neutral_rov<S>();
+  p.r_b = p.r_g;  // no restoring at all: only the current drives it
+  const kv::VehicleModel<S> model(p);
+  kv::VehicleWorkspace<S> ws;
+  kv::VehicleState<S> x;
+  x.attitude = kelp::quaternion_from_euler(S(0), S(0), S(0.7));  // yawed: the current is rotated
+  const Vector3<S> current(S(0.5), S(-0.2), S(0.05));
+  const Vector6<S> zero = Vector6<S>::Zero();
+  for (int k = 0; k < 6000; ++k) kv::rk4_step(model, ws, x, S(0.01), zero, zero, current);
+  const Vector3<S> v_ned = x.attitude * Vector3<S>(x.nu.template head<3>());
+  CHECK((v_ned - current).norm() < S(2e-3));
+  // The transient spin decays slowly (roll and yaw have quadratic damping only).
+  CHECK(x.nu.template tail<3>().norm() < S(0.02));
+}
+
+TEST_CASE("equal relative flow gives equal hydrodynamic force", "[vehicle][current]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws1, ws2;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  kv::VehicleState<double> still, moving;
+  still.attitude = moving.attitude = kelp::quaternion_from_euler(0.1, -0.2, 1.0);
+  const Vector3<double> current(0.6, -0.3, 0.1);
+  const Vector3<double> vc_body = still.attitude.conjugate() * current;
+  Vector6<double> rel;
+  rel << 0.3, -0.1, 0.05, 0, 0, 0;
+  // (a) vehicle moving through still water with ν = rel; (b) vehicle moving with ν = rel + ν_c in
+  // the current: same ν_r, no rotation ⇒ same damping, same C_A, and the same acceleration.
+  still.nu = rel;
+  moving.nu = rel;
+  moving.nu.head<3>() += vc_body;
+  const Vector6<double> a1 = kv::forward_dynamics(model, ws1, still, zero, zero);
+  const Vector6<double> a2 = kv::forward_dynamics(model, ws2, moving, zero, zero, current);
+  CHECK((ws1.damping - ws2.damping).norm() < 1e-12);
+  CHECK((ws1.coriolis_added_mass - ws2.coriolis_added_mass).norm() < 1e-12);
+  CHECK((a1 - a2).norm() < 1e-12);
+  // With rotation too, the hydrodynamic terms depend on ν_r only.
+  still.nu.tail<3>() << 0.2, -0.1, 0.3;
+  moving.nu.tail<3>() = still.nu.tail<3>();
+  kv::forward_dynamics(model, ws1, still, zero, zero);
+  kv::forward_dynamics(model, ws2, moving, zero, zero, current);
+  CHECK((ws1.damping - ws2.damping).norm() < 1e-12);
+  CHECK((ws1.coriolis_added_mass - ws2.coriolis_added_mass).norm() < 1e-12);
+  CHECK((ws2.nu_r - still.nu).norm() < 1e-12);
+}
+
+TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage",
+          "[vehicle][integrators]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  x.nu << 0.2, 0.1, -0.1, 0.05, 0.02, -0.1;
+  Vector6<double> t1, t2;
+  t1 << 10, 0, 5, 0, 1, 0;
+  t2 << -3, 2, 0, 0.5, 0, 1;
+  const Vector6<double> a = kv::forward_dynamics(model, ws, x, t1, t2);
+  const Vector6<double> b = kv::forward_dynamics(model, ws, x, t1 + t2, Vector6<double>::Zero());
+  CHECK((a - b).norm() < 1e-12);
+  // M ν̇ equals the right-hand side that was solved (the LDLT solve is exact to rounding).
+  CHECK((model.mass_matrix() * ws.nu_dot - ws.rhs).norm() < 1e-10);
+
+  // A callable that returns the same constant wrench reproduces rk4_step.
+  kv::VehicleState<double> y = x, z = x;
+  kv::rk4_step(model, ws, y, 0.01, t1, t2);
+  int calls = 0;
+  kv::rk4_step_with(
+      model, ws, z, 0.01,
+      [&](const kv::VehicleState<double>&, double) -> Vector6<double> {
+        ++calls;
+        return t1 + t2;
+      },
+      Vector3<double>::Zero());
+  CHECK(calls == 4);
+  CHECK((y.nu - z.nu).norm() < 1e-15);
+  CHECK((y.position - z.position).norm() < 1e-15);
+}
+
+TEST_CASE("Euler kinematics agree with the quaternion kinematics", "[vehicle][kinematics]") {
+  const double phi = 0.2, theta = -0.4, psi = 1.1;
+  Vector6<double> eta, nu;
+  eta << 1, 2, 3, phi, theta, psi;
+  nu << 0.5, -0.2, 0.1, 0.3, -0.1, 0.2;
+  const Vector6<double> eta_dot = kv::eta_rate_euler(eta, nu);
+  const auto q = kelp::quaternion_from_euler(phi, theta, psi);
+  const auto rate = kv::pose_rate(q, nu);
+  CHECK((eta_dot.head<3>() - rate.position_dot).norm() < 1e-12);
+  // Euler angles a small time later, both ways.
+  const double h = 1e-6;
+  kelp::Quaternion<double> q2;
+  q2.coeffs() = q.coeffs() + h * rate.attitude_dot;
+  kv::renormalize(q2);
+  const Vector3<double> e2 = kelp::euler_from_quaternion(q2);
+  CHECK(((e2 - Vector3<double>(phi, theta, psi)) / h - eta_dot.tail<3>()).norm() < 1e-5);
+}
+
+TEST_CASE("a failed step throws and leaves the state unchanged", "[vehicle][integrators]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  x.position << 1, 2, 3;
+  x.nu << 0.1, 0, 0, 0, 0, 0.1;
+  const kv::VehicleState<double> before = x;
+  Vector6<double> bad = Vector6<double>::Zero();
+  bad(0) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(kv::rk4_step(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
+                  kelp::numerical_error);
+  CHECK_THROWS_AS(kv::semi_implicit_euler_step(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
+                  kelp::numerical_error);
+  CHECK(x.position == before.position);
+  CHECK(x.nu == before.nu);
+  CHECK(x.attitude.coeffs() == before.attitude.coeffs());
+  CHECK_THROWS_WITH(
+      kv::rk4_step(model, ws, x, 0.0, Vector6<double>::Zero(), Vector6<double>::Zero()),
+      Catch::Contains("dt"));
+}
+
+TEMPLATE_TEST_CASE("forward dynamics and steps do not allocate", "[vehicle][malloc]", double,
+                   float) {
+  using S = TestType;
+  const auto preset = kv::bluerov2_heavy<S>();
+  const kv::VehicleModel<S> model(preset.parameters);
+  const kv::ThrusterAllocation<S> thrusters(preset.thruster_positions, preset.thruster_directions);
+  kv::VehicleWorkspace<S> ws;
+  kv::VehicleState<S> x;
+  x.nu << S(0.3), S(0.1), S(-0.1), S(0.05), S(0.02), S(0.1);
+  Eigen::Matrix<S, Eigen::Dynamic, 1> f(thrusters.size());
+  Vector6<S> tau = Vector6<S>::Zero(), tau_env = Vector6<S>::Zero();
+  tau_env(2) = S(3);
+  const Vector3<S> current(S(0.2), S(0.1), S(0));
+  tau(0) = S(20);
+  tau(5) = S(1);
+  Eigen::internal::set_is_malloc_allowed(false);
+  thrusters.distribute(tau, f);
+  tau = thrusters.wrench(f);
+  const Vector6<S> a = kv::forward_dynamics(model, ws, x, tau, tau_env, current);
+  kv::rk4_step(model, ws, x, S(0.01), tau, tau_env, current);
+  kv::semi_implicit_euler_step(model, ws, x, S(0.01), tau, tau_env, current);
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(a.allFinite());
+  CHECK(x.nu.allFinite());
+}

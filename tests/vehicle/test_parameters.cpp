@@ -1,0 +1,92 @@
+// Bad user input is rejected with kelp::invalid_argument naming the field
+// (kelp/vehicle/model.hpp, rigid_body.hpp, damping.hpp, thrusters.hpp).
+#include <catch2/catch.hpp>
+#include <functional>
+#include <limits>
+
+#include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/thrusters.hpp"
+
+namespace kv = kelp::vehicle;
+using P = kv::VehicleParameters<double>;
+
+namespace {
+
+void expect_rejected(const std::function<void(P&)>& spoil, const char* field) {
+  P p = kv::bluerov2_heavy<double>().parameters;
+  spoil(p);
+  INFO("field " << field);
+  CHECK_THROWS_AS(kv::VehicleModel<double>(p), kelp::invalid_argument);
+  CHECK_THROWS_WITH(kv::VehicleModel<double>(p), Catch::Contains(field));
+}
+
+const double kNan = std::numeric_limits<double>::quiet_NaN();
+const double kInf = std::numeric_limits<double>::infinity();
+
+}  // namespace
+
+TEST_CASE("presets are valid", "[vehicle][parameters]") {
+  CHECK_NOTHROW(kv::VehicleModel<double>(kv::bluerov2_heavy<double>().parameters));
+  CHECK_NOTHROW(kv::VehicleModel<double>(kv::blueboat<double>().parameters));
+  CHECK_NOTHROW(kv::VehicleModel<float>(kv::bluerov2_heavy<float>().parameters));
+  CHECK_NOTHROW(kv::VehicleModel<float>(kv::blueboat<float>().parameters));
+  CHECK_NOTHROW(kv::bluerov2_heavy<double>().pwm.validate());
+  CHECK_NOTHROW(kv::blueboat<double>().pwm.validate());
+}
+
+TEST_CASE("bad vehicle parameters name the field", "[vehicle][parameters]") {
+  expect_rejected([](P& p) { p.mass = -1; }, "mass");
+  expect_rejected([](P& p) { p.mass = 0; }, "mass");
+  expect_rejected([](P& p) { p.mass = kNan; }, "mass");
+  expect_rejected([](P& p) { p.inertia(1, 1) = -0.1; }, "inertia");
+  expect_rejected([](P& p) { p.inertia(0, 1) = 0.5; }, "inertia");  // not symmetric
+  expect_rejected(
+      [](P& p) {  // symmetric but indefinite
+        p.inertia(0, 1) = p.inertia(1, 0) = 1.0;
+      },
+      "inertia");
+  expect_rejected([](P& p) { p.inertia(2, 2) = kInf; }, "inertia");
+  expect_rejected([](P& p) { p.r_g(1) = kNan; }, "r_g");
+  expect_rejected([](P& p) { p.r_b(2) = -kInf; }, "r_b");
+  expect_rejected([](P& p) { p.displaced_volume = -0.01; }, "displaced_volume");
+  expect_rejected([](P& p) { p.density = kNan; }, "density");
+  expect_rejected([](P& p) { p.gravity = 0; }, "gravity");
+  expect_rejected([](P& p) { p.added_mass(3, 3) = -1; }, "added_mass");
+  expect_rejected([](P& p) { p.added_mass(0, 5) = p.added_mass(5, 0) = 10; }, "added_mass");
+  expect_rejected([](P& p) { p.added_mass(0, 1) = 1; }, "added_mass");
+  expect_rejected([](P& p) { p.added_mass(4, 4) = kNan; }, "added_mass");
+  expect_rejected([](P& p) { p.damping.linear(0, 0) = kInf; }, "linear_damping");
+  expect_rejected([](P& p) { p.damping.linear(0, 0) = -2; }, "linear_damping");
+  expect_rejected([](P& p) { p.damping.quadratic(5) = -1; }, "quadratic_damping");
+  expect_rejected([](P& p) { p.damping.quadratic(5) = kNan; }, "quadratic_damping");
+  expect_rejected(
+      [](P& p) {
+        p.hydrostatics = kv::Hydrostatics::surface;
+        p.waterplane_area = 0;
+      },
+      "waterplane_area");
+  expect_rejected(
+      [](P& p) {
+        p.hydrostatics = kv::Hydrostatics::surface;
+        p.waterplane_area = 0.2;
+        p.gm_transverse = kNan;
+      },
+      "gm_transverse");
+}
+
+TEST_CASE("bad thruster layouts name the field", "[vehicle][parameters]") {
+  kelp::Matrix3X<double> r(3, 2), d(3, 2);
+  r << 0, 0, 0.1, -0.1, 0, 0;
+  d << 1, 1, 0, 0, 0, 0;
+  CHECK_NOTHROW(kv::ThrusterAllocation<double>(r, d));
+  kelp::Matrix3X<double> d0 = d;
+  d0.col(1).setZero();
+  CHECK_THROWS_WITH(kv::ThrusterAllocation<double>(r, d0), Catch::Contains("thruster_directions"));
+  kelp::Matrix3X<double> rn = r;
+  rn(0, 0) = kNan;
+  CHECK_THROWS_WITH(kv::ThrusterAllocation<double>(rn, d), Catch::Contains("thruster_positions"));
+  kelp::Matrix3X<double> d3(3, 3);
+  d3.setOnes();
+  CHECK_THROWS_WITH(kv::ThrusterAllocation<double>(r, d3), Catch::Contains("thruster_directions"));
+}

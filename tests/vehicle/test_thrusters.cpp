@@ -1,0 +1,142 @@
+// Thrusters (kelp/vehicle/thrusters.hpp) and the thruster layouts of the presets
+// (kelp/vehicle/presets.hpp).
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/thrusters.hpp"
+
+using kelp::Vector3;
+using kelp::Vector6;
+namespace kv = kelp::vehicle;
+
+TEST_CASE("BlueROV2 Heavy allocation matches ArduSub's vectored_6dof motor factors",
+          "[vehicle][thrusters]") {
+  const auto p = kv::bluerov2_heavy<double>();
+  const kv::ThrusterAllocation<double> alloc(p.thruster_positions, p.thruster_directions);
+  REQUIRE(alloc.size() == 8);
+  CHECK(alloc.rank() == 6);
+  // ArduSub AP_Motors6DOF.cpp vectored_6dof factors (sitl.md §1.7), per motor:
+  // roll, pitch, yaw, throttle (climb), forward, lateral. A positive factor means a positive
+  // output pushes the vehicle along that demand: roll → +K, pitch → +M, yaw → +N,
+  // climb → −Z (NED), forward → +X, lateral → +Y.
+  const double factors[8][6] = {{0, 0, +1, 0, -1, +1}, {0, 0, -1, 0, -1, -1}, {0, 0, -1, 0, +1, +1},
+                                {0, 0, +1, 0, +1, -1}, {+1, -1, 0, -1, 0, 0}, {-1, -1, 0, -1, 0, 0},
+                                {+1, +1, 0, -1, 0, 0}, {-1, +1, 0, -1, 0, 0}};
+  const auto& B = alloc.matrix();
+  // ArduSub's table is idealised: where a factor is 0 the real geometry may still give a small
+  // term (the horizontal thrusters sit 8.5 cm below the CO, so they also roll and pitch by at
+  // most 0.085 m × 1/√2 = 0.06 m); where it is ±1 the sign must match.
+  const int rows[6] = {3, 4, 5, 2, 0, 1};
+  const double flip[6] = {1, 1, 1, -1, 1, 1};  // climb is −Z in NED
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      INFO("motor " << i + 1 << " factor " << j);
+      const double b = flip[j] * B(rows[j], i);
+      if (factors[i][j] == 0) {
+        CHECK(std::abs(b) < 0.061);
+      } else {
+        CHECK(b * factors[i][j] > 0.05);
+      }
+    }
+  }
+  // Symmetry of the layout: all four verticals at +1 give a pure downward force 4 N, no moment;
+  // the four horizontals at the "forward" pattern give pure surge 4/√2 N.
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(8);
+  f.tail<4>().setOnes();
+  Vector6<double> expected = Vector6<double>::Zero();
+  expected(2) = 4;
+  CHECK((alloc.wrench(f) - expected).norm() < 1e-12);
+  f.setZero();
+  f.head<4>() << -1, -1, 1, 1;
+  expected.setZero();
+  expected(0) = 4 / std::sqrt(2.0);
+  expected(4) = 0.085 * 4 / std::sqrt(2.0);  // thrust 8.5 cm below the CO pitches the nose up
+  CHECK((alloc.wrench(f) - expected).norm() < 1e-12);
+}
+
+TEST_CASE("pseudo-inverse allocation reproduces any wrench of a fully actuated vehicle",
+          "[vehicle][thrusters]") {
+  const auto p = kv::bluerov2_heavy<double>();
+  const kv::ThrusterAllocation<double> alloc(p.thruster_positions, p.thruster_directions);
+  Eigen::VectorXd f(8);
+  for (int k = 0; k < 20; ++k) {
+    const Vector6<double> tau = Vector6<double>::Random() * 20;
+    alloc.distribute(tau, f);
+    CHECK((alloc.wrench(f) - tau).norm() < 1e-9 * tau.norm());
+  }
+}
+
+TEST_CASE("BlueBoat skid steering: equal thrust surges, differential thrust yaws",
+          "[vehicle][thrusters]") {
+  const auto p = kv::blueboat<double>();
+  const kv::ThrusterAllocation<double> alloc(p.thruster_positions, p.thruster_directions);
+  CHECK(alloc.rank() == 2);
+  const Vector6<double> fwd = alloc.wrench(Eigen::Vector2d(10, 10));
+  CHECK(fwd(0) == Approx(20));
+  CHECK(fwd(5) == Approx(0).margin(1e-12));
+  // Left (port, y = -0.295) forward, right reverse: turn to starboard, N = 2 · 10 · 0.295 > 0.
+  const Vector6<double> turn = alloc.wrench(Eigen::Vector2d(10, -10));
+  CHECK(turn(0) == Approx(0).margin(1e-12));
+  CHECK(turn(5) == Approx(2 * 10 * 0.295));
+  // Least squares for a wrench it cannot make exactly: the surge and yaw parts are met.
+  Vector6<double> tau = Vector6<double>::Zero();
+  tau << 20, 5, 0, 0, 0, 3;
+  Eigen::VectorXd f(2);
+  alloc.distribute(tau, f);
+  const Vector6<double> got = alloc.wrench(f);
+  CHECK(got(0) == Approx(20).epsilon(0.02));
+  CHECK(got(5) == Approx(3).epsilon(0.02));
+}
+
+TEMPLATE_TEST_CASE("T200 curve, its peak and its inverse", "[vehicle][thrusters]", double, float) {
+  using S = TestType;
+  // F(1) = −140.3 + 389.9 − 404.1 + 176.0 + 8.9 = 30.4 N (sum of the coefficients).
+  CHECK(double(kv::t200_thrust(S(1))) == Approx(30.4).epsilon(1e-6));
+  CHECK(kv::t200_thrust(S(0)) == S(0));
+  CHECK(double(kv::t200_thrust(S(-0.6))) == Approx(-double(kv::t200_thrust(S(0.6)))));
+  CHECK(kv::t200_thrust(S(2)) == kv::t200_thrust(S(1)));  // clamped
+  // The published constants: slope zero at the peak, peak value = max thrust.
+  CHECK(std::abs(kv::t200_thrust_slope(kv::t200_peak_command)) < 0.05);
+  CHECK(kv::t200_thrust(kv::t200_peak_command) == Approx(kv::t200_max_thrust).epsilon(1e-5));
+  // Monotone on [0, u_peak].
+  for (int i = 1; i <= 100; ++i) {
+    const double u = kv::t200_peak_command * i / 100.0;
+    CHECK(kv::t200_thrust_slope(u) > 0);
+  }
+  const double tol = std::is_same<S, float>::value ? 1e-3 : 1e-9;
+  for (double f = -30.0; f <= 30.0; f += 0.75) {
+    const S u = kv::t200_command(S(f));
+    CHECK(double(kv::t200_thrust(u)) == Approx(f).margin(tol * 30));
+    CHECK(std::abs(double(u)) <= kv::t200_peak_command + 1e-6);
+  }
+  CHECK(double(kv::t200_command(S(100))) == Approx(kv::t200_peak_command));
+  CHECK(double(kv::t200_command(S(-100))) == Approx(-kv::t200_peak_command));
+}
+
+TEMPLATE_TEST_CASE("PWM <-> command mapping with deadband", "[vehicle][thrusters]", double, float) {
+  using S = TestType;
+  const kv::PwmMapping<S> m;  // 1100-1500-1900, ±25 µs
+  m.validate();
+  CHECK(kv::command_from_pwm(S(1900), m) == S(1));
+  CHECK(kv::command_from_pwm(S(1100), m) == S(-1));
+  CHECK(kv::command_from_pwm(S(1500), m) == S(0));
+  CHECK(kv::command_from_pwm(S(1520), m) == S(0));
+  CHECK(kv::command_from_pwm(S(1475), m) == S(0));
+  CHECK(double(kv::command_from_pwm(S(1600), m)) == Approx(0.25));  // (1600−1500)/400
+  CHECK(double(kv::command_from_pwm(S(1300), m)) == Approx(-0.5));
+  CHECK(kv::command_from_pwm(S(2100), m) == S(1));
+  CHECK(double(kv::pwm_from_command(S(0.25), m)) == Approx(1600));
+  CHECK(double(kv::pwm_from_command(S(-1), m)) == Approx(1100));
+  CHECK(double(kv::pwm_from_command(S(3), m)) == Approx(1900));
+  for (double u = -1; u <= 1; u += 0.125) {
+    if (std::abs(u) * 400 <= 25) continue;
+    CHECK(double(kv::command_from_pwm(kv::pwm_from_command(S(u), m), m)) == Approx(u).margin(1e-6));
+  }
+  kv::PwmMapping<S> bad;
+  bad.deadband_us = S(450);
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("deadband_us"));
+  bad = kv::PwmMapping<S>();
+  bad.max_us = S(1400);
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("max_us"));
+}
