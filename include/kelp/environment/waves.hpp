@@ -62,16 +62,72 @@ struct WaveBlock {
       ay[kWaveBlock], az[kWaveBlock];
 };
 
+/// Accumulators of elevation, velocity and acceleration for kLanes lanes.
+template <int kLanes>
+struct WaveLanes {
+  double zeta[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, ax[kLanes] = {},
+         ay[kLanes] = {}, az[kLanes] = {};
+};
+
+/// Adds component j's contribution at (x, y, ze) to lane l of `acc`: the Airy sums of the file
+/// comment, with F_h, F_v written with decaying exponentials only.
+template <bool kFinite, int kLanes>
+KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::size_t j, double t,
+                                             double x, double y, double ze, WaveLanes<kLanes>& acc,
+                                             int l) {
+  double sn, cs;
+  fast_sincos(c.kx[j] * x + c.ky[j] * y + (c.phase[j] - c.omega[j] * t), sn, cs);
+  const double e = fast_exp_nonpositive_unchecked(-c.k[j] * ze);  // k·ze ≤ 700 by the caller
+  double fh = e, fv = e;
+  if constexpr (kFinite) {
+    const double e2 = fast_exp_nonpositive(-c.k[j] * (c.two_h - ze));
+    fh = (e + e2) * c.q[j];
+    fv = (e - e2) * c.q[j];
+  }
+  acc.zeta[l] += c.amp[j] * cs;
+  const double ah = c.aw[j] * fh, awh = c.aw2[j] * fh;  // a ω F_h and a ω² F_h
+  const double hv = ah * cs, ha = awh * sn;
+  acc.vx[l] += hv * c.cosb[j];
+  acc.vy[l] += hv * c.sinb[j];
+  acc.ax[l] += ha * c.cosb[j];
+  acc.ay[l] += ha * c.sinb[j];
+  if constexpr (kFinite) {
+    acc.vz[l] -= (c.aw[j] * fv) * sn;
+    acc.az[l] += (c.aw2[j] * fv) * cs;
+  } else {  // F_v = F_h in deep water
+    acc.vz[l] -= ah * sn;
+    acc.az[l] += awh * cs;
+  }
+}
+
 /// Adds every component's elevation, velocity and acceleration to the block's accumulators.
-/// The inner loop over points has no branch and calls only inline arithmetic, so it vectorises.
+/// Several points: points go in lanes (a compile-time width the compiler maps onto vector
+/// registers; the last lane group is padded with copies of its first point) and the lane
+/// accumulators stay in registers across the loop over components. One point: the components go
+/// in lanes instead, and the lanes are summed at the end. Neither inner loop has a branch or a
+/// call, so both vectorise.
 template <bool kFinite>
 KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView& c, WaveBlock& b,
                                                         int m, double t) {
-  // Points go in lanes of kLanes (a compile-time width the compiler maps onto vector registers,
-  // padding the last lane group with copies of its first point); the accumulators of one lane
-  // group stay in registers across the loop over components.
   constexpr int kLanes = 8;
-  const double two_h = c.two_h;
+  if (m == 1) {
+    WaveLanes<kLanes> acc;
+    const double x = b.x[0], y = b.y[0], ze = b.ze[0];
+    std::size_t j0 = 0;
+    for (; j0 + kLanes <= c.n; j0 += kLanes)
+      for (int l = 0; l < kLanes; ++l) wave_term<kFinite>(c, j0 + l, t, x, y, ze, acc, l);
+    for (std::size_t j = j0; j < c.n; ++j) wave_term<kFinite>(c, j, t, x, y, ze, acc, 0);
+    for (int l = 0; l < kLanes; ++l) {
+      b.zeta[0] += acc.zeta[l];
+      b.vx[0] += acc.vx[l];
+      b.vy[0] += acc.vy[l];
+      b.vz[0] += acc.vz[l];
+      b.ax[0] += acc.ax[l];
+      b.ay[0] += acc.ay[l];
+      b.az[0] += acc.az[l];
+    }
+    return;
+  }
   for (int i0 = 0; i0 < m; i0 += kLanes) {
     double x[kLanes], y[kLanes], ze[kLanes];
     for (int l = 0; l < kLanes; ++l) {
@@ -80,41 +136,18 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
       y[l] = b.y[i];
       ze[l] = b.ze[i];
     }
-    double zeta[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, ax[kLanes] = {},
-           ay[kLanes] = {}, az[kLanes] = {};
-    for (std::size_t j = 0; j < c.n; ++j) {
-      const double kx = c.kx[j], ky = c.ky[j], k = c.k[j], c0 = c.phase[j] - c.omega[j] * t;
-      const double a = c.amp[j], aw = c.aw[j], aw2 = c.aw2[j], cb = c.cosb[j], sb = c.sinb[j];
-      const double q = c.q[j];
-      for (int l = 0; l < kLanes; ++l) {
-        double sn, cs;
-        fast_sincos(kx * x[l] + ky * y[l] + c0, sn, cs);
-        const double e = fast_exp_nonpositive_unchecked(-k * ze[l]);  // k·ze ≤ 700
-        double fh = e, fv = e;
-        if constexpr (kFinite) {
-          const double e2 = fast_exp_nonpositive(-k * (two_h - ze[l]));
-          fh = (e + e2) * q;
-          fv = (e - e2) * q;
-        }
-        zeta[l] += a * cs;
-        const double hv = aw * fh * cs, ha = aw2 * fh * sn;
-        vx[l] += hv * cb;
-        vy[l] += hv * sb;
-        vz[l] -= aw * fv * sn;
-        ax[l] += ha * cb;
-        ay[l] += ha * sb;
-        az[l] += aw2 * fv * cs;
-      }
-    }
+    WaveLanes<kLanes> acc;
+    for (std::size_t j = 0; j < c.n; ++j)
+      for (int l = 0; l < kLanes; ++l) wave_term<kFinite>(c, j, t, x[l], y[l], ze[l], acc, l);
     for (int l = 0; l < kLanes && i0 + l < m; ++l) {
       const int i = i0 + l;
-      b.zeta[i] += zeta[l];
-      b.vx[i] += vx[l];
-      b.vy[i] += vy[l];
-      b.vz[i] += vz[l];
-      b.ax[i] += ax[l];
-      b.ay[i] += ay[l];
-      b.az[i] += az[l];
+      b.zeta[i] += acc.zeta[l];
+      b.vx[i] += acc.vx[l];
+      b.vy[i] += acc.vy[l];
+      b.vz[i] += acc.vz[l];
+      b.ax[i] += acc.ax[l];
+      b.ay[i] += acc.ay[l];
+      b.az[i] += acc.az[l];
     }
   }
 }

@@ -12,12 +12,14 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/fast_math.hpp"
 
 namespace kelp {
 namespace environment {
@@ -143,6 +145,15 @@ class WindField {
   /// \brief Wind speed U(t) = U₁₀ + u_g(t) [m/s] at time t [s].
   Scalar speed(const Scalar& t) const {
     using std::cos;
+    if constexpr (std::is_floating_point_v<Scalar>) {
+      double u = params_.speed, sn, cs;
+      const double td = static_cast<double>(t);
+      for (std::size_t j = 0; j < amp_.size(); ++j) {
+        detail::fast_sincos(omega_[j] * td + phase_[j], sn, cs);
+        u += amp_[j] * cs;
+      }
+      return static_cast<Scalar>(u);
+    }
     Scalar u(params_.speed);
     for (std::size_t j = 0; j < amp_.size(); ++j)
       u += Scalar(amp_[j]) * cos(Scalar(omega_[j]) * t + Scalar(phase_[j]));
