@@ -46,7 +46,7 @@ namespace detail {
 
 /// Per-component constants of a wave field, as plain arrays (see `WaveField`).
 struct WaveComponentsView {
-  const double *omega, *k, *amp, *phase, *kx, *ky, *cosb, *sinb, *aw, *aw2, *q;
+  const double *omega, *k, *amp, *phase, *kx, *ky, *cosb, *sinb, *aw, *aw2, *q, *e2h;
   std::size_t n;
   double two_h;  ///< twice the water depth (finite depth only)
 };
@@ -80,7 +80,9 @@ KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::s
   const double e = fast_exp_nonpositive_unchecked(-c.k[j] * ze);  // k·ze ≤ 700 by the caller
   double fh = e, fv = e;
   if constexpr (kFinite) {
-    const double e2 = fast_exp_nonpositive(-c.k[j] * (c.two_h - ze));
+    // e^{−k(2h − z)} = e^{−2kh} / e^{−kz}: a division instead of a second exponential (e > 0
+    // because the caller clamps k z ≤ 700; e^{−2kh} ≤ e² may underflow to 0, which is right).
+    const double e2 = c.e2h[j] / e;
     fh = (e + e2) * c.q[j];
     fv = (e - e2) * c.q[j];
   }
@@ -285,7 +287,7 @@ class WaveField {
     const double w_lo = p.omega_min_factor * wp, w_hi = p.omega_max_factor * wp;
     const double dw = (w_hi - w_lo) / static_cast<double>(n);
     for (auto* v :
-         {&omega_, &k_, &amp_, &phase_, &dir_, &kx_, &ky_, &cosb_, &sinb_, &aw_, &aw2_, &q_})
+         {&omega_, &k_, &amp_, &phase_, &dir_, &kx_, &ky_, &cosb_, &sinb_, &aw_, &aw2_, &q_, &e2h_})
       v->resize(n);
     for (std::size_t j = 0; j < n; ++j) {
       const double u = p.jitter ? uniform() : 0.5;
@@ -319,6 +321,7 @@ class WaveField {
       // 1 / (1 − e^{−2kh}): the common factor of cosh/sinh ratios written with decaying
       // exponentials only (no overflow for large k h).
       q_[j] = std::isinf(p.depth) ? 1.0 : 1.0 / (-std::expm1(-2.0 * k * p.depth));
+      e2h_[j] = std::isinf(p.depth) ? 0.0 : std::exp(-2.0 * k * p.depth);
     }
     finite_depth_ = !std::isinf(p.depth);
     z_exp_limit_ = 700.0 / k_.back();  // k grows with j: k_.back() is the largest
@@ -524,16 +527,16 @@ class WaveField {
   }
 
   detail::WaveComponentsView view() const {
-    return {omega_.data(), k_.data(),     amp_.data(),        phase_.data(), kx_.data(),
-            ky_.data(),    cosb_.data(),  sinb_.data(),       aw_.data(),    aw2_.data(),
-            q_.data(),     omega_.size(), 2.0 * params_.depth};
+    return {omega_.data(), k_.data(),    amp_.data(),   phase_.data(),      kx_.data(),
+            ky_.data(),    cosb_.data(), sinb_.data(),  aw_.data(),         aw2_.data(),
+            q_.data(),     e2h_.data(),  omega_.size(), 2.0 * params_.depth};
   }
 
   WaveFieldParameters params_;
   bool finite_depth_ = false;
   bool force_baseline_ = false;
   double z_exp_limit_ = std::numeric_limits<double>::infinity();
-  std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, q_;
+  std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, q_, e2h_;
 };
 
 /// \brief Double-precision wave field.
