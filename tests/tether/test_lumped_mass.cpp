@@ -99,13 +99,13 @@ TEST_CASE("node masses, volumes and lumped lengths", "[tether][model]") {
   CHECK(m.last_free_node() == 3);
 }
 
-TEST_CASE("axial force: EA strain plus damping when stretched, nothing in compression",
-          "[tether][forces]") {
+TEST_CASE(
+    "axial force: EA strain when stretched, never elastic compression, dashpot BA strain rate",
+    "[tether][forces]") {
   kelp_test::Vacuum<double> env;
   env.g = 0;  // isolate the axial force
   auto p = kelp_test::benchmark_line<double>(1);
   p.length = 2.0;
-  p.internal_damping = 50.0;
   const kt::TetherModeld m(p);
   kt::TetherWorkspaced ws(m);
   kelp::Matrix3X<double> x(3, 2), v = kelp::Matrix3X<double>::Zero(3, 2);
@@ -117,21 +117,29 @@ TEST_CASE("axial force: EA strain plus damping when stretched, nothing in compre
   CHECK(ws.tension(0) == Approx(50.0).epsilon(1e-9));
   CHECK((ws.force.col(0) - 50.0 * u).norm() < 1e-9);
   CHECK((ws.force.col(1) + 50.0 * u).norm() < 1e-9);
-  // Separating at 0.2 m/s: damping adds BA·ε̇ = 50 · 0.2/2 = 5 N.
-  v.col(1) = 0.2 * u;
-  kt::compute_forces(m, ws, env, 0.0, x, v);
-  CHECK(ws.tension(0) == Approx(55.0).epsilon(1e-9));
-  // Approaching fast: damping would make the tension negative → clamped at zero.
-  v.col(1) = -4.0 * u;
-  kt::compute_forces(m, ws, env, 0.0, x, v);
-  CHECK(ws.tension(0) == 0.0);
-  CHECK(ws.force.col(0).norm() == 0.0);
-  // Compressed (shorter than l): slack, no force at all even when separating.
+  // Slack (shorter than l) without damping: no force at all, whatever the motion.
   x.col(1) = 1.5 * u;
-  v.col(1) = 0.3 * u;
+  v.col(1) = Vector3<double>(0.3, -0.2, 0.5);
   kt::compute_forces(m, ws, env, 0.0, x, v);
   CHECK(ws.tension(0) == 0.0);
   CHECK(ws.force.norm() == 0.0);
+
+  // With internal damping BA = 50 N s the dashpot adds BA·ε̇ at any length (as MoorDyn's Td).
+  p.internal_damping = 50.0;
+  const kt::TetherModeld md(p);
+  x.col(1) = 2.001 * u;
+  v.col(1) = 0.2 * u;  // separating at 0.2 m/s: ε̇ = 0.1 1/s → +5 N
+  kt::compute_forces(md, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(55.0).epsilon(1e-9));
+  // Slack and closing at 0.4 m/s: the dashpot alone resists, −10 N, the elastic part is zero.
+  x.col(1) = 1.5 * u;
+  v.col(1) = -0.4 * u;
+  kt::compute_forces(md, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(-10.0).epsilon(1e-9));
+  // Slack and at rest: nothing.
+  v.col(1).setZero();
+  kt::compute_forces(md, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == 0.0);
 }
 
 TEST_CASE("weight, buoyancy, drag and fluid inertia on a node", "[tether][forces]") {

@@ -9,7 +9,6 @@
 /// as it was.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
@@ -62,6 +61,15 @@ struct ImplicitOptions {
   /// Convergence when max_i |R_i| / a_i ≤ this [m/s], R_i the momentum residual of node i and
   /// a_i its isotropic mass; default ≈ 100·√ε (1.5e-6 m/s in double, 0.03 m/s in float).
   Scalar velocity_tolerance = Scalar(100) * std::sqrt(std::numeric_limits<Scalar>::epsilon());
+  /// Segments at least (1 − band)·l long start each Newton iteration's active set in the taut
+  /// branch (see detail::active_set_direction); 0 starts from the stretched segments.
+  Scalar slack_band = Scalar(0);
+  /// Maximum active-set passes (block-tridiagonal solves, no force evaluation) per Newton
+  /// iteration; 1 is plain Newton on the current branch.
+  int max_active_set_passes = 16;
+  /// Maximum line-search corrections (secant steps, each one force evaluation) per Newton
+  /// iteration; 0 always takes the full Newton step.
+  int max_backtracks = 3;
 };
 
 /// \brief What one step did.
@@ -97,43 +105,124 @@ Matrix3<Scalar> segment_block(const TetherWorkspace<Scalar>& ws, int s, Scalar c
   return a;
 }
 
+/// Inverse of a symmetric positive definite 3×3 matrix by cofactors (one division, no square
+/// root: the block-Thomas sweep is a serial dependency chain, so latency matters more than flops).
+/// Positive definiteness is checked by Sylvester's criterion on the leading minors; returns
+/// false if it fails. Only the lower triangle of D is read. Well conditioned here: the blocks are
+/// mass plus stiffness, cond(D) ≲ h²k/m.
+template <typename Scalar>
+bool spd_inverse3(const Matrix3<Scalar>& d, Matrix3<Scalar>& inv) {
+  const Scalar a = d(0, 0), b = d(1, 0), c = d(2, 0), e = d(1, 1), f = d(2, 1), g = d(2, 2);
+  const Scalar c00 = e * g - f * f, c01 = c * f - b * g, c02 = b * f - c * e;
+  const Scalar minor2 = a * e - b * b;
+  const Scalar det = a * c00 + b * c01 + c * c02;
+  if (!(a > Scalar(0) && minor2 > Scalar(0) && det > Scalar(0))) return false;
+  const Scalar k = Scalar(1) / det;
+  inv(0, 0) = c00 * k;
+  inv(1, 0) = inv(0, 1) = c01 * k;
+  inv(2, 0) = inv(0, 2) = c02 * k;
+  inv(1, 1) = (a * g - c * c) * k;
+  inv(2, 1) = inv(1, 2) = (b * c - a * f) * k;
+  inv(2, 2) = minor2 * k;
+  return true;
+}
+
 /// Solves J δ = rhs over the free nodes, J = c_m M + c_v (−∂F/∂v) + c_x (−∂F/∂x), block
-/// tridiagonal and symmetric positive definite, by block-Thomas elimination with a 3×3 Cholesky
-/// factorisation per block. Reads the Jacobian ingredients of the last compute_forces<true>;
-/// writes ws.delta. O(N), no heap allocation.
+/// tridiagonal and symmetric positive definite, by block-Thomas elimination (block LDLᵀ): each
+/// Schur-complement block D'_i = D_i − A_{i−1} D'^{-1}_{i−1} A_{i−1} is inverted in closed form
+/// (3×3, SPD-checked). Reads the Jacobian ingredients of the last compute_forces<true>; writes
+/// ws.delta. O(N), no heap allocation.
 template <typename Scalar>
 void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                              Scalar c_m, Scalar c_v, Scalar c_x) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  Eigen::LLT<Matrix3<Scalar>> llt;
-  Matrix3<Scalar> a_prev = Matrix3<Scalar>::Zero();
+  Matrix3<Scalar> a_prev = Matrix3<Scalar>::Zero(), a_next = Matrix3<Scalar>::Zero(), inv;
+  if (f0 > 0) a_prev = segment_block(ws, f0 - 1, c_v, c_x);
   for (int i = f0; i <= f1; ++i) {
     Matrix3<Scalar> d = c_m * node_mass_matrix(ws, i) + c_v * ws.node_dv[i];
     d(2, 2) += c_x * ws.node_kz(i);
     Vector3<Scalar> r = ws.rhs.col(i);
-    if (i > 0) {
-      const Matrix3<Scalar> a = segment_block(ws, i - 1, c_v, c_x);
-      d += a;
-      if (i > f0) {
-        d.noalias() -= a_prev * ws.block_g[i - 1];
-        r.noalias() += a_prev * ws.delta.col(i - 1);
-      }
+    if (i > 0) d += a_prev;
+    if (i > f0) {
+      // Off-diagonal blocks are −A_{i−1}: D' = D − A G, r' = r + A z with G = D'⁻¹A, z = D'⁻¹r.
+      d.noalias() -= a_prev * ws.block_g[i - 1];
+      r.noalias() += a_prev * ws.delta.col(i - 1);
     }
     if (i < n) {
-      a_prev = segment_block(ws, i, c_v, c_x);
-      d += a_prev;
+      a_next = segment_block(ws, i, c_v, c_x);
+      d += a_next;
     }
-    llt.compute(d);
-    if (llt.info() != Eigen::Success)
+    if (!spd_inverse3(d, inv))
       ::kelp::detail::throw_numerical_error(
-          "tether Newton step: Jacobian block not positive "
-          "definite");
-    ws.delta.col(i) = llt.solve(r);
-    if (i < f1) ws.block_g[i] = llt.solve(a_prev);
+          "tether Newton step: Jacobian block not positive definite; the state is unchanged");
+    ws.delta.col(i).noalias() = inv * r;
+    if (i < f1) ws.block_g[i].noalias() = inv * a_next;
+    a_prev = a_next;
   }
   for (int i = f1 - 1; i >= f0; --i)
     ws.delta.col(i).noalias() += ws.block_g[i] * ws.delta.col(i + 1);
+}
+
+/// Newton direction with a primal–dual active set for the kink of the elastic tension at
+/// l_s = l (semismooth Newton on T_el = EA·max(0, ε)): in the linear model each segment's elastic
+/// part is either on — T_el ≈ EA ε + (EA/l) u·Δδx, negative values allowed inside the linear
+/// model — or off. The set starts from the segments with l_s ≥ (1 − band)·l, and is updated from
+/// the predicted lengths until it repeats (at most `max_passes` solves). Reads ws.rhs (= −R) and
+/// the Jacobian terms of compute_forces<true>; writes ws.delta; ws.rhs is restored.
+template <typename Scalar>
+void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
+                          Scalar band, int max_passes) {
+  const int n = model.segments();
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  const Scalar l = model.segment_length(), inv_l = model.inverse_segment_length();
+  const Scalar ea = model.parameters().axial_stiffness, ea_l = model.axial_spring();
+  if (max_passes <= 1 && !(band > Scalar(0))) {
+    solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+    return;
+  }
+  ws.rhs_true = ws.rhs;
+  ws.seg_true_k_uu = ws.seg_k_uu;
+  for (int s = 0; s < n; ++s)
+    ws.seg_active(s) = ws.stretched_length(s) >= (Scalar(1) - band) * l ? Scalar(1) : Scalar(0);
+  for (int pass = 0;; ++pass) {
+    ws.rhs = ws.rhs_true;
+    for (int s = 0; s < n; ++s) {
+      const bool stretched = ws.stretched_length(s) > l;
+      const bool active = ws.seg_active(s) > Scalar(0);
+      ws.seg_k_uu(s) = ws.seg_true_k_uu(s);
+      if (active == stretched) continue;
+      const auto u = ws.direction.col(s);
+      // Elastic force of the taut branch at the current point (negative when slack).
+      const Scalar te = ea * (ws.stretched_length(s) - l) * inv_l;
+      if (active) {  // slack, modelled taut: add the (compressive) branch value and stiffness
+        ws.rhs.col(s) += (gh * te) * u;
+        ws.rhs.col(s + 1) -= (gh * te) * u;
+        ws.seg_k_uu(s) += ea_l;
+      } else {  // stretched, modelled slack: remove its elastic force and stiffness
+        ws.rhs.col(s) -= (gh * te) * u;
+        ws.rhs.col(s + 1) += (gh * te) * u;
+        ws.seg_k_uu(s) -= ea_l;
+      }
+    }
+    solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+    if (pass + 1 >= max_passes) break;
+    bool changed = false;
+    for (int s = 0; s < n; ++s) {
+      Scalar dl(0);
+      const auto u = ws.direction.col(s);
+      if (s >= f0 && s <= f1) dl -= gh * u.dot(ws.delta.col(s));
+      if (s + 1 >= f0 && s + 1 <= f1) dl += gh * u.dot(ws.delta.col(s + 1));
+      const bool now = ws.stretched_length(s) + dl > l;
+      if (now != (ws.seg_active(s) > Scalar(0))) {
+        changed = true;
+        ws.seg_active(s) = now ? Scalar(1) : Scalar(0);
+      }
+    }
+    if (!changed) break;
+  }
+  ws.seg_k_uu = ws.seg_true_k_uu;
+  ws.rhs.swap(ws.rhs_true);
 }
 
 template <typename Scalar>
@@ -309,35 +398,74 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
 
   StepReport<Scalar> report;
   report.converged = false;
-  for (int it = 0;; ++it) {
-    compute_forces<true>(model, ws, env, t1, ws.x1, ws.v1);
+  // Evaluates F at (x, v), writes rhs = −R = γh F − M (v − v̂) on the free nodes and returns the
+  // merit Σ |R_i/a_i|²; `res` gets the scaled max-norm max_i |R_i|/a_i.
+  const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& res) {
+    compute_forces<true>(model, ws, env, t1, x, v);
     ++report.force_evaluations;
-    // rhs = −R = γh F − M (v − v̂) on the free nodes; scaled residual max |R_i| / a_i.
-    Scalar res(0);
+    Scalar merit(0);
+    res = Scalar(0);
     for (int i = f0; i <= f1; ++i) {
-      const Vector3<Scalar> dvel = ws.v1.col(i) - ws.v0.col(i);
+      const Vector3<Scalar> dvel = v.col(i) - ws.v0.col(i);
       const Vector3<Scalar> q = ws.tangent.col(i);
       const Vector3<Scalar> r =
           gh * ws.force.col(i) - (ws.mass_iso(i) * dvel + (ws.mass_tan(i) * q.dot(dvel)) * q);
       ws.rhs.col(i) = r;
-      res = std::max(res, Scalar(r.cwiseAbs().maxCoeff() / ws.mass_iso(i)));
+      const Scalar inv_a = Scalar(1) / ws.mass_iso(i);
+      res = std::max(res, Scalar(r.cwiseAbs().maxCoeff() * inv_a));
+      merit += r.squaredNorm() * inv_a * inv_a;
     }
-    report.residual = res;
-    if (!(res == res))
+    if (!(merit == merit) || !(merit < std::numeric_limits<Scalar>::infinity()))
       ::kelp::detail::throw_numerical_error(
-          "step_implicit: non-finite residual; the state is "
-          "unchanged");
+          "step_implicit: non-finite residual; the state is unchanged");
+    return merit;
+  };
+  Scalar res(0);
+  evaluate(ws.x1, ws.v1, res);
+  ws.xs = ws.x1;  // carries the kinematic end positions into the trial iterates
+  ws.vs = ws.v1;
+  for (int it = 0;; ++it) {
+    report.residual = res;
     if (res <= options.velocity_tolerance) {
       report.converged = true;
       break;
     }
     if (it >= options.max_iterations) break;
-    detail::solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+    detail::active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
     ++report.newton_iterations;
-    for (int i = f0; i <= f1; ++i) {
-      ws.v1.col(i) += ws.delta.col(i);
-      ws.x1.col(i) = ws.x0.col(i) + gh * ws.v1.col(i);
+    // Line search. R is the gradient of the step's incremental potential
+    // Φ(v) = ½(v − v̂)ᵀM(v − v̂) + U(x̂ + γh v) + γh·(dissipation potential), which is convex for
+    // this model up to the tangent dependence of drag and added mass (elastic energy
+    // ½EA/l·max(0, l_s − l)² is convex in x). Along x(α) = x + αδ the slope φ'(α) = R(α)·δ is
+    // therefore increasing, with φ'(0) = −δᵀJδ < 0. The full Newton step is kept unless it
+    // overshoots the minimum along δ (φ'(1) > ½|φ'(0)|, e.g. across the kink of the tension at
+    // l_s = l, where plain Newton can cycle between the slack and the taut branch); then secant
+    // steps on φ' home in on the minimum. Each trial costs one force evaluation.
+    const auto slope = [&]() {
+      Scalar g(0);
+      for (int i = f0; i <= f1; ++i) g -= ws.rhs.col(i).dot(ws.delta.col(i));
+      return g;
+    };
+    const Scalar g0 = slope();
+    Scalar a_lo(0), g_lo = g0, alpha(1), trial_res(0);
+    for (int ls = 0;; ++ls) {
+      for (int i = f0; i <= f1; ++i) {
+        ws.vs.col(i) = ws.v1.col(i) + alpha * ws.delta.col(i);
+        ws.xs.col(i) = ws.x0.col(i) + gh * ws.vs.col(i);
+      }
+      evaluate(ws.xs, ws.vs, trial_res);
+      if (ls >= options.max_backtracks || !(g0 < Scalar(0))) break;
+      const Scalar g = slope();
+      if (g <= Scalar(-0.5) * g0) break;
+      // Secant on φ' between (a_lo, g_lo < 0) and (alpha, g > 0).
+      const Scalar a_new = a_lo + (alpha - a_lo) * (-g_lo) / (g - g_lo);
+      if (!(a_new > a_lo && a_new < alpha)) break;
+      alpha = a_new;
+      (void)a_lo;
     }
+    ws.x1.swap(ws.xs);
+    ws.v1.swap(ws.vs);
+    res = trial_res;
   }
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
   // commit() stores the pre-step state as BDF2 history.
@@ -501,7 +629,7 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
   detail::apply_boundary(model, b, Scalar(0), state.position, state.velocity);
   ImplicitOptions<Scalar> inner;
   inner.max_iterations = 6;
-  inner.velocity_tolerance = tol / (Scalar(100) * model.node_mass(model.segments() / 2));
+  const Scalar m_ref = model.node_mass(model.segments() / 2);
   StaticResult<Scalar> result;
   Scalar h = options.initial_pseudo_dt;
   const Scalar h_max(1e6);
@@ -520,7 +648,8 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
       }
       if (it >= options.max_iterations) break;
       ws.xs = state.position;  // undo point
-      inner.velocity_tolerance = std::max(inner.velocity_tolerance, Scalar(0));
+      // The inner residual is h·F/m in velocity units: ask for forces a tenth of the tolerance.
+      inner.velocity_tolerance = Scalar(0.1) * tol * h / m_ref;
       const StepReport<Scalar> r = step_implicit(model, ws, env, state, b, h, false, inner);
       state.time = t_entry;
       state.velocity.setZero();

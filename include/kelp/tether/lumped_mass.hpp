@@ -259,17 +259,20 @@ struct TetherWorkspace {
   VectorX<Scalar> submerged;            ///< 1 if node i is below the free surface, else 0
   // --- per evaluation, per segment ------------------------------------------------------------
   Matrix3X<Scalar> direction;        ///< unit vector u_s from node s to s+1 (0 if zero length)
-  VectorX<Scalar> tension;           ///< segment tension T_s ≥ 0 [N]
+  VectorX<Scalar> tension;           ///< axial force T_s: elastic (≥ 0) plus dashpot [N]
   VectorX<Scalar> stretched_length;  ///< segment length l_s [m]
   // --- Jacobian ingredients (filled when requested) --------------------------------------------
-  VectorX<Scalar> seg_k_uu;    ///< ∂F/∂x along u: EA/l − T/l_s (active segments)
+  VectorX<Scalar> seg_k_uu;  ///< axial stiffness minus geometric term: EA/l − T⁺/l_s or −T⁺/l_s
   VectorX<Scalar> seg_k_perp;  ///< geometric stiffness T/l_s [N/m]
-  VectorX<Scalar> seg_c_uu;    ///< BA/l on active segments [N s/m]
+  VectorX<Scalar> seg_c_uu;    ///< BA/l [N s/m]
   Mat3Vector node_dv;          ///< −∂F_i/∂v_i from drag and seabed [N s/m]
   VectorX<Scalar> node_kz;     ///< −∂F_z/∂z from the seabed [N/m]
   // --- linear solver and integrator buffers ----------------------------------------------------
   Mat3Vector block_g;           ///< block-Thomas multipliers D'^{-1} B
   Matrix3X<Scalar> rhs, delta;  ///< Newton right-hand side and correction
+  Matrix3X<Scalar> rhs_true;    ///< −R saved while the active-set passes modify rhs
+  VectorX<Scalar> seg_true_k_uu, seg_true_k_perp, seg_true_c_uu;  ///< saved Jacobian terms
+  VectorX<Scalar> seg_active;  ///< 1 if segment s is taut in the Newton step's linear model
   Matrix3X<Scalar> x0, v0, x1, v1, xs, vs, kx, kv, x_prev, v_prev;  ///< integrator stages
   bool has_previous = false;                                        ///< BDF2 history valid
   Scalar previous_dt = Scalar(0);  ///< step of the stored history [s]
@@ -289,7 +292,9 @@ struct TetherWorkspace {
     for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &submerged, &node_kz})
       v->setZero(n);
     direction.setZero(3, s);
-    for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu})
+    rhs_true.setZero(3, n);
+    for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu,
+                               &seg_true_k_uu, &seg_true_k_perp, &seg_true_c_uu, &seg_active})
       v->setZero(s);
     node_dv.assign(n, Mat3::Zero());
     block_g.assign(n, Mat3::Zero());
@@ -322,7 +327,9 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 /// (`ws.mass_iso`, `ws.mass_tan`), plus tensions, tangents and seabed forces. Per node i:
 /// \f[ F_i = T_i u_i − T_{i−1} u_{i−1} + (m_i − ρ V_i) g e_z + F^{drag}_i + F^{FK}_i + F^{bed}_i
 /// \f]
-/// - axial: T_s = max(0, EA ε_s + BA ε̇_s) when l_s > l, else 0 (no compression);
+/// - axial: T_s = EA ε_s (only when l_s > l: the elastic force never compresses) + BA ε̇_s (the
+///   internal dashpot acts at any length, as in MoorDyn; with BA = 0 a slack segment carries no
+///   force);
 /// - drag (Morison, on v_r = u_water − v_i): ½ρ d l_i Cdn |v_rn| v_rn + ½ρ π d l_i Cdt |v_rt| v_rt;
 /// - fluid inertia: ρ V_i [(1 + Can)(I − q qᵀ) + (1 + Cat) q qᵀ] a_water;
 /// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force);
@@ -351,40 +358,38 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
 
   env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
 
-  // Segments: tension along u_s (zero when slack).
+  // Segments: elastic tension EA·ε when stretched (never compressive) plus the internal dashpot
+  // BA·ε̇, which, as in MoorDyn (Line.cpp: Td), acts whether or not the segment is stretched, so
+  // that the axial force is continuous in the node positions (a dashpot switched on at l_s = l
+  // would make it jump, which Newton's method cannot handle).
   for (int s = 0; s < n; ++s) {
     const V3 d = x.col(s + 1) - x.col(s);
     const Scalar ls2 = d.squaredNorm();
-    Scalar tension(0), k_uu(0), k_perp(0), c_uu(0);
-    if (ls2 > l2) {
-      const Scalar ls = sqrt(ls2), inv_ls = Scalar(1) / ls;
+    const Scalar ls = sqrt(ls2);
+    ws.stretched_length(s) = ls;
+    Scalar tension(0), k_axial(0);
+    if (ls > Scalar(0)) {
+      const Scalar inv_ls = Scalar(1) / ls;
       const V3 u = d * inv_ls;
-      const Scalar strain_rate = u.dot(v.col(s + 1) - v.col(s)) * inv_l;
-      tension = ea * (ls - l) * inv_l + ba * strain_rate;
       ws.direction.col(s) = u;
-      ws.stretched_length(s) = ls;
-      if (tension > Scalar(0)) {
-        k_perp = tension * inv_ls;
-        k_uu = ea_l - k_perp;
-        c_uu = ba_l;
-      } else {
-        tension = Scalar(0);
+      if (ls2 > l2) {
+        tension = ea * (ls - l) * inv_l;
+        k_axial = ea_l;
+      }
+      if (ba != Scalar(0)) tension += ba * u.dot(v.col(s + 1) - v.col(s)) * inv_l;
+      if constexpr (WithJacobian) {
+        // ∂(T u)/∂x_{s+1} = k_axial u uᵀ + (T/l_s)(I − u uᵀ); the geometric term is kept only for
+        // T > 0 so that the Jacobian stays positive semi-definite.
+        const Scalar k_perp = tension > Scalar(0) ? tension * inv_ls : Scalar(0);
+        ws.seg_k_uu(s) = k_axial - k_perp;
+        ws.seg_k_perp(s) = k_perp;
       }
     } else {
-      const Scalar ls = sqrt(ls2);
-      ws.stretched_length(s) = ls;
-      // The direction of a slack segment is kept for diagnostics and the static solve's Jacobian.
-      if (ls > Scalar(0))
-        ws.direction.col(s) = d / ls;
-      else
-        ws.direction.col(s).setZero();
+      ws.direction.col(s).setZero();
+      if constexpr (WithJacobian) ws.seg_k_uu(s) = ws.seg_k_perp(s) = Scalar(0);
     }
     ws.tension(s) = tension;
-    if constexpr (WithJacobian) {
-      ws.seg_k_uu(s) = k_uu;
-      ws.seg_k_perp(s) = k_perp;
-      ws.seg_c_uu(s) = c_uu;
-    }
+    if constexpr (WithJacobian) ws.seg_c_uu(s) = ba_l;
   }
 
   // Nodes.
