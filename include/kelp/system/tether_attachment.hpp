@@ -1,0 +1,107 @@
+/// \file
+/// \brief Attaching the ends of a lumped-mass tether to points on vehicles: the end motion from a
+/// vehicle state, and the tether force turned into a body-frame wrench the vehicle dynamics can
+/// take. `vehicle` and `tether` do not include each other; they meet here (DESIGN.md).
+///
+/// Frames: world NED; body x forward, y starboard, z down. A point r_b fixed in the body moves
+/// with p = p_CO + R r_b, ṗ = R (v + ω × r_b) (Fossen 2021, eq. 2.106 form).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+#include "kelp/vehicle/state.hpp"
+
+namespace kelp::system {
+
+/// \brief NED motion of the body-fixed point `r_body` [m] of a vehicle, as a tether end motion:
+/// position p_CO + R r_b, velocity R (v + ω × r_b). The acceleration is left zero: a VehicleState
+/// carries no ν̇ (pass one through `EndMotion::acceleration` if the caller has it).
+/// \tparam Scalar double or float. \param[in] vehicle state \param[in] r_body point, body frame [m]
+template <typename Scalar, typename Derived>
+tether::EndMotion<Scalar> attachment_motion(const vehicle::VehicleState<Scalar>& vehicle,
+                                            const Eigen::MatrixBase<Derived>& r_body) {
+  tether::EndMotion<Scalar> m;
+  m.position = vehicle.point_position(r_body);
+  m.velocity = vehicle.point_velocity(r_body);
+  return m;
+}
+
+/// \brief Body-frame generalized force τ = (Rᵀ f, r_b × Rᵀ f) on a vehicle from an NED force
+/// `force_ned` [N] applied at the body-fixed point `r_body` [m] (Fossen 2021, eq. 2.122 form:
+/// moment about the CO). Add it to the vehicle's τ.
+template <typename Scalar, typename D1, typename D2>
+Vector6<Scalar> attachment_wrench(const vehicle::VehicleState<Scalar>& vehicle,
+                                  const Eigen::MatrixBase<D1>& r_body,
+                                  const Eigen::MatrixBase<D2>& force_ned) {
+  const Vector3<Scalar> f_body = vehicle.attitude.conjugate() * Vector3<Scalar>(force_ned);
+  Vector6<Scalar> tau;
+  tau.template head<3>() = f_body;
+  tau.template tail<3>() = Vector3<Scalar>(r_body).cross(f_body);
+  return tau;
+}
+
+/// \brief Boundary of a tether whose start end is at `r_start_body` on `start` (e.g. the ASV) and
+/// whose far end is at `r_end_body` on `end` (e.g. the AUV).
+template <typename Scalar, typename D1, typename D2>
+tether::TetherBoundary<Scalar> tether_boundary(const vehicle::VehicleState<Scalar>& start,
+                                               const Eigen::MatrixBase<D1>& r_start_body,
+                                               const vehicle::VehicleState<Scalar>& end,
+                                               const Eigen::MatrixBase<D2>& r_end_body) {
+  tether::TetherBoundary<Scalar> b;
+  b.start = attachment_motion(start, r_start_body);
+  b.end = attachment_motion(end, r_end_body);
+  return b;
+}
+
+/// \brief What the tether does to the two vehicles over a step.
+template <typename Scalar>
+struct TetherLoads {
+  /// Force on the start attachment point, NED [N].
+  Vector3<Scalar> force_start_ned = Vector3<Scalar>::Zero();
+  /// Force on the far attachment point, NED [N].
+  Vector3<Scalar> force_end_ned = Vector3<Scalar>::Zero();
+  /// Generalized force on the start vehicle, body frame (N, N m).
+  Vector6<Scalar> tau_start = Vector6<Scalar>::Zero();
+  /// Generalized force on the far vehicle, body frame (N, N m).
+  Vector6<Scalar> tau_end = Vector6<Scalar>::Zero();
+  /// Sub-steps taken.
+  int substeps = 0;
+};
+
+/// \brief Advances the tether by `dt` [s] (in sub-steps no longer than `max_dt`) with its ends
+/// attached to `r_start_body` on `start` and `r_end_body` on `end` (the vehicles are taken to
+/// move with their current velocities through the interval), and returns the loads on both
+/// vehicles from the last sub-step, ready to be added to their τ. The tether model's ends must be
+/// `kinematic`. No heap allocation.
+/// \throws kelp::invalid_argument for bad input or free tether ends; kelp::numerical_error (tether
+/// state unchanged) when a sub-step fails.
+template <typename Scalar, typename Env, typename D1, typename D2>
+TetherLoads<Scalar> advance_attached_tether(
+    const tether::TetherModel<Scalar>& model, tether::TetherWorkspace<Scalar>& ws, const Env& env,
+    tether::TetherState<Scalar>& state, const vehicle::VehicleState<Scalar>& start,
+    const Eigen::MatrixBase<D1>& r_start_body, const vehicle::VehicleState<Scalar>& end,
+    const Eigen::MatrixBase<D2>& r_end_body, Scalar dt, Scalar max_dt,
+    tether::Integrator integrator, const tether::ImplicitOptions<Scalar>& options = {}) {
+  KELP_CHECK(model.parameters().start_mode == tether::EndMode::kinematic &&
+                 model.parameters().end_mode == tether::EndMode::kinematic,
+             "advance_attached_tether: both tether ends (start_mode, end_mode) must be kinematic");
+  check_all_finite(r_start_body, "r_start_body");
+  check_all_finite(r_end_body, "r_end_body");
+  const tether::TetherBoundary<Scalar> b = tether_boundary(start, r_start_body, end, r_end_body);
+  TetherLoads<Scalar> loads;
+  loads.substeps = tether::advance(model, ws, env, state, b, dt, max_dt, integrator, options);
+  loads.force_start_ned = ws.end_forces.on_start;
+  loads.force_end_ned = ws.end_forces.on_end;
+  loads.tau_start = attachment_wrench(start, r_start_body, loads.force_start_ned);
+  loads.tau_end = attachment_wrench(end, r_end_body, loads.force_end_ned);
+  return loads;
+}
+
+using TetherLoadsd = TetherLoads<double>;  ///< TetherLoads<double>
+using TetherLoadsf = TetherLoads<float>;   ///< TetherLoads<float>
+
+}  // namespace kelp::system

@@ -1,0 +1,114 @@
+// Attaching tether ends to vehicles: end motion of a body-fixed point, the body-frame wrench of
+// an NED force, and a tether step between two vehicles.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "kelp/core/rotation.hpp"
+#include "kelp/environment/environment.hpp"
+#include "kelp/system/tether_attachment.hpp"
+#include "kelp/tether/initial_state.hpp"
+
+namespace kt = kelp::tether;
+namespace ks = kelp::system;
+using kelp::Vector3;
+using kelp::Vector6;
+
+TEMPLATE_TEST_CASE("attachment motion is the body-fixed point's position and velocity",
+                   "[system][attachment]", double, float) {
+  using S = TestType;
+  kelp::vehicle::VehicleState<S> v;
+  v.position = Vector3<S>(S(1), S(2), S(3));
+  v.attitude = kelp::quaternion_from_euler(S(0.1), S(-0.2), S(0.7));
+  v.nu << S(0.5), S(-0.1), S(0.2), S(0.05), S(-0.03), S(0.2);
+  const Vector3<S> r(S(0.4), S(-0.2), S(0.1));
+  const kt::EndMotion<S> m = ks::attachment_motion(v, r);
+  CHECK((m.position - (v.position + v.attitude * r)).norm() < S(1e-6));
+  // Finite difference of the point position along the motion: p(t+h) with
+  // position += R v h and attitude += ½ q ⊗ ω h (Fossen eq. 2.75), compared with R (v + ω × r).
+  const S h = S(1e-4);
+  kelp::vehicle::VehicleState<S> w = v;
+  w.position += (v.attitude * Vector3<S>(v.nu.template head<3>())) * h;
+  const Eigen::Matrix<S, 4, 1> qd = kelp::quaternion_rate(v.attitude, v.nu.template tail<3>());
+  w.attitude = kelp::Quaternion<S>(v.attitude.w() + h * qd(0), v.attitude.x() + h * qd(1),
+                                   v.attitude.y() + h * qd(2), v.attitude.z() + h * qd(3))
+                   .normalized();
+  const Vector3<S> fd = (w.point_position(r) - v.point_position(r)) / h;
+  CHECK((fd - m.velocity).norm() < S(2e-3));
+  CHECK(m.acceleration.isZero());
+}
+
+TEST_CASE("attachment wrench: force in body axes and moment r x f about the CO",
+          "[system][attachment]") {
+  kelp::vehicle::VehicleStated v;
+  v.attitude = kelp::quaternion_from_euler(0.0, 0.0, kelp::pi / 2);  // heading east
+  const Vector3<double> r(1.0, 0.0, 0.5);                            // 1 m forward, 0.5 m down
+  // A 10 N force pointing north on a vehicle heading east acts to port (−y body).
+  const Vector6<double> tau = ks::attachment_wrench(v, r, Vector3<double>(10, 0, 0));
+  CHECK(tau(0) == Approx(0).margin(1e-12));
+  CHECK(tau(1) == Approx(-10));
+  CHECK(tau(2) == Approx(0).margin(1e-12));
+  // Moment = r × f_body = (1, 0, 0.5) × (0, −10, 0) = (5, 0, −10).
+  CHECK(tau(3) == Approx(5));
+  CHECK(tau(4) == Approx(0).margin(1e-12));
+  CHECK(tau(5) == Approx(-10));
+  // Power balance: the force does the same work on the point as τ on ν.
+  v.nu << 0.3, -0.2, 0.1, 0.02, 0.05, -0.1;
+  const Vector3<double> f(3, -1, 2);
+  const Vector6<double> t2 = ks::attachment_wrench(v, r, f);
+  CHECK(t2.dot(v.nu) == Approx(f.dot(v.point_velocity(r))));
+}
+
+TEST_CASE("tether between two vehicles: loads balance the line and follow the vehicles",
+          "[system][attachment]") {
+  kelp::environment::Environmentd env;
+  kt::TetherParametersd p;
+  p.segments = 20;
+  p.internal_damping = 100.0;
+  const kt::TetherModeld model(p);
+  kt::TetherWorkspaced ws(model);
+  // ASV at the surface with the tether 0.5 m behind its CO; AUV 10 m north, 5 m down, tether on
+  // its top 0.2 m forward of the CO.
+  kelp::vehicle::VehicleStated asv, auv;
+  asv.position = Vector3<double>(0.5, 0, 0);
+  auv.position = Vector3<double>(9.8, 0, 5.2);
+  const Vector3<double> r_asv(-0.5, 0, 0), r_auv(0.2, 0, -0.2);
+  kt::TetherStated state;
+  REQUIRE(kt::static_initial_state(model, ws, env, asv.point_position(r_asv),
+                                   auv.point_position(r_auv), state)
+              .converged);
+  CHECK((state.position.col(0) - Vector3<double>(0, 0, 0)).norm() < 1e-12);
+  CHECK((state.position.col(20) - Vector3<double>(10, 0, 5)).norm() < 1e-12);
+  // Both vehicles at rest: a 0.1 s advance keeps the static loads. The vertical forces carry the
+  // submerged weight of the line; the horizontal ones are equal and opposite (H).
+  const auto loads = ks::advance_attached_tether(model, ws, env, state, asv, r_asv, auv, r_auv, 0.1,
+                                                 0.01, kt::Integrator::bdf2);
+  CHECK(loads.substeps == 10);
+  const double w = model.submerged_weight_per_length(env.water_density(), env.gravity());
+  CHECK(loads.force_start_ned.z() + loads.force_end_ned.z() == Approx(w * p.length).epsilon(1e-4));
+  CHECK(loads.force_start_ned.x() == Approx(-loads.force_end_ned.x()).epsilon(1e-4));
+  CHECK(loads.force_start_ned.x() > 0);  // the ASV is pulled towards the AUV
+  // The AUV's tether point is above and forward of its CO: the downward-backward pull pitches
+  // its nose down (negative pitch moment M = r_z f_x − r_x f_z with f_x < 0, f_z > 0).
+  CHECK(loads.tau_end(4) < 0);
+  CHECK(loads.tau_start.head<3>().isApprox(loads.force_start_ned));  // ASV level, heading north
+  // Moving the AUV away tightens the tether: after 2 s at 1 m/s north the pull grows.
+  kelp::vehicle::VehicleStated moving = auv;
+  moving.nu(0) = 1.0;
+  ks::TetherLoadsd last;
+  for (int k = 0; k < 20; ++k) {
+    last = ks::advance_attached_tether(model, ws, env, state, asv, r_asv, moving, r_auv, 0.1, 0.01,
+                                       kt::Integrator::implicit_euler);
+    moving.position.x() += 0.1;
+  }
+  CHECK(state.position(0, 20) == Approx(12.0).epsilon(1e-9));
+  CHECK(last.force_end_ned.norm() > 1.5 * loads.force_end_ned.norm());
+  // Free tether ends cannot be attached.
+  kt::TetherParametersd pf = p;
+  pf.end_mode = kt::EndMode::free;
+  const kt::TetherModeld free_model(pf);
+  kt::TetherWorkspaced wf(free_model);
+  kt::TetherStated sf(free_model);
+  CHECK_THROWS_AS(ks::advance_attached_tether(free_model, wf, env, sf, asv, r_asv, auv, r_auv, 0.1,
+                                              0.01, kt::Integrator::bdf2),
+                  kelp::invalid_argument);
+}
