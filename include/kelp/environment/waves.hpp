@@ -176,9 +176,15 @@ __attribute__((target("avx2,fma"))) inline void wave_accumulate_avx2(const WaveC
     wave_accumulate_impl<false>(c, b, m, t);
 }
 
+#if defined(__clang__)
+#define KELP_ENV_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx2,fma")))
+#else  // GCC keeps 256-bit vectors for AVX-512 unless told otherwise
+#define KELP_ENV_TARGET_AVX512 \
+  __attribute__((target("avx512f,avx512dq,avx2,fma,prefer-vector-width=512")))
+#endif
 /// The same kernel compiled for AVX-512 (8 doubles per instruction).
-__attribute__((target("avx512f,avx512dq,avx2,fma,prefer-vector-width=512"))) inline void
-wave_accumulate_avx512(const WaveComponentsView& c, WaveBlock& b, int m, double t, bool finite) {
+KELP_ENV_TARGET_AVX512 inline void wave_accumulate_avx512(const WaveComponentsView& c, WaveBlock& b,
+                                                          int m, double t, bool finite) {
   if (finite)
     wave_accumulate_impl<true>(c, b, m, t);
   else
