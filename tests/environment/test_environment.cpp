@@ -5,6 +5,17 @@
 #include <limits>
 
 #include "kelp/environment/environment.hpp"
+#include "kelp/environment/sea_state.hpp"
+
+// Every public class, for every supported floating scalar (Jets: test_environment_jet.cpp).
+template class kelp::environment::Environment<double>;
+template class kelp::environment::Environment<float>;
+template class kelp::environment::WaveField<double>;
+template class kelp::environment::WaveField<float>;
+template class kelp::environment::CurrentModel<double>;
+template class kelp::environment::CurrentModel<float>;
+template class kelp::environment::WindField<double>;
+template class kelp::environment::WindField<float>;
 
 using kelp::Matrix3X;
 using kelp::Vector3;
