@@ -74,6 +74,15 @@ TEST_CASE("bad environment input throws kelp::invalid_argument naming the field"
   CHECK_THROWS_WITH(env.set_seabed_depth(nan), Catch::Contains("seabed_depth"));
   CHECK_THROWS_WITH(env.set_current(Vector3<double>(nan, 0, 0)), Catch::Contains("current"));
   CHECK_NOTHROW(env.set_seabed_depth(std::numeric_limits<double>::infinity()));
+  // Waves built with another gravity than the environment's are refused, in either order.
+  kelp::environment::WaveFieldParameters wp;
+  wp.spectrum.significant_height = 1.0;
+  wp.gravity = 9.81;
+  CHECK_THROWS_WITH(env.set_waves(kelp::environment::WaveField<double>(wp)),
+                    Catch::Contains("waves.gravity"));
+  env.set_gravity(9.81);
+  CHECK_NOTHROW(env.set_waves(kelp::environment::WaveField<double>(wp)));
+  CHECK_THROWS_WITH(env.set_gravity(9.80665), Catch::Contains("waves.gravity"));
   env.set_seabed_depth(30.0);
   CHECK(env.seabed_depth() == 30.0);
 }

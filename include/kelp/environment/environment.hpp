@@ -44,7 +44,8 @@ struct EnvironmentSample {
 /// 1.225 kg/m³, g = kelp::standard_gravity, no seabed, no current, no waves, no wind.
 /// All queries are `const` and allocate nothing; in still water they only copy zeros.
 /// The parts are built separately (`CurrentModel`, `WaveField`, `WindField`) and set here; see
-/// `sea_state.hpp` for presets. The wave field's `depth` should be the seabed depth.
+/// `sea_state.hpp` for presets. The wave field and the current profile carry their own water
+/// depth (set them to the seabed depth); the wave field's gravity must match this one.
 /// \tparam Scalar double, float or an automatic-differentiation type.
 template <typename Scalar>
 class Environment {
@@ -82,6 +83,7 @@ class Environment {
   /// naming `gravity`.
   Environment& set_gravity(Scalar g) {
     check_positive(g, "gravity");
+    check_wave_gravity(waves_, value_of(g));
     gravity_ = g;
     return *this;
   }
@@ -106,8 +108,12 @@ class Environment {
     current_ = current;
     return *this;
   }
-  /// \brief Sets the wave field (a default-constructed `WaveField` is a calm sea).
+  /// \brief Sets the wave field (a default-constructed `WaveField` is a calm sea). Its dispersion
+  /// relation must use this environment's gravity; its `depth` should be the seabed depth (deep
+  /// water, +∞, is an accepted approximation over any seabed deeper than about half a wavelength).
+  /// \throws kelp::invalid_argument naming `waves.gravity` when the gravities differ.
   Environment& set_waves(const WaveField<Scalar>& waves) {
+    check_wave_gravity(waves, value_of(gravity_));
     waves_ = waves;
     return *this;
   }
@@ -173,6 +179,11 @@ class Environment {
   }
 
  private:
+  static void check_wave_gravity(const WaveField<Scalar>& waves, double g) {
+    KELP_CHECK(waves.empty() || std::abs(waves.parameters().gravity - g) <= 1e-6 * g,
+               "waves.gravity must equal the environment's gravity");
+  }
+
   Scalar water_density_ = Scalar(kelp::seawater_density);
   Scalar air_density_ = Scalar(kelp::air_density);
   Scalar gravity_ = Scalar(kelp::standard_gravity);
