@@ -197,6 +197,9 @@ TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage"
   CHECK((a - b).norm() < 1e-12);
   // M ν̇ equals the right-hand side that was solved (the LDLT solve is exact to rounding).
   CHECK((model.mass_matrix() * ws.nu_dot - ws.rhs).norm() < 1e-10);
+  // M⁻¹ taken from the LDLT factorisation once is the inverse of M.
+  CHECK((model.mass_inverse() * model.mass_matrix() - Matrix6<double>::Identity()).norm() < 1e-12);
+  CHECK((model.mass_inverse() * ws.rhs - model.mass_ldlt().solve(ws.rhs)).norm() < 1e-12);
 
   // A callable that returns the same constant wrench reproduces rk4_step.
   kv::VehicleState<double> y = x, z = x;
