@@ -67,6 +67,11 @@ struct ImplicitOptions {
   /// Maximum active-set passes (block-tridiagonal solves, no force evaluation) per Newton
   /// iteration; 1 is plain Newton on the current branch.
   int max_active_set_passes = 16;
+  /// When false, the last of the `max_iterations` Newton corrections is applied without
+  /// evaluating the forces again (no line search, no convergence check) and the end forces are
+  /// extrapolated linearly with the Jacobian. With max_iterations = 1 this is the linearly
+  /// implicit (Rosenbrock–Euler-type) scheme: one force evaluation and one O(N) solve per step.
+  bool check_convergence = true;
   /// Maximum line-search corrections (secant steps, each one force evaluation) per Newton
   /// iteration; 0 always takes the full Newton step.
   int max_backtracks = 3;
@@ -88,14 +93,6 @@ struct StepReport {
 
 namespace detail {
 
-template <typename Scalar>
-Matrix3<Scalar> node_mass_matrix(const TetherWorkspace<Scalar>& ws, int i) {
-  const Vector3<Scalar> q = ws.tangent.col(i);
-  Matrix3<Scalar> m = (ws.mass_tan(i) * q) * q.transpose();
-  m.diagonal().array() += ws.mass_iso(i);
-  return m;
-}
-
 /// A_s = c_v·(−∂F/∂v) + c_x·(−∂F/∂x) coupling block of segment s (symmetric PSD).
 template <typename Scalar>
 Matrix3<Scalar> segment_block(const TetherWorkspace<Scalar>& ws, int s, Scalar c_v, Scalar c_x) {
@@ -105,63 +102,125 @@ Matrix3<Scalar> segment_block(const TetherWorkspace<Scalar>& ws, int s, Scalar c
   return a;
 }
 
-/// Inverse of a symmetric positive definite 3×3 matrix by cofactors (one division, no square
-/// root: the block-Thomas sweep is a serial dependency chain, so latency matters more than flops).
-/// Positive definiteness is checked by Sylvester's criterion on the leading minors; returns
-/// false if it fails. Only the lower triangle of D is read. Well conditioned here: the blocks are
-/// mass plus stiffness, cond(D) ≲ h²k/m.
-template <typename Scalar>
-bool spd_inverse3(const Matrix3<Scalar>& d, Matrix3<Scalar>& inv) {
-  const Scalar a = d(0, 0), b = d(1, 0), c = d(2, 0), e = d(1, 1), f = d(2, 1), g = d(2, 2);
-  const Scalar c00 = e * g - f * f, c01 = c * f - b * g, c02 = b * f - c * e;
-  const Scalar minor2 = a * e - b * b;
-  const Scalar det = a * c00 + b * c01 + c * c02;
-  if (!(a > Scalar(0) && minor2 > Scalar(0) && det > Scalar(0))) return false;
-  const Scalar k = Scalar(1) / det;
-  inv(0, 0) = c00 * k;
-  inv(1, 0) = inv(0, 1) = c01 * k;
-  inv(2, 0) = inv(0, 2) = c02 * k;
-  inv(1, 1) = (a * g - c * c) * k;
-  inv(2, 1) = inv(1, 2) = (b * c - a * f) * k;
-  inv(2, 2) = minor2 * k;
-  return true;
-}
-
 /// Solves J δ = rhs over the free nodes, J = c_m M + c_v (−∂F/∂v) + c_x (−∂F/∂x), block
-/// tridiagonal and symmetric positive definite, by block-Thomas elimination (block LDLᵀ): each
-/// Schur-complement block D'_i = D_i − A_{i−1} D'^{-1}_{i−1} A_{i−1} is inverted in closed form
-/// (3×3, SPD-checked). Reads the Jacobian ingredients of the last compute_forces<true>; writes
-/// ws.delta. O(N), no heap allocation.
+/// tridiagonal and symmetric positive definite, by block-Thomas elimination (block LDLᵀ). The
+/// off-diagonal block of segment s is −A_s with A_s = α_s u uᵀ + β_s I (α = c_v BA/l + c_x k_uu,
+/// β = c_x k_perp), so the Schur complements D'_i = D_i − A_{i−1} D'⁻¹_{i−1} A_{i−1} and the
+/// back substitution δ_i = z_i + D'⁻¹_i A_i δ_{i+1} are written with symmetric 3×3 algebra
+/// (6 stored entries, closed-form SPD inverse). Reads the Jacobian ingredients of the last
+/// compute_forces<true>; writes ws.delta (and ws.block_inv). O(N), no heap allocation.
 template <typename Scalar>
 void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                              Scalar c_m, Scalar c_v, Scalar c_x) {
+  using S = Scalar;
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  Matrix3<Scalar> a_prev = Matrix3<Scalar>::Zero(), a_next = Matrix3<Scalar>::Zero(), inv;
-  if (f0 > 0) a_prev = segment_block(ws, f0 - 1, c_v, c_x);
+  // Segment coupling A_s = al u uᵀ + be I.
+  const auto seg = [&](int s, S& al, S& be, S& ux, S& uy, S& uz) {
+    al = c_v * ws.seg_c_uu(s) + c_x * ws.seg_k_uu(s);
+    be = c_x * ws.seg_k_perp(s);
+    ux = ws.direction(0, s);
+    uy = ws.direction(1, s);
+    uz = ws.direction(2, s);
+  };
+  // Previous node's inverse (symmetric: 00 10 20 11 21 22) and segment i−1.
+  S p00(0), p10(0), p20(0), p11(0), p21(0), p22(0);
+  S al_p(0), be_p(0), ux_p(0), uy_p(0), uz_p(0);
+  if (f0 > 0) seg(f0 - 1, al_p, be_p, ux_p, uy_p, uz_p);
   for (int i = f0; i <= f1; ++i) {
-    Matrix3<Scalar> d = c_m * node_mass_matrix(ws, i) + c_v * ws.node_dv[i];
-    d(2, 2) += c_x * ws.node_kz(i);
-    Vector3<Scalar> r = ws.rhs.col(i);
-    if (i > 0) d += a_prev;
-    if (i > f0) {
-      // Off-diagonal blocks are −A_{i−1}: D' = D − A G, r' = r + A z with G = D'⁻¹A, z = D'⁻¹r.
-      d.noalias() -= a_prev * ws.block_g[i - 1];
-      r.noalias() += a_prev * ws.delta.col(i - 1);
+    // D = c_m (a I + b q qᵀ) + c_v D_v + c_x kz e_z e_zᵀ.
+    const S a = c_m * ws.mass_iso(i), bq = c_m * ws.mass_tan(i);
+    const S qx = ws.tangent(0, i), qy = ws.tangent(1, i), qz = ws.tangent(2, i);
+    const Matrix3<S>& dv = ws.node_dv[i];
+    S d00 = a + bq * qx * qx + c_v * dv(0, 0);
+    S d10 = bq * qy * qx + c_v * dv(1, 0);
+    S d20 = bq * qz * qx + c_v * dv(2, 0);
+    S d11 = a + bq * qy * qy + c_v * dv(1, 1);
+    S d21 = bq * qz * qy + c_v * dv(2, 1);
+    S d22 = a + bq * qz * qz + c_v * dv(2, 2) + c_x * ws.node_kz(i);
+    S r0 = ws.rhs(0, i), r1 = ws.rhs(1, i), r2 = ws.rhs(2, i);
+    if (i > 0) {
+      // + A_{i−1}
+      d00 += al_p * ux_p * ux_p + be_p;
+      d10 += al_p * uy_p * ux_p;
+      d20 += al_p * uz_p * ux_p;
+      d11 += al_p * uy_p * uy_p + be_p;
+      d21 += al_p * uz_p * uy_p;
+      d22 += al_p * uz_p * uz_p + be_p;
+      if (i > f0) {
+        // − A P A with P = D'⁻¹_{i−1}: w = P u, σ = u·w,
+        // A P A = α² σ u uᵀ + αβ (u wᵀ + w uᵀ) + β² P.
+        const S wx = p00 * ux_p + p10 * uy_p + p20 * uz_p;
+        const S wy = p10 * ux_p + p11 * uy_p + p21 * uz_p;
+        const S wz = p20 * ux_p + p21 * uy_p + p22 * uz_p;
+        const S sig = ux_p * wx + uy_p * wy + uz_p * wz;
+        const S aa = al_p * al_p * sig, ab = al_p * be_p, bb = be_p * be_p;
+        d00 -= aa * ux_p * ux_p + ab * (ux_p * wx + wx * ux_p) + bb * p00;
+        d10 -= aa * uy_p * ux_p + ab * (uy_p * wx + wy * ux_p) + bb * p10;
+        d20 -= aa * uz_p * ux_p + ab * (uz_p * wx + wz * ux_p) + bb * p20;
+        d11 -= aa * uy_p * uy_p + ab * (uy_p * wy + wy * uy_p) + bb * p11;
+        d21 -= aa * uz_p * uy_p + ab * (uz_p * wy + wz * uy_p) + bb * p21;
+        d22 -= aa * uz_p * uz_p + ab * (uz_p * wz + wz * uz_p) + bb * p22;
+        // r += A z_{i−1}
+        const S z0 = ws.delta(0, i - 1), z1 = ws.delta(1, i - 1), z2 = ws.delta(2, i - 1);
+        const S uz_dot = al_p * (ux_p * z0 + uy_p * z1 + uz_p * z2);
+        r0 += uz_dot * ux_p + be_p * z0;
+        r1 += uz_dot * uy_p + be_p * z1;
+        r2 += uz_dot * uz_p + be_p * z2;
+      }
     }
+    S al(0), be(0), ux(0), uy(0), uz(0);
     if (i < n) {
-      a_next = segment_block(ws, i, c_v, c_x);
-      d += a_next;
+      seg(i, al, be, ux, uy, uz);
+      d00 += al * ux * ux + be;
+      d10 += al * uy * ux;
+      d20 += al * uz * ux;
+      d11 += al * uy * uy + be;
+      d21 += al * uz * uy;
+      d22 += al * uz * uz + be;
     }
-    if (!spd_inverse3(d, inv))
+    // Closed-form inverse of the SPD block (Sylvester's criterion checked).
+    const S c00 = d11 * d22 - d21 * d21, c01 = d20 * d21 - d10 * d22, c02 = d10 * d21 - d20 * d11;
+    const S minor2 = d00 * d11 - d10 * d10;
+    const S det = d00 * c00 + d10 * c01 + d20 * c02;
+    if (!(d00 > S(0) && minor2 > S(0) && det > S(0)))
       ::kelp::detail::throw_numerical_error(
           "tether Newton step: Jacobian block not positive definite; the state is unchanged");
-    ws.delta.col(i).noalias() = inv * r;
-    if (i < f1) ws.block_g[i].noalias() = inv * a_next;
-    a_prev = a_next;
+    const S k = S(1) / det;
+    p00 = c00 * k;
+    p10 = c01 * k;
+    p20 = c02 * k;
+    p11 = (d00 * d22 - d20 * d20) * k;
+    p21 = (d10 * d20 - d00 * d21) * k;
+    p22 = minor2 * k;
+    ws.delta(0, i) = p00 * r0 + p10 * r1 + p20 * r2;
+    ws.delta(1, i) = p10 * r0 + p11 * r1 + p21 * r2;
+    ws.delta(2, i) = p20 * r0 + p21 * r1 + p22 * r2;
+    auto inv = ws.block_inv.col(i);
+    inv(0) = p00;
+    inv(1) = p10;
+    inv(2) = p20;
+    inv(3) = p11;
+    inv(4) = p21;
+    inv(5) = p22;
+    al_p = al;
+    be_p = be;
+    ux_p = ux;
+    uy_p = uy;
+    uz_p = uz;
   }
-  for (int i = f1 - 1; i >= f0; --i)
-    ws.delta.col(i).noalias() += ws.block_g[i] * ws.delta.col(i + 1);
+  // Back substitution: δ_i += P_i A_i δ_{i+1}.
+  for (int i = f1 - 1; i >= f0; --i) {
+    S al, be, ux, uy, uz;
+    seg(i, al, be, ux, uy, uz);
+    const S y0 = ws.delta(0, i + 1), y1 = ws.delta(1, i + 1), y2 = ws.delta(2, i + 1);
+    const S ud = al * (ux * y0 + uy * y1 + uz * y2);
+    const S t0 = ud * ux + be * y0, t1 = ud * uy + be * y1, t2 = ud * uz + be * y2;
+    const auto p = ws.block_inv.col(i);
+    ws.delta(0, i) += p(0) * t0 + p(1) * t1 + p(2) * t2;
+    ws.delta(1, i) += p(1) * t0 + p(3) * t1 + p(4) * t2;
+    ws.delta(2, i) += p(2) * t0 + p(4) * t1 + p(5) * t2;
+  }
 }
 
 /// Newton direction with a primal–dual active set for the kink of the elastic tension at
@@ -400,8 +459,12 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
   report.converged = false;
   // Evaluates F at (x, v), writes rhs = −R = γh F − M (v − v̂) on the free nodes and returns the
   // merit Σ |R_i/a_i|²; `res` gets the scaled max-norm max_i |R_i|/a_i.
-  const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& res) {
-    compute_forces<true>(model, ws, env, t1, x, v);
+  const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& res,
+                            bool with_jacobian) {
+    if (with_jacobian)
+      compute_forces<true>(model, ws, env, t1, x, v);
+    else
+      compute_forces<false>(model, ws, env, t1, x, v);
     ++report.force_evaluations;
     Scalar merit(0);
     res = Scalar(0);
@@ -421,7 +484,8 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
     return merit;
   };
   Scalar res(0);
-  evaluate(ws.x1, ws.v1, res);
+  evaluate(ws.x1, ws.v1, res, true);
+  bool have_jacobian = true;
   ws.xs = ws.x1;  // carries the kinematic end positions into the trial iterates
   ws.vs = ws.v1;
   for (int it = 0;; ++it) {
@@ -431,8 +495,29 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       break;
     }
     if (it >= options.max_iterations) break;
+    if (!have_jacobian) {  // the last trial was evaluated without the Jacobian terms
+      evaluate(ws.x1, ws.v1, res, true);
+      have_jacobian = true;
+    }
     detail::active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
     ++report.newton_iterations;
+    if (!options.check_convergence && it + 1 >= options.max_iterations) {
+      // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
+      // end segments: ΔF = (γh K_s + C_s) δv of the neighbouring free node.
+      for (int i = f0; i <= f1; ++i) {
+        ws.v1.col(i) += ws.delta.col(i);
+        ws.x1.col(i) = ws.x0.col(i) + gh * ws.v1.col(i);
+      }
+      ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+      const int n = model.segments();
+      if (f0 == 1 && n >= 2)
+        ws.end_forces.on_start += detail::segment_block(ws, 0, Scalar(1), gh) * ws.delta.col(1);
+      if (f1 == n - 1 && n >= 2)
+        ws.end_forces.on_end +=
+            detail::segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
+      detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_implicit");
+      return report;
+    }
     // Line search. R is the gradient of the step's incremental potential
     // Φ(v) = ½(v − v̂)ᵀM(v − v̂) + U(x̂ + γh v) + γh·(dissipation potential), which is convex for
     // this model up to the tangent dependence of drag and added mass (elastic energy
@@ -447,13 +532,17 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       return g;
     };
     const Scalar g0 = slope();
-    Scalar a_lo(0), g_lo = g0, alpha(1), trial_res(0);
+    const Scalar a_lo(0), g_lo = g0;
+    Scalar alpha(1), trial_res(0);
     for (int ls = 0;; ++ls) {
       for (int i = f0; i <= f1; ++i) {
         ws.vs.col(i) = ws.v1.col(i) + alpha * ws.delta.col(i);
         ws.xs.col(i) = ws.x0.col(i) + gh * ws.vs.col(i);
       }
-      evaluate(ws.xs, ws.vs, trial_res);
+      // The trial is usually the converged point, so its Jacobian terms are skipped (they are
+      // recomputed, one evaluation more, only if another Newton iteration follows).
+      evaluate(ws.xs, ws.vs, trial_res, false);
+      have_jacobian = false;
       if (ls >= options.max_backtracks || !(g0 < Scalar(0))) break;
       const Scalar g = slope();
       if (g <= Scalar(-0.5) * g0) break;
@@ -461,7 +550,6 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       const Scalar a_new = a_lo + (alpha - a_lo) * (-g_lo) / (g - g_lo);
       if (!(a_new > a_lo && a_new < alpha)) break;
       alpha = a_new;
-      (void)a_lo;
     }
     ws.x1.swap(ws.xs);
     ws.v1.swap(ws.vs);
@@ -671,5 +759,14 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
   ws.has_previous = false;
   return result;
 }
+
+using StepReportd = StepReport<double>;            ///< StepReport<double>
+using StepReportf = StepReport<float>;             ///< StepReport<float>
+using ImplicitOptionsd = ImplicitOptions<double>;  ///< ImplicitOptions<double>
+using ImplicitOptionsf = ImplicitOptions<float>;   ///< ImplicitOptions<float>
+using StaticOptionsd = StaticOptions<double>;      ///< StaticOptions<double>
+using StaticOptionsf = StaticOptions<float>;       ///< StaticOptions<float>
+using StaticResultd = StaticResult<double>;        ///< StaticResult<double>
+using StaticResultf = StaticResult<float>;         ///< StaticResult<float>
 
 }  // namespace kelp::tether

@@ -268,9 +268,9 @@ struct TetherWorkspace {
   Mat3Vector node_dv;          ///< −∂F_i/∂v_i from drag and seabed [N s/m]
   VectorX<Scalar> node_kz;     ///< −∂F_z/∂z from the seabed [N/m]
   // --- linear solver and integrator buffers ----------------------------------------------------
-  Mat3Vector block_g;           ///< block-Thomas multipliers D'^{-1} B
-  Matrix3X<Scalar> rhs, delta;  ///< Newton right-hand side and correction
-  Matrix3X<Scalar> rhs_true;    ///< −R saved while the active-set passes modify rhs
+  Eigen::Matrix<Scalar, 6, Eigen::Dynamic> block_inv;  ///< block-Thomas D'⁻¹ (symmetric, 6 entries)
+  Matrix3X<Scalar> rhs, delta;                         ///< Newton right-hand side and correction
+  Matrix3X<Scalar> rhs_true;  ///< −R saved while the active-set passes modify rhs
   VectorX<Scalar> seg_true_k_uu, seg_true_k_perp, seg_true_c_uu;  ///< saved Jacobian terms
   VectorX<Scalar> seg_active;  ///< 1 if segment s is taut in the Newton step's linear model
   Matrix3X<Scalar> x0, v0, x1, v1, xs, vs, kx, kv, x_prev, v_prev;  ///< integrator stages
@@ -297,7 +297,7 @@ struct TetherWorkspace {
                                &seg_true_k_uu, &seg_true_k_perp, &seg_true_c_uu, &seg_active})
       v->setZero(s);
     node_dv.assign(n, Mat3::Zero());
-    block_g.assign(n, Mat3::Zero());
+    block_inv.setZero(6, n);
     has_previous = false;
   }
 };

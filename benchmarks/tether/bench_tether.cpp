@@ -1,0 +1,109 @@
+// Lumped-mass tether benchmarks on the benchmark line of shared/reference/tether.md (20 m,
+// d 8 mm, 0.07 kg/m, EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1, no internal damping), ends 10 m apart
+// horizontally and 5 m vertically in still seawater, started from static equilibrium with the
+// far (AUV) end heaving 0.1 m at 0.2 Hz so that every step works on a moving line.
+//
+//   BM_TetherForces/<N>            one force evaluation (no Jacobian)
+//   BM_TetherStep/<integrator>/<N> one full step at the integrator's dt: 0.8 × the explicit
+//                                  stability estimate for symplectic Euler, RK2, RK4; 10 ms for
+//                                  the implicit schemes (bdf2_one_newton: one unchecked Newton
+//                                  correction per step, see ImplicitOptions::check_convergence)
+// Counters: ns_per_node = time / (force evaluations × nodes) — for the implicit schemes this
+// includes the Jacobian assembly and the block-tridiagonal solves; realtime_factor = simulated
+// seconds per CPU second; evals_per_step and newton_per_step for the implicit schemes.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+
+namespace kt = kelp::tether;
+using kelp::Vector3;
+
+namespace {
+
+struct Setup {
+  kelp::environment::Environmentd env;
+  kt::TetherModeld model;
+  kt::TetherWorkspaced ws;
+  kt::TetherStated state;
+  Vector3<double> a{0, 0, 0}, b{10, 0, 5};
+
+  explicit Setup(int n) : model(params(n)), ws(model) {
+    kt::static_initial_state(model, ws, env, a, b, state);
+  }
+  static kt::TetherParametersd params(int n) {
+    kt::TetherParametersd p;
+    p.segments = n;
+    return p;
+  }
+  kt::TetherBoundaryd boundary(double t) const {
+    const double amp = 0.1, w = 2 * kelp::pi * 0.2;
+    kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(a, b);
+    bnd.end.position.z() += amp * (1 - std::cos(w * t));
+    bnd.end.velocity.z() = amp * w * std::sin(w * t);
+    bnd.end.acceleration.z() = amp * w * w * std::cos(w * t);
+    return bnd;
+  }
+};
+
+void BM_TetherForces(benchmark::State& st) {
+  const int n = static_cast<int>(st.range(0));
+  Setup s(n);
+  for (auto _ : st) {
+    kt::compute_forces(s.model, s.ws, s.env, 0.0, s.state.position, s.state.velocity);
+    benchmark::DoNotOptimize(s.ws.force.data());
+    benchmark::ClobberMemory();
+  }
+  st.counters["ns_per_node"] =
+      benchmark::Counter(1e-9 * static_cast<double>(st.iterations()) * (n + 1),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_implicit = false) {
+  const int n = static_cast<int>(st.range(0));
+  Setup s(n);
+  const double dt =
+      kt::is_implicit(integ) ? 0.01 : kt::estimate_stable_dt(s.model, integ, s.env.water_density());
+  kt::ImplicitOptionsd options;
+  if (linearly_implicit) {
+    options.max_iterations = 1;
+    options.check_convergence = false;
+  }
+  double evals = 0, newton = 0;
+  for (auto _ : st) {
+    const kt::StepReportd r =
+        kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, integ, options);
+    evals += r.force_evaluations;
+    newton += r.newton_iterations;
+    benchmark::DoNotOptimize(s.state.position.data());
+  }
+  const double iters = static_cast<double>(st.iterations());
+  st.counters["ns_per_node"] = benchmark::Counter(
+      1e-9 * evals * (n + 1), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  st.counters["realtime_factor"] = benchmark::Counter(iters * dt, benchmark::Counter::kIsRate);
+  st.counters["dt_us"] = dt * 1e6;
+  if (kt::is_implicit(integ)) {
+    st.counters["evals_per_step"] = evals / iters;
+    st.counters["newton_per_step"] = newton / iters;
+  }
+}
+
+void sizes(benchmark::internal::Benchmark* b) {
+  for (int n : {10, 20, 50, 100, 200}) b->Arg(n);
+  b->Unit(benchmark::kMicrosecond);
+}
+
+}  // namespace
+
+BENCHMARK(BM_TetherForces)->Apply(sizes)->Unit(benchmark::kNanosecond);
+BENCHMARK_CAPTURE(BM_TetherStep, symplectic_euler, kt::Integrator::symplectic_euler)->Apply(sizes);
+BENCHMARK_CAPTURE(BM_TetherStep, rk2, kt::Integrator::rk2)->Apply(sizes);
+BENCHMARK_CAPTURE(BM_TetherStep, rk4, kt::Integrator::rk4)->Apply(sizes);
+BENCHMARK_CAPTURE(BM_TetherStep, implicit_euler, kt::Integrator::implicit_euler)->Apply(sizes);
+BENCHMARK_CAPTURE(BM_TetherStep, bdf2, kt::Integrator::bdf2)->Apply(sizes);
+// One unchecked Newton correction per step (ImplicitOptions::check_convergence = false).
+BENCHMARK_CAPTURE(BM_TetherStep, bdf2_one_newton, kt::Integrator::bdf2, true)->Apply(sizes);
