@@ -425,8 +425,9 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       const Scalar kn = kn_per_l * li, kt = kt_per_l * li;
       f += (kn * vn_abs) * vn + (kt * abs(vq) * vq) * q;
       // Froude–Krylov plus added-mass forcing from the water acceleration.
-      const V3& aw = ws.water_acceleration.col(i);
-      f += (rho * vol) * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
+      const V3 aw = ws.water_acceleration.col(i);
+      if (aw.squaredNorm() > Scalar(0))  // skipped in still water and steady current
+        f += (rho * vol) * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
       ws.mass_iso(i) = m + rho * vol * can;
       ws.mass_tan(i) = rho * vol * (cat - can);
       if constexpr (WithJacobian) {
