@@ -59,8 +59,11 @@ struct ImplicitOptions {
   /// Maximum Newton corrections per step (each: one Jacobian factorisation and solve).
   int max_iterations = 4;
   /// Convergence when max_i |R_i| / a_i ≤ this [m/s], R_i the momentum residual of node i and
-  /// a_i its isotropic mass; default ≈ 100·√ε (1.5e-6 m/s in double, 0.03 m/s in float).
-  Scalar velocity_tolerance = Scalar(100) * std::sqrt(std::numeric_limits<Scalar>::epsilon());
+  /// a_i its isotropic mass (an error ΔF in the node force shows up as γh ΔF / a_i). Default
+  /// 1.5e-6 m/s in double; 1e-3 m/s in single precision, whose rounding of ~10 m coordinates
+  /// already costs EA/l · 6e-7 m of tension (use a softer line or double for stiff tethers).
+  Scalar velocity_tolerance =
+      Scalar(std::numeric_limits<Scalar>::epsilon() > Scalar(1e-10) ? 1e-3 : 1.5e-6);
   /// Segments at least (1 − band)·l long start each Newton iteration's active set in the taut
   /// branch (see detail::active_set_direction); 0 starts from the stretched segments.
   Scalar slack_band = Scalar(0);
@@ -736,8 +739,8 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
       }
       if (it >= options.max_iterations) break;
       ws.xs = state.position;  // undo point
-      // The inner residual is h·F/m in velocity units: ask for forces a tenth of the tolerance.
-      inner.velocity_tolerance = Scalar(0.1) * tol * h / m_ref;
+      // The inner residual is h·F/m in velocity units: ask for forces half the tolerance.
+      inner.velocity_tolerance = Scalar(0.5) * tol * h / m_ref;
       const StepReport<Scalar> r = step_implicit(model, ws, env, state, b, h, false, inner);
       state.time = t_entry;
       state.velocity.setZero();
