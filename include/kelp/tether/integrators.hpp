@@ -134,13 +134,13 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
     // D = c_m (a I + b q qᵀ) + c_v D_v + c_x kz e_z e_zᵀ.
     const S a = c_m * ws.mass_iso(i), bq = c_m * ws.mass_tan(i);
     const S qx = ws.tangent(0, i), qy = ws.tangent(1, i), qz = ws.tangent(2, i);
-    const Matrix3<S>& dv = ws.node_dv[i];
-    S d00 = a + bq * qx * qx + c_v * dv(0, 0);
-    S d10 = bq * qy * qx + c_v * dv(1, 0);
-    S d20 = bq * qz * qx + c_v * dv(2, 0);
-    S d11 = a + bq * qy * qy + c_v * dv(1, 1);
-    S d21 = bq * qz * qy + c_v * dv(2, 1);
-    S d22 = a + bq * qz * qz + c_v * dv(2, 2) + c_x * ws.node_kz(i);
+    const auto dv = ws.node_dv.col(i);
+    S d00 = a + bq * qx * qx + c_v * dv(0);
+    S d10 = bq * qy * qx + c_v * dv(1);
+    S d20 = bq * qz * qx + c_v * dv(2);
+    S d11 = a + bq * qy * qy + c_v * dv(3);
+    S d21 = bq * qz * qy + c_v * dv(4);
+    S d22 = a + bq * qz * qz + c_v * dv(5) + c_x * ws.node_kz(i);
     S r0 = ws.rhs(0, i), r1 = ws.rhs(1, i), r2 = ws.rhs(2, i);
     if (i > 0) {
       // + A_{i−1}
@@ -453,7 +453,11 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
   } else {
     ws.x0 = state.position;
     ws.v0 = state.velocity;
-    ws.v1 = state.velocity;
+    // Predictor: linear extrapolation of the velocity when the last step had the same dt.
+    if (ws.has_previous && ws.previous_dt == dt)
+      ws.v1.noalias() = Scalar(2) * state.velocity - ws.v_prev;
+    else
+      ws.v1 = state.velocity;
   }
   ws.x1.noalias() = ws.x0 + gh * ws.v1;
   detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);

@@ -19,7 +19,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <vector>
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
@@ -244,9 +243,6 @@ struct EndForces {
 /// content is valid after the last force evaluation.
 template <typename Scalar>
 struct TetherWorkspace {
-  using Mat3 = Matrix3<Scalar>;
-  using Mat3Vector = std::vector<Mat3, Eigen::aligned_allocator<Mat3>>;
-
   // --- per evaluation, per node -------------------------------------------------------------
   Matrix3X<Scalar> force;               ///< net force on each node (no constraint force), NED [N]
   Matrix3X<Scalar> acceleration;        ///< node accelerations, NED [m/s²]
@@ -265,8 +261,9 @@ struct TetherWorkspace {
   VectorX<Scalar> seg_k_uu;  ///< axial stiffness minus geometric term: EA/l − T⁺/l_s or −T⁺/l_s
   VectorX<Scalar> seg_k_perp;  ///< geometric stiffness T/l_s [N/m]
   VectorX<Scalar> seg_c_uu;    ///< BA/l [N s/m]
-  Mat3Vector node_dv;          ///< −∂F_i/∂v_i from drag and seabed [N s/m]
-  VectorX<Scalar> node_kz;     ///< −∂F_z/∂z from the seabed [N/m]
+  /// −∂F_i/∂v_i from drag and seabed, symmetric (xx, yx, zx, yy, zy, zz) [N s/m]
+  Eigen::Matrix<Scalar, 6, Eigen::Dynamic> node_dv;
+  VectorX<Scalar> node_kz;  ///< −∂F_z/∂z from the seabed [N/m]
   // --- linear solver and integrator buffers ----------------------------------------------------
   Eigen::Matrix<Scalar, 6, Eigen::Dynamic> block_inv;  ///< block-Thomas D'⁻¹ (symmetric, 6 entries)
   Matrix3X<Scalar> rhs, delta;                         ///< Newton right-hand side and correction
@@ -296,7 +293,7 @@ struct TetherWorkspace {
     for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu,
                                &seg_true_k_uu, &seg_true_k_perp, &seg_true_c_uu, &seg_active})
       v->setZero(s);
-    node_dv.assign(n, Mat3::Zero());
+    node_dv.setZero(6, n);
     block_inv.setZero(6, n);
     has_previous = false;
   }
@@ -413,8 +410,8 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     const Scalar zeta = Scalar(env.surface_elevation(x(0, i), x(1, i), t));
     const bool wet = !(x(2, i) < -zeta);
     ws.submerged(i) = wet ? Scalar(1) : Scalar(0);
-    Eigen::Matrix<Scalar, 3, 3> dv;
-    if constexpr (WithJacobian) dv.setZero();
+    // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
+    Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
     if (wet) {
       f(2) += (m - rho * vol) * g;
       // Morison drag on the relative velocity, split along q.
@@ -431,10 +428,16 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       ws.mass_iso(i) = m + rho * vol * can;
       ws.mass_tan(i) = rho * vol * (cat - can);
       if constexpr (WithJacobian) {
-        // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ.
-        dv.noalias() = (kn * vn_abs) * (Matrix3<Scalar>::Identity() - q * q.transpose());
-        if (vn_abs > Scalar(0)) dv.noalias() += (kn / vn_abs) * (vn * vn.transpose());
-        dv.noalias() += (Scalar(2) * kt * abs(vq)) * (q * q.transpose());
+        // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ
+        // = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
+        const Scalar c1 = kn * vn_abs, cn = vn_abs > Scalar(0) ? kn / vn_abs : Scalar(0);
+        const Scalar c31 = Scalar(2) * kt * abs(vq) - c1;
+        dv[0] = c1 + c31 * q(0) * q(0) + cn * vn(0) * vn(0);
+        dv[1] = c31 * q(1) * q(0) + cn * vn(1) * vn(0);
+        dv[2] = c31 * q(2) * q(0) + cn * vn(2) * vn(0);
+        dv[3] = c1 + c31 * q(1) * q(1) + cn * vn(1) * vn(1);
+        dv[4] = c31 * q(2) * q(1) + cn * vn(2) * vn(1);
+        dv[5] = c1 + c31 * q(2) * q(2) + cn * vn(2) * vn(2);
       }
     } else {
       f(2) += m * g;
@@ -449,7 +452,7 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       if (normal > Scalar(0)) {
         f(2) -= normal;
         kz = bed_k * li;
-        if constexpr (WithJacobian) dv(2, 2) += bed_c * li;
+        if constexpr (WithJacobian) dv[5] += bed_c * li;
         if (p.seabed_friction > Scalar(0)) {
           const Scalar vh2 = v(0, i) * v(0, i) + v(1, i) * v(1, i);
           const Scalar vf = p.friction_velocity;
@@ -458,8 +461,8 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
           f(0) -= coef * v(0, i);
           f(1) -= coef * v(1, i);
           if constexpr (WithJacobian) {
-            dv(0, 0) += coef;
-            dv(1, 1) += coef;
+            dv[0] += coef;
+            dv[3] += coef;
           }
         }
       } else {
@@ -468,7 +471,7 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     }
     ws.seabed_force(i) = normal;
     if constexpr (WithJacobian) {
-      ws.node_dv[i] = dv;
+      for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
       ws.node_kz(i) = kz;
     }
     ws.force.col(i) = f;
