@@ -239,15 +239,38 @@ void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scal
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   const Scalar l = model.segment_length(), inv_l = model.inverse_segment_length();
   const Scalar ea = model.parameters().axial_stiffness, ea_l = model.axial_spring();
-  if (max_passes <= 1 && !(band > Scalar(0))) {
+  // Updates the active set from the lengths predicted by ws.delta; true if it changed.
+  const auto update = [&]() {
+    bool changed = false;
+    for (int s = 0; s < n; ++s) {
+      Scalar dl(0);
+      const auto u = ws.direction.col(s);
+      if (s >= f0 && s <= f1) dl -= gh * u.dot(ws.delta.col(s));
+      if (s + 1 >= f0 && s + 1 <= f1) dl += gh * u.dot(ws.delta.col(s + 1));
+      const bool now = ws.stretched_length(s) + dl > l;
+      if (now != (ws.seg_active(s) > Scalar(0))) {
+        changed = true;
+        ws.seg_active(s) = now ? Scalar(1) : Scalar(0);
+      }
+    }
+    return changed;
+  };
+  bool on_true_branch = true;
+  for (int s = 0; s < n; ++s) {
+    const bool active = ws.stretched_length(s) >= (Scalar(1) - band) * l;
+    ws.seg_active(s) = active ? Scalar(1) : Scalar(0);
+    if (active != (ws.stretched_length(s) > l)) on_true_branch = false;
+  }
+  int pass = 0;
+  if (on_true_branch) {
+    // Common case: plain Newton; done unless the predicted lengths cross l.
     solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
-    return;
+    if (max_passes <= 1 || !update()) return;
+    pass = 1;
   }
   ws.rhs_true = ws.rhs;
   ws.seg_true_k_uu = ws.seg_k_uu;
-  for (int s = 0; s < n; ++s)
-    ws.seg_active(s) = ws.stretched_length(s) >= (Scalar(1) - band) * l ? Scalar(1) : Scalar(0);
-  for (int pass = 0;; ++pass) {
+  for (;; ++pass) {
     ws.rhs = ws.rhs_true;
     for (int s = 0; s < n; ++s) {
       const bool stretched = ws.stretched_length(s) > l;
@@ -268,20 +291,7 @@ void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scal
       }
     }
     solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
-    if (pass + 1 >= max_passes) break;
-    bool changed = false;
-    for (int s = 0; s < n; ++s) {
-      Scalar dl(0);
-      const auto u = ws.direction.col(s);
-      if (s >= f0 && s <= f1) dl -= gh * u.dot(ws.delta.col(s));
-      if (s + 1 >= f0 && s + 1 <= f1) dl += gh * u.dot(ws.delta.col(s + 1));
-      const bool now = ws.stretched_length(s) + dl > l;
-      if (now != (ws.seg_active(s) > Scalar(0))) {
-        changed = true;
-        ws.seg_active(s) = now ? Scalar(1) : Scalar(0);
-      }
-    }
-    if (!changed) break;
+    if (pass + 1 >= max_passes || !update()) break;
   }
   ws.seg_k_uu = ws.seg_true_k_uu;
   ws.rhs.swap(ws.rhs_true);
