@@ -333,3 +333,71 @@ TEST_CASE("stable-dt estimate follows the axial frequency 2 sqrt(EA/(l m))", "[t
   // tether.md: explicit schemes need dt ≲ 0.1 ms on this line.
   CHECK(kt::estimate_stable_dt(model, kt::Integrator::rk4) < 2e-4);
 }
+
+TEST_CASE("bending forces are the gradient of the bending energy and straighten a bent line",
+          "[tether][bending]") {
+  kelp_test::Vacuum<double> env;
+  env.g = 0;
+  auto p = kelp_test::benchmark_line<double>(6);
+  p.length = 6.0;
+  p.bending_stiffness = 2.0;  // EI [N m²]
+  p.start_mode = p.end_mode = kt::EndMode::free;
+  const kt::TetherModeld m(p);
+  kt::TetherWorkspaced ws(m);
+  // A zig-zag whose segments are all shorter than l = 1 m (slack: no axial force), so the only
+  // force is bending; compare with central differences of the bending energy EI/l Σ (1 − c).
+  kt::TetherStated s(m);
+  for (int i = 0; i <= 6; ++i)
+    s.position.col(i) = Vector3<double>(0.8 * i, 0.3 * std::sin(1.7 * i), 0.2 * std::cos(2.3 * i));
+  kt::compute_forces(m, ws, env, 0.0, s.position, s.velocity);
+  const double h = 1e-6;
+  double fsum = 0;
+  Vector3<double> moment = Vector3<double>::Zero();
+  for (int i = 0; i <= 6; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      kt::TetherStated sp = s, sm = s;
+      sp.position(k, i) += h;
+      sm.position(k, i) -= h;
+      const double grad = (kt::tether_energy(m, env, sp) - kt::tether_energy(m, env, sm)) / (2 * h);
+      INFO("node " << i << " axis " << k);
+      CHECK(ws.force(k, i) == Approx(-grad).margin(1e-7));
+    }
+    fsum += ws.force.col(i).norm();
+    moment += Vector3<double>(s.position.col(i)).cross(Vector3<double>(ws.force.col(i)));
+  }
+  CHECK(fsum > 0.1);  // the zig-zag is loaded
+  // Internal forces: no net force, no net moment.
+  CHECK(ws.force.rowwise().sum().norm() < 1e-12);
+  CHECK(moment.norm() < 1e-12);
+
+  // A free line released from a V shape in vacuum straightens: bending energy turns into motion
+  // and the total is conserved (symplectic Euler at a quarter of a stable dt that includes EI).
+  kt::TetherStated v(m);
+  for (int i = 0; i <= 6; ++i)
+    // Segments 0.999 m long (slack, so bending is the only force), 0.3 m rise per segment.
+    v.position.col(i) = Vector3<double>(0.9529 * i, 0.3 * std::abs(i - 3.0), 0.0);
+  const double e0 = kt::tether_energy(m, env, v);
+  const double dt = kt::estimate_stable_dt(m, kt::Integrator::symplectic_euler, 0.0, 0.25);
+  double max_ke = 0, max_drift = 0;
+  const auto b = kt::TetherBoundaryd::fixed(Vector3<double>::Zero(), Vector3<double>::Zero());
+  while (v.time < 1.0) {
+    kt::step_symplectic_euler(m, ws, env, v, b, dt);
+    double ke = 0;
+    for (int i = 0; i <= 6; ++i) ke += 0.5 * m.node_mass(i) * v.velocity.col(i).squaredNorm();
+    max_ke = std::max(max_ke, ke);
+    max_drift = std::max(max_drift, std::abs(kt::tether_energy(m, env, v) - e0));
+  }
+  INFO("bending energy " << e0 << " J, peak KE " << max_ke << " J, drift " << max_drift);
+  CHECK(e0 > 0.01);
+  CHECK(max_ke > 0.5 * e0);
+  CHECK(max_drift < 0.01 * e0);
+  CHECK(std::isfinite(kt::estimate_stable_dt(m, kt::Integrator::rk4)));
+  // EI raises the estimated frequency: ω² = ω²_axial + 16 EI/(l³ m), largest at the free end
+  // nodes, which carry half a segment (m = 0.035 kg).
+  auto p0 = p;
+  p0.bending_stiffness = 0;
+  const double w_axial = kt::highest_axial_frequency(kt::TetherModeld(p0), 0.0);
+  const double m_node = 0.07 * 0.5;
+  CHECK(kt::highest_axial_frequency(m, 0.0) ==
+        Approx(std::sqrt(w_axial * w_axial + 16 * 2.0 / m_node)).epsilon(1e-12));
+}

@@ -596,21 +596,28 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
   return {};
 }
 
-/// \brief Largest angular frequency of the axial node–spring chain [rad/s], bounded by
-/// Gershgorin's theorem: ω²_max ≤ max_i Σ_j |K_ij| / m_i = max_i 2 k_i / m_i, with k_i the sum of
-/// the segment spring constants EA/l acting on free node i and m_i its axial mass (structural
-/// plus tangential added mass, nodes taken as submerged).
+/// \brief Largest angular frequency of the line [rad/s], bounded by Gershgorin's theorem.
+/// Axial chain: ω²_a ≤ max_i Σ_j |K_ij| / m_i = max_i 2 k_i / m_i, with k_i the sum of the segment
+/// spring constants EA/l on free node i and m_i its axial mass (structural plus tangential added
+/// mass, nodes taken as submerged). Bending (EI > 0): the discrete bending stiffness is
+/// (EI/l³)·DᵀD with D the second difference (‖DᵀD‖ ≤ 16), so ω²_b ≤ 16 EI/(l³ m_n) with m_n the
+/// normal (added-mass) node mass. Returns √(ω²_a + ω²_b).
 template <typename Scalar>
 Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_density) {
   using std::sqrt;
   const int n = model.segments();
   const TetherParameters<Scalar>& p = model.parameters();
+  const Scalar l = model.segment_length();
   Scalar w2(0);
   for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
     const int springs = (i > 0 ? 1 : 0) + (i < n ? 1 : 0);
-    const Scalar m =
-        model.node_mass(i) + water_density * model.node_volume(i) * p.tangential_added_mass;
-    w2 = std::max(w2, Scalar(2) * Scalar(springs) * model.axial_spring() / m);
+    const Scalar rv = water_density * model.node_volume(i);
+    const Scalar m = model.node_mass(i) + rv * p.tangential_added_mass;
+    Scalar wi = Scalar(2) * Scalar(springs) * model.axial_spring() / m;
+    if (p.bending_stiffness > Scalar(0))
+      wi += Scalar(16) * p.bending_stiffness /
+            (l * l * l * (model.node_mass(i) + rv * p.normal_added_mass));
+    w2 = std::max(w2, wi);
   }
   return sqrt(w2);
 }

@@ -55,6 +55,12 @@ struct TetherParameters {
   Scalar axial_stiffness = Scalar(1e5);
   /// Internal (axial) damping BA [N s]: the damping tension is BA · ε̇ (ε the strain).
   Scalar internal_damping = Scalar(0);
+  /// Bending stiffness EI [N m²] (0: a perfectly flexible line). Discrete bending energy
+  /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
+  /// κ = θ/l. Enters the implicit schemes through the residual only (not the Jacobian: it would
+  /// couple nodes i−1 and i+1), so keep EI/l³ ≪ node mass / dt² there; the explicit stable-dt
+  /// estimate accounts for it.
+  Scalar bending_stiffness = Scalar(0);
   /// Normal drag coefficient Cdn [-] (on the projected area d·l).
   Scalar normal_drag = Scalar(1.2);
   /// Tangential drag coefficient Cdt [-] (on the wetted surface π·d·l, as MoorDyn does).
@@ -99,6 +105,7 @@ class TetherModel {
     check_positive(p.mass_per_length, "mass_per_length");
     check_positive(p.axial_stiffness, "axial_stiffness");
     check_non_negative(p.internal_damping, "internal_damping");
+    check_non_negative(p.bending_stiffness, "bending_stiffness");
     check_non_negative(p.normal_drag, "normal_drag");
     check_non_negative(p.tangential_drag, "tangential_drag");
     check_non_negative(p.normal_added_mass, "normal_added_mass");
@@ -249,6 +256,7 @@ struct TetherWorkspace {
   Matrix3X<Scalar> tangent;             ///< unit node tangent q_i (zero if degenerate)
   Matrix3X<Scalar> water_velocity;      ///< current + wave orbital velocity at each node [m/s]
   Matrix3X<Scalar> water_acceleration;  ///< water acceleration at each node [m/s²]
+  Matrix3X<Scalar> bending;             ///< bending force on each node (when EI > 0) [N]
   VectorX<Scalar> mass_iso;             ///< a_i: M_i = a_i I + b_i q qᵀ [kg]
   VectorX<Scalar> mass_tan;             ///< b_i [kg]
   VectorX<Scalar> seabed_force;         ///< upward normal seabed contact force on node i [N]
@@ -283,8 +291,8 @@ struct TetherWorkspace {
   void resize(int nodes) {
     const int n = nodes, s = nodes - 1;
     for (Matrix3X<Scalar>* m :
-         {&force, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs, &delta, &x0,
-          &v0, &x1, &v1, &xs, &vs, &kx, &kv, &x_prev, &v_prev})
+         {&force, &bending, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs,
+          &delta, &x0, &v0, &x1, &v1, &xs, &vs, &kx, &kv, &x_prev, &v_prev})
       m->setZero(3, n);
     for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &submerged, &node_kz})
       v->setZero(n);
@@ -389,6 +397,26 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     if constexpr (WithJacobian) ws.seg_c_uu(s) = ba_l;
   }
 
+  // Bending: E_i = k (1 − c), c = u_a·u_b, k = EI/l at interior node i between segment a (i−1)
+  // and b (i); F_{i−1} = −k (u_b − c u_a)/l_a, F_{i+1} = k (u_a − c u_b)/l_b, F_i = −F_{i−1} −
+  // F_{i+1}.
+  const bool bending = p.bending_stiffness > Scalar(0);
+  if (bending) {
+    ws.bending.setZero();
+    const Scalar k = p.bending_stiffness * inv_l;
+    for (int i = 1; i < n; ++i) {
+      const Scalar la = ws.stretched_length(i - 1), lb = ws.stretched_length(i);
+      if (!(la > Scalar(0) && lb > Scalar(0))) continue;
+      const V3 ua = ws.direction.col(i - 1), ub = ws.direction.col(i);
+      const Scalar c = ua.dot(ub);
+      const V3 fa = (-k / la) * (ub - c * ua);
+      const V3 fb = (k / lb) * (ua - c * ub);
+      ws.bending.col(i - 1) += fa;
+      ws.bending.col(i + 1) += fb;
+      ws.bending.col(i) -= fa + fb;
+    }
+  }
+
   // Nodes.
   const Scalar half_rho_d = Scalar(0.5) * rho * p.diameter;
   const Scalar kn_per_l = half_rho_d * p.normal_drag;
@@ -405,6 +433,7 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     V3 f = V3::Zero();
     if (i < n) f += ws.tension(i) * ws.direction.col(i);
     if (i > 0) f -= ws.tension(i - 1) * ws.direction.col(i - 1);
+    if (bending) f += ws.bending.col(i);
 
     const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
     const Scalar zeta = Scalar(env.surface_elevation(x(0, i), x(1, i), t));
@@ -519,7 +548,8 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
 
 /// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
 /// the submerged weight −Σ (mᵢ − ρVᵢ) g zᵢ (NED z down) + elastic ½ EA/l Σ (l_s − l)² over
-/// stretched segments. Ignores the seabed spring. Recomputes the tangents and wetness itself.
+/// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
+/// tangents and wetness itself.
 template <typename Scalar, typename Env>
 Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
                      const TetherState<Scalar>& state) {
@@ -533,6 +563,14 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
     const Scalar ls = (state.position.col(s + 1) - state.position.col(s)).norm();
     if (ls > l) e += Scalar(0.5) * model.axial_spring() * (ls - l) * (ls - l);
   }
+  if (p.bending_stiffness > Scalar(0))
+    for (int i = 1; i < n; ++i) {
+      const Vector3<Scalar> a = state.position.col(i) - state.position.col(i - 1);
+      const Vector3<Scalar> b = state.position.col(i + 1) - state.position.col(i);
+      const Scalar na = a.norm(), nb = b.norm();
+      if (na > Scalar(0) && nb > Scalar(0))
+        e += p.bending_stiffness / l * (Scalar(1) - a.dot(b) / (na * nb));
+    }
   for (int i = 0; i <= n; ++i) {
     const Vector3<Scalar> chord =
         state.position.col(i < n ? i + 1 : n) - state.position.col(i > 0 ? i - 1 : 0);
