@@ -13,6 +13,9 @@ namespace ks = kelp::system;
 using kelp::Vector3;
 using kelp::Vector6;
 
+template struct ks::TetherLoads<double>;
+template struct ks::TetherLoads<float>;
+
 TEMPLATE_TEST_CASE("attachment motion is the body-fixed point's position and velocity",
                    "[system][attachment]", double, float) {
   using S = TestType;

@@ -263,3 +263,36 @@ TEST_CASE("a buoyant tether with a free end floats up to the surface",
   CHECK(std::abs(s.position(2, 15)) < 0.2);
   CHECK(ws.end_forces.on_start.z() < 0);  // pulls the anchor up
 }
+
+TEST_CASE("a slack line falls onto the seabed without compression and comes to rest on it",
+          "[tether][dynamics][seabed]") {
+  kelp_test::TestWater<double> env;
+  env.bed = 12.0;
+  auto p = kelp_test::benchmark_line<double>(20);
+  p.seabed_friction = 0.3;
+  const kt::TetherModeld model(p);
+  kt::TetherWorkspaced ws(model);
+  // Ends on the bed 8 m apart; the 20 m line starts 2 m above it in a wide S (slack everywhere).
+  const Vector3<double> a(0, 0, 12), b(8, 0, 12);
+  kt::TetherStated s(model);
+  for (int i = 0; i <= 20; ++i)
+    s.position.col(i) = Vector3<double>(0.4 * i, 2.5 * std::sin(kelp::pi * i / 10.0),
+                                        i == 0 || i == 20 ? 12.0 : 10.0);
+  const auto bnd = kt::TetherBoundaryd::fixed(a, b);
+  double min_tension = 0;
+  for (int k = 0; k < 2000; ++k) {
+    kt::step(model, ws, env, s, bnd, 0.01, kt::Integrator::bdf2);
+    // BA = 0: the axial force is purely elastic and must never be compressive.
+    min_tension = std::min(min_tension, ws.tension.minCoeff());
+  }
+  CHECK(min_tension >= 0.0);
+  // At rest on the bed: each interior node's contact force carries its submerged weight
+  // (kb d l (z − h) = w l) and the line barely moves.
+  const double w = model.submerged_weight_per_length(env.rho, env.g);
+  for (int i = 2; i <= 18; ++i) {
+    INFO("node " << i);
+    CHECK(ws.seabed_force(i) == Approx(w * model.node_length(i)).epsilon(0.02));
+    CHECK(s.position(2, i) > 12.0);
+  }
+  CHECK(s.velocity.cwiseAbs().maxCoeff() < 1e-3);
+}

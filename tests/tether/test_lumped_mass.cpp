@@ -26,6 +26,16 @@ template struct kt::TetherBoundary<double>;
 template struct kt::TetherBoundary<float>;
 template struct kt::EndMotion<double>;
 template struct kt::EndMotion<float>;
+template struct kt::EndForces<double>;
+template struct kt::EndForces<float>;
+template struct kt::ImplicitOptions<double>;
+template struct kt::ImplicitOptions<float>;
+template struct kt::StepReport<double>;
+template struct kt::StepReport<float>;
+template struct kt::StaticOptions<double>;
+template struct kt::StaticOptions<float>;
+template struct kt::StaticResult<double>;
+template struct kt::StaticResult<float>;
 
 TEST_CASE("bad tether parameters throw invalid_argument naming the field", "[tether][errors]") {
   const double nan = std::numeric_limits<double>::quiet_NaN();
