@@ -153,6 +153,30 @@ TEMPLATE_TEST_CASE("a passive neutrally buoyant vehicle ends up moving with a un
   CHECK(x.nu.template tail<3>().norm() < S(0.02));
 }
 
+TEST_CASE("a body spinning while drifting with the current keeps drifting with it",
+          "[vehicle][current]") {
+  // Galilean check of the irrotational-current correction M_A ν̇_c with ν̇_c = (ν_c,1 × ω, 0):
+  // a neutrally buoyant body with r_g = r_b = 0, no damping, launched with ν_r = (0, 0, 0, 0, 0, r)
+  // is, in the water frame, a body spinning about a principal axis in still water. It must keep
+  // ν_r = 0 in translation, so its NED velocity stays equal to the current. (With the sign of ν̇_c
+  // flipped, or the term dropped, it would drift off.)
+  auto p = neutral_rov<double>();
+  p.damping = kv::DampingParameters<double>();
+  p.r_b = p.r_g = Vector3<double>::Zero();
+  const kv::VehicleModel<double> model(p);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  const Vector3<double> current(0.4, -0.3, 0.1);
+  x.nu.head<3>() = x.attitude.conjugate() * current;
+  x.nu(5) = 0.8;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  for (int k = 0; k < 5000; ++k) kv::rk4_step(model, ws, x, 0.002, zero, zero, current);
+  const Vector3<double> v_ned = x.attitude * Vector3<double>(x.nu.head<3>());
+  CHECK((v_ned - current).norm() < 1e-9);
+  CHECK((x.position - 10.0 * current).norm() < 1e-8);
+  CHECK(x.nu(5) == Approx(0.8).epsilon(1e-12));
+}
+
 TEST_CASE("equal relative flow gives equal hydrodynamic force", "[vehicle][current]") {
   const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
   kv::VehicleWorkspace<double> ws1, ws2;

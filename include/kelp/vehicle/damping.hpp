@@ -70,4 +70,9 @@ Vector6<Scalar> damping_force(const DampingParameters<Scalar>& p,
   return f;
 }
 
+/// \brief Damping coefficients in double precision.
+using DampingParametersd = DampingParameters<double>;
+/// \brief Damping coefficients in single precision.
+using DampingParametersf = DampingParameters<float>;
+
 }  // namespace kelp::vehicle

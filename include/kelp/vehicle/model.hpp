@@ -257,11 +257,17 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   return forward_dynamics(model, ws, state, tau, tau_env, Vector3<Scalar>::Zero());
 }
 
+/// \brief Vehicle parameters in double precision.
 using VehicleParametersd = VehicleParameters<double>;
+/// \brief Vehicle parameters in single precision.
 using VehicleParametersf = VehicleParameters<float>;
+/// \brief Vehicle model in double precision.
 using VehicleModeld = VehicleModel<double>;
+/// \brief Vehicle model in single precision.
 using VehicleModelf = VehicleModel<float>;
+/// \brief Forward-dynamics workspace in double precision.
 using VehicleWorkspaced = VehicleWorkspace<double>;
+/// \brief Forward-dynamics workspace in single precision.
 using VehicleWorkspacef = VehicleWorkspace<float>;
 
 }  // namespace kelp::vehicle

@@ -150,4 +150,9 @@ VehiclePreset<Scalar> blueboat(const Scalar& density = Scalar(seawater_density),
   return p;
 }
 
+/// \brief Vehicle preset in double precision.
+using VehiclePresetd = VehiclePreset<double>;
+/// \brief Vehicle preset in single precision.
+using VehiclePresetf = VehiclePreset<float>;
+
 }  // namespace kelp::vehicle

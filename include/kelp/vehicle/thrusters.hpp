@@ -211,9 +211,13 @@ Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMap
                          : m.neutral_us + u * (m.neutral_us - m.min_us);
 }
 
+/// \brief Thruster allocation in double precision.
 using ThrusterAllocationd = ThrusterAllocation<double>;
+/// \brief Thruster allocation in single precision.
 using ThrusterAllocationf = ThrusterAllocation<float>;
+/// \brief PWM mapping in double precision.
 using PwmMappingd = PwmMapping<double>;
+/// \brief PWM mapping in single precision.
 using PwmMappingf = PwmMapping<float>;
 
 }  // namespace kelp::vehicle
