@@ -4,6 +4,9 @@
 /// analytic block-tridiagonal Jacobian (O(N) block-Thomas solve); an explicit stable-dt estimate,
 /// a sub-stepping driver and a static-equilibrium solve.
 ///
+/// Kinematic ends follow the prescribed EndMotion within a step (p + vτ + ½aτ²). Explicit schemes
+/// report the end forces at the start of the step, implicit ones at its end.
+///
 /// Every step works in preallocated workspace buffers (no heap allocation) and commits the new
 /// state only when it is finite: a failed step throws `kelp::numerical_error` and leaves the state
 /// as it was.
@@ -437,9 +440,16 @@ StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Sc
 /// x̂ = (4x_n − x_{n−1})/3, v̂ = (4v_n − v_{n−1})/3) the unknown node velocities solve
 /// R(v) = M (v − v̂) − γh F(x̂ + γh v, v) = 0. The Jacobian J = M + γh D_v + (γh)² D_x
 /// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
-/// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness) is block
-/// tridiagonal, symmetric positive definite, and solved in O(N) by block-Thomas elimination
-/// (no dense N×N). End forces are those of the final iterate, at t + dt.
+/// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
+/// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
+/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
+/// the direction dependence of the dashpot, bending (EI). Each Newton direction settles which
+/// segments are taut with a primal–dual active set (detail::active_set_direction) and is
+/// shortened by a secant line search on the slope R·δ when it overshoots. The initial guess
+/// extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt. Up to
+/// `options.max_iterations` corrections; the step is taken even if the tolerance is not met
+/// (see StepReport::converged). End forces are those of the final iterate, at t + dt.
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
 /// the result is not finite.
 template <typename Scalar, typename Env>

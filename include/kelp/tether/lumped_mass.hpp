@@ -1,7 +1,7 @@
 /// \file
 /// \brief Lumped-mass tether model: parameters, workspace, state, end conditions and the force
-/// evaluation (axial tension, internal damping, weight and buoyancy, Morison drag, added mass,
-/// fluid-inertia forcing, seabed contact).
+/// evaluation (axial tension, internal damping, optional bending stiffness, weight and buoyancy,
+/// Morison drag, added mass, fluid-inertia forcing, seabed contact with friction).
 ///
 /// The line of unstretched length L is cut into N segments of length l = L/N joined at N+1 nodes
 /// (node 0 = start end, e.g. the ASV; node N = far end, e.g. the AUV). The model follows the
