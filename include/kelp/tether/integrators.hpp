@@ -60,7 +60,7 @@ inline bool is_implicit(Integrator i) {
 template <typename Scalar>
 struct ImplicitOptions {
   /// Maximum Newton corrections per step (each: one Jacobian factorisation and solve).
-  int max_iterations = 4;
+  int max_iterations = 8;
   /// Convergence when max_i |R_i| / a_i ≤ this [m/s], R_i the momentum residual of node i and
   /// a_i its isotropic mass (an error ΔF in the node force shows up as γh ΔF / a_i). Default
   /// 1.5e-6 m/s in double; 1e-3 m/s in single precision, whose rounding of ~10 m coordinates
@@ -72,7 +72,7 @@ struct ImplicitOptions {
   Scalar slack_band = Scalar(0);
   /// Maximum active-set passes (block-tridiagonal solves, no force evaluation) per Newton
   /// iteration; 1 is plain Newton on the current branch.
-  int max_active_set_passes = 16;
+  int max_active_set_passes = 32;
   /// When false, the last of the `max_iterations` Newton corrections is applied without
   /// evaluating the forces again (no line search, no convergence check) and the end forces are
   /// extrapolated linearly with the Jacobian. With max_iterations = 1 this is the linearly
@@ -80,7 +80,7 @@ struct ImplicitOptions {
   bool check_convergence = true;
   /// Maximum line-search corrections (secant steps, each one force evaluation) per Newton
   /// iteration; 0 always takes the full Newton step.
-  int max_backtracks = 3;
+  int max_backtracks = 6;
 };
 
 /// \brief What one step did.
