@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <type_traits>
+#include <vector>
 
 #include "kelp/core/rotation.hpp"
 #include "kelp/vehicle/integrators.hpp"
@@ -133,6 +134,54 @@ TEMPLATE_TEST_CASE("a heave step settles", "[vehicle][behaviour]", double, float
   tau(2) = S(20);
   for (int k = 0; k < 1000; ++k) kv::rk4_step(rov, ws, y, S(0.01), tau, Vector6<S>::Zero());
   CHECK(double(y.nu(2)) == Approx(steady_speed(33, 190, 20)).epsilon(0.01));
+}
+
+TEST_CASE("BlueBoat heave, roll and pitch oscillate with the linear natural periods",
+          "[vehicle][behaviour]") {
+  // Free decay from a small offset; the period between successive upward zero crossings is
+  // compared with the damped linear period 2π / (ω_n √(1 − ζ²)), ω_n = √(k / m_eff),
+  // ζ = c / (2 √(k m_eff)), with k from the preset's hydrostatics (ρ g A_wp, ρ g ∇ GM_T,
+  // ρ g ∇ GM_L), m_eff = rigid + added inertia and c the linear damping. The quadratic damping
+  // is negligible at these amplitudes.
+  const auto preset = kv::blueboat<double>();
+  const auto& p = preset.parameters;
+  const kv::VehicleModel<double> boat(p);
+  const double rho_g = p.density * p.gravity;
+  struct Dof {
+    int index;
+    double k, m_eff, c;
+  };
+  const Dof dofs[3] = {
+      {2, rho_g * p.waterplane_area, p.mass + p.added_mass(2, 2), p.damping.linear(2, 2)},
+      {3, rho_g * p.displaced_volume * p.gm_transverse, p.inertia(0, 0) + p.added_mass(3, 3),
+       p.damping.linear(3, 3)},
+      {4, rho_g * p.displaced_volume * p.gm_longitudinal, p.inertia(1, 1) + p.added_mass(4, 4),
+       p.damping.linear(4, 4)}};
+  for (const Dof& d : dofs) {
+    INFO("dof " << d.index);
+    kv::VehicleWorkspace<double> ws;
+    kv::VehicleState<double> x;
+    const auto coordinate = [&]() {
+      return d.index == 2 ? x.position(2) : kelp::euler_from_quaternion(x.attitude)(d.index - 3);
+    };
+    if (d.index == 2) x.position(2) = 0.005;
+    if (d.index == 3) x.attitude = kelp::quaternion_from_euler(0.01, 0.0, 0.0);
+    if (d.index == 4) x.attitude = kelp::quaternion_from_euler(0.0, 0.01, 0.0);
+    const double dt = 1e-4, zeta = d.c / (2 * std::sqrt(d.k * d.m_eff));
+    const double period = 2 * kelp::pi / (std::sqrt(d.k / d.m_eff) * std::sqrt(1 - zeta * zeta));
+    std::vector<double> crossings;
+    double prev = coordinate();
+    for (int k = 1; k < 40000 && crossings.size() < 2; ++k) {
+      kv::rk4_step(boat, ws, x, dt, Vector6<double>::Zero(), Vector6<double>::Zero());
+      const double now = coordinate();
+      if (prev < 0 && now >= 0) crossings.push_back((k - now / (now - prev)) * dt);
+      prev = now;
+    }
+    REQUIRE(crossings.size() == 2);
+    CHECK(crossings[1] - crossings[0] == Approx(period).epsilon(0.02));
+    CHECK(period > 0.3);  // a sensible small-boat period, not a numerically stiff mode
+    CHECK(period < 2.0);
+  }
 }
 
 TEMPLATE_TEST_CASE("a passive neutrally buoyant vehicle ends up moving with a uniform current",
