@@ -425,9 +425,13 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
   const Scalar bed_k = p.seabed_stiffness * p.diameter, bed_c = p.seabed_damping * p.diameter;
   for (int i = 0; i <= n; ++i) {
     // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends.
+    // The drag below is written with the unnormalised chord and 1/|c|² so that its square root
+    // and the tangent's run in parallel instead of one after the other.
     const V3 chord = x.col(i < n ? i + 1 : n) - x.col(i > 0 ? i - 1 : 0);
     const Scalar c2 = chord.squaredNorm();
-    const V3 q = c2 > Scalar(0) ? V3(chord / sqrt(c2)) : V3::Zero();
+    const Scalar inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
+    const Scalar inv_c = sqrt(inv_c2);
+    const V3 q = chord * inv_c;
     ws.tangent.col(i) = q;
 
     V3 f = V3::Zero();
@@ -445,9 +449,10 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       f(2) += (m - rho * vol) * g;
       // Morison drag on the relative velocity, split along q.
       const V3 vr = ws.water_velocity.col(i) - v.col(i);
-      const Scalar vq = vr.dot(q);
-      const V3 vn = vr - vq * q;
+      const Scalar vc = vr.dot(chord);  // = |c| v_q
+      const V3 vn = vr - (vc * inv_c2) * chord;
       const Scalar vn_abs = sqrt(vn.squaredNorm());
+      const Scalar vq = vc * inv_c;
       const Scalar kn = kn_per_l * li, kt = kt_per_l * li;
       f += (kn * vn_abs) * vn + (kt * abs(vq) * vq) * q;
       // Froude–Krylov plus added-mass forcing from the water acceleration.
