@@ -411,3 +411,39 @@ TEST_CASE("bending forces are the gradient of the bending energy and straighten 
   CHECK(kt::highest_axial_frequency(m, 0.0) ==
         Approx(std::sqrt(w_axial * w_axial + 16 * 2.0 / m_node)).epsilon(1e-12));
 }
+
+TEST_CASE("seabed: spring-damper contact and saturated-viscous friction", "[tether][seabed]") {
+  kelp_test::TestWater<double> env;
+  env.bed = 10.0;
+  auto p = kelp_test::benchmark_line<double>(2);
+  p.length = 2.0;
+  p.seabed_friction = 0.5;
+  p.friction_velocity = 0.01;
+  p.normal_drag = p.tangential_drag = 0.0;  // isolate the contact forces
+  const kt::TetherModeld m(p);
+  kt::TetherWorkspaced ws(m);
+  kelp::Matrix3X<double> x(3, 3), v = kelp::Matrix3X<double>::Zero(3, 3);
+  x << 0, 0.999, 1.998, 0, 0, 0, 10, 10.001, 10;  // slack; middle node 1 mm into the bed
+  // Normal force (z − h) kb d l_i = 1e-3 · 3e6 · 0.008 · 1 = 24 N upwards.
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.seabed_force(1) == Approx(24.0));
+  const double w = m.submerged_weight_per_length(env.rho, env.g);
+  CHECK(ws.force(2, 1) == Approx(w - 24.0));
+  // Sinking at 1 mm/s adds cb d l ż = 3e5 · 0.008 · 1e-3 = 2.4 N.
+  v(2, 1) = 1e-3;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.seabed_force(1) == Approx(26.4));
+  // Sliding at 0.2 m/s (> v_f): Coulomb friction μ N = 13.2 N against the motion.
+  v(0, 1) = 0.2;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.force(0, 1) == Approx(-0.5 * 26.4));
+  // Creeping at 1 mm/s (< v_f): viscous, μ N v / v_f.
+  v(0, 1) = 1e-3;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.force(0, 1) == Approx(-0.5 * 26.4 * 0.1));
+  // Rising out of the bed fast enough: the contact never pulls the node down.
+  v(2, 1) = -0.1;
+  kt::compute_forces(m, ws, env, 0.0, x, v);
+  CHECK(ws.seabed_force(1) == 0.0);
+  CHECK(ws.force(2, 1) == Approx(w));
+}
