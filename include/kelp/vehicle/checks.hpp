@@ -26,14 +26,18 @@ void check_symmetric_definite(const Eigen::MatrixBase<Derived>& m, const char* f
   check_all_finite(m, field);
   KELP_CHECK(m.rows() == m.cols(), std::string(field) + " must be square");
   const Eigen::Index n = m.rows();
-  Eigen::MatrixXd v(n, n);
+  // Same compile-time size as the input (3×3 inertia, 6×6 added mass / damping): fixed-size
+  // eigen-solvers, which also keep g++ 12's -Wmaybe-uninitialized false positives in Eigen's
+  // dynamic-size kernels out of users' -O2 -Werror builds.
+  using Mat = Eigen::Matrix<double, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime>;
+  Mat v(n, n);
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i < n; ++i) v(i, j) = value_of(m(i, j));
   const double scale = v.cwiseAbs().maxCoeff();
   KELP_CHECK((v - v.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale,
              std::string(field) + " must be symmetric");
   if (n == 0) return;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(v, Eigen::EigenvaluesOnly);
+  Eigen::SelfAdjointEigenSolver<Mat> eig(v, Eigen::EigenvaluesOnly);
   const double lowest = eig.eigenvalues().minCoeff();
   if (semi) {
     KELP_CHECK(lowest >= -1e-12 * scale, std::string(field) + " must be positive semi-definite");
