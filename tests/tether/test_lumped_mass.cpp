@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kelp/environment/environment.hpp"
+#include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "tether_test_support.hpp"
@@ -342,6 +343,29 @@ TEST_CASE("stable-dt estimate follows the axial frequency 2 sqrt(EA/(l m))", "[t
   CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2)));
   // tether.md: explicit schemes need dt ≲ 0.1 ms on this line.
   CHECK(kt::estimate_stable_dt(model, kt::Integrator::rk4) < 2e-4);
+  // Internal damping shrinks it by √(1 + ζ²) − ζ, ζ = (4 BA/l)/(2 m ω): BA = 100 N s → ζ ≈ 5.98.
+  auto pd = kelp_test::benchmark_line<double>(100);
+  pd.internal_damping = 100.0;
+  const kt::TetherModeld damped(pd);
+  const double zeta = 4 * 100.0 / 0.2 / (2 * 0.014 * w);
+  CHECK(kt::estimate_stable_dt(damped, kt::Integrator::symplectic_euler, 1025.0, 1.0) ==
+        Approx(2 / w * (std::sqrt(1 + zeta * zeta) - zeta)));
+  // ... and RK4 at the estimate stays bounded on a heavily damped, moving line.
+  auto p20 = kelp_test::benchmark_line<double>(20);
+  p20.internal_damping = 1000.0;
+  const kt::TetherModeld m20(p20);
+  kt::TetherWorkspaced ws(m20);
+  kelp::environment::Environmentd env;
+  auto s =
+      kt::catenary_initial_state(m20, env, Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
+  auto b = kt::TetherBoundaryd::fixed(Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
+  b.end.velocity.z() = 0.3;
+  const double dt = kt::estimate_stable_dt(m20, kt::Integrator::rk4);
+  for (int k = 0; k < 5000; ++k) {
+    b.end.position.z() = 5 + 0.3 * s.time;
+    kt::step_rk4(m20, ws, env, s, b, dt);
+  }
+  CHECK(s.velocity.cwiseAbs().maxCoeff() < 2.0);
 }
 
 TEST_CASE("bending forces are the gradient of the bending energy and straighten a bent line",
