@@ -66,6 +66,36 @@ TEMPLATE_TEST_CASE("without damping or forcing, RK4 conserves the kinetic energy
   CHECK(x.nu.norm() > S(0.1));  // it really moved and rotated
 }
 
+TEST_CASE("without damping, kinetic + hydrostatic potential energy is conserved",
+          "[vehicle][energy]") {
+  // A pendulum: W = B with the CB above the CG, released tilted and spinning. With NED z down the
+  // potential is U = -W z_CG + B z_CB, z_P = z + (R r_P)_z, so that -dU/dt = -νᵀ g (the restoring
+  // term does exactly the work that changes ½ νᵀ M ν). E = ½ νᵀ M ν + U must stay constant.
+  auto p = neutral_rov<double>();
+  p.damping = kv::DampingParameters<double>();
+  p.r_g = Vector3<double>(0.005, -0.01, 0.03);
+  p.r_b = Vector3<double>(0.0, 0.0, -0.02);
+  const kv::VehicleModel<double> model(p);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  x.attitude = kelp::quaternion_from_euler(0.6, -0.4, 0.2);
+  x.nu << 0.1, 0.0, -0.05, 0.3, 0.2, -0.4;
+  const auto energy = [&](const kv::VehicleState<double>& s) {
+    const double z_g = s.point_position(p.r_g)(2), z_b = s.point_position(p.r_b)(2);
+    return 0.5 * s.nu.dot(model.mass_matrix() * s.nu) - model.weight() * z_g +
+           model.buoyancy() * z_b;
+  };
+  const double e0 = energy(x);
+  const double scale = model.weight() * 0.05;  // energy scale of the pendulum [J]
+  double worst = 0;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  for (int k = 0; k < 10000; ++k) {
+    kv::rk4_step(model, ws, x, 0.001, zero, zero);
+    worst = std::max(worst, std::abs(energy(x) - e0) / scale);
+  }
+  CHECK(worst < 1e-6);
+}
+
 TEMPLATE_TEST_CASE("BlueROV2 Heavy at constant surge thrust reaches the speed where tau = D(u)u",
                    "[vehicle][behaviour]", double, float) {
   using S = TestType;
