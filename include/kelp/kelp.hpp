@@ -1,5 +1,6 @@
 /// \file
-/// \brief Umbrella header: everything in kelp that needs Eigen only (not `kelp/ceres/`).
+/// \brief Umbrella header: everything in kelp that needs Eigen only. The Ceres catenary solver
+/// (`kelp/ceres/catenary_solver.hpp`, target `kelp::ceres`) is included separately.
 #pragma once
 
 #include "kelp/core/constants.hpp"
@@ -7,4 +8,16 @@
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/environment.hpp"
+#include "kelp/environment/sea_state.hpp"
+#include "kelp/environment/wave_loads.hpp"
+#include "kelp/system/tether_attachment.hpp"
+#include "kelp/tether/catenary.hpp"
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+#include "kelp/vehicle/integrators.hpp"
+#include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/state.hpp"
+#include "kelp/vehicle/thrusters.hpp"
