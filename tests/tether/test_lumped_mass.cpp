@@ -207,6 +207,35 @@ TEST_CASE("weight, buoyancy, drag and fluid inertia on a node", "[tether][forces
   CHECK(ws.mass_tan(1) == 0.0);
 }
 
+TEST_CASE("a still environment skips the water query and gives the same forces",
+          "[tether][forces]") {
+  // Environment without waves or current: compute_forces keeps zeroed water buffers instead of
+  // querying it. A workspace that last saw a current must give the same forces as a fresh one.
+  auto p = kelp_test::benchmark_line<double>(8);
+  const kt::TetherModeld m(p);
+  kelp::environment::Environmentd calm, flowing;
+  flowing.set_current(Vector3<double>(0.4, -0.2, 0.1));
+  const Vector3<double> a(0, 0, 1), b(4, 1, 3);
+  kt::TetherStated s = kt::straight_line_state(m, a, b);
+  s.position.row(2).array() += 0.1 * s.position.row(0).array().sin();
+  for (int i = 0; i < m.nodes(); ++i) s.velocity.col(i) = Vector3<double>(0.1 * i, 0.05, -0.2);
+  kt::TetherWorkspaced fresh(m), reused(m);
+  kt::compute_forces<true>(m, fresh, calm, 0.0, s.position, s.velocity);
+  kt::compute_forces<true>(m, reused, flowing, 0.0, s.position, s.velocity);
+  CHECK_FALSE(reused.force.isApprox(fresh.force));
+  kt::compute_forces<true>(m, reused, calm, 0.0, s.position, s.velocity);
+  CHECK(reused.water_velocity.isZero(0.0));
+  CHECK(reused.water_acceleration.isZero(0.0));
+  CHECK(reused.force == fresh.force);
+  CHECK(reused.node_dv == fresh.node_dv);
+  // The same line in a duck-typed still environment (always queried) agrees as well.
+  kelp_test::TestWater<double> water;
+  kt::TetherWorkspaced duck(m);
+  kt::compute_forces<true>(m, duck, water, 0.0, s.position, s.velocity);
+  CHECK(duck.force.isApprox(fresh.force, 1e-14));
+  CHECK(duck.node_dv.isApprox(fresh.node_dv, 1e-14));
+}
+
 TEST_CASE("analytic block-tridiagonal Jacobian agrees with finite differences",
           "[tether][jacobian]") {
   // J δ = c_m M δ − c_v ∂F/∂v δ − c_x ∂F/∂x δ, evaluated by central differences of F, must equal

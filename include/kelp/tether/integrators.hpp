@@ -145,35 +145,30 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
     S d21 = bq * qz * qy + c_v * dv(4);
     S d22 = a + bq * qz * qz + c_v * dv(5) + c_x * ws.node_kz(i);
     S r0 = ws.rhs(0, i), r1 = ws.rhs(1, i), r2 = ws.rhs(2, i);
-    if (i > 0) {
-      // + A_{i−1}
-      d00 += al_p * ux_p * ux_p + be_p;
-      d10 += al_p * uy_p * ux_p;
-      d20 += al_p * uz_p * ux_p;
-      d11 += al_p * uy_p * uy_p + be_p;
-      d21 += al_p * uz_p * uy_p;
-      d22 += al_p * uz_p * uz_p + be_p;
-      if (i > f0) {
-        // − A P A with P = D'⁻¹_{i−1}: w = P u, σ = u·w,
-        // A P A = α² σ u uᵀ + αβ (u wᵀ + w uᵀ) + β² P.
-        const S wx = p00 * ux_p + p10 * uy_p + p20 * uz_p;
-        const S wy = p10 * ux_p + p11 * uy_p + p21 * uz_p;
-        const S wz = p20 * ux_p + p21 * uy_p + p22 * uz_p;
-        const S sig = ux_p * wx + uy_p * wy + uz_p * wz;
-        const S aa = al_p * al_p * sig, ab = al_p * be_p, bb = be_p * be_p;
-        d00 -= aa * ux_p * ux_p + ab * (ux_p * wx + wx * ux_p) + bb * p00;
-        d10 -= aa * uy_p * ux_p + ab * (uy_p * wx + wy * ux_p) + bb * p10;
-        d20 -= aa * uz_p * ux_p + ab * (uz_p * wx + wz * ux_p) + bb * p20;
-        d11 -= aa * uy_p * uy_p + ab * (uy_p * wy + wy * uy_p) + bb * p11;
-        d21 -= aa * uz_p * uy_p + ab * (uz_p * wy + wz * uy_p) + bb * p21;
-        d22 -= aa * uz_p * uz_p + ab * (uz_p * wz + wz * uz_p) + bb * p22;
-        // r += A z_{i−1}
-        const S z0 = ws.delta(0, i - 1), z1 = ws.delta(1, i - 1), z2 = ws.delta(2, i - 1);
-        const S uz_dot = al_p * (ux_p * z0 + uy_p * z1 + uz_p * z2);
-        r0 += uz_dot * ux_p + be_p * z0;
-        r1 += uz_dot * uy_p + be_p * z1;
-        r2 += uz_dot * uz_p + be_p * z2;
-      }
+    // + A_{i−1} − A_{i−1} P A_{i−1} with P = D'⁻¹_{i−1} (zero, as are α, β and u before the
+    // first segment, when node i − 1 is not eliminated): with w = P u, σ = u·w,
+    // A − A P A = u yᵀ + y uᵀ + β I − β² P, y = ½(α − α² σ) u − αβ w.
+    {
+      const S wx = p00 * ux_p + p10 * uy_p + p20 * uz_p;
+      const S wy = p10 * ux_p + p11 * uy_p + p21 * uz_p;
+      const S wz = p20 * ux_p + p21 * uy_p + p22 * uz_p;
+      const S sig = ux_p * wx + uy_p * wy + uz_p * wz;
+      const S cu = S(0.5) * al_p * (S(1) - al_p * sig), ab = al_p * be_p, bb = be_p * be_p;
+      const S yx = cu * ux_p - ab * wx, yy = cu * uy_p - ab * wy, yz = cu * uz_p - ab * wz;
+      d00 += S(2) * ux_p * yx + (be_p - bb * p00);
+      d10 += uy_p * yx + yy * ux_p - bb * p10;
+      d20 += uz_p * yx + yz * ux_p - bb * p20;
+      d11 += S(2) * uy_p * yy + (be_p - bb * p11);
+      d21 += uz_p * yy + yz * uy_p - bb * p21;
+      d22 += S(2) * uz_p * yz + (be_p - bb * p22);
+    }
+    if (i > f0) {
+      // r += A z_{i−1}
+      const S z0 = ws.delta(0, i - 1), z1 = ws.delta(1, i - 1), z2 = ws.delta(2, i - 1);
+      const S uz_dot = al_p * (ux_p * z0 + uy_p * z1 + uz_p * z2);
+      r0 += uz_dot * ux_p + be_p * z0;
+      r1 += uz_dot * uy_p + be_p * z1;
+      r2 += uz_dot * uz_p + be_p * z2;
     }
     S al(0), be(0), ux(0), uy(0), uz(0);
     if (i < n) {
@@ -465,21 +460,33 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
   const Scalar gamma = use_bdf2 ? Scalar(2) / Scalar(3) : Scalar(1);
   const Scalar gh = gamma * dt;
   // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
+  // One pass over the nodes for the history, the predictor and its positions.
+  const int cols = model.nodes();
   if (use_bdf2) {
-    const Scalar third = Scalar(1) / Scalar(3);
-    ws.x0.noalias() = (Scalar(4) * third) * state.position - third * ws.x_prev;
-    ws.v0.noalias() = (Scalar(4) * third) * state.velocity - third * ws.v_prev;
-    ws.v1.noalias() = Scalar(2) * state.velocity - ws.v_prev;
+    const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
+    for (int i = 0; i < cols; ++i) {
+      const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
+      const Vector3<Scalar> xp = ws.x_prev.col(i), vp = ws.v_prev.col(i);
+      const Vector3<Scalar> xh = four_thirds * xn - third * xp;
+      const Vector3<Scalar> v1 = Scalar(2) * vn - vp;
+      ws.x0.col(i) = xh;
+      ws.v0.col(i) = four_thirds * vn - third * vp;
+      ws.v1.col(i) = v1;
+      ws.x1.col(i) = xh + gh * v1;
+    }
   } else {
-    ws.x0 = state.position;
-    ws.v0 = state.velocity;
     // Predictor: linear extrapolation of the velocity when the last step had the same dt.
-    if (ws.has_previous && ws.previous_dt == dt)
-      ws.v1.noalias() = Scalar(2) * state.velocity - ws.v_prev;
-    else
-      ws.v1 = state.velocity;
+    const bool extrapolate = ws.has_previous && ws.previous_dt == dt;
+    for (int i = 0; i < cols; ++i) {
+      const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
+      const Vector3<Scalar> v1 =
+          extrapolate ? Vector3<Scalar>(Scalar(2) * vn - ws.v_prev.col(i)) : vn;
+      ws.x0.col(i) = xn;
+      ws.v0.col(i) = vn;
+      ws.v1.col(i) = v1;
+      ws.x1.col(i) = xn + gh * v1;
+    }
   }
-  ws.x1.noalias() = ws.x0 + gh * ws.v1;
   detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
 
   StepReport<Scalar> report;
@@ -510,8 +517,15 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
   Scalar res(0);
   evaluate(ws.x1, ws.v1, res, true);
   bool have_jacobian = true;
-  ws.xs = ws.x1;  // carries the kinematic end positions into the trial iterates
-  ws.vs = ws.v1;
+  // The trial iterates take the kinematic end nodes from here (the free ones are overwritten).
+  for (int i = 0; i < cols; ++i) {
+    if (i >= f0 && i <= f1) {
+      i = f1;
+      continue;
+    }
+    ws.xs.col(i) = ws.x1.col(i);
+    ws.vs.col(i) = ws.v1.col(i);
+  }
   for (int it = 0;; ++it) {
     report.residual = res;
     if (res <= options.velocity_tolerance) {

@@ -19,6 +19,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
@@ -280,6 +282,9 @@ struct TetherWorkspace {
   VectorX<Scalar> seg_active;  ///< 1 if segment s is taut in the Newton step's linear model
   Matrix3X<Scalar> x0, v0, x1, v1, xs, vs, kx, kv, x_prev, v_prev;  ///< integrator stages
   bool has_previous = false;                                        ///< BDF2 history valid
+  /// water_velocity and water_acceleration hold zeros (set by resize and by compute_forces in a
+  /// still environment, whose water query it then skips; cleared when the query runs)
+  bool water_is_zero = false;
   Scalar previous_dt = Scalar(0);  ///< step of the stored history [s]
   EndForces<Scalar> end_forces;    ///< forces on the attachment points after the last step
 
@@ -304,10 +309,32 @@ struct TetherWorkspace {
     node_dv.setZero(6, n);
     block_inv.setZero(6, n);
     has_previous = false;
+    water_is_zero = true;
   }
 };
 
 namespace detail {
+
+/// True for environments that can say they are still water at all times: no wave components
+/// (`env.waves().empty()`) and no current (`env.current().is_zero()`), as
+/// kelp::environment::Environment can. Other environments are always queried.
+template <typename Env, typename = void>
+struct has_still_water_query : std::false_type {};
+template <typename Env>
+struct has_still_water_query<
+    Env, std::void_t<decltype(bool(std::declval<const Env&>().waves().empty())),
+                     decltype(bool(std::declval<const Env&>().current().is_zero()))>>
+    : std::true_type {};
+
+/// True when `env` has no waves and no current: its water velocity and acceleration are zero
+/// everywhere and at all times.
+template <typename Env>
+bool is_still_water(const Env& env) {
+  if constexpr (has_still_water_query<Env>::value)
+    return env.waves().empty() && env.current().is_zero();
+  else
+    return false;
+}
 
 /// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.
 template <typename Scalar, typename DX, typename DV>
@@ -361,22 +388,32 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
   const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
   const Scalar ea = p.axial_stiffness, ba = p.internal_damping;
 
-  env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
+  // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
+  // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
+  const bool still = detail::is_still_water(env);
+  if (!still) {
+    ws.water_is_zero = false;
+    env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
+  } else if (!ws.water_is_zero) {
+    ws.water_velocity.setZero();
+    ws.water_acceleration.setZero();
+    ws.water_is_zero = true;
+  }
 
   // Segments: elastic tension EA·ε when stretched (never compressive) plus the internal dashpot
   // BA·ε̇, which, as in MoorDyn (Line.cpp: Td), acts whether or not the segment is stretched, so
   // that the axial force is continuous in the node positions (a dashpot switched on at l_s = l
-  // would make it jump, which Newton's method cannot handle).
-  for (int s = 0; s < n; ++s) {
+  // would make it jump, which Newton's method cannot handle). Returns T_s u_s.
+  const auto segment = [&](int s) -> V3 {
     const V3 d = x.col(s + 1) - x.col(s);
     const Scalar ls2 = d.squaredNorm();
     const Scalar ls = sqrt(ls2);
     ws.stretched_length(s) = ls;
     Scalar tension(0), k_axial(0);
+    V3 u = V3::Zero();
     if (ls > Scalar(0)) {
       const Scalar inv_ls = Scalar(1) / ls;
-      const V3 u = d * inv_ls;
-      ws.direction.col(s) = u;
+      u = d * inv_ls;
       if (ls2 > l2) {
         tension = ea * (ls - l) * inv_l;
         k_axial = ea_l;
@@ -389,19 +426,22 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
         ws.seg_k_uu(s) = k_axial - k_perp;
         ws.seg_k_perp(s) = k_perp;
       }
-    } else {
-      ws.direction.col(s).setZero();
-      if constexpr (WithJacobian) ws.seg_k_uu(s) = ws.seg_k_perp(s) = Scalar(0);
+    } else if constexpr (WithJacobian) {
+      ws.seg_k_uu(s) = ws.seg_k_perp(s) = Scalar(0);
     }
+    ws.direction.col(s) = u;
     ws.tension(s) = tension;
     if constexpr (WithJacobian) ws.seg_c_uu(s) = ba_l;
-  }
+    return tension * u;
+  };
 
   // Bending: E_i = k (1 − c), c = u_a·u_b, k = EI/l at interior node i between segment a (i−1)
   // and b (i); F_{i−1} = −k (u_b − c u_a)/l_a, F_{i+1} = k (u_a − c u_b)/l_b, F_i = −F_{i−1} −
-  // F_{i+1}.
+  // F_{i+1}. It needs every segment first; without it the segments are computed inside the node
+  // loop (one pass over the line).
   const bool bending = p.bending_stiffness > Scalar(0);
   if (bending) {
+    for (int s = 0; s < n; ++s) segment(s);
     ws.bending.setZero();
     const Scalar k = p.bending_stiffness * inv_l;
     for (int i = 1; i < n; ++i) {
@@ -417,12 +457,31 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     }
   }
 
-  // Nodes.
+  // Nodes. The interior nodes share their mass, volume and length; the constants of the three
+  // kinds of node (start, interior, end) are computed once per evaluation.
   const Scalar half_rho_d = Scalar(0.5) * rho * p.diameter;
   const Scalar kn_per_l = half_rho_d * p.normal_drag;
   const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
   const Scalar can = p.normal_added_mass, cat = p.tangential_added_mass;
   const Scalar bed_k = p.seabed_stiffness * p.diameter, bed_c = p.seabed_damping * p.diameter;
+  struct NodeConstants {
+    Scalar li, dry_weight, wet_weight, rho_vol, kn, kt, mass_dry, mass_iso_wet, mass_tan_wet;
+  };
+  const auto node_constants = [&](int i) {
+    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
+    return NodeConstants{li,
+                         m * g,
+                         (m - rho * vol) * g,
+                         rho * vol,
+                         kn_per_l * li,
+                         kt_per_l * li,
+                         m,
+                         m + rho * vol * can,
+                         rho * vol * (cat - can)};
+  };
+  const NodeConstants kinds[3] = {node_constants(0), node_constants(n > 1 ? 1 : 0),
+                                  node_constants(n)};
+  V3 tu_prev = V3::Zero();  // T_{i−1} u_{i−1}
   for (int i = 0; i <= n; ++i) {
     // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends.
     // The drag below is written with the unnormalised chord and 1/|c|² so that its square root
@@ -434,33 +493,39 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     const V3 q = chord * inv_c;
     ws.tangent.col(i) = q;
 
-    V3 f = V3::Zero();
-    if (i < n) f += ws.tension(i) * ws.direction.col(i);
-    if (i > 0) f -= ws.tension(i - 1) * ws.direction.col(i - 1);
+    V3 f;
+    if (i < n) {
+      const V3 tu = bending ? V3(ws.tension(i) * ws.direction.col(i)) : segment(i);
+      f = tu - tu_prev;
+      tu_prev = tu;
+    } else {
+      f = -tu_prev;
+    }
     if (bending) f += ws.bending.col(i);
 
-    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
-    const Scalar zeta = Scalar(env.surface_elevation(x(0, i), x(1, i), t));
+    const NodeConstants& nc = kinds[i == 0 ? 0 : (i == n ? 2 : 1)];
+    const Scalar li = nc.li;
+    const Scalar zeta = still ? Scalar(0) : Scalar(env.surface_elevation(x(0, i), x(1, i), t));
     const bool wet = !(x(2, i) < -zeta);
     ws.submerged(i) = wet ? Scalar(1) : Scalar(0);
     // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
     Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
     if (wet) {
-      f(2) += (m - rho * vol) * g;
+      f(2) += nc.wet_weight;
       // Morison drag on the relative velocity, split along q.
       const V3 vr = ws.water_velocity.col(i) - v.col(i);
       const Scalar vc = vr.dot(chord);  // = |c| v_q
       const V3 vn = vr - (vc * inv_c2) * chord;
       const Scalar vn_abs = sqrt(vn.squaredNorm());
       const Scalar vq = vc * inv_c;
-      const Scalar kn = kn_per_l * li, kt = kt_per_l * li;
+      const Scalar kn = nc.kn, kt = nc.kt;
       f += (kn * vn_abs) * vn + (kt * abs(vq) * vq) * q;
       // Froude–Krylov plus added-mass forcing from the water acceleration.
       const V3 aw = ws.water_acceleration.col(i);
-      if (aw.squaredNorm() > Scalar(0))  // skipped in still water and steady current
-        f += (rho * vol) * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
-      ws.mass_iso(i) = m + rho * vol * can;
-      ws.mass_tan(i) = rho * vol * (cat - can);
+      if (!still && aw.squaredNorm() > Scalar(0))  // skipped in still water and steady current
+        f += nc.rho_vol * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
+      ws.mass_iso(i) = nc.mass_iso_wet;
+      ws.mass_tan(i) = nc.mass_tan_wet;
       if constexpr (WithJacobian) {
         // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ
         // = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
@@ -474,8 +539,8 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
         dv[5] = c1 + c31 * q(2) * q(2) + cn * vn(2) * vn(2);
       }
     } else {
-      f(2) += m * g;
-      ws.mass_iso(i) = m;
+      f(2) += nc.dry_weight;
+      ws.mass_iso(i) = nc.mass_dry;
       ws.mass_tan(i) = Scalar(0);
     }
     // Seabed: spring–damper normal force (never pulling) and saturated-viscous friction.
