@@ -501,16 +501,24 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       compute_forces<false>(model, ws, env, t1, x, v);
     ++report.force_evaluations;
     res = Scalar(0);
+    Scalar sum(0);
+    using std::abs;
     for (int i = f0; i <= f1; ++i) {
-      const Vector3<Scalar> dvel = v.col(i) - ws.v0.col(i);
-      const Vector3<Scalar> q = ws.tangent.col(i);
-      const Vector3<Scalar> r =
-          gh * ws.force.col(i) - (ws.mass_iso(i) * dvel + (ws.mass_tan(i) * q.dot(dvel)) * q);
-      ws.rhs.col(i) = r;
-      res = std::max(res, Scalar(r.cwiseAbs().maxCoeff() / ws.mass_iso(i)));
+      const Scalar d0 = v(0, i) - ws.v0(0, i), d1 = v(1, i) - ws.v0(1, i),
+                   d2 = v(2, i) - ws.v0(2, i);
+      const Scalar q0 = ws.tangent(0, i), q1 = ws.tangent(1, i), q2 = ws.tangent(2, i);
+      const Scalar a = ws.mass_iso(i), bqd = ws.mass_tan(i) * (q0 * d0 + q1 * d1 + q2 * d2);
+      const Scalar r0 = gh * ws.force(0, i) - (a * d0 + bqd * q0);
+      const Scalar r1 = gh * ws.force(1, i) - (a * d1 + bqd * q1);
+      const Scalar r2 = gh * ws.force(2, i) - (a * d2 + bqd * q2);
+      ws.rhs(0, i) = r0;
+      ws.rhs(1, i) = r1;
+      ws.rhs(2, i) = r2;
+      res = std::max(res, Scalar(std::max(std::max(abs(r0), abs(r1)), abs(r2)) / a));
+      sum += (r0 + r1) + r2;
     }
     // NaN fails every comparison and std::max keeps its first argument: test the sum instead.
-    if (!is_finite(ws.rhs.sum()))
+    if (!is_finite(sum))
       ::kelp::detail::throw_numerical_error(
           "step_implicit: non-finite residual; the state is unchanged");
   };
