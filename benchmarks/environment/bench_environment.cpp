@@ -63,6 +63,21 @@ void BM_SampleWaterCalm(benchmark::State& state) {
   }
 }
 
+// Calm sea with a constant current: the water query only writes the current.
+void BM_SampleWaterCalmCurrent(benchmark::State& state) {
+  Environment<double> env;
+  env.set_current(kelp::Vector3<double>(0.5, -0.2, 0.0));
+  const auto pts = tether_nodes<double>(100);
+  kelp::Matrix3X<double> vel(3, 100), acc(3, 100);
+  double t = 0;
+  for (auto _ : state) {
+    env.sample_water(pts, t, vel, acc);
+    benchmark::DoNotOptimize(vel.data());
+    benchmark::DoNotOptimize(acc.data());
+    t += 0.01;
+  }
+}
+
 void BM_SamplePoint(benchmark::State& state) {
   const auto env = rough_sea<double>(std::numeric_limits<double>::infinity(), 64);
   kelp::Vector3<double> p(1.0, 2.0, 3.0);
@@ -90,5 +105,6 @@ BENCHMARK(BM_SampleWaterDeep)->Args({100, 64})->Args({10, 64})->Args({100, 16});
 BENCHMARK(BM_SampleWaterFiniteDepth)->Args({100, 64});
 BENCHMARK(BM_SampleWaterDeepFloat)->Args({100, 64});
 BENCHMARK(BM_SampleWaterCalm);
+BENCHMARK(BM_SampleWaterCalmCurrent);
 BENCHMARK(BM_SamplePoint);
 BENCHMARK(BM_SamplePointCalm);

@@ -86,3 +86,34 @@ TEST_CASE("bad environment input throws kelp::invalid_argument naming the field"
   env.set_seabed_depth(30.0);
   CHECK(env.seabed_depth() == 30.0);
 }
+
+TEMPLATE_TEST_CASE("a calm sea writes the current (uniform or profiled) and zero acceleration",
+                   "[environment]", double, float) {
+  // The calm path skips the wave pass; it must still overwrite both outputs.
+  using S = TestType;
+  kelp::environment::CurrentParameters cp;
+  cp.speed = 0.7;
+  cp.direction = 1.1;
+  cp.profile.kind = kelp::environment::CurrentProfileKind::linear;
+  cp.profile.depth = 20.0;
+  cp.profile.bottom_ratio = 0.25;
+  Environment<S> still, profiled;
+  profiled.set_current(kelp::environment::CurrentModel<S>(cp));
+  Matrix3X<S> pts(3, 6), vel(3, 6), acc(3, 6);
+  pts << 0, 1, 2, 3, 4, 5,  //
+      0, 0, 1, 1, 2, 2,     //
+      -1, 0, 5, 10, 20, 30;
+  for (const Environment<S>* env : {&still, &profiled}) {
+    vel.setConstant(S(99));
+    acc.setConstant(S(99));
+    Eigen::internal::set_is_malloc_allowed(false);
+    env->sample_water(pts, S(2), vel, acc);
+    Eigen::internal::set_is_malloc_allowed(true);
+    for (Eigen::Index i = 0; i < pts.cols(); ++i) {
+      const auto s = env->sample(Vector3<S>(pts.col(i)), S(2));
+      CHECK((vel.col(i) - s.current).norm() <= S(1e-6));
+      CHECK(acc.col(i).norm() == S(0));
+    }
+  }
+  CHECK(vel(0, 0) != S(0));  // the profiled current is not zero at the surface
+}

@@ -1,6 +1,7 @@
 // Wave spectra, dispersion and irregular-wave kinematics: variances, peaks, the dispersion
 // relation, depth decay, the kinematic free-surface condition, continuity, reproducibility by
 // seed, batch vs point queries without allocation, and input validation.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -324,4 +325,47 @@ TEST_CASE("bad wave input throws kelp::invalid_argument naming the field", "[env
   const WaveField<double> c(calm);
   CHECK(c.empty());
   CHECK(c.kinematics(Vector3<double>(0, 0, 1), 3.0).velocity.norm() == 0.0);
+}
+
+TEST_CASE("the wave kernel's exp and sign-split sin/cos keep their error bounds",
+          "[environment][waves]") {
+  // fast_exp_nonpositive_unchecked<false> (one-term ln 2 reduction, used by the wave kernel):
+  // absolute error ≤ 1.3e-17 + 1e-15·e^x (the kernel sums a·e^{−kz}); fast_sincos_unsigned
+  // returns (sin, cos) up to the sign it reports.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> neg(-700.0, 0.0), small(-8.0, 0.0), ang(-1e4, 1e4);
+  double worst_exp = 0, worst_sc = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const double x = (i % 2) ? neg(rng) : small(rng);
+    const double e = detail::fast_exp_nonpositive_unchecked<false>(x);
+    worst_exp = std::max(worst_exp, std::abs(e - std::exp(x)) / (1.3e-17 + 1e-15 * std::exp(x)));
+    const double a = ang(rng);
+    double s, c;
+    std::uint64_t sign;
+    detail::fast_sincos_unsigned(a, s, c, sign);
+    const double sg = sign ? -1.0 : 1.0;
+    worst_sc = std::max({worst_sc, std::abs(sg * s - std::sin(a)), std::abs(sg * c - std::cos(a))});
+  }
+  CHECK(worst_exp <= 1.0);
+  CHECK(worst_sc < 1e-12);  // |a| ≤ 1e4: the argument itself carries ~|a|·1e-16
+}
+
+TEST_CASE("points below every trough (elevation sum skipped) match point queries",
+          "[environment][waves]") {
+  // The batch kernel skips the elevation sum for lane groups deeper than Σ a_j; their results
+  // must be those of the point query, which always sums it.
+  auto p = sea(4.5, 9.5, SpectrumKind::jonswap);
+  p.spreading = 1.0;
+  const WaveField<double> w(p);
+  double amp_sum = 0;
+  for (std::size_t j = 0; j < w.size(); ++j) amp_sum += w.amplitude(j);
+  const int n = 45;
+  Matrix3X<double> pts(3, n), vel(3, n), acc(3, n);
+  for (int i = 0; i < n; ++i) pts.col(i) << 0.4 * i, -0.2 * i, amp_sum - 3.0 + 0.25 * i;
+  w.kinematics(pts, 3.3, vel, acc);
+  for (int i = 0; i < n; ++i) {
+    const auto k = w.kinematics(Vector3<double>(pts.col(i)), 3.3);
+    CHECK((vel.col(i) - k.velocity).norm() <= 1e-12 * (1 + k.velocity.norm()));
+    CHECK((acc.col(i) - k.acceleration).norm() <= 1e-12 * (1 + k.acceleration.norm()));
+  }
 }

@@ -167,6 +167,21 @@ class Environment {
                     Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
     KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
                "sample_water: velocity and acceleration must have as many columns as points");
+    if (waves_.empty()) {  // calm sea: no wave pass, the current is written directly
+      acceleration.setZero();
+      if (current_.is_zero()) {
+        velocity.setZero();
+        return;
+      }
+      const Vector3<Scalar> vs = current_.surface_velocity(t);
+      if (current_.parameters().profile.kind == CurrentProfileKind::uniform) {
+        velocity = vs.replicate(1, points.cols());
+        return;
+      }
+      for (Eigen::Index i = 0; i < points.cols(); ++i)
+        velocity.col(i) = vs * profile_factor(current_.parameters().profile, points(2, i));
+      return;
+    }
     waves_.kinematics(points, t, velocity, acceleration);
     if (current_.is_zero()) return;
     const Vector3<Scalar> vs = current_.surface_velocity(t);

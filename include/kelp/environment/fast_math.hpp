@@ -2,9 +2,10 @@
 /// \brief Branch-free double-precision sin/cos and exp written so that loops over them
 /// auto-vectorise (plain SSE2 is enough); used by the wave kinematics kernel.
 ///
-/// Accuracy: |error| ≲ 1e-14 relative for exp on [−700, 0] and ≲ 1e-15 absolute for sin/cos
-/// with |x| ≤ 10 rad, ≲ 1e-11 with |x| ≤ 1e5 rad (Cody–Waite reduction with a two-part π/2 split
-/// and fdlibm's minimax kernels on [−π/4, π/4]; a Taylor polynomial on [−ln2/2, ln2/2] for exp).
+/// Accuracy: |error| ≲ 1e-15 relative for exp on [−700, 0] and ≲ 1e-15 absolute for sin/cos
+/// with |x| ≤ 10 rad, ≲ 1e-11 with |x| ≤ 1e5 rad (Cody–Waite reduction by multiples of π with a
+/// two-part split and near-minimax polynomials on [−π/2, π/2]; Cody–Waite reduction by ln 2 and
+/// a near-minimax polynomial on [−ln2/2, ln2/2] for exp).
 /// The tests compare them against std::sin/std::cos/std::exp.
 #pragma once
 
@@ -31,68 +32,103 @@ KELP_ENV_ALWAYS_INLINE inline double round_nearest(double x) {
   return (x + magic) - magic;
 }
 
-/// sin and cos of x (|x| ≤ 1e5 for full accuracy).
-KELP_ENV_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
-  constexpr double two_over_pi = 0.636619772367581343076;
-  // π/2 ≈ p1 + p2 (fdlibm's pio2_1, pio2_2; the remainder pio2_2t is 2.0e-21): p1 has 33
+/// sin and cos of x (|x| ≤ 1e5 for full accuracy) up to a common sign: sin x = ±s, cos x = ±c,
+/// with the sign bit of ± in `sign` (0 or 2^63, to be applied by XOR, see `flip_sign`). A
+/// caller that multiplies both by one factor applies the sign once, to that factor.
+KELP_ENV_ALWAYS_INLINE inline void fast_sincos_unsigned(double x, double& s, double& c,
+                                                        std::uint64_t& sign) {
+  constexpr double inv_pi = 0.318309886183790671538;
+  // π ≈ p1 + p2 (twice fdlibm's pio2_1, pio2_2; the remainder is 4.1e-21): p1 has 33
   // significant bits, so n·p1 is exact for |n| < 2^20.
-  constexpr double p1 = 1.57079632673412561417e+00;
-  constexpr double p2 = 6.07710050630396597660e-11;
-  // n = round(x·2/π) by the 1.5·2^52 trick; the low mantissa bits of `biased` then hold n in
-  // two's complement, so n mod 4 (the quadrant) is read from them directly.
+  constexpr double p1 = 3.14159265346825122833e+00;
+  constexpr double p2 = 1.21542010126079319532e-10;
+  // n = round(x/π) by the 1.5·2^52 trick; the lowest mantissa bit of `biased` is then the
+  // parity of n. x = r + nπ with |r| ≤ π/2, and (sin x, cos x) = (−1)^n (sin r, cos r): one sign
+  // flip instead of fdlibm's quadrant swap (fewer operations in a vector loop).
   constexpr double magic = 6755399441055744.0;
-  const double biased = x * two_over_pi + magic;
+  const double biased = x * inv_pi + magic;
   const double n = biased - magic;
-  // The third term n·p3 (≤ 2e-16 for |n| ≤ 1e5) is below the kernels' error: left out.
+  // The third term n·p3 (≤ 2e-16 for |n| ≤ 3e4) is below the kernels' error: left out.
   const double r = (x - n * p1) - n * p2;
   const double r2 = r * r;
-  // Minimax polynomials of fdlibm's __kernel_sin / __kernel_cos (Sun Microsystems, 1993) on
-  // |r| ≤ π/4, error below 2^-58.
-  constexpr double s1 = -1.66666666666666324348e-01, s2 = 8.33333333332248946124e-03,
-                   s3 = -1.98412698298579493134e-04, s4 = 2.75573137070700676789e-06,
-                   s5 = -2.50507602534068634195e-08, s6 = 1.58969099521155010221e-10;
-  constexpr double c1 = 4.16666666666666019037e-02, c2 = -1.38888888888741095749e-03,
-                   c3 = 2.48015872894767294178e-05, c4 = -2.75573143513906633035e-07,
-                   c5 = 2.08757232129817482790e-09, c6 = -1.13596475577881948265e-11;
-  const double r4 = r2 * r2;
-  // Estrin-style split of the Horner chains for more instruction-level parallelism.
-  const double ps = (s1 + r2 * s2) + r4 * ((s3 + r2 * s4) + r4 * (s5 + r2 * s6));
-  const double pc = (c1 + r2 * c2) + r4 * ((c3 + r2 * c4) + r4 * (c5 + r2 * c6));
-  const double sp = r + r * r2 * ps;
-  const double cp = (1.0 - 0.5 * r2) + r4 * pc;
-  // Quadrant q = n mod 4: x = r + qπ/2, so (sin x, cos x) = (sp, cp), (cp, −sp), (−sp, −cp),
-  // (−cp, sp) for q = 0..3. Select and flip signs with bit masks (vectorises as integer SIMD).
-  std::uint64_t q, sb, cb;
+  // Polynomials in r² on |r| ≤ π/2: Chebyshev interpolants (near-minimax) of
+  // (sin r / r − 1)/r² (degree 7 in r², error 3e-19) and (cos r − 1 + r²/2)/r⁴ (degree 6,
+  // error 1e-17), computed in 50-digit arithmetic (mpmath.chebyfit) and rounded to double.
+  constexpr double s1 = -0.16666666666666666, s2 = 0.008333333333333316,
+                   s3 = -0.00019841269841254974, s4 = 2.7557319219163234e-06,
+                   s5 = -2.5052107616996182e-08, s6 = 1.6058977312464087e-10,
+                   s7 = -7.643970296798572e-13, s8 = 2.7314447669863995e-15;
+  constexpr double c2 = 0.04166666666666666, c3 = -0.0013888888888884767,
+                   c4 = 2.480158729891355e-05, c5 = -2.7557318573366175e-07,
+                   c6 = 2.0876681558867395e-09, c7 = -1.1466252259718479e-11,
+                   c8 = 4.6464359591124806e-14;
+  // Horner form (the fewest operations; the loops around this function supply the
+  // parallelism).
+  const double ps =
+      s1 + r2 * (s2 + r2 * (s3 + r2 * (s4 + r2 * (s5 + r2 * (s6 + r2 * (s7 + r2 * s8))))));
+  const double pc = c2 + r2 * (c3 + r2 * (c4 + r2 * (c5 + r2 * (c6 + r2 * (c7 + r2 * c8)))));
+  s = r + (r * r2) * ps;
+  c = 1.0 + r2 * (-0.5 + r2 * pc);
+  std::uint64_t q;
   std::memcpy(&q, &biased, sizeof q);
-  std::memcpy(&sb, &sp, sizeof sb);
-  std::memcpy(&cb, &cp, sizeof cb);
-  const std::uint64_t swap = std::uint64_t(0) - (q & 1u);  // all ones when q is odd
-  std::uint64_t so = (cb & swap) | (sb & ~swap);
-  std::uint64_t co = (sb & swap) | (cb & ~swap);
-  so ^= (q & 2u) << 62;         // sin < 0 in quadrants 2, 3
-  co ^= ((q + 1u) & 2u) << 62;  // cos < 0 in quadrants 1, 2
-  std::memcpy(&s, &so, sizeof s);
-  std::memcpy(&c, &co, sizeof c);
+  sign = q << 63;  // the parity of n in the sign bit
+}
+
+/// x with its sign bit XORed with `sign` (0 or 2^63): x or −x without a branch.
+KELP_ENV_ALWAYS_INLINE inline double flip_sign(double x, std::uint64_t sign) {
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof b);
+  b ^= sign;
+  std::memcpy(&x, &b, sizeof x);
+  return x;
+}
+
+/// sin and cos of x (|x| ≤ 1e5 for full accuracy).
+KELP_ENV_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
+  std::uint64_t sign;
+  fast_sincos_unsigned(x, s, c, sign);
+  s = flip_sign(s, sign);
+  c = flip_sign(c, sign);
 }
 
 /// e^x for −708 ≤ x ≤ 0 (no range check: the caller guarantees the range).
+///
+/// With kSplitLn2 = false the reduction r = x − n ln2 uses ln 2 rounded to double (one fused
+/// multiply-add instead of two): the relative error then grows by |n|·2.3e-17 (≤ 2.3e-14 at
+/// x = −700), so the absolute error |x|·1.44·2.3e-17·e^x stays below 1.3e-17 for every x ≤ 0.
+/// The wave kernel sums terms a e^{−kz}, for which that absolute bound is what counts.
+template <bool kSplitLn2 = true>
 KELP_ENV_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
   constexpr double log2e = 1.44269504088896340736;
   constexpr double ln2_hi = 6.93147180369123816490e-01;  // fdlibm's ln2_hi / ln2_lo split
   constexpr double ln2_lo = 1.90821492927058770002e-10;
-  constexpr double magic = 6755399441055744.0;
-  const double n = (x * log2e + magic) - magic;
-  const double r = (x - n * ln2_hi) - n * ln2_lo;
-  // Taylor series of e^r on |r| ≤ ln2/2 to r^11 (remainder < 7e-15 relative), split for
-  // instruction-level parallelism.
-  const double r2 = r * r, r4 = r2 * r2, r8 = r4 * r4;
-  const double p01 = 1.0 + r, p23 = 1.0 / 2 + r * (1.0 / 6), p45 = 1.0 / 24 + r * (1.0 / 120),
-               p67 = 1.0 / 720 + r * (1.0 / 5040), p89 = 1.0 / 40320 + r * (1.0 / 362880),
-               pab = 1.0 / 3628800 + r * (1.0 / 39916800);
-  const double pr = (p01 + r2 * p23) + r4 * (p45 + r2 * p67) + r8 * (p89 + r2 * pab);
-  // 2^n: put n + 1023 into the low mantissa bits of a double (adding 2^52), then shift them
-  // into the exponent field.
-  const double biased = n + (1023.0 + 4503599627370496.0);
+  // n = round(x·log2 e) by the 1.5·2^52 trick, with 1023 added to the constant: the low
+  // mantissa bits of `biased` then hold n + 1023, the biased exponent of 2^n (used below).
+  constexpr double magic = 6755399441055744.0 + 1023.0;
+  const double biased = x * log2e + magic;
+  const double n = biased - magic;
+  double r;
+  if constexpr (kSplitLn2) {
+    r = (x - n * ln2_hi) - n * ln2_lo;
+  } else {
+    r = x - n * 0.693147180559945309417;
+  }
+  // Degree-10 Chebyshev interpolant (near-minimax) of e^r on |r| ≤ ln2/2, error 2.2e-16,
+  // computed in 50-digit arithmetic (mpmath.chebyfit) and rounded to double; Horner form (the
+  // fewest operations; the loops around this function supply the parallelism).
+  constexpr double e0 = 1.0, e1 = 1.0000000000000067, e2 = 0.5000000000000006,
+                   e3 = 0.16666666666554406, e4 = 0.04166666666657314, e5 = 0.008333333385667782,
+                   e6 = 0.0013888888932488599, e7 = 0.00019841170270440067,
+                   e8 = 2.4801504346997686e-05, e9 = 2.764018079620985e-06,
+                   e10 = 2.7626357241447223e-07;
+  const double pr =
+      e0 +
+      r * (e1 +
+           r * (e2 +
+                r * (e3 +
+                     r * (e4 + r * (e5 + r * (e6 + r * (e7 + r * (e8 + r * (e9 + r * e10)))))))));
+  // 2^n: shift n + 1023 (0 < n + 1023 < 2^11) from the low mantissa bits of `biased` into the
+  // exponent field; the higher bits of `biased` fall off the top.
   std::uint64_t bits;
   std::memcpy(&bits, &biased, sizeof bits);
   bits <<= 52;

@@ -46,9 +46,12 @@ namespace detail {
 
 /// Per-component constants of a wave field, as plain arrays (see `WaveField`).
 struct WaveComponentsView {
-  const double *omega, *k, *amp, *phase, *kx, *ky, *cosb, *sinb, *aw, *aw2, *q, *e2h;
+  const double *omega, *k, *amp, *phase, *kx, *ky, *aw, *aw2, *awc, *aws, *aw2c, *aw2s, *q, *e2h;
   std::size_t n;
   double two_h;  ///< twice the water depth (finite depth only)
+  /// A depth no trough reaches: (Σ a_j)(1 + 1e-9) ≥ |ζ| with room for rounding. The batch
+  /// kernel does not sum the elevation of points at least this deep (they are always wet).
+  double trough_bound;
 };
 
 /// Points per block of the batch kernel.
@@ -69,78 +72,91 @@ struct WaveLanes {
          ay[kLanes] = {}, az[kLanes] = {};
 };
 
-/// Adds component j's contribution at (x, y, ze) to lane l of `acc`: the Airy sums of the file
-/// comment, with F_h, F_v written with decaying exponentials only.
-template <bool kFinite, int kLanes>
-KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::size_t j, double t,
-                                             double x, double y, double ze, WaveLanes<kLanes>& acc,
-                                             int l) {
+/// Adds component j's contribution at (x, y, −nze), phase alpha = φ_j − ω_j t, to lane l of
+/// `acc`: the Airy sums of the file comment, with F_h, F_v written with decaying exponentials only
+/// and the direction cosines folded into the per-component constants (a ω cos β, a ω sin β,
+/// a ω² cos β, a ω² sin β). The common sign of (sin θ, cos θ) is applied once, to the depth
+/// factor. Without kZeta the elevation is not summed (the caller knows every
+/// lane is below any trough).
+template <bool kFinite, bool kZeta, int kLanes>
+KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::size_t j,
+                                             double alpha, double x, double y, double nze,
+                                             WaveLanes<kLanes>& acc, int l) {
   double sn, cs;
-  fast_sincos(c.kx[j] * x + c.ky[j] * y + (c.phase[j] - c.omega[j] * t), sn, cs);
-  const double e = fast_exp_nonpositive_unchecked(-c.k[j] * ze);  // k·ze ≤ 700 by the caller
+  std::uint64_t sign;
+  // Grouped so that the per-component constant alpha = φ − ω t is the addend of a fused
+  // multiply-add.
+  fast_sincos_unsigned(c.kx[j] * x + (c.ky[j] * y + alpha), sn, cs, sign);
+  // k·ze ≤ 700 by the caller; e carries the sign of (sin θ, cos θ).
+  const double e = flip_sign(fast_exp_nonpositive_unchecked<false>(c.k[j] * nze), sign);
   double fh = e, fv = e;
   if constexpr (kFinite) {
-    // e^{−k(2h − z)} = e^{−2kh} / e^{−kz}: a division instead of a second exponential (e > 0
+    // e^{−k(2h − z)} = e^{−2kh} / e^{−kz}: a division instead of a second exponential (e ≠ 0
     // because the caller clamps k z ≤ 700; e^{−2kh} ≤ e² may underflow to 0, which is right).
+    // Both terms carry the sign of e.
     const double e2 = c.e2h[j] / e;
     fh = (e + e2) * c.q[j];
     fv = (e - e2) * c.q[j];
   }
-  acc.zeta[l] += c.amp[j] * cs;
-  const double ah = c.aw[j] * fh, awh = c.aw2[j] * fh;  // a ω F_h and a ω² F_h
-  const double hv = ah * cs, ha = awh * sn;
-  acc.vx[l] += hv * c.cosb[j];
-  acc.vy[l] += hv * c.sinb[j];
-  acc.ax[l] += ha * c.cosb[j];
-  acc.ay[l] += ha * c.sinb[j];
+  if constexpr (kZeta) acc.zeta[l] += c.amp[j] * flip_sign(cs, sign);
+  const double hc = fh * cs, hs = fh * sn;  // F_h cos θ, F_h sin θ
+  acc.vx[l] += c.awc[j] * hc;
+  acc.vy[l] += c.aws[j] * hc;
+  acc.ax[l] += c.aw2c[j] * hs;
+  acc.ay[l] += c.aw2s[j] * hs;
   if constexpr (kFinite) {
-    acc.vz[l] -= (c.aw[j] * fv) * sn;
-    acc.az[l] += (c.aw2[j] * fv) * cs;
+    acc.vz[l] -= c.aw[j] * (fv * sn);
+    acc.az[l] += c.aw2[j] * (fv * cs);
   } else {  // F_v = F_h in deep water
-    acc.vz[l] -= ah * sn;
-    acc.az[l] += awh * cs;
+    acc.vz[l] -= c.aw[j] * hs;
+    acc.az[l] += c.aw2[j] * hc;
   }
 }
 
-/// Adds every component's elevation, velocity and acceleration to the block's accumulators.
-/// Several points: points go in lanes (a compile-time width the compiler maps onto vector
-/// registers; the last lane group is padded with copies of its first point) and the lane
-/// accumulators stay in registers across the loop over components. One point: the components go
-/// in lanes instead, and the lanes are summed at the end. Neither inner loop has a branch or a
-/// call, so both vectorise.
-template <bool kFinite>
-KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView& c, WaveBlock& b,
-                                                        int m, double t) {
-  constexpr int kLanes = 8;
-  if (m == 1) {
-    WaveLanes<kLanes> acc;
-    const double x = b.x[0], y = b.y[0], ze = b.ze[0];
-    std::size_t j0 = 0;
-    for (; j0 + kLanes <= c.n; j0 += kLanes)
-      for (int l = 0; l < kLanes; ++l) wave_term<kFinite>(c, j0 + l, t, x, y, ze, acc, l);
-    for (std::size_t j = j0; j < c.n; ++j) wave_term<kFinite>(c, j, t, x, y, ze, acc, 0);
-    for (int l = 0; l < kLanes; ++l) {
-      b.zeta[0] += acc.zeta[l];
-      b.vx[0] += acc.vx[l];
-      b.vy[0] += acc.vy[l];
-      b.vz[0] += acc.vz[l];
-      b.ax[0] += acc.ax[l];
-      b.ay[0] += acc.ay[l];
-      b.az[0] += acc.az[l];
-    }
-    return;
+/// Components per chunk of the batch kernel: the phases φ_j − ω_j t of a chunk are computed
+/// once per call into a stack array.
+inline constexpr std::size_t kWaveChunk = 128;
+
+/// Adds components [j0, j0 + nj) (phases `alpha`) to points [i0, min(i0 + kLanes, m)) of the
+/// block (the first chunk, j0 = 0, writes the sums instead): points go in lanes (a compile-time
+/// width the compiler maps onto vector registers; a short group is padded with copies of its first
+/// point) and the lane accumulators stay in registers across the loop over components.
+template <bool kFinite, int kLanes>
+KELP_ENV_ALWAYS_INLINE inline void wave_group(const WaveComponentsView& c, const double* alpha,
+                                              std::size_t j0, std::size_t nj, WaveBlock& b, int i0,
+                                              int m) {
+  double x[kLanes], y[kLanes], nze[kLanes];
+  bool below_troughs = true;  // every lane deeper than the lowest possible trough
+  for (int l = 0; l < kLanes; ++l) {
+    const int i = i0 + l < m ? i0 + l : i0;
+    x[l] = b.x[i];
+    y[l] = b.y[i];
+    nze[l] = -b.ze[i];
+    below_troughs = below_troughs && b.z[i] >= c.trough_bound;
   }
-  for (int i0 = 0; i0 < m; i0 += kLanes) {
-    double x[kLanes], y[kLanes], ze[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-      const int i = i0 + l < m ? i0 + l : i0;
-      x[l] = b.x[i];
-      y[l] = b.y[i];
-      ze[l] = b.ze[i];
+  WaveLanes<kLanes> acc;
+  // The elevation only decides whether a point is above the free surface; none of these is.
+  if (below_troughs) {
+    for (std::size_t j = 0; j < nj; ++j)
+      for (int l = 0; l < kLanes; ++l)
+        wave_term<kFinite, false>(c, j0 + j, alpha[j], x[l], y[l], nze[l], acc, l);
+  } else {
+    for (std::size_t j = 0; j < nj; ++j)
+      for (int l = 0; l < kLanes; ++l)
+        wave_term<kFinite, true>(c, j0 + j, alpha[j], x[l], y[l], nze[l], acc, l);
+  }
+  if (j0 == 0) {  // the first chunk writes the block's sums (no zeroing pass before the kernel)
+    for (int l = 0; l < kLanes && i0 + l < m; ++l) {
+      const int i = i0 + l;
+      b.zeta[i] = acc.zeta[l];
+      b.vx[i] = acc.vx[l];
+      b.vy[i] = acc.vy[l];
+      b.vz[i] = acc.vz[l];
+      b.ax[i] = acc.ax[l];
+      b.ay[i] = acc.ay[l];
+      b.az[i] = acc.az[l];
     }
-    WaveLanes<kLanes> acc;
-    for (std::size_t j = 0; j < c.n; ++j)
-      for (int l = 0; l < kLanes; ++l) wave_term<kFinite>(c, j, t, x[l], y[l], ze[l], acc, l);
+  } else {
     for (int l = 0; l < kLanes && i0 + l < m; ++l) {
       const int i = i0 + l;
       b.zeta[i] += acc.zeta[l];
@@ -154,13 +170,55 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
   }
 }
 
+/// Writes every component's elevation, velocity and acceleration sums into the block.
+/// Several points: groups of kWide points in lanes (`wave_group`), the rest in groups of 8 and
+/// a last one of 4 (less padding). One point: the components go in lanes instead, and the lanes are
+/// summed at the end. Neither inner loop has a branch or a call, so both vectorise. The components
+/// are taken in chunks whose phases at time t are computed first.
+template <bool kFinite, int kWide>
+KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView& c, WaveBlock& b,
+                                                        int m, double t) {
+  constexpr int kLanes = 8;
+  alignas(64) double alpha[kWaveChunk];
+  for (std::size_t j0 = 0; j0 < c.n; j0 += kWaveChunk) {
+    const std::size_t nj = std::min(kWaveChunk, c.n - j0);
+    for (std::size_t j = 0; j < nj; ++j) alpha[j] = c.phase[j0 + j] - c.omega[j0 + j] * t;
+    if (m == 1) {
+      WaveLanes<kLanes> acc;
+      const double x = b.x[0], y = b.y[0], nze = -b.ze[0];
+      std::size_t j = 0;
+      for (; j + kLanes <= nj; j += kLanes)
+        for (int l = 0; l < kLanes; ++l)
+          wave_term<kFinite, true>(c, j0 + j + l, alpha[j + l], x, y, nze, acc, l);
+      for (; j < nj; ++j) wave_term<kFinite, true>(c, j0 + j, alpha[j], x, y, nze, acc, 0);
+      if (j0 == 0) b.zeta[0] = b.vx[0] = b.vy[0] = b.vz[0] = b.ax[0] = b.ay[0] = b.az[0] = 0.0;
+      for (int l = 0; l < kLanes; ++l) {
+        b.zeta[0] += acc.zeta[l];
+        b.vx[0] += acc.vx[l];
+        b.vy[0] += acc.vy[l];
+        b.vz[0] += acc.vz[l];
+        b.ax[0] += acc.ax[l];
+        b.ay[0] += acc.ay[l];
+        b.az[0] += acc.az[l];
+      }
+      continue;
+    }
+    int i0 = 0;
+    if constexpr (kWide > kLanes)
+      for (; m - i0 > kLanes; i0 += kWide) wave_group<kFinite, kWide>(c, alpha, j0, nj, b, i0, m);
+    for (; m - i0 > kLanes / 2; i0 += kLanes)
+      wave_group<kFinite, kLanes>(c, alpha, j0, nj, b, i0, m);
+    if (i0 < m) wave_group<kFinite, kLanes / 2>(c, alpha, j0, nj, b, i0, m);  // ≤ 4 left
+  }
+}
+
 /// The kernel for the baseline instruction set of the build.
 inline void wave_accumulate_baseline(const WaveComponentsView& c, WaveBlock& b, int m, double t,
                                      bool finite) {
   if (finite)
-    wave_accumulate_impl<true>(c, b, m, t);
+    wave_accumulate_impl<true, 8>(c, b, m, t);
   else
-    wave_accumulate_impl<false>(c, b, m, t);
+    wave_accumulate_impl<false, 8>(c, b, m, t);
 }
 
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(__AVX2__)
@@ -171,9 +229,9 @@ __attribute__((target("avx2,fma"))) inline void wave_accumulate_avx2(const WaveC
                                                                      WaveBlock& b, int m, double t,
                                                                      bool finite) {
   if (finite)
-    wave_accumulate_impl<true>(c, b, m, t);
+    wave_accumulate_impl<true, 8>(c, b, m, t);
   else
-    wave_accumulate_impl<false>(c, b, m, t);
+    wave_accumulate_impl<false, 8>(c, b, m, t);
 }
 
 #if defined(__clang__)
@@ -186,9 +244,9 @@ __attribute__((target("avx2,fma"))) inline void wave_accumulate_avx2(const WaveC
 KELP_ENV_TARGET_AVX512 inline void wave_accumulate_avx512(const WaveComponentsView& c, WaveBlock& b,
                                                           int m, double t, bool finite) {
   if (finite)
-    wave_accumulate_impl<true>(c, b, m, t);
+    wave_accumulate_impl<true, 16>(c, b, m, t);
   else
-    wave_accumulate_impl<false>(c, b, m, t);
+    wave_accumulate_impl<false, 16>(c, b, m, t);
 }
 
 /// The widest kernel the CPU runs (checked once): 2 = AVX-512, 1 = AVX2 + FMA, 0 = baseline.
@@ -292,8 +350,8 @@ class WaveField {
     const double wp = 2.0 * kelp::pi / p.spectrum.peak_period;
     const double w_lo = p.omega_min_factor * wp, w_hi = p.omega_max_factor * wp;
     const double dw = (w_hi - w_lo) / static_cast<double>(n);
-    for (auto* v :
-         {&omega_, &k_, &amp_, &phase_, &dir_, &kx_, &ky_, &cosb_, &sinb_, &aw_, &aw2_, &q_, &e2h_})
+    for (auto* v : {&omega_, &k_, &amp_, &phase_, &dir_, &kx_, &ky_, &cosb_, &sinb_, &aw_, &aw2_,
+                    &awc_, &aws_, &aw2c_, &aw2s_, &q_, &e2h_})
       v->resize(n);
     for (std::size_t j = 0; j < n; ++j) {
       const double u = p.jitter ? uniform() : 0.5;
@@ -324,12 +382,19 @@ class WaveField {
       ky_[j] = k * sinb_[j];
       aw_[j] = a * w;
       aw2_[j] = a * w * w;
+      awc_[j] = aw_[j] * cosb_[j];
+      aws_[j] = aw_[j] * sinb_[j];
+      aw2c_[j] = aw2_[j] * cosb_[j];
+      aw2s_[j] = aw2_[j] * sinb_[j];
       // 1 / (1 − e^{−2kh}): the common factor of cosh/sinh ratios written with decaying
       // exponentials only (no overflow for large k h).
       q_[j] = std::isinf(p.depth) ? 1.0 : 1.0 / (-std::expm1(-2.0 * k * p.depth));
       e2h_[j] = std::isinf(p.depth) ? 0.0 : std::exp(-2.0 * k * p.depth);
     }
     finite_depth_ = !std::isinf(p.depth);
+    double amp_sum = 0.0;
+    for (double a : amp_) amp_sum += a;
+    trough_bound_ = amp_sum * (1.0 + 1e-9);
     z_exp_limit_ = 700.0 / k_.back();  // k grows with j: k_.back() is the largest
   }
 
@@ -484,8 +549,7 @@ class WaveField {
       double z = b.z[i] < 0.0 ? 0.0 : b.z[i];  // crest region: kinematics of z = 0
       if (finite_depth_ && z > h) z = h;       // below the seabed: those at the seabed
       if (z > z_exp_limit_) z = z_exp_limit_;  // e^{−k z} < 1e-304 beyond: keeps k z ≤ 700
-      b.ze[i] = z;
-      b.zeta[i] = b.vx[i] = b.vy[i] = b.vz[i] = b.ax[i] = b.ay[i] = b.az[i] = 0.0;
+      b.ze[i] = z;                             // the kernel writes b's sums: no zeroing here
     }
     if (force_baseline_)
       detail::wave_accumulate_baseline(view(), b, m, t, finite_depth_);
@@ -533,16 +597,19 @@ class WaveField {
   }
 
   detail::WaveComponentsView view() const {
-    return {omega_.data(), k_.data(),    amp_.data(),   phase_.data(),      kx_.data(),
-            ky_.data(),    cosb_.data(), sinb_.data(),  aw_.data(),         aw2_.data(),
-            q_.data(),     e2h_.data(),  omega_.size(), 2.0 * params_.depth};
+    return {omega_.data(),       k_.data(),    amp_.data(), phase_.data(), kx_.data(),
+            ky_.data(),          aw_.data(),   aw2_.data(), awc_.data(),   aws_.data(),
+            aw2c_.data(),        aw2s_.data(), q_.data(),   e2h_.data(),   omega_.size(),
+            2.0 * params_.depth, trough_bound_};
   }
 
   WaveFieldParameters params_;
   bool finite_depth_ = false;
   bool force_baseline_ = false;
   double z_exp_limit_ = std::numeric_limits<double>::infinity();
-  std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, q_, e2h_;
+  double trough_bound_ = 0.0;  ///< see `detail::WaveComponentsView::trough_bound`
+  std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, awc_, aws_,
+      aw2c_, aw2s_, q_, e2h_;
 };
 
 /// \brief Double-precision wave field.
