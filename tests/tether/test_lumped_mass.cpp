@@ -211,6 +211,9 @@ TEST_CASE("a still environment skips the water query and gives the same forces",
           "[tether][forces]") {
   // Environment without waves or current: compute_forces keeps zeroed water buffers instead of
   // querying it. A workspace that last saw a current must give the same forces as a fresh one.
+  static_assert(kt::detail::has_still_water_query<kelp::environment::Environmentd>::value,
+                "Environment must expose waves().empty() and current().is_zero()");
+  static_assert(!kt::detail::has_still_water_query<kelp_test::TestWater<double>>::value);
   auto p = kelp_test::benchmark_line<double>(8);
   const kt::TetherModeld m(p);
   kelp::environment::Environmentd calm, flowing;
