@@ -38,6 +38,23 @@ TEMPLATE_TEST_CASE("a default environment is still seawater with standard gravit
     CHECK(s.wind.norm() == S(0));
   }
   CHECK(env.surface_elevation(S(1), S(2), S(3)) == S(0));
+  CHECK(env.is_still_water());
+}
+
+TEMPLATE_TEST_CASE("is_still_water is false as soon as there is a current or a wave",
+                   "[environment]", double, float) {
+  using S = TestType;
+  Environment<S> with_current, with_waves;
+  with_current.set_current(Vector3<S>(S(0), S(0.1), S(0)));
+  CHECK_FALSE(with_current.is_still_water());
+  kelp::environment::WaveFieldParameters wp;
+  wp.spectrum.significant_height = 1.0;
+  wp.n_components = 8;
+  with_waves.set_waves(kelp::environment::WaveField<S>(wp));
+  CHECK_FALSE(with_waves.is_still_water());
+  // Wind alone leaves the water still.
+  CHECK(
+      kelp::environment::make_environment<S>(kelp::environment::presets::calm()).is_still_water());
 }
 
 TEMPLATE_TEST_CASE("a constant current is seen at every point, alone and in the batch query",

@@ -122,6 +122,10 @@ class Environment {
     wind_ = wind;
     return *this;
   }
+  /// \brief True when the water is still everywhere and at all times (no wave components and no
+  /// current), so that water velocity and acceleration are zero at every point: callers such as
+  /// the tether may skip their water queries.
+  bool is_still_water() const { return waves_.empty() && current_.is_zero(); }
   /// \brief The current model.
   const CurrentModel<Scalar>& current() const { return current_; }
   /// \brief The wave field.

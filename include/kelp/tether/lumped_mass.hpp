@@ -315,23 +315,22 @@ struct TetherWorkspace {
 
 namespace detail {
 
-/// True for environments that can say they are still water at all times: no wave components
-/// (`env.waves().empty()`) and no current (`env.current().is_zero()`), as
-/// kelp::environment::Environment can. Other environments are always queried.
+/// True for environments that can say they are still water at all times through
+/// `bool is_still_water() const`, as kelp::environment::Environment can. Other environments are
+/// always queried.
 template <typename Env, typename = void>
 struct has_still_water_query : std::false_type {};
 template <typename Env>
 struct has_still_water_query<
-    Env, std::void_t<decltype(bool(std::declval<const Env&>().waves().empty())),
-                     decltype(bool(std::declval<const Env&>().current().is_zero()))>>
+    Env, std::void_t<decltype(bool(std::declval<const Env&>().is_still_water()))>>
     : std::true_type {};
 
-/// True when `env` has no waves and no current: its water velocity and acceleration are zero
-/// everywhere and at all times.
+/// True when `env` reports still water: its water velocity and acceleration are zero everywhere
+/// and at all times.
 template <typename Env>
 bool is_still_water(const Env& env) {
   if constexpr (has_still_water_query<Env>::value)
-    return env.waves().empty() && env.current().is_zero();
+    return env.is_still_water();
   else
     return false;
 }
