@@ -1,26 +1,33 @@
 // The fast catenary path: the reference case, the statuses and the paper's equations.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstddef>
+#include <cstdlib>
 #include <limits>
+#include <new>
 
 #include "kelp/tether/catenary.hpp"
+#include "random_geometry.hpp"
 
 using kelp::tether::CatenaryOptions;
 using kelp::tether::CatenaryStatus;
 using kelp::tether::solve_catenary;
+using kelp_test::paper_residual_ld;
 
+// Global operator new of this test executable, replaced to count calls: solve_catenary works on
+// scalars and never touches an Eigen object, so EIGEN_RUNTIME_NO_MALLOC cannot see an allocation
+// there (a std::vector or std::function would go unnoticed); this counter does.
 namespace {
-
-// The paper's two equations as residuals, evaluated in long double so that the check does not
-// share the solver's double-precision rounding; returned relative to L.
-long double paper_residual_ld(long double a, long double c, long double D, long double dz,
-                              long double L) {
-  const long double r1 = a * (std::cosh((D - c) / a) - std::cosh(c / a)) - dz;
-  const long double r2 = a * (std::sinh((D - c) / a) + std::sinh(c / a)) - L;
-  return std::max(std::fabs(r1), std::fabs(r2)) / L;
-}
-
+std::size_t g_operator_new_calls = 0;
 }  // namespace
+
+void* operator new(std::size_t size) {
+  ++g_operator_new_calls;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 TEST_CASE("reference case of tether.md to 6 digits", "[catenary]") {
   // tether.md: D = 10, dz = +5, L = 20 -> a = 2.358583, c = 4.397588 (MoorPy, FAST-v7 and an
@@ -134,9 +141,34 @@ TEST_CASE("iteration limit is reported as max_iterations", "[catenary]") {
   CHECK(std::isfinite(r.a));
 }
 
-TEST_CASE("the fast path does not allocate", "[catenary]") {
+TEST_CASE("the fast path and the 3-D helper do not allocate", "[catenary]") {
+  // The instrument is live: a call to the global operator new is counted.
+  const std::size_t probe = g_operator_new_calls;
+  ::operator delete(::operator new(16));
+  REQUIRE(g_operator_new_calls == probe + 1);
+  // solve_catenary on every status (scalars only: the operator new counter is the check), then
+  // the 3-D helper and its queries (Eigen vectors: EIGEN_RUNTIME_NO_MALLOC checks them too).
+  CatenaryOptions<double> opt;
+  opt.EA = 1e4;
+  const std::size_t before = g_operator_new_calls;
   Eigen::internal::set_is_malloc_allowed(false);
   const auto r = solve_catenary(10.0, 5.0, 20.0);
+  const auto rf = solve_catenary(10.0f, 5.0f, 20.0f);
+  const auto taut = solve_catenary(3.0, 4.0, 4.9, opt);
+  const auto vertical = solve_catenary(0.0, 2.0, 5.0);
+  const auto invalid = solve_catenary(-1.0, 0.0, 3.0);
+  const kelp::Vector3<double> start(0, 0, 0), end(10, 0, -5);
+  const auto shape = kelp::tether::catenary_between(start, end, 20.0, 0.2);
+  const kelp::Vector3<double> f = shape.force_on_start() + shape.force_on_end() +
+                                  shape.point_at(7.0) + shape.vertex() + shape.lowest_point();
+  const double t = shape.tension_at(3.0);
   Eigen::internal::set_is_malloc_allowed(true);
+  const std::size_t after = g_operator_new_calls;
+  CHECK(after == before);
   CHECK(r.status == CatenaryStatus::converged);
+  CHECK(rf.status == CatenaryStatus::converged);
+  CHECK(taut.status == CatenaryStatus::taut);
+  CHECK(vertical.status == CatenaryStatus::vertical);
+  CHECK(invalid.status == CatenaryStatus::invalid_input);
+  CHECK(std::isfinite(f.sum() + t));
 }

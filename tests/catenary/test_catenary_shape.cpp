@@ -19,6 +19,23 @@ namespace {
 // tether.md: d = 8 mm, 0.07 kg/m, rho = 1025, g = 9.81 -> w = 0.181268 N/m.
 const double kPi = 3.14159265358979323846;
 const double kW = (0.07 - 1025.0 * kPi * 0.004 * 0.004) * 9.81;
+
+// Independent of the solver: a of the paper's equations from 2a sinh(D/2a) = sqrt(L² − dz²) by
+// bisection on u = D/(2a) in long double, then c = D/2 − a atanh(dz/L).
+void independent_catenary(long double D, long double dz, long double L, long double& a,
+                          long double& c) {
+  const long double target = std::sqrt(L * L - dz * dz) / D;  // sinh(u)/u
+  long double lo = 0.0L, hi = 100.0L;
+  for (int i = 0; i < 200; ++i) {
+    const long double u = 0.5L * (lo + hi);
+    if (std::sinh(u) / u > target)
+      hi = u;
+    else
+      lo = u;
+  }
+  a = D / (lo + hi);  // D / (2u)
+  c = 0.5L * D - a * std::atanh(dz / L);
+}
 }  // namespace
 
 TEST_CASE("3-D reference case: H, V and |T| at both ends to 6 digits", "[catenary][shape]") {
@@ -98,6 +115,49 @@ TEST_CASE("a buoyant line is the mirror image of a hanging one", "[catenary][sha
   CHECK(buoy.horizontal_tension() == Approx(hang.horizontal_tension()).epsilon(1e-12));
   // The buoyant vertex is the highest point of the arch.
   CHECK(buoy.vertex().z() < std::min(start.z(), end_m.z()));
+  // ... at the height an independent solve gives: in the mirrored plane (D = 6, dz' = 3, L = 12)
+  // the vertex lies a(cosh(c/a) − 1) beyond the start, i.e. that much above it for w < 0.
+  long double a = 0, c = 0;
+  independent_catenary(6, 3, 12, a, c);
+  REQUIRE(c > 0);  // the vertex lies on the cable, between the ends
+  REQUIRE(c < 6);
+  const double top = double(10.0L - a * (std::cosh(c / a) - 1.0L));
+  CHECK(buoy.vertex().z() == Approx(top).epsilon(1e-12));
+  CHECK(buoy.vertex().x() == Approx(double(c)).epsilon(1e-12));
+  // No point of the cable is above the top of the arch, and the cable reaches it.
+  double highest = start.z();
+  for (int i = 0; i <= 1200; ++i) {
+    const double z = buoy.point_at(12.0 * i / 1200).z();
+    CHECK(z >= top - 1e-12);
+    highest = std::min(highest, z);
+  }
+  CHECK(highest == Approx(top).epsilon(1e-6));
+}
+
+TEST_CASE("iteration limit: end forces, H and tensions agree (last iterate)", "[catenary][shape]") {
+  // A solve stopped by the iteration limit reports the shape of its last iterate; its horizontal
+  // tension, end forces and tension_at must describe that same iterate (H = a·|w| everywhere).
+  kelp::tether::CatenaryOptions<double> opt;
+  opt.max_iterations = 1;
+  opt.tolerance = 0.0;  // never satisfied unless the residual is exactly zero
+  for (double w : {kW, -0.3}) {
+    const double L = 20.0;
+    const V3 start(1.0, 2.0, 0.0);
+    const V3 end = start + 10.0 * V3(0.6, 0.8, 0.0) + V3(0, 0, -5.0);
+    const auto shape = catenary_between(start, end, L, w, opt);
+    REQUIRE(shape.status() == CatenaryStatus::max_iterations);
+    const double a = shape.result().a;
+    REQUIRE(std::isfinite(a));
+    REQUIRE(a > 0);
+    CHECK(shape.horizontal_tension() == Approx(std::abs(w) * a).epsilon(1e-15));
+    const V3 fs = shape.force_on_start(), fe = shape.force_on_end();
+    CHECK(fs.head<2>().norm() == Approx(shape.horizontal_tension()).epsilon(1e-12));
+    CHECK((fs.head<2>() + fe.head<2>()).norm() < 1e-12);
+    CHECK(shape.tension_at(0.0) == Approx(fs.norm()).epsilon(1e-12));
+    CHECK(shape.tension_at(L) == Approx(fe.norm()).epsilon(1e-12));
+    // The ends carry the weight of the iterate's arc length, L(1 + R2/L): within its residual.
+    CHECK(std::abs(fs.z() + fe.z() - w * L) <= std::abs(w) * L * (shape.result().residual + 1e-14));
+  }
 }
 
 TEST_CASE("taut, vertical and invalid 3-D lines", "[catenary][shape]") {

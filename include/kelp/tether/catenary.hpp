@@ -46,7 +46,8 @@ enum class CatenaryStatus {
   vertical,   ///< D ≤ vertical_tolerance·L: the ends are vertically aligned; a = 0, c = 0.
   invalid_input,   ///< NaN or ±Inf input, L ≤ 0, D < 0 or a negative vertical_tolerance (3-D
                    ///< helper: also a non-finite w, or an end below options.seabed_depth).
-  max_iterations,  ///< The iteration limit was hit; a, c hold the last iterate.
+  max_iterations,  ///< The iteration limit was hit; a, c hold the last iterate (3-D helper: the
+                   ///< shape, H = a·|w|, end forces and tensions all describe that iterate).
 };
 
 /// \brief A short lower-case name of a status ("converged", "taut", ...), for logs and messages.
@@ -135,6 +136,15 @@ struct LogSinhc {
   double d2;  ///< h''(u) = 1/u² − 1/sinh²(u)
 };
 
+/// Taylor series of the Langevin function coth(u) − 1/u = u/3 − u³/45 + 2u⁵/945 − u⁷/4725 +
+/// 2u⁹/93555 (next term −1382u¹¹/638512875: relative truncation error ~6e-12 at u = 0.25, ~6e-9
+/// at u = 0.5). The one place both h' evaluations below take it from.
+inline double langevin_series(double u) {
+  const double v = u * u;
+  return u * (1.0 / 3.0 +
+              v * (-1.0 / 45.0 + v * (2.0 / 945.0 + v * (-1.0 / 4725.0 + v * (2.0 / 93555.0)))));
+}
+
 /// Evaluates h, h', h'' with full relative precision and without overflow at the cost of one
 /// transcendental call below u = 0.5 (Taylor series of sinh(u)/u − 1, then log1p) and two above
 /// (E = e^{−2u}: h = u + ln((1 − E)/(2u)), coth u = (1 + E)/(1 − E), sinh⁻² u = 4E/(1 − E)²).
@@ -148,9 +158,7 @@ inline LogSinhc eval_log_sinhc(double u) {
                               v * (1.0 / 5040.0 + v * (1.0 / 362880.0 + v * (1.0 / 39916800.0 +
                                                                              v / 6227020800.0)))));
     out.h = std::log1p(sm1);
-    // Langevin series u/3 − u³/45 + 2u⁵/945 − u⁷/4725 + 2u⁹/93555 (used for the step only).
-    out.d1 = u * (1.0 / 3.0 + v * (-1.0 / 45.0 +
-                                   v * (2.0 / 945.0 + v * (-1.0 / 4725.0 + v * (2.0 / 93555.0)))));
+    out.d1 = langevin_series(u);  // ~6e-9 relative at u = 0.5: used for the step only
     out.d2 = 1.0 / 3.0 +
              v * (-1.0 / 15.0 + v * (2.0 / 189.0 + v * (-7.0 / 4725.0 + v * (18.0 / 93555.0))));
     return out;
@@ -164,14 +172,10 @@ inline LogSinhc eval_log_sinhc(double u) {
   return out;
 }
 
-/// h'(u) = coth(u) − 1/u to full precision (series below 0.25); used for the implicit-function
-/// derivatives.
+/// h'(u) = coth(u) − 1/u to ~1e-11 relative or better (series below 0.25); used for the
+/// implicit-function derivatives.
 inline double log_sinhc_d1(double u) {
-  if (u < 0.25) {
-    const double v = u * u;
-    return u * (1.0 / 3.0 +
-                v * (-1.0 / 45.0 + v * (2.0 / 945.0 + v * (-1.0 / 4725.0 + v * (2.0 / 93555.0)))));
-  }
+  if (u < 0.25) return langevin_series(u);
   return 1.0 / std::tanh(u) - 1.0 / u;
 }
 
@@ -507,7 +511,11 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
 /// vanishing sag). `vertical` — the ends are vertically aligned: the line runs from the start to
 /// the vertex (lowest point for w ≥ 0, highest for w < 0) and back to the end along the vertical,
 /// s_start = (L − Δz')/2 from the start (Δz' the height difference in the mirrored plane), H = 0,
-/// each end carries the weight of its own branch. `invalid_input` — every query returns NaN.
+/// each end carries the weight of its own branch. `max_iterations` — the shape, H = a·|w|, the end
+/// forces and tension_at() are all those of the solver's last iterate (a, c in result()), so they
+/// agree with one another (|force_on_start()| = tension_at(0)) but satisfy the paper's equations
+/// only to result().residual; check status() before relying on them. `invalid_input` — every
+/// query returns NaN.
 ///
 /// **Seabed contact** (options.seabed_depth finite, w > 0, both ends at or above the seabed; an end
 /// below it gives `invalid_input`). When the free catenary's lowest point would lie below the
@@ -554,7 +562,11 @@ class CatenaryShape {
     dz_ = buoyant_ ? Scalar(-dz_up) : dz_up;
     weight_ = abs(w_);
     result_ = solve_catenary(D_, dz_, L_, options);
-    H_ = result_.status == CatenaryStatus::converged ? Scalar(result_.a * weight_) : Scalar(0.0);
+    // converged and max_iterations (the last iterate) alike: every query below describes the same
+    // a, c, so that force_on_start/force_on_end and tension_at agree whatever the status.
+    const bool has_iterate = result_.status == CatenaryStatus::converged ||
+                             result_.status == CatenaryStatus::max_iterations;
+    H_ = has_iterate ? Scalar(result_.a * weight_) : Scalar(0.0);
     const bool slack =
         result_.status == CatenaryStatus::converged || result_.status == CatenaryStatus::vertical;
     if (has_seabed && !buoyant_ && value_of(w_) > 0.0 && slack &&
@@ -569,7 +581,7 @@ class CatenaryShape {
   /// residual, taut tension (for a grounded line see the class description).
   const CatenaryResult<Scalar>& result() const { return result_; }
   /// \brief Horizontal tension H = a·|w| [N], the same all along the line (0 when vertical, taut or
-  /// invalid).
+  /// invalid; for max_iterations that of the last iterate, like the shape and the end forces).
   Scalar horizontal_tension() const { return H_; }
   /// \brief Horizontal distance between the ends D [m].
   Scalar horizontal_distance() const { return D_; }
