@@ -90,8 +90,10 @@ TEST_CASE("tether between two vehicles: loads balance the line and follow the ve
   CHECK(loads.force_start_ned.z() + loads.force_end_ned.z() == Approx(w * p.length).epsilon(1e-4));
   CHECK(loads.force_start_ned.x() == Approx(-loads.force_end_ned.x()).epsilon(1e-4));
   CHECK(loads.force_start_ned.x() > 0);  // the ASV is pulled towards the AUV
-  // The AUV's tether point is above and forward of its CO: the downward-backward pull pitches
-  // its nose down (negative pitch moment M = r_z f_x − r_x f_z with f_x < 0, f_z > 0).
+  // The AUV's tether point is 0.2 m forward (r_x > 0) and 0.2 m above (r_z < 0) its CO and the
+  // line pulls it backward (f_x < 0) and down (f_z > 0). In the pitch moment M = r_z f_x − r_x f_z
+  // the first term is nose-up and the second nose-down; the downward pull is larger than the
+  // backward one here, so the r_x f_z term dominates and the nose pitches down (M < 0).
   CHECK(loads.tau_end(4) < 0);
   CHECK(loads.tau_start.head<3>().isApprox(loads.force_start_ned));  // ASV level, heading north
   // Moving the AUV away tightens the tether: after 2 s at 1 m/s north the pull grows. The

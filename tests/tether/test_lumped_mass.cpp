@@ -3,6 +3,7 @@
 // allocation-free steps.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "kelp/environment/environment.hpp"
@@ -100,7 +101,10 @@ TEST_CASE("node masses, volumes and lumped lengths", "[tether][model]") {
   CHECK(m.segment_length() == Approx(5.0));
   CHECK(m.node_mass(0) == Approx(0.07 * 2.5));
   CHECK(m.node_mass(2) == Approx(0.07 * 5.0));
-  CHECK(m.node_mass(4) == Approx(0.07 * 2.5 + 2.0));
+  // The far end is kinematic: its point mass belongs to the body that moves it.
+  CHECK(m.node_mass(4) == Approx(0.07 * 2.5));
+  p.end_mode = kt::EndMode::free;
+  CHECK(kt::TetherModeld(p).node_mass(4) == Approx(0.07 * 2.5 + 2.0));
   double total_volume = 0;
   for (int i = 0; i < 5; ++i) total_volume += m.node_volume(i);
   CHECK(total_volume == Approx(kelp::pi * 0.008 * 0.008 / 4 * 20));
@@ -502,4 +506,125 @@ TEST_CASE("seabed: spring-damper contact and saturated-viscous friction", "[teth
   kt::compute_forces(m, ws, env, 0.0, x, v);
   CHECK(ws.seabed_force(1) == 0.0);
   CHECK(ws.force(2, 1) == Approx(w));
+}
+
+TEST_CASE("point masses count only at free ends: a kinematic end reports no point-mass load",
+          "[tether][model][regression]") {
+  kelp_test::TestWater<double> env;
+  auto p = kelp_test::benchmark_line<double>(10);
+  const kt::TetherModeld plain(p);
+  p.start_point_mass = 3.0;
+  p.end_point_mass = 5.0;
+  const kt::TetherModeld massive(p);  // both ends kinematic: the point masses are ignored
+  CHECK(massive.node_mass(0) == plain.node_mass(0));
+  CHECK(massive.node_mass(10) == plain.node_mass(10));
+  // The end forces of an accelerating, sagging line are those of the line alone.
+  const Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  auto bnd = kt::TetherBoundaryd::fixed(a, b);
+  bnd.start.acceleration = Vector3<double>(0.5, -0.2, 1.0);
+  bnd.end.acceleration = Vector3<double>(-1.0, 0.3, 2.0);
+  const auto s = kt::catenary_initial_state(plain, env, a, b);
+  kt::TetherWorkspaced w1(plain), w2(massive);
+  kt::compute_forces(plain, w1, env, 0.0, s.position, s.velocity);
+  kt::compute_forces(massive, w2, env, 0.0, s.position, s.velocity);
+  const auto f1 = kt::end_forces_from_workspace(plain, w1, bnd);
+  const auto f2 = kt::end_forces_from_workspace(massive, w2, bnd);
+  CHECK((f1.on_start - f2.on_start).norm() == 0.0);
+  CHECK((f1.on_end - f2.on_end).norm() == 0.0);
+  // A free end carries its point mass.
+  p.end_mode = kt::EndMode::free;
+  const kt::TetherModeld free_end(p);
+  CHECK(free_end.node_mass(10) == Approx(plain.node_mass(10) + 5.0));
+  CHECK(free_end.node_mass(0) == plain.node_mass(0));
+}
+
+TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is unchanged",
+          "[tether][errors][regression]") {
+  kelp::environment::Environmentd env;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(10));
+  kt::TetherWorkspaced ws(model);
+  const Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  const auto bnd = kt::TetherBoundaryd::fixed(a, b);
+  const kt::TetherStated good = kt::catenary_initial_state(model, env, a, b);
+  const auto same = [](const kt::TetherStated& x, const kt::TetherStated& y) {
+    // Bitwise (NaN included).
+    return x.position.cols() == y.position.cols() &&
+           std::memcmp(x.position.data(), y.position.data(),
+                       sizeof(double) * std::size_t(x.position.size())) == 0 &&
+           std::memcmp(x.velocity.data(), y.velocity.data(),
+                       sizeof(double) * std::size_t(x.velocity.size())) == 0 &&
+           std::memcmp(&x.time, &y.time, sizeof(double)) == 0;
+  };
+
+  SECTION("advance: more than INT_MAX sub-steps") {
+    auto s = good;
+    CHECK_THROWS_AS(kt::advance(model, ws, env, s, bnd, 1e3, 1e-7, kt::Integrator::rk4),
+                    kelp::invalid_argument);
+    CHECK_THROWS_WITH(kt::advance(model, ws, env, s, bnd, 1e3, 1e-7, kt::Integrator::rk4),
+                      Catch::Contains("max_dt"));
+    CHECK(same(s, good));
+  }
+
+  SECTION("ImplicitOptions") {
+    const auto expect = [&](kt::ImplicitOptionsd o, const char* field) {
+      INFO(field);
+      for (auto integ : {kt::Integrator::implicit_euler, kt::Integrator::bdf2}) {
+        auto s = good;
+        CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, 0.01, integ, o), kelp::invalid_argument);
+        CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 0.01, integ, o), Catch::Contains(field));
+        CHECK(same(s, good));
+        CHECK_THROWS_AS(kt::advance(model, ws, env, s, bnd, 0.05, 0.01, integ, o),
+                        kelp::invalid_argument);
+        CHECK(same(s, good));
+      }
+    };
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    kt::ImplicitOptionsd o;
+    o.max_iterations = 0;
+    expect(o, "max_iterations");
+    o = {};
+    o.velocity_tolerance = 0.0;
+    expect(o, "velocity_tolerance");
+    o.velocity_tolerance = -1e-6;
+    expect(o, "velocity_tolerance");
+    o.velocity_tolerance = nan;
+    expect(o, "velocity_tolerance");
+    o.velocity_tolerance = inf;
+    expect(o, "velocity_tolerance");
+    o = {};
+    o.slack_band = -0.1;
+    expect(o, "slack_band");
+    o.slack_band = nan;
+    expect(o, "slack_band");
+    o = {};
+    o.max_active_set_passes = 0;
+    expect(o, "max_active_set_passes");
+    o = {};
+    o.max_backtracks = -1;
+    expect(o, "max_backtracks");
+  }
+
+  SECTION("non-finite state") {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    struct Case {
+      int which;
+      const char* field;
+    };
+    for (const Case c :
+         {Case{0, "state.position"}, Case{1, "state.velocity"}, Case{2, "state.time"}}) {
+      for (auto integ : {kt::Integrator::symplectic_euler, kt::Integrator::rk2, kt::Integrator::rk4,
+                         kt::Integrator::implicit_euler, kt::Integrator::bdf2}) {
+        INFO(c.field << " " << kt::integrator_name(integ));
+        auto s = good;
+        if (c.which == 0) s.position(2, 4) = nan;
+        if (c.which == 1) s.velocity(0, 6) = std::numeric_limits<double>::infinity();
+        if (c.which == 2) s.time = nan;
+        const auto before = s;
+        CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, 1e-4, integ), kelp::invalid_argument);
+        CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 1e-4, integ), Catch::Contains(c.field));
+        CHECK(same(s, before));
+      }
+    }
+  }
 }

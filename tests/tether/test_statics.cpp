@@ -217,3 +217,71 @@ TEST_CASE("float and double agree on the static equilibrium and a dynamic run",
   CHECK((sf.position.cast<double>() - sd.position).cwiseAbs().maxCoeff() < 5e-3);
   CHECK(double(wsf.end_forces.on_end.norm()) == Approx(wsd.end_forces.on_end.norm()).epsilon(1e-2));
 }
+
+TEST_CASE("a rejected pseudo step restarts from the position before it",
+          "[tether][statics][regression]") {
+  // With max_iterations = 1 the solve takes one pseudo-transient step. When that step's Newton
+  // solve does not converge the step is rejected: the position must go back to the one before
+  // the step (here the start), not to an intermediate Newton iterate.
+  kelp_test::TestWater<double> env;
+  env.bed = 8.0;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(20));
+  const kelp::Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  const kt::TetherStated start = kt::straight_line_state(model, a, b);  // slack, far from rest
+  kt::StaticOptionsd options;
+  options.max_iterations = 1;
+  options.initial_pseudo_dt = 20.0;  // a huge first pseudo step: the line falls onto the bed
+  // The same first pseudo step by hand (solve_static_equilibrium's inner settings): it must fail
+  // to converge for this test to mean anything.
+  {
+    kt::TetherWorkspaced ws(model);
+    kt::TetherStated s = start;
+    const double tol =
+        1e-7 * model.parameters().mass_per_length * model.parameters().length * env.gravity();
+    kt::ImplicitOptionsd inner;
+    inner.max_iterations = 6;
+    inner.velocity_tolerance = 0.5 * tol * options.initial_pseudo_dt / model.node_mass(10);
+    const auto r = kt::step_implicit(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b),
+                                     options.initial_pseudo_dt, false, inner);
+    REQUIRE_FALSE(r.converged);
+  }
+  kt::TetherWorkspaced ws(model);
+  kt::TetherStated s = start;
+  const auto r =
+      kt::solve_static_equilibrium(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), options);
+  CHECK_FALSE(r.converged);
+  CHECK(r.iterations == 1);
+  CHECK(s.position == start.position);
+  CHECK(s.velocity.isZero());
+  CHECK(s.time == start.time);
+}
+
+TEST_CASE("the catenary initial state rests on the environment's seabed, not below it",
+          "[tether][statics][seabed][regression]") {
+  // 20 m line from (0,0,0) to (10,0,5) with the seabed at 8 m: the free catenary would sag to
+  // about 10.4 m, 2.4 m into the bed (and start with contact forces of ~6e4 N per node).
+  kelp_test::TestWater<double> env;
+  env.bed = 8.0;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(20));
+  const kelp::Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  kt::CatenaryStatus status{};
+  const auto s = kt::catenary_initial_state(model, env, a, b, &status);
+  CHECK(status == kt::CatenaryStatus::converged);
+  CHECK((s.position.col(0) - a).norm() == 0.0);
+  CHECK((s.position.col(20) - b).norm() == 0.0);
+  int resting = 0;
+  for (int i = 0; i <= 20; ++i) {
+    INFO("node " << i << " z " << s.position(2, i));
+    CHECK(s.position(2, i) <= env.bed + 1e-9);
+    if (std::abs(s.position(2, i) - env.bed) < 1e-9) ++resting;
+  }
+  CHECK(resting >= 3);  // the grounded part lies on the bed
+  // Its contact forces are moderate: nothing like the metres-deep penetration of the free shape.
+  kt::TetherWorkspaced ws(model);
+  kt::compute_forces(model, ws, env, 0.0, s.position, s.velocity);
+  CHECK(ws.seabed_force.maxCoeff() < 1e-6);
+  // No finite seabed: the free catenary as before.
+  kelp_test::TestWater<double> deep;
+  const auto free = kt::catenary_initial_state(model, deep, a, b);
+  CHECK(free.position.row(2).maxCoeff() > 10.0);
+}

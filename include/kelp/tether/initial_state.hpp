@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
@@ -19,8 +20,12 @@ namespace kelp::tether {
 /// with w = (μ − ρA) g the submerged weight per length from the environment's water density and
 /// gravity (a buoyant line, w < 0, gives the inverted catenary). A taut geometry gives the straight
 /// line; if the catenary solve fails (`invalid_input`, `max_iterations`) the straight line is used
-/// as well. The status is reported through `status` when non-null.
-/// \param[in] model the tether \param[in] env environment (water_density(), gravity())
+/// as well. When the environment has a finite seabed (`seabed_depth()`) and both ends are at or
+/// above it, the catenary is solved with that seabed (CatenaryOptions::seabed_depth), so a line
+/// long enough to touch down starts with its grounded part lying on the bed rather than below
+/// it. The status is reported through `status` when non-null.
+/// \param[in] model the tether \param[in] env environment (water_density(), gravity(),
+/// seabed_depth())
 /// \param[in] start_ned node 0, NED [m] \param[in] end_ned node N, NED [m]
 /// \param[out] status catenary status (optional)
 /// \throws kelp::invalid_argument naming `start_ned` / `end_ned` when not finite.
@@ -34,7 +39,11 @@ TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, con
   const Scalar w =
       model.submerged_weight_per_length(Scalar(env.water_density()), Scalar(env.gravity()));
   const Scalar L = model.parameters().length;
-  const CatenaryShape<Scalar> shape = catenary_between(start_ned, end_ned, L, w);
+  CatenaryOptions<Scalar> options;
+  const double bed = double(value_of(Scalar(env.seabed_depth())));
+  if (std::isfinite(bed) && value_of(start_ned.z()) <= bed && value_of(end_ned.z()) <= bed)
+    options.seabed_depth = bed;
+  const CatenaryShape<Scalar> shape = catenary_between(start_ned, end_ned, L, w, options);
   const CatenaryStatus st = shape.status();
   if (status) *status = st;
   if (!(shape.result().ok() || st == CatenaryStatus::taut))

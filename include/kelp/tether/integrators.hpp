@@ -301,11 +301,13 @@ bool all_finite_fast(const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v) {
   return isfinite(value_of(x.sum() + v.sum()));
 }
 
+/// Commits (x, v) as the state at t + dt if finite; keeps the state before the step in
+/// ws.x_prev / ws.v_prev (BDF2 history, and the undo point of solve_static_equilibrium) with its
+/// step and the time of the committed state, so that a later step can tell whether the history
+/// belongs to the state it is given (see history_matches).
 template <typename Scalar>
-void commit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
-            TetherState<Scalar>& state, const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v,
-            Scalar dt, const char* who) {
-  (void)model;
+void commit(TetherWorkspace<Scalar>& ws, TetherState<Scalar>& state, const Matrix3X<Scalar>& x,
+            const Matrix3X<Scalar>& v, Scalar dt, const char* who) {
   if (!all_finite_fast(x, v))
     ::kelp::detail::throw_numerical_error(std::string(who) +
                                           ": non-finite node state; the state is unchanged");
@@ -316,6 +318,26 @@ void commit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
   state.position = x;
   state.velocity = v;
   state.time += dt;
+  ws.history_time = state.time;
+}
+
+/// True when the workspace's history (x_prev, v_prev) is the step just before `state` with the
+/// same step `dt`: it was committed by the last step and the state's time is still the time of
+/// that commit (a state reset, or a workspace shared between states, fails the test).
+template <typename Scalar>
+bool history_matches(const TetherWorkspace<Scalar>& ws, const TetherState<Scalar>& state,
+                     Scalar dt) {
+  return ws.has_previous && ws.previous_dt == dt && state.time == ws.history_time;
+}
+
+/// Checks the Newton settings. \throws kelp::invalid_argument naming the field.
+template <typename Scalar>
+void check_implicit_options(const ImplicitOptions<Scalar>& o) {
+  KELP_CHECK(o.max_iterations >= 1, "ImplicitOptions::max_iterations must be >= 1");
+  check_positive(o.velocity_tolerance, "ImplicitOptions::velocity_tolerance");
+  check_non_negative(o.slack_band, "ImplicitOptions::slack_band");
+  KELP_CHECK(o.max_active_set_passes >= 1, "ImplicitOptions::max_active_set_passes must be >= 1");
+  KELP_CHECK(o.max_backtracks >= 0, "ImplicitOptions::max_backtracks must be >= 0");
 }
 
 template <typename Scalar>
@@ -326,6 +348,9 @@ void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<S
   KELP_CHECK(ws.force.cols() == model.nodes(), "workspace was built for a different tether");
   KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
              "state.position and state.velocity must have segments + 1 columns");
+  // One pass over the state; the named check runs only to build the message.
+  if (!(all_finite_fast(state.position, state.velocity) && is_finite(state.time)))
+    check_state(model, state);
   check_boundary(b);
 }
 
@@ -360,7 +385,7 @@ StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
   ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
   ws.x1.noalias() = ws.x0 + dt * ws.v1;
   detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_symplectic_euler");
+  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_symplectic_euler");
   StepReport<Scalar> r;
   r.force_evaluations = 1;
   return r;
@@ -386,7 +411,7 @@ StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Sc
   ws.x1.noalias() = ws.x0 + dt * ws.vs;
   ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
   detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_rk2");
+  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_rk2");
   StepReport<Scalar> r;
   r.force_evaluations = 2;
   return r;
@@ -422,7 +447,7 @@ StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Sc
     }
   }
   detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_rk4");
+  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_rk4");
   StepReport<Scalar> r;
   r.force_evaluations = 4;
   return r;
@@ -454,9 +479,12 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
                                  bool bdf2 = false, const ImplicitOptions<Scalar>& options = {}) {
   using std::abs;
   detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::check_implicit_options(options);
   const Scalar t1 = state.time + dt;
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  const bool use_bdf2 = bdf2 && ws.has_previous && ws.previous_dt == dt;
+  // The history (BDF2, velocity predictor) is used only if it is this state's previous step.
+  const bool history = detail::history_matches(ws, state, dt);
+  const bool use_bdf2 = bdf2 && history;
   const Scalar gamma = use_bdf2 ? Scalar(2) / Scalar(3) : Scalar(1);
   const Scalar gh = gamma * dt;
   // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
@@ -476,7 +504,7 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
     }
   } else {
     // Predictor: linear extrapolation of the velocity when the last step had the same dt.
-    const bool extrapolate = ws.has_previous && ws.previous_dt == dt;
+    const bool extrapolate = history;
     for (int i = 0; i < cols; ++i) {
       const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
       const Vector3<Scalar> v1 =
@@ -561,7 +589,7 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       if (f1 == n - 1 && n >= 2)
         ws.end_forces.on_end +=
             detail::segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
-      detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_implicit");
+      detail::commit(ws, state, ws.x1, ws.v1, dt, "step_implicit");
       return report;
     }
     // Line search. R is the gradient of the step's incremental potential
@@ -603,7 +631,7 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
   }
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
   // commit() stores the pre-step state as BDF2 history.
-  detail::commit(model, ws, state, ws.x1, ws.v1, dt, "step_implicit");
+  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_implicit");
   return report;
 }
 
@@ -699,9 +727,12 @@ int advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const
   using std::ceil;
   check_positive(duration, "duration");
   check_positive(max_dt, "max_dt");
-  const int n = std::max(1, static_cast<int>(ceil(value_of(duration / max_dt))));
+  const double ratio = ceil(value_of(duration / max_dt));
+  KELP_CHECK(ratio <= double(std::numeric_limits<int>::max()),
+             "max_dt too small for duration: more than INT_MAX sub-steps");
+  const int n = std::max(1, static_cast<int>(ratio));
   const Scalar h = duration / Scalar(n);
-  // Backup in the (otherwise per-step) stage buffers kx/kv.
+  // Entry backup in kx/kv (no single step uses them).
   ws.kx = state.position;
   ws.kv = state.velocity;
   const Scalar t_entry = state.time;
@@ -775,8 +806,8 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
   b.end.velocity.setZero();
   b.start.acceleration.setZero();
   b.end.acceleration.setZero();
-  // Work on a copy in the workspace (kx/kv are free outside a step) so that a failure leaves
-  // `state` as it was; iterate on `state` itself and restore on error.
+  // Keep the entry state in kx/kv (no single step uses them) and iterate on `state` itself,
+  // restoring it on error.
   ws.kx = state.position;
   ws.kv = state.velocity;
   const Scalar t_entry = state.time;
@@ -802,14 +833,18 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
         break;
       }
       if (it >= options.max_iterations) break;
-      ws.xs = state.position;  // undo point
-      // The inner residual is h·F/m in velocity units: ask for forces half the tolerance.
+      // The inner residual is max_i h·|F_i|/a_i [m/s], a_i the node's isotropic mass (structural
+      // plus added mass), not m_ref: this tolerance asks for |F_i| ≤ ½·tol·a_i/m_ref, half the
+      // force tolerance for an interior node in air, looser where added mass or a point mass
+      // makes a_i > m_ref (the outer loop checks |F_i| ≤ tol itself).
       inner.velocity_tolerance = Scalar(0.5) * tol * h / m_ref;
       const StepReport<Scalar> r = step_implicit(model, ws, env, state, b, h, false, inner);
       state.time = t_entry;
       state.velocity.setZero();
       if (!r.converged && h > options.initial_pseudo_dt * Scalar(1e-6)) {
-        state.position = ws.xs;
+        // Undo: commit() kept the position before the step in ws.x_prev, a buffer the Newton
+        // iteration does not touch (its trial buffers xs/vs do not survive the step).
+        state.position = ws.x_prev;
         h *= Scalar(0.25);
       } else if (r.newton_iterations <= 3) {
         h = std::min(h_max, h * Scalar(2));

@@ -84,9 +84,11 @@ struct TetherParameters {
   EndMode start_mode = EndMode::kinematic;
   /// Motion of the far end (node N).
   EndMode end_mode = EndMode::kinematic;
-  /// Extra point mass lumped at node 0 [kg] (used when the start end is free).
+  /// Extra point mass lumped at node 0 [kg], used only when the start end is free (a kinematic
+  /// end's mass belongs to the body that moves it, so it is not reported as tether load).
   Scalar start_point_mass = Scalar(0);
-  /// Extra point mass lumped at node N [kg] (used when the far end is free).
+  /// Extra point mass lumped at node N [kg], used only when the far end is free (see
+  /// start_point_mass).
   Scalar end_point_mass = Scalar(0);
 };
 
@@ -134,8 +136,8 @@ class TetherModel {
       node_mass_(i) = p.mass_per_length * li;
       node_volume_(i) = area_ * li;
     }
-    node_mass_(0) += p.start_point_mass;
-    node_mass_(n) += p.end_point_mass;
+    if (p.start_mode == EndMode::free) node_mass_(0) += p.start_point_mass;
+    if (p.end_mode == EndMode::free) node_mass_(n) += p.end_point_mass;
     first_free_ = p.start_mode == EndMode::kinematic ? 1 : 0;
     last_free_ = p.end_mode == EndMode::kinematic ? n - 1 : n;
   }
@@ -156,7 +158,8 @@ class TetherModel {
   Scalar axial_damper() const { return ba_over_l_; }
   /// \brief Cross-section area A = π d²/4 [m²].
   Scalar area() const { return area_; }
-  /// \brief Structural mass of node i [kg] (μ times its share of length, plus any point mass).
+  /// \brief Structural mass of node i [kg] (μ times its share of length, plus the point mass of a
+  /// free end).
   Scalar node_mass(int i) const { return node_mass_(i); }
   /// \brief Displaced volume of node i [m³] (A times its share of length).
   Scalar node_volume(int i) const { return node_volume_(i); }
@@ -277,11 +280,17 @@ struct TetherWorkspace {
   // --- linear solver and integrator buffers ----------------------------------------------------
   Eigen::Matrix<Scalar, 6, Eigen::Dynamic> block_inv;  ///< block-Thomas D'⁻¹ (symmetric, 6 entries)
   Matrix3X<Scalar> rhs, delta;                         ///< Newton right-hand side and correction
-  Matrix3X<Scalar> rhs_true;  ///< −R saved while the active-set passes modify rhs
-  VectorX<Scalar> seg_true_k_uu, seg_true_k_perp, seg_true_c_uu;  ///< saved Jacobian terms
-  VectorX<Scalar> seg_active;  ///< 1 if segment s is taut in the Newton step's linear model
-  Matrix3X<Scalar> x0, v0, x1, v1, xs, vs, kx, kv, x_prev, v_prev;  ///< integrator stages
-  bool has_previous = false;                                        ///< BDF2 history valid
+  Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
+  VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
+  VectorX<Scalar> seg_active;     ///< 1 if segment s is taut in the Newton step's linear model
+  Matrix3X<Scalar> x0, v0, x1, v1, xs, vs;  ///< integrator stages and Newton/line-search iterates
+  /// State at entry of `advance` / `solve_static_equilibrium`, restored when they fail (not used
+  /// by the single steps)
+  Matrix3X<Scalar> kx, kv;
+  /// State before the last committed step (BDF2 history, velocity predictor)
+  Matrix3X<Scalar> x_prev, v_prev;
+  bool has_previous = false;        ///< x_prev, v_prev hold a committed step
+  Scalar history_time = Scalar(0);  ///< time of the state committed by the last step [s]
   /// water_velocity and water_acceleration hold zeros (set by resize and by compute_forces in a
   /// still environment, whose water query it then skips; cleared when the query runs)
   bool water_is_zero = false;
@@ -304,7 +313,7 @@ struct TetherWorkspace {
     direction.setZero(3, s);
     rhs_true.setZero(3, n);
     for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu,
-                               &seg_true_k_uu, &seg_true_k_perp, &seg_true_c_uu, &seg_active})
+                               &seg_true_k_uu, &seg_active})
       v->setZero(s);
     node_dv.setZero(6, n);
     block_inv.setZero(6, n);
