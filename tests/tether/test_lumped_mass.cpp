@@ -299,6 +299,75 @@ TEST_CASE("analytic block-tridiagonal Jacobian agrees with finite differences",
   }
 }
 
+TEST_CASE("analytic Jacobian with seabed contact, friction and drag agrees with finite differences",
+          "[tether][jacobian][seabed]") {
+  // Half the nodes press into the seabed (stiffness node_kz, damping, friction) while drag acts
+  // on all of them, with c_x > 0 and c_v > 0 at once. D_x leaves out the drag's dependence on
+  // the node tangents by design (see step_implicit), so the position part is differenced on
+  // the same line without drag (drag is an additive force term); the velocity part, where the
+  // drag Jacobian is exact, on the full line. Contact nodes move only vertically: the friction
+  // Jacobian (coefficient μN/v_f, N held fixed) is exact for a zero horizontal velocity, and
+  // internal damping is off because D_x also leaves out its direction dependence.
+  kelp_test::TestWater<double> env;
+  env.bed = 5.0;
+  env.current = Vector3<double>(0.2, -0.1, 0.0);
+  auto p = kelp_test::benchmark_line<double>(8);
+  p.length = 8.0;
+  p.normal_added_mass = 0.0;
+  p.seabed_friction = 0.5;
+  const kt::TetherModeld m(p);
+  auto p_nodrag = p;
+  p_nodrag.normal_drag = p_nodrag.tangential_drag = 0.0;
+  const kt::TetherModeld m_nodrag(p_nodrag);
+  kt::TetherWorkspaced ws(m), ws_nodrag(m_nodrag);
+  kelp::Matrix3X<double> x(3, 9), v(3, 9);
+  for (int i = 0; i <= 8; ++i) {
+    const bool contact = i % 2 == 1;
+    x.col(i) =
+        Vector3<double>(1.01 * i, 0.05 * std::sin(1.3 * i),
+                        contact ? 5.02 + 0.01 * std::cos(i) : 4.9 + 0.05 * std::cos(0.7 * i));
+    v.col(i) = contact ? Vector3<double>(0.0, 0.0, 0.03 * std::sin(2.0 * i))
+                       : Vector3<double>(0.3 * std::sin(i), 0.2 * std::cos(2.0 * i), -0.1 * i);
+  }
+  const double cm = 1.0, cv = 0.05, cx = 1e-3;
+  kt::compute_forces<true>(m, ws, env, 0.0, x, v);
+  int in_contact = 0;
+  for (int i = 1; i <= 7; ++i) {
+    INFO("node " << i);
+    CHECK((ws.seabed_force(i) > 0) == (i % 2 == 1));
+    if (ws.seabed_force(i) > 0) {
+      ++in_contact;
+      CHECK(ws.node_kz(i) > 0);
+      CHECK(ws.node_dv(0, i) > 1000.0);  // friction μN/v_f dominates the drag
+    }
+  }
+  CHECK(in_contact == 4);
+  kelp::Matrix3X<double> r(3, 9);
+  for (int i = 0; i <= 8; ++i) r.col(i) = Vector3<double>(std::cos(i), 1.0, std::sin(0.5 * i));
+  ws.rhs = r;
+  kt::detail::solve_block_tridiagonal(m, ws, cm, cv, cx);
+  kelp::Matrix3X<double> d = ws.delta;
+  d.col(0).setZero();
+  d.col(8).setZero();
+  const double eps = 1e-7;
+  kelp::Matrix3X<double> fp(3, 9), fm(3, 9), jd(3, 9);
+  kt::compute_forces(m, ws, env, 0.0, x, v + eps * d);
+  fp = ws.force;
+  kt::compute_forces(m, ws, env, 0.0, x, v - eps * d);
+  fm = ws.force;
+  jd = -cv * (fp - fm) / (2 * eps);
+  kt::compute_forces(m_nodrag, ws_nodrag, env, 0.0, x + eps * d, v);
+  fp = ws_nodrag.force;
+  kt::compute_forces(m_nodrag, ws_nodrag, env, 0.0, x - eps * d, v);
+  fm = ws_nodrag.force;
+  jd -= cx * (fp - fm) / (2 * eps);
+  for (int i = 1; i <= 7; ++i) {
+    jd.col(i) += cm * m.node_mass(i) * d.col(i);
+    INFO("node " << i << ": " << jd.col(i).transpose() << " vs " << r.col(i).transpose());
+    CHECK((jd.col(i) - r.col(i)).norm() < 1e-6 * r.col(i).norm());
+  }
+}
+
 TEMPLATE_TEST_CASE("steps allocate nothing on the heap", "[tether][malloc]", double, float) {
   using S = TestType;
   kelp::environment::Environment<S> env;
