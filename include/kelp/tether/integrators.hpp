@@ -656,6 +656,21 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
   return {};
 }
 
+namespace detail {
+
+/// Number of segment springs on node i of a line of n segments (1 at an end, else 2).
+inline int node_springs(int i, int n) { return (i > 0 ? 1 : 0) + (i < n ? 1 : 0); }
+
+/// Axial mass of node i [kg]: structural plus tangential added mass, the node taken as
+/// submerged in water of density ρ [kg/m³].
+template <typename Scalar>
+Scalar axial_node_mass(const TetherModel<Scalar>& model, int i, Scalar water_density) {
+  return model.node_mass(i) +
+         water_density * model.node_volume(i) * model.parameters().tangential_added_mass;
+}
+
+}  // namespace detail
+
 /// \brief Largest angular frequency of the line [rad/s], bounded by Gershgorin's theorem.
 /// Axial chain: ω²_a ≤ max_i Σ_j |K_ij| / m_i = max_i 2 k_i / m_i, with k_i the sum of the segment
 /// spring constants EA/l on free node i and m_i its axial mass (structural plus tangential added
@@ -670,9 +685,9 @@ Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_de
   const Scalar l = model.segment_length();
   Scalar w2(0);
   for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
-    const int springs = (i > 0 ? 1 : 0) + (i < n ? 1 : 0);
+    const int springs = detail::node_springs(i, n);
     const Scalar rv = water_density * model.node_volume(i);
-    const Scalar m = model.node_mass(i) + rv * p.tangential_added_mass;
+    const Scalar m = detail::axial_node_mass(model, i, water_density);
     Scalar wi = Scalar(2) * Scalar(springs) * model.axial_spring() / m;
     if (p.bending_stiffness > Scalar(0))
       wi += Scalar(16) * p.bending_stiffness /
@@ -707,9 +722,8 @@ Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrato
   Scalar zeta(0);
   const int n = model.segments();
   for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
-    const int springs = (i > 0 ? 1 : 0) + (i < n ? 1 : 0);
-    const Scalar m = model.node_mass(i) + water_density * model.node_volume(i) *
-                                              model.parameters().tangential_added_mass;
+    const int springs = detail::node_springs(i, n);
+    const Scalar m = detail::axial_node_mass(model, i, water_density);
     zeta = std::max(zeta, Scalar(2) * Scalar(springs) * model.axial_damper() / (Scalar(2) * m * w));
   }
   return safety * limit / w * (sqrt(Scalar(1) + zeta * zeta) - zeta);

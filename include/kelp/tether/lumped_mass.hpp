@@ -344,6 +344,36 @@ bool is_still_water(const Env& env) {
     return false;
 }
 
+/// Tangent of node i of a line of n segments: the chord c = r_{i+1} − r_{i−1} inside (the
+/// adjacent segment at the ends), 1/|c|² and 1/|c| (both zero for a zero chord) and the unit
+/// tangent q = c/|c| (zero for a zero chord).
+template <typename Scalar>
+struct NodeTangent {
+  Vector3<Scalar> chord;
+  Scalar inv_c2, inv_c;
+  Vector3<Scalar> q;
+};
+
+/// The NodeTangent of node i of positions `x` (3 × (n+1)).
+template <typename Scalar, typename DX>
+NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n) {
+  using std::sqrt;
+  NodeTangent<Scalar> t;
+  t.chord = x.col(i < n ? i + 1 : n) - x.col(i > 0 ? i - 1 : 0);
+  const Scalar c2 = t.chord.squaredNorm();
+  t.inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
+  t.inv_c = sqrt(t.inv_c2);
+  t.q = t.chord * t.inv_c;
+  return t;
+}
+
+/// True when a node at NED depth z [m] is in the water under a free surface at elevation ζ [m]
+/// (z ≥ −ζ; a node exactly at the surface counts as wet).
+template <typename Scalar>
+bool is_wet(Scalar z, Scalar zeta) {
+  return !(z < -zeta);
+}
+
 /// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.
 template <typename Scalar, typename DX, typename DV>
 void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scalar>& b, Scalar tau,
@@ -494,11 +524,10 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends.
     // The drag below is written with the unnormalised chord and 1/|c|² so that its square root
     // and the tangent's run in parallel instead of one after the other.
-    const V3 chord = x.col(i < n ? i + 1 : n) - x.col(i > 0 ? i - 1 : 0);
-    const Scalar c2 = chord.squaredNorm();
-    const Scalar inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
-    const Scalar inv_c = sqrt(inv_c2);
-    const V3 q = chord * inv_c;
+    const detail::NodeTangent<Scalar> nt = detail::node_tangent<Scalar>(x, i, n);
+    const V3& chord = nt.chord;
+    const Scalar inv_c2 = nt.inv_c2, inv_c = nt.inv_c;
+    const V3& q = nt.q;
     ws.tangent.col(i) = q;
 
     V3 f;
@@ -514,7 +543,7 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     const NodeConstants& nc = kinds[i == 0 ? 0 : (i == n ? 2 : 1)];
     const Scalar li = nc.li;
     const Scalar zeta = still ? Scalar(0) : Scalar(env.surface_elevation(x(0, i), x(1, i), t));
-    const bool wet = !(x(2, i) < -zeta);
+    const bool wet = detail::is_wet(Scalar(x(2, i)), zeta);
     ws.submerged(i) = wet ? Scalar(1) : Scalar(0);
     // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
     Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
@@ -650,13 +679,10 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
         e += p.bending_stiffness / l * (Scalar(1) - a.dot(b) / (na * nb));
     }
   for (int i = 0; i <= n; ++i) {
-    const Vector3<Scalar> chord =
-        state.position.col(i < n ? i + 1 : n) - state.position.col(i > 0 ? i - 1 : 0);
-    const Scalar c = chord.norm();
-    const Vector3<Scalar> q = c > Scalar(0) ? Vector3<Scalar>(chord / c) : Vector3<Scalar>::Zero();
+    const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n).q;
     const Scalar zeta =
         Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
-    const bool wet = !(state.position(2, i) < -zeta);
+    const bool wet = detail::is_wet(state.position(2, i), zeta);
     const Scalar m = model.node_mass(i), rv = wet ? rho * model.node_volume(i) : Scalar(0);
     const Vector3<Scalar> vi = state.velocity.col(i);
     const Scalar vq = vi.dot(q);
