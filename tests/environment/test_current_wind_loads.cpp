@@ -219,6 +219,9 @@ TEST_CASE("wind loads: the constant-coefficient model reduces to the paper's for
   TabulatedWindCoefficients bad = t;
   bad.cy.pop_back();
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("cx, cy, cn"));
+  // A malformed table is refused at evaluation too, never read out of bounds.
+  CHECK_THROWS_WITH(bad(0.3), Catch::Contains("cx, cy, cn"));
+  CHECK_THROWS_AS(TabulatedWindCoefficients{}(0.3), kelp::invalid_argument);
 }
 
 TEST_CASE("the paper's wave load oscillates at the encounter frequency along the wave",

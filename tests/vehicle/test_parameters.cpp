@@ -4,6 +4,7 @@
 #include <functional>
 #include <limits>
 
+#include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/thrusters.hpp"
@@ -89,4 +90,40 @@ TEST_CASE("bad thruster layouts name the field", "[vehicle][parameters]") {
   kelp::Matrix3X<double> d3(3, 3);
   d3.setOnes();
   CHECK_THROWS_WITH(kv::ThrusterAllocation<double>(r, d3), Catch::Contains("thruster_directions"));
+  // A 2-row position matrix is refused before anything is copied out of it.
+  const Eigen::MatrixXd r2 = Eigen::MatrixXd::Zero(2, 2);
+  CHECK_THROWS_WITH(kv::ThrusterAllocation<double>(r2, d), Catch::Contains("thruster_positions"));
+}
+
+TEST_CASE("thruster force vectors of the wrong size are refused", "[vehicle][parameters]") {
+  kelp::Matrix3X<double> r(3, 2), d(3, 2);
+  r << 0, 0, 0.1, -0.1, 0, 0;
+  d << 1, 1, 0, 0, 0, 0;
+  const kv::ThrusterAllocation<double> alloc(r, d);
+  Eigen::VectorXd three(3);
+  three.setOnes();
+  CHECK_THROWS_WITH(alloc.wrench(three), Catch::Contains("one entry per thruster"));
+  CHECK_THROWS_WITH(alloc.distribute(kelp::Vector6<double>::Ones(), three),
+                    Catch::Contains("one entry per thruster"));
+  CHECK(three.size() == 3);  // not silently resized
+}
+
+TEST_CASE("steps refuse a non-unit attitude or a non-finite state, leaving it unchanged",
+          "[vehicle][parameters]") {
+  const auto rov = kv::bluerov2_heavy<double>();
+  const kv::VehicleModeld model(rov.parameters);
+  kv::VehicleWorkspaced ws;
+  const kelp::Vector6<double> tau = kelp::Vector6<double>::Zero();
+  kv::VehicleStated zero_q;
+  zero_q.attitude.coeffs().setZero();
+  const kv::VehicleStated before = zero_q;
+  CHECK_THROWS_WITH(kv::rk4_step(model, ws, zero_q, 1e-3, tau, tau), Catch::Contains("attitude"));
+  CHECK_THROWS_WITH(kv::semi_implicit_euler_step(model, ws, zero_q, 1e-3, tau, tau),
+                    Catch::Contains("attitude"));
+  CHECK(zero_q.attitude.coeffs() == before.attitude.coeffs());
+  kv::VehicleStated nan_nu;
+  nan_nu.nu(2) = kNan;
+  CHECK_THROWS_WITH(kv::rk4_step(model, ws, nan_nu, 1e-3, tau, tau), Catch::Contains("state.nu"));
+  kv::VehicleStated ok;
+  CHECK_NOTHROW(kv::rk4_step(model, ws, ok, 1e-3, tau, tau));
 }

@@ -217,7 +217,13 @@ struct TabulatedWindCoefficients {
       KELP_CHECK(angle[i] > angle[i - 1], "wind table angle must be strictly increasing");
   }
   /// \brief (C_X, C_Y, C_N) at γ_rw [rad] (any value; wrapped to (−π, π]).
+  /// \throws kelp::invalid_argument when the table is too short or its columns differ in length
+  /// (the O(1) part of validate(), checked on every call so a malformed table never reads out of
+  /// bounds).
   Eigen::Vector3d operator()(double gamma) const {
+    KELP_CHECK(angle.size() >= 2, "wind table angle needs at least 2 entries");
+    KELP_CHECK(cx.size() == angle.size() && cy.size() == angle.size() && cn.size() == angle.size(),
+               "wind table cx, cy, cn must have as many entries as angle");
     gamma = std::remainder(gamma, 2.0 * kelp::pi);
     const double sign = gamma < 0.0 ? -1.0 : 1.0;
     const double g = std::abs(gamma);

@@ -69,6 +69,19 @@ void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& n
   state = next;
 }
 
+/// Checks what a step takes from the caller: dt > 0, a finite state and a unit attitude (a zero or
+/// badly scaled quaternion would otherwise be silently read as some rotation by Eigen).
+template <typename Scalar>
+void check_step_input(const VehicleState<Scalar>& state, const Scalar& dt) {
+  check_positive(dt, "dt");
+  check_all_finite(state.position, "state.position");
+  check_all_finite(state.nu, "state.nu");
+  check_all_finite(state.attitude.coeffs(), "state.attitude");
+  using std::abs;
+  KELP_CHECK(abs(value_of(state.attitude.squaredNorm()) - 1.0) < 1e-3,
+             "state.attitude must be a unit quaternion");
+}
+
 }  // namespace detail
 
 /// \brief One classical fourth-order Runge–Kutta step of length `dt` with a wrench evaluated at
@@ -79,12 +92,13 @@ void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& n
 /// \param[in,out] state advanced by dt on success, unchanged on failure.
 /// \param[in] dt step [s], > 0. \param[in] wrench callable as above.
 /// \param[in] current_ned v_c^n [m/s], NED, constant over the step.
-/// \throws kelp::invalid_argument naming `dt`; kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
+/// kelp::numerical_error on a non-finite result.
 template <typename Scalar, typename WrenchFn, typename DC>
 void rk4_step_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                    VehicleState<Scalar>& state, const Scalar& dt, WrenchFn&& wrench,
                    const Eigen::MatrixBase<DC>& current_ned) {
-  check_positive(dt, "dt");
+  detail::check_step_input(state, dt);
   const Scalar half = Scalar(0.5) * dt;
   const Vector3<Scalar> vc(current_ned);
   const StateDerivative<Scalar> k1 =
@@ -109,7 +123,8 @@ void rk4_step_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
 /// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
 /// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
-/// \throws kelp::invalid_argument naming `dt`; kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
+/// kelp::numerical_error on a non-finite result.
 template <typename Scalar, typename DT, typename DE, typename DC>
 void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
               VehicleState<Scalar>& state, const Scalar& dt, const Eigen::MatrixBase<DT>& tau,
@@ -138,7 +153,8 @@ void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
 /// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
 /// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
-/// \throws kelp::invalid_argument naming `dt`; kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
+/// kelp::numerical_error on a non-finite result.
 template <typename Scalar, typename DT, typename DE, typename DC>
 void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                               VehicleState<Scalar>& state, const Scalar& dt,
@@ -148,7 +164,7 @@ void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspac
   using std::cos;
   using std::sin;
   using std::sqrt;
-  check_positive(dt, "dt");
+  detail::check_step_input(state, dt);
   VehicleState<Scalar> next;
   next.nu = state.nu + dt * forward_dynamics(model, ws, state, tau, tau_env, current_ned);
   next.position =

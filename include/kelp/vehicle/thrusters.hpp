@@ -55,7 +55,9 @@ class ThrusterAllocation {
   template <typename DP, typename DD>
   ThrusterAllocation(const Eigen::MatrixBase<DP>& positions,
                      const Eigen::MatrixBase<DD>& directions)
-      : positions_(positions), matrix_(allocation_matrix(positions, directions)) {
+      : matrix_(allocation_matrix(positions, directions)) {
+    // positions_ is assigned only after allocation_matrix() has checked the shapes.
+    positions_ = positions;
     directions_ = matrix_.template topRows<3>();
     Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<Scalar, 6, Eigen::Dynamic>> cod(matrix_);
     pseudo_inverse_ = cod.pseudoInverse();
@@ -78,7 +80,7 @@ class ThrusterAllocation {
   /// \brief Body wrench τ = B f [N, N m] of the thruster forces f [N] (n-vector).
   template <typename Derived>
   Vector6<Scalar> wrench(const Eigen::MatrixBase<Derived>& forces) const {
-    KELP_ASSERT(forces.size() == size());
+    KELP_CHECK(forces.size() == size(), "forces must have one entry per thruster");
     Vector6<Scalar> tau;
     tau.noalias() = matrix_ * forces;
     return tau;
@@ -88,13 +90,13 @@ class ThrusterAllocation {
   /// (least-squares when τ is not reachable). `forces` must already have n rows.
   template <typename DW, typename DF>
   void distribute(const Eigen::MatrixBase<DW>& tau, Eigen::MatrixBase<DF>& forces) const {
-    KELP_ASSERT(forces.size() == size());
+    KELP_CHECK(forces.size() == size(), "forces must have one entry per thruster");
     forces.noalias() = pseudo_inverse_ * tau;
   }
 
  private:
-  Matrix3X<Scalar> positions_;
   Eigen::Matrix<Scalar, 6, Eigen::Dynamic> matrix_;
+  Matrix3X<Scalar> positions_;
   Matrix3X<Scalar> directions_;
   Eigen::Matrix<Scalar, Eigen::Dynamic, 6> pseudo_inverse_;
   Eigen::Index rank_ = 0;
