@@ -264,7 +264,7 @@ TEST_CASE("small-body wave force is (rho V + M_A) times the fluid acceleration",
 
 TEST_CASE("surface-following restoring: a hull riding the surface feels nothing",
           "[environment][waves]") {
-  Hydrostatics h;
+  SurfaceHydrostatics h;
   h.waterplane_area = 0.6, h.displaced_volume = 0.015, h.gm_transverse = 0.4,
   h.gm_longitudinal = 1.0;
   const double zeta = 0.3, sn = 0.05, se = -0.02, psi = 0.4;
@@ -320,7 +320,7 @@ TEST_CASE("a vehicle in the calm preset feels zero environmental force",
   // BlueBoat-like ASV at the surface, BlueROV2-like AUV at 10 m, over a minute.
   const WindAreas boat_areas{0.25, 0.45, 1.2};
   const ConstantWindCoefficients boat_c{0.9, 0.8, 0.1};
-  Hydrostatics boat;
+  SurfaceHydrostatics boat;
   boat.waterplane_area = 0.55, boat.displaced_volume = 0.015, boat.gm_transverse = 0.5,
   boat.gm_longitudinal = 1.2;
   const Vector3<double> rov_ma(6.36, 7.12, 18.68);

@@ -304,18 +304,25 @@ TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage"
   CHECK((model.mass_inverse() * model.mass_matrix() - Matrix6<double>::Identity()).norm() < 1e-12);
   CHECK((model.mass_inverse() * ws.rhs - model.mass_ldlt().solve(ws.rhs)).norm() < 1e-12);
 
-  // A callable that returns the same constant wrench reproduces rk4_step.
+  // A callable that returns the same constant wrench reproduces rk4_step, and it is called at the
+  // classical RK4 stage offsets 0, dt/2, dt/2, dt.
   kv::VehicleState<double> y = x, z = x;
   kv::rk4_step(model, ws, y, 0.01, t1, t2);
   int calls = 0;
+  double offsets[4] = {-1, -1, -1, -1};
   kv::rk4_step_with(
       model, ws, z, 0.01,
-      [&](const kv::VehicleState<double>&, double) -> Vector6<double> {
+      [&](const kv::VehicleState<double>&, double t) -> Vector6<double> {
+        if (calls < 4) offsets[calls] = t;
         ++calls;
         return t1 + t2;
       },
       Vector3<double>::Zero());
   CHECK(calls == 4);
+  CHECK(offsets[0] == 0.0);
+  CHECK(offsets[1] == Approx(0.005));
+  CHECK(offsets[2] == Approx(0.005));
+  CHECK(offsets[3] == Approx(0.01));
   CHECK((y.nu - z.nu).norm() < 1e-15);
   CHECK((y.position - z.position).norm() < 1e-15);
 }

@@ -97,7 +97,7 @@ TEMPLATE_TEST_CASE("T200 curve, its peak and its inverse", "[vehicle][thrusters]
   CHECK(double(kv::t200_thrust(S(-0.6))) == Approx(-double(kv::t200_thrust(S(0.6)))));
   CHECK(kv::t200_thrust(S(2)) == kv::t200_thrust(S(1)));  // clamped
   // The published constants: slope zero at the peak, peak value = max thrust.
-  CHECK(std::abs(kv::t200_thrust_slope(kv::t200_peak_command)) < 0.05);
+  CHECK(std::abs(kv::t200_thrust_slope(kv::t200_peak_command)) < 1e-3);  // measured 8e-5
   CHECK(kv::t200_thrust(kv::t200_peak_command) == Approx(kv::t200_max_thrust).epsilon(1e-5));
   // Monotone on [0, u_peak].
   for (int i = 1; i <= 100; ++i) {

@@ -138,7 +138,7 @@ Vector3<Scalar> small_body_wave_force(const Scalar& rho, const Scalar& displaced
 }
 
 /// \brief Linear hydrostatics of a surface vessel about its calm-water equilibrium.
-struct Hydrostatics {
+struct SurfaceHydrostatics {
   double rho = kelp::seawater_density;      ///< water density [kg/m³]
   double gravity = kelp::standard_gravity;  ///< [m/s²]
   double waterplane_area = 0.0;             ///< A_wp [m²]
@@ -178,7 +178,7 @@ Eigen::Matrix<Scalar, 2, 1> surface_attitude(const Scalar& slope_north, const Sc
 /// \param[in] zeta local elevation ζ [m] (up) \param[in] slope_north ∂ζ/∂x [-]
 /// \param[in] slope_east ∂ζ/∂y [-]
 template <typename Scalar>
-Vector6<Scalar> surface_following_restoring(const Hydrostatics& h, const Scalar& heave,
+Vector6<Scalar> surface_following_restoring(const SurfaceHydrostatics& h, const Scalar& heave,
                                             const Scalar& phi, const Scalar& theta,
                                             const Scalar& psi, const Scalar& zeta,
                                             const Scalar& slope_north, const Scalar& slope_east) {
@@ -195,7 +195,7 @@ Vector6<Scalar> surface_following_restoring(const Hydrostatics& h, const Scalar&
 /// restoring −Gη, i.e. G η_s = (0, 0, −ρgA_wp ζ, ρg∇GM_T φ_s, ρg∇GM_L θ_s, 0) [N, N·m]. Add it
 /// to a vehicle model that already has its own (calm-water) restoring g(η). Zero in a calm sea.
 template <typename Scalar>
-Vector6<Scalar> wave_restoring(const Hydrostatics& h, const Scalar& psi, const Scalar& zeta,
+Vector6<Scalar> wave_restoring(const SurfaceHydrostatics& h, const Scalar& psi, const Scalar& zeta,
                                const Scalar& slope_north, const Scalar& slope_east) {
   const Eigen::Matrix<Scalar, 2, 1> att = surface_attitude(slope_north, slope_east, psi);
   const double rg = h.rho * h.gravity;
