@@ -95,6 +95,15 @@ TEST_CASE("bad thruster layouts name the field", "[vehicle][parameters]") {
   CHECK_THROWS_WITH(kv::ThrusterAllocation<double>(r2, d), Catch::Contains("thruster_positions"));
 }
 
+TEST_CASE("NaN thruster commands, forces and PWM are refused, not passed through",
+          "[vehicle][parameters]") {
+  CHECK_THROWS_WITH(kv::t200_thrust(kNan), Catch::Contains("thruster command"));
+  CHECK_THROWS_WITH(kv::t200_command(kNan), Catch::Contains("thruster force"));
+  CHECK_THROWS_WITH(kv::command_from_pwm(kNan), Catch::Contains("pwm"));
+  CHECK_THROWS_WITH(kv::pwm_from_command(kNan), Catch::Contains("thruster command"));
+  CHECK(kv::t200_thrust(2.0) == kv::t200_thrust(1.0));  // out-of-range commands still saturate
+}
+
 TEST_CASE("thruster force vectors of the wrong size are refused", "[vehicle][parameters]") {
   kelp::Matrix3X<double> r(3, 2), d(3, 2);
   r << 0, 0, 0.1, -0.1, 0, 0;

@@ -108,6 +108,7 @@ class ThrusterAllocation {
 /// \param[in] u normalised command (positive: thrust along the thruster direction).
 template <typename Scalar>
 Scalar t200_thrust(const Scalar& u_in) {
+  check_finite(u_in, "thruster command u");
   Scalar u = u_in;
   if (value_of(u) > 1.0) u = Scalar(1);
   if (value_of(u) < -1.0) u = Scalar(-1);
@@ -142,6 +143,7 @@ inline constexpr double t200_max_thrust = 30.62175;
 /// \param[in] force desired thrust [N] along the thruster direction.
 template <typename Scalar>
 Scalar t200_command(const Scalar& force) {
+  check_finite(force, "thruster force");
   const double f = value_of(force);
   if (f >= t200_max_thrust) return Scalar(t200_peak_command);
   if (f <= -t200_max_thrust) return Scalar(-t200_peak_command);
@@ -192,6 +194,7 @@ struct PwmMapping {
 /// clamped (as ArduPilot's SITL submarine does: no rescaling of the dead band).
 template <typename Scalar>
 Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
+  check_finite(pwm_us, "pwm");
   const Scalar d = pwm_us - m.neutral_us;
   const double dv = value_of(d);
   if (dv <= value_of(m.deadband_us) && dv >= -value_of(m.deadband_us)) return Scalar(0);
@@ -206,6 +209,7 @@ Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmM
 /// `AP_Motors6DOF::calc_thrust_to_pwm`, sitl.md §1.7). The dead band is not skipped.
 template <typename Scalar>
 Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
+  check_finite(u_in, "thruster command u");
   Scalar u = u_in;
   if (value_of(u) > 1.0) u = Scalar(1);
   if (value_of(u) < -1.0) u = Scalar(-1);
