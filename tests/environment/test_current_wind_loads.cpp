@@ -50,6 +50,22 @@ TEST_CASE("Fossen's 3-D current has speed V_c and the paper's north component",
   const Vector3<double> v0(0.3, -0.4, 0.05);
   CHECK((CurrentModel<double>::constant(v0).velocity(Vector3<double>(0, 0, 5), 0.0) - v0).norm() <
         1e-15);
+  // Its direction is the azimuth the current flows towards, in every quadrant (south-west here:
+  // atan2(−0.4, −0.3) = −2.2143 rad), with and without a vertical part.
+  for (const Vector3<double>& vq :
+       {Vector3<double>(-0.3, -0.4, 0.0), Vector3<double>(-0.3, 0.4, 0.1),
+        Vector3<double>(0.0, -0.5, 0.0), Vector3<double>(0.0, 0.0, 0.2)}) {
+    const auto c = CurrentModel<double>::constant(vq);
+    CHECK((c.velocity(Vector3<double>(0, 0, 5), 0.0) - vq).norm() < 1e-15);
+    const double beta = c.direction_at(0.0);
+    if (vq(2) == 0.0 && vq.head<2>().norm() > 0) {
+      CHECK(beta == Approx(std::atan2(vq(1), vq(0))).margin(1e-12));
+    }
+    // With a vertical part β is Fossen's angle, not exactly the horizontal azimuth, but it points
+    // into the same horizontal quadrant (before the fix a westward current was reported eastward).
+    CHECK(std::cos(beta) * vq(0) >= 0.0);
+    CHECK(std::sin(beta) * vq(1) >= 0.0);
+  }
 }
 
 TEST_CASE("current profiles: power law is zero at the seabed, linear reaches its ratio",

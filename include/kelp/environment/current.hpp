@@ -183,9 +183,12 @@ class CurrentModel {
     const double u = value_of(v_ned(0)), v = value_of(v_ned(1)), w = value_of(v_ned(2));
     CurrentParameters p;
     p.speed = std::sqrt(u * u + v * v + w * w);
-    // Invert Fossen's parametrisation: sin β = v/V, tan α = w/u.
-    p.direction = std::atan2(v, std::sqrt(u * u + w * w));
-    p.vertical_angle = std::atan2(w, u);
+    // Invert Fossen's parametrisation u = V cos α cos β, v = V sin β, w = V sin α cos β with
+    // α ∈ [−π/2, π/2] (so cos α ≥ 0): β is then the horizontal azimuth the current flows towards
+    // (atan2(v, u) for a horizontal current), and tan α = w/u.
+    p.vertical_angle =
+        u != 0.0 ? std::atan(w / u) : (w != 0.0 ? std::copysign(kelp::pi / 2, w) : 0.0);
+    p.direction = std::atan2(v, std::copysign(std::hypot(u, w), u));
     return CurrentModel(p);
   }
 
