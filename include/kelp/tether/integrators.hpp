@@ -363,6 +363,18 @@ void derivative(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, c
   accelerations_from_forces(model, ws, b.start.acceleration, b.end.acceleration, acc);
 }
 
+/// Shared start of the explicit steps: checks the inputs and copies the state into x0, v0 with
+/// the prescribed end motion at the start of the step applied.
+template <typename Scalar>
+void begin_explicit_step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                         const TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
+                         Scalar dt) {
+  check_step_inputs(model, ws, state, boundary, dt);
+  ws.x0 = state.position;
+  ws.v0 = state.velocity;
+  apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
+}
+
 }  // namespace detail
 
 /// \brief One semi-implicit (symplectic) Euler step of length `dt` [s]:
@@ -375,11 +387,8 @@ StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
                                          TetherWorkspace<Scalar>& ws, const Env& env,
                                          TetherState<Scalar>& state,
                                          const TetherBoundary<Scalar>& boundary, Scalar dt) {
-  detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::begin_explicit_step(model, ws, state, boundary, dt);
   const Scalar t = state.time;
-  ws.x0 = state.position;
-  ws.v0 = state.velocity;
-  detail::apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
   detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
   ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
@@ -397,11 +406,8 @@ template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
                             const TetherBoundary<Scalar>& boundary, Scalar dt) {
-  detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::begin_explicit_step(model, ws, state, boundary, dt);
   const Scalar t = state.time, h2 = Scalar(0.5) * dt;
-  ws.x0 = state.position;
-  ws.v0 = state.velocity;
-  detail::apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
   detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
   ws.xs.noalias() = ws.x0 + h2 * ws.v0;
@@ -423,11 +429,8 @@ template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
                             const TetherBoundary<Scalar>& boundary, Scalar dt) {
-  detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::begin_explicit_step(model, ws, state, boundary, dt);
   const Scalar t = state.time;
-  ws.x0 = state.position;
-  ws.v0 = state.velocity;
-  detail::apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
   ws.xs = ws.x0;
   ws.vs = ws.v0;
   ws.x1 = ws.x0;
