@@ -13,6 +13,21 @@
 
 namespace kelp {
 
+/// \brief Wraps a type so that a function parameter of type `identity_t<T>` is not used for
+/// template argument deduction (a non-deduced context).
+///
+/// Step functions take `dt` as `identity_t<Scalar>`: `Scalar` is deduced from the model alone, and
+/// a literal such as `0.01` (a `double`) converts to `float` for a float model instead of making
+/// the deduction conflict.
+template <class T>
+struct identity {
+  using type = T;  ///< The wrapped type, unchanged.
+};
+
+/// \brief `T` in a non-deduced context; see `kelp::identity`.
+template <class T>
+using identity_t = typename identity<T>::type;
+
 /// \brief The value part of a scalar as a double: the number itself for arithmetic types, the
 /// real part `x.a` (recursively) for automatic-differentiation types such as `ceres::Jet`.
 template <typename Scalar>
