@@ -36,7 +36,7 @@ TEST_CASE("wave kinematics: Jet derivatives match finite differences", "[environ
     const Vector3<double> x0(3.0, -2.0, 4.0);
     const double t = 5.0;
     const Vector3<Jet> xj(Jet(x0(0), 0), Jet(x0(1), 1), Jet(x0(2), 2));
-    const auto kj = wj.kinematics(xj, Jet(t));
+    const auto kj = wj.kinematics(xj, t);
     const double h = 1e-6;
     for (int d = 0; d < 3; ++d) {
       Vector3<double> e = Vector3<double>::Zero();
@@ -49,7 +49,7 @@ TEST_CASE("wave kinematics: Jet derivatives match finite differences", "[environ
       }
     }
     // Elevation gradient = slope.
-    const Jet z = wj.elevation(xj(0), xj(1), Jet(t));
+    const Jet z = wj.elevation(xj(0), xj(1), t);
     const auto s = wd.slope(x0(0), x0(1), t);
     CHECK(z.v(0) == Approx(s(0)).margin(1e-12));
     CHECK(z.v(1) == Approx(s(1)).margin(1e-12));
@@ -64,7 +64,7 @@ TEST_CASE("environment sample with Jets: current profile derivative", "[environm
   cp.profile.depth = 20.0;
   env.set_current(CurrentModel<Jet>(cp));
   const Vector3<Jet> p(Jet(1.0), Jet(2.0), Jet(10.0, 2));
-  const auto s = env.sample(p, Jet(3.0));
+  const auto s = env.sample(p, 3.0);
   // d/dz of ((20 − z)/20)^{1/7} at z = 10: −(1/7)(1/20)(0.5)^{−6/7} = −0.0129393.
   CHECK(s.current(0).v(2) == Approx(-(1.0 / 7) / 20 * std::pow(0.5, -6.0 / 7)).epsilon(1e-10));
   CHECK(s.wind.norm().a > 0.0);
@@ -72,7 +72,7 @@ TEST_CASE("environment sample with Jets: current profile derivative", "[environm
   kelp::Matrix3X<Jet> pts(3, 2), vel(3, 2), acc(3, 2);
   pts.col(0) = p;
   pts.col(1) = p;
-  env.sample_water(pts, Jet(3.0), vel, acc);
+  env.sample_water(pts, 3.0, vel, acc);
   CHECK((vel.col(0) - s.current - s.wave_velocity).norm().a < 1e-12);
   // Loads compile and differentiate with Jets.
   const Vector3<Jet> f =

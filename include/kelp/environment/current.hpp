@@ -204,15 +204,14 @@ class CurrentModel {
     return varying_ ? interpolate(direction_, t) : params_.direction;
   }
   /// \brief Current velocity at the surface, NED [m/s], at time t [s].
-  Vector3<Scalar> surface_velocity(const Scalar& t) const {
-    const double tv = value_of(t);
-    return current_velocity_ned(Scalar(speed_at(tv)), Scalar(params_.vertical_angle),
-                                Scalar(direction_at(tv)));
+  Vector3<Scalar> surface_velocity(double t) const {
+    return current_velocity_ned(Scalar(speed_at(t)), Scalar(params_.vertical_angle),
+                                Scalar(direction_at(t)));
   }
   /// \brief Current velocity at NED point p [m] and time t [s], NED [m/s]. Above the surface
   /// (z < 0) the surface value is returned.
   template <typename Derived>
-  Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, const Scalar& t) const {
+  Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, double t) const {
     return surface_velocity(t) * profile_factor(params_.profile, Scalar(p(2)));
   }
 

@@ -43,6 +43,8 @@ struct EnvironmentSample {
 /// A default-constructed environment is still water (`calm()`): seawater of 1025 kg/m³, air of
 /// 1.225 kg/m³, g = kelp::standard_gravity, no seabed, no current, no waves, no wind.
 /// All queries are `const` and allocate nothing; in still water they only copy zeros.
+/// Time is a `double` [s] for every Scalar (one clock: a float model must not drift or stop after
+/// hours); wave phases are formed in double before any cast to Scalar.
 /// The parts are built separately (`CurrentModel`, `WaveField`, `WindField`) and set here; see
 /// `sea_state.hpp` for presets. The wave field and the current profile carry their own water
 /// depth (set them to the seabed depth); the wave field's gravity must match this one.
@@ -135,7 +137,7 @@ class Environment {
 
   /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
   /// and acceleration (zero above the free surface), surface elevation at (x, y), wind at 10 m.
-  EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, Scalar t) const {
+  EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t) const {
     EnvironmentSample<Scalar> s;
     if (!current_.is_zero()) s.current = current_.velocity(p_ned, t);
     if (!waves_.empty()) {
@@ -149,13 +151,13 @@ class Environment {
   }
 
   /// \brief Free-surface elevation ζ(x, y, t) [m], positive up (x north, y east [m], t [s]).
-  Scalar surface_elevation(Scalar x, Scalar y, Scalar t) const {
+  Scalar surface_elevation(Scalar x, Scalar y, double t) const {
     if (waves_.empty()) return Scalar(0);
     return waves_.elevation(x, y, t);
   }
 
   /// \brief Free-surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t).
-  Eigen::Matrix<Scalar, 2, 1> surface_slope(Scalar x, Scalar y, Scalar t) const {
+  Eigen::Matrix<Scalar, 2, 1> surface_slope(Scalar x, Scalar y, double t) const {
     return waves_.slope(x, y, t);
   }
 
@@ -166,7 +168,7 @@ class Environment {
   /// `acceleration.col(i)` = wave orbital acceleration there (no wave part above the free
   /// surface; the current there is the surface current). \param[in] points 3×n NED positions [m]
   /// \param[in] t time [s] \param[out] velocity 3×n [m/s] \param[out] acceleration 3×n [m/s²]
-  void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, Scalar t,
+  void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                     Eigen::Ref<Matrix3X<Scalar>> velocity,
                     Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
     KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),

@@ -91,6 +91,20 @@ KELP_ENV_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
   c = flip_sign(c, sign);
 }
 
+/// x reduced to [−π, π] by subtracting the nearest multiple of 2π: x − 2πn, n = round(x/2π)
+/// (|x| < 2^51). Cody–Waite reduction with 2π split in three parts (26 + 26 + 53 bits): n·h1 and
+/// n·h2 are exact for |n| < 2^27 (|x| < 8e8 rad), so the reduced phase carries only the rounding
+/// of x itself and ≲ 1e-16 rad of its own. Used to bring a wave phase φ − ω t (formed in double)
+/// into the range where `fast_sincos` and a single-precision cast are accurate, however large t.
+KELP_ENV_ALWAYS_INLINE inline double wrap_two_pi(double x) {
+  constexpr double inv_two_pi = 0.15915494309189535;
+  constexpr double h1 = 6.283185243606567;       // 26 significant bits
+  constexpr double h2 = 6.357301884918343e-08;   // next 26 bits
+  constexpr double h3 = 2.4492935982947064e-16;  // the rest, rounded
+  const double n = round_nearest(x * inv_two_pi);
+  return ((x - n * h1) - n * h2) - n * h3;
+}
+
 /// e^x for −708 ≤ x ≤ 0 (no range check: the caller guarantees the range).
 ///
 /// With kSplitLn2 = false the reduction r = x − n ln2 uses ln 2 rounded to double (one fused

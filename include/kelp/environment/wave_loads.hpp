@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <type_traits>
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
@@ -90,10 +91,11 @@ Scalar encounter_frequency(const Scalar& omega, const Scalar& g, const Scalar& s
 /// ω = √(2π g / Λ) from deep-water dispersion, ω_e from `encounter_frequency`. Assumes the
 /// vessel's heading and speed vary slowly compared with the wave period (ω_e t is evaluated with
 /// the current ψ and U).
-/// \param[in] w wave and hull \param[in] t time [s] \param[in] psi heading [rad]
+/// \param[in] w wave and hull \param[in] t time [s] (a double for every Scalar)
+/// \param[in] psi heading [rad]
 /// \param[in] speed forward speed U [m/s]
 template <typename Scalar>
-Vector3<Scalar> paper_wave_load(const PaperWave& w, const Scalar& t, const Scalar& psi,
+Vector3<Scalar> paper_wave_load(const PaperWave& w, double t, const Scalar& psi,
                                 const Scalar& speed) {
   using std::cos;
   using std::sin;
@@ -101,10 +103,19 @@ Vector3<Scalar> paper_wave_load(const PaperWave& w, const Scalar& t, const Scala
   const double f =
       paper_wave_force(w.rho, w.gravity, w.beam, w.length, w.draft, w.amplitude, w.wavelength);
   const double omega = std::sqrt(2.0 * kelp::pi * w.gravity / w.wavelength);
-  const Scalar beta = Scalar(w.direction) - psi;
-  const Scalar we = encounter_frequency(Scalar(omega), Scalar(w.gravity), speed, beta);
-  const Scalar ft = Scalar(f) * cos(we * t + Scalar(w.phase));
-  return Vector3<Scalar>(ft * cos(beta), ft * sin(beta), Scalar(0));
+  if constexpr (std::is_floating_point_v<Scalar>) {
+    // Time is a double for every Scalar: ω_e t is formed (and reduced) in double, then cast.
+    const double beta = w.direction - static_cast<double>(psi);
+    const double we = encounter_frequency(omega, w.gravity, static_cast<double>(speed), beta);
+    const double ft = f * std::cos(std::remainder(we * t + w.phase, 2.0 * kelp::pi));
+    return Vector3<Scalar>(static_cast<Scalar>(ft * std::cos(beta)),
+                           static_cast<Scalar>(ft * std::sin(beta)), Scalar(0));
+  } else {
+    const Scalar beta = Scalar(w.direction) - psi;
+    const Scalar we = encounter_frequency(Scalar(omega), Scalar(w.gravity), speed, beta);
+    const Scalar ft = Scalar(f) * cos(we * Scalar(t) + Scalar(w.phase));
+    return Vector3<Scalar>(ft * cos(beta), ft * sin(beta), Scalar(0));
+  }
 }
 
 /// \brief First-order wave force on a small submerged body, body frame [N]:

@@ -4,6 +4,10 @@
 /// velocity and acceleration at any point, in deep water or finite depth; a batch query for many
 /// points without heap allocation.
 ///
+/// Time is a `double` for every Scalar: the phase φ − ω t is formed in double and reduced to
+/// [−π, π] before anything is cast to Scalar, so a float model reads the same sea as a double one
+/// after any run length.
+///
 /// Frames: world NED (x north, y east, z down), mean free surface at z = 0. The elevation ζ is
 /// positive UP (the free surface lies at NED z = −ζ). A component travelling towards the NED
 /// azimuth β (from north, clockwise) has the phase θ = k (x cos β + y sin β) − ω t + φ and
@@ -182,7 +186,9 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
   alignas(64) double alpha[kWaveChunk];
   for (std::size_t j0 = 0; j0 < c.n; j0 += kWaveChunk) {
     const std::size_t nj = std::min(kWaveChunk, c.n - j0);
-    for (std::size_t j = 0; j < nj; ++j) alpha[j] = c.phase[j0 + j] - c.omega[j0 + j] * t;
+    // φ − ω t in double, reduced to [−π, π]: exact to double rounding for any t.
+    for (std::size_t j = 0; j < nj; ++j)
+      alpha[j] = wrap_two_pi(c.phase[j0 + j] - c.omega[j0 + j] * t);
     if (m == 1) {
       WaveLanes<kLanes> acc;
       const double x = b.x[0], y = b.y[0], nze = -b.ze[0];
@@ -424,15 +430,23 @@ class WaveField {
     return v;
   }
 
+  /// \brief The time part φ_j − ω_j t of component j's phase [rad], formed in double and reduced
+  /// to [−π, π] (time is a double for every Scalar, so the phase does not lose precision as t
+  /// grows, nor with a single-precision model). \param[in] j component \param[in] t time [s]
+  double time_phase(std::size_t j, double t) const {
+    return detail::wrap_two_pi(phase_[j] - omega_[j] * t);
+  }
+
   /// \brief Surface elevation ζ(x, y, t) [m], positive up.
-  /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s]
-  Scalar elevation(const Scalar& x, const Scalar& y, const Scalar& t) const {
+  /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s] (a double for
+  /// every Scalar)
+  Scalar elevation(const Scalar& x, const Scalar& y, double t) const {
     if constexpr (std::is_floating_point_v<Scalar>) {
-      const double xd = x, yd = y, td = t;
+      const double xd = x, yd = y;
       double z = 0.0;
       for (std::size_t j = 0; j < omega_.size(); ++j) {
         double s, c;
-        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + (phase_[j] - omega_[j] * td), s, c);
+        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + time_phase(j, t), s, c);
         z += amp_[j] * c;
       }
       return static_cast<Scalar>(z);
@@ -440,30 +454,43 @@ class WaveField {
       using std::cos;
       Scalar z(0);
       for (std::size_t j = 0; j < omega_.size(); ++j)
-        z += Scalar(amp_[j]) * cos(Scalar(kx_[j]) * x + Scalar(ky_[j]) * y +
-                                   (Scalar(phase_[j]) - Scalar(omega_[j]) * t));
+        z += Scalar(amp_[j]) *
+             cos(Scalar(kx_[j]) * x + Scalar(ky_[j]) * y + Scalar(time_phase(j, t)));
       return z;
     }
   }
 
   /// \brief Surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t): the rise of the surface per metre
   /// north and per metre east.
-  Eigen::Matrix<Scalar, 2, 1> slope(const Scalar& x, const Scalar& y, const Scalar& t) const {
-    using std::sin;
-    Scalar sx(0), sy(0);
-    for (std::size_t j = 0; j < omega_.size(); ++j) {
-      const Scalar s = Scalar(amp_[j]) * sin(Scalar(kx_[j]) * x + Scalar(ky_[j]) * y +
-                                             (Scalar(phase_[j]) - Scalar(omega_[j]) * t));
-      sx -= Scalar(kx_[j]) * s;
-      sy -= Scalar(ky_[j]) * s;
+  /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s]
+  Eigen::Matrix<Scalar, 2, 1> slope(const Scalar& x, const Scalar& y, double t) const {
+    if constexpr (std::is_floating_point_v<Scalar>) {
+      const double xd = x, yd = y;
+      double sx = 0.0, sy = 0.0;
+      for (std::size_t j = 0; j < omega_.size(); ++j) {
+        double s, c;
+        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + time_phase(j, t), s, c);
+        sx -= kx_[j] * amp_[j] * s;
+        sy -= ky_[j] * amp_[j] * s;
+      }
+      return Eigen::Matrix<Scalar, 2, 1>(static_cast<Scalar>(sx), static_cast<Scalar>(sy));
+    } else {
+      using std::sin;
+      Scalar sx(0), sy(0);
+      for (std::size_t j = 0; j < omega_.size(); ++j) {
+        const Scalar s = Scalar(amp_[j]) *
+                         sin(Scalar(kx_[j]) * x + Scalar(ky_[j]) * y + Scalar(time_phase(j, t)));
+        sx -= Scalar(kx_[j]) * s;
+        sy -= Scalar(ky_[j]) * s;
+      }
+      return Eigen::Matrix<Scalar, 2, 1>(sx, sy);
     }
-    return Eigen::Matrix<Scalar, 2, 1>(sx, sy);
   }
 
   /// \brief Elevation, orbital velocity and acceleration at NED point `p` and time `t`.
   /// \param[in] p NED position [m] \param[in] t time [s]
   template <typename Derived>
-  WaveKinematics<Scalar> kinematics(const Eigen::MatrixBase<Derived>& p, const Scalar& t) const {
+  WaveKinematics<Scalar> kinematics(const Eigen::MatrixBase<Derived>& p, double t) const {
     WaveKinematics<Scalar> out;
     if (empty()) return out;
     if constexpr (std::is_floating_point_v<Scalar>) {
@@ -471,7 +498,7 @@ class WaveField {
       b.x[0] = static_cast<double>(p(0));
       b.y[0] = static_cast<double>(p(1));
       b.z[0] = static_cast<double>(p(2));
-      run_block(b, 1, static_cast<double>(t));
+      run_block(b, 1, t);
       out.elevation = static_cast<Scalar>(b.zeta[0]);
       out.velocity << static_cast<Scalar>(b.vx[0]), static_cast<Scalar>(b.vy[0]),
           static_cast<Scalar>(b.vz[0]);
@@ -487,7 +514,7 @@ class WaveField {
   /// no heap allocation. Overwrites `velocity` and `acceleration` (3×n each).
   /// \param[in] points 3×n NED [m] \param[in] t time [s]
   /// \param[out] velocity 3×n NED [m/s] \param[out] acceleration 3×n NED [m/s²]
-  void kinematics(const Eigen::Ref<const Matrix3X<Scalar>>& points, const Scalar& t,
+  void kinematics(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                   Eigen::Ref<Matrix3X<Scalar>> velocity,
                   Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
     KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
@@ -500,7 +527,7 @@ class WaveField {
     const Eigen::Index n = points.cols();
     if constexpr (std::is_floating_point_v<Scalar>) {
       Block b;
-      const double td = static_cast<double>(t);
+      const double td = t;
       for (Eigen::Index i0 = 0; i0 < n; i0 += kBlock) {
         const int m = static_cast<int>(std::min<Eigen::Index>(kBlock, n - i0));
         for (int i = 0; i < m; ++i) {
@@ -564,7 +591,7 @@ class WaveField {
 
   /// The same sums with ADL math for automatic-differentiation scalars. The crest and seabed
   /// clamps use the value part only (they select a branch, not a derivative).
-  void generic_point(const Vector3<Scalar>& p, const Scalar& t, WaveKinematics<Scalar>& out) const {
+  void generic_point(const Vector3<Scalar>& p, double t, WaveKinematics<Scalar>& out) const {
     using std::cos;
     using std::exp;
     using std::sin;
@@ -573,8 +600,7 @@ class WaveField {
     if (finite_depth_ && value_of(z) > params_.depth) z = Scalar(params_.depth);
     out = WaveKinematics<Scalar>();
     for (std::size_t j = 0; j < omega_.size(); ++j) {
-      const Scalar th = Scalar(kx_[j]) * p(0) + Scalar(ky_[j]) * p(1) +
-                        (Scalar(phase_[j]) - Scalar(omega_[j]) * t);
+      const Scalar th = Scalar(kx_[j]) * p(0) + Scalar(ky_[j]) * p(1) + Scalar(time_phase(j, t));
       const Scalar s = sin(th), c = cos(th);
       const Scalar e = exp(Scalar(-k_[j]) * z);
       Scalar fh = e, fv = e;

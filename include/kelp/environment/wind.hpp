@@ -143,24 +143,17 @@ class WindField {
     return v;
   }
   /// \brief Wind speed U(t) = U₁₀ + u_g(t) [m/s] at time t [s].
-  Scalar speed(const Scalar& t) const {
-    using std::cos;
-    if constexpr (std::is_floating_point_v<Scalar>) {
-      double u = params_.speed, sn, cs;
-      const double td = static_cast<double>(t);
-      for (std::size_t j = 0; j < amp_.size(); ++j) {
-        detail::fast_sincos(omega_[j] * td + phase_[j], sn, cs);
-        u += amp_[j] * cs;
-      }
-      return static_cast<Scalar>(u);
+  /// Time is a double for every Scalar; the phase is formed in double and reduced to [−π, π].
+  Scalar speed(double t) const {
+    double u = params_.speed, sn, cs;
+    for (std::size_t j = 0; j < amp_.size(); ++j) {
+      detail::fast_sincos(detail::wrap_two_pi(omega_[j] * t + phase_[j]), sn, cs);
+      u += amp_[j] * cs;
     }
-    Scalar u(params_.speed);
-    for (std::size_t j = 0; j < amp_.size(); ++j)
-      u += Scalar(amp_[j]) * cos(Scalar(omega_[j]) * t + Scalar(phase_[j]));
-    return u;
+    return Scalar(u);
   }
   /// \brief Wind velocity (air motion) at 10 m, NED [m/s], at time t [s]; horizontal.
-  Vector3<Scalar> velocity(const Scalar& t) const {
+  Vector3<Scalar> velocity(double t) const {
     if (params_.speed == 0.0) return Vector3<Scalar>::Zero();
     const Scalar u = speed(t);
     return Vector3<Scalar>(u * Scalar(cos_dir_), u * Scalar(sin_dir_), Scalar(0));
