@@ -9,7 +9,7 @@ namespace {
 
 void BM_CeresWarmFastPath(benchmark::State& state) {
   const auto grid = kelp_bench::catenary_grid();
-  kelp::ceres::CatenarySolver solver;
+  kelp::ceres_solver::CatenarySolver solver;
   for (auto _ : state) {
     for (const auto& g : grid) {
       auto r = solver.solve(g.D, g.dz, g.L);
@@ -27,7 +27,7 @@ void BM_CeresWarmPreviousStep(benchmark::State& state) {
   std::vector<kelp::tether::CatenaryResult<double>> previous;
   for (const auto& g : grid)
     previous.push_back(kelp::tether::solve_catenary(g.D * (1 - 1e-4), g.dz - 1e-4 * g.L, g.L));
-  kelp::ceres::CatenarySolver solver;
+  kelp::ceres_solver::CatenarySolver solver;
   int64_t iterations = 0;
   for (auto _ : state) {
     for (size_t i = 0; i < grid.size(); ++i) {
@@ -50,7 +50,7 @@ void BM_CeresPoorGuess(benchmark::State& state) {
   const auto grid = kelp_bench::catenary_grid();
   std::vector<kelp::tether::CatenaryResult<double>> exact;
   for (const auto& g : grid) exact.push_back(kelp::tether::solve_catenary(g.D, g.dz, g.L));
-  kelp::ceres::CatenarySolver solver;
+  kelp::ceres_solver::CatenarySolver solver;
   int64_t iterations = 0, failures = 0, restarts = 0;
   for (auto _ : state) {
     for (size_t i = 0; i < grid.size(); ++i) {
@@ -73,7 +73,7 @@ void BM_CeresPoorGuess(benchmark::State& state) {
 BENCHMARK(BM_CeresPoorGuess);
 
 void BM_CeresNaiveStartReferenceCase(benchmark::State& state) {
-  kelp::ceres::CatenarySolver solver;
+  kelp::ceres_solver::CatenarySolver solver;
   int iterations = 0;
   for (auto _ : state) {
     auto r = solver.solve(10.0, 5.0, 20.0, 20.0, 5.0);

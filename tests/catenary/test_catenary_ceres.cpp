@@ -4,14 +4,30 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <type_traits>
 
 #include "kelp/ceres/catenary_solver.hpp"
 #include "random_geometry.hpp"
 
 using kelp::tether::CatenaryOptions;
 using kelp::tether::CatenaryStatus;
-namespace kc = kelp::ceres;
+namespace kc = kelp::ceres_solver;
 namespace kt = kelp::tether;
+
+// Code written inside `namespace kelp` (as kelp's own headers and user extensions are) must see
+// Ceres' namespace under its own name: a `kelp::ceres` namespace used to hide every Ceres name it
+// did not re-export (here `ceres::isfinite`), and this did not compile.
+namespace kelp::user_extension {
+using JetInKelp = ceres::Jet<double, 2>;
+inline bool jet_is_finite(const JetInKelp& x) { return ceres::isfinite(x); }
+}  // namespace kelp::user_extension
+
+TEST_CASE("Ceres path: ::ceres is not shadowed inside namespace kelp", "[catenary][ceres]") {
+  STATIC_REQUIRE(std::is_same_v<kelp::user_extension::JetInKelp, ::ceres::Jet<double, 2>>);
+  CHECK(kelp::user_extension::jet_is_finite(::ceres::Jet<double, 2>(1.0, 0)));
+  CHECK_FALSE(kelp::user_extension::jet_is_finite(
+      ::ceres::Jet<double, 2>(std::numeric_limits<double>::quiet_NaN(), 0)));
+}
 
 TEST_CASE("Ceres path: reference case of tether.md", "[catenary][ceres]") {
   const auto r = kc::solve_catenary(10.0, 5.0, 20.0);

@@ -15,7 +15,7 @@ template struct kelp::tether::CatenaryResult<J3>;
 template struct kelp::tether::CatenaryOptions<J3>;
 template kelp::tether::CatenaryResult<J3> kelp::tether::solve_catenary(
     J3, J3, J3, const kelp::tether::CatenaryOptions<J3>&);
-template kelp::tether::CatenaryResult<J3> kelp::ceres::solve_catenary(
+template kelp::tether::CatenaryResult<J3> kelp::ceres_solver::solve_catenary(
     J3, J3, J3, double, double, const kelp::tether::CatenaryOptions<J3>&);
 
 namespace kelp {
@@ -69,7 +69,7 @@ TEST_CASE("Jet: da, dc by implicit differentiation match finite differences", "[
       CHECK(r.c.v[k] == Approx(fd.c[k]).epsilon(1e-5).margin(1e-6 * scale_c));
     }
     // The Ceres path (IFT on the paper's equations) gives the same derivatives.
-    const auto rc = kelp::ceres::solve_catenary(seed(g[0], 0), seed(g[1], 1), seed(g[2], 2));
+    const auto rc = kelp::ceres_solver::solve_catenary(seed(g[0], 0), seed(g[1], 1), seed(g[2], 2));
     REQUIRE(rc.status == CatenaryStatus::converged);
     for (int k = 0; k < 3; ++k) {
       CHECK(rc.a.v[k] == Approx(r.a.v[k]).epsilon(1e-8).margin(1e-12));

@@ -8,9 +8,12 @@
 /// warm-started from the fast analytic path (kelp/tether/catenary.hpp) by default or from a
 /// caller's guess (e.g. the previous control step). Geometry statuses (taut, vertical, invalid
 /// input) are decided exactly as on the fast path. This is the only kelp directory that includes
-/// Ceres. Inside `namespace kelp` the name `ceres` now means `kelp::ceres`: kelp code spells Ceres'
-/// namespace `::ceres`, and `Jet`, `TinySolver` and `TinySolverAutoDiffFunction` are re-exported
-/// into `kelp::ceres` so that `ceres::Jet<double, N>` written inside `namespace kelp` still works.
+/// Ceres.
+///
+/// The namespace is `kelp::ceres_solver` (header path and CMake target stay `kelp/ceres/...` and
+/// `kelp::ceres`): a namespace named `kelp::ceres` would hide Ceres' own `::ceres` from any code
+/// inside `namespace kelp` (user code included), so that `ceres::Jet<double, N>` written there
+/// would not find Ceres' type.
 #pragma once
 
 #include <cmath>
@@ -25,13 +28,8 @@
 #include "kelp/tether/catenary.hpp"
 
 namespace kelp {
-namespace ceres {
-
-/// \brief Ceres' own names re-exported, so that code inside `namespace kelp` that writes
-/// `ceres::Jet<double, N>` (which now finds `kelp::ceres` first) keeps meaning Ceres' types.
-using ::ceres::Jet;
-using ::ceres::TinySolver;
-using ::ceres::TinySolverAutoDiffFunction;
+/// \brief The Ceres-based solvers (target `kelp::ceres`, headers under `kelp/ceres/`).
+namespace ceres_solver {
 
 using tether::CatenaryOptions;
 using tether::CatenaryResult;
@@ -261,5 +259,5 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L, double a0, 
   return solver.solve(D, dz, L, a0, c0, options);
 }
 
-}  // namespace ceres
+}  // namespace ceres_solver
 }  // namespace kelp
