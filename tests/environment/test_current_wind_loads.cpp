@@ -264,7 +264,8 @@ TEST_CASE("the paper's wave load oscillates at the encounter frequency along the
 
 TEST_CASE("small-body wave force is (rho V + M_A) times the fluid acceleration",
           "[environment][waves]") {
-  // BlueROV2 Heavy numbers (reference/vehicles.md): ∇ = 0.0134 m³, added mass 6.36/7.12/18.68 kg.
+  // BlueROV2 Heavy numbers (von Benzon et al. 2022, Table A1): ∇ = 0.0134 m³, added mass
+  // 6.36/7.12/18.68 kg.
   const double rho = 1025, vol = 0.0134;
   const Vector3<double> ma(6.36, 7.12, 18.68);
   const Matrix3<double> R = kelp::rotation_zyx(0.0, 0.0, kelp::pi / 2);  // heading east

@@ -1,5 +1,5 @@
 // Static equilibrium of the lumped-mass tether against the analytic catenary (reference case of
-// shared/reference/tether.md), seabed contact and a buoyant line.
+// docs/equations.md, section 3), seabed contact and a buoyant line.
 #include <catch2/catch.hpp>
 #include <cmath>
 

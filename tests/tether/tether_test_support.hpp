@@ -1,5 +1,5 @@
 // Shared helpers of the tether tests: minimal environments satisfying the duck-typed interface
-// of kelp::environment::Environment, and the benchmark line of shared/reference/tether.md.
+// of kelp::environment::Environment, and the benchmark line (docs/equations.md, section 4).
 #pragma once
 
 #include <Eigen/Core>
@@ -52,7 +52,7 @@ struct TestWater {
   }
 };
 
-/// The benchmark line of shared/reference/tether.md: 20 m, d 8 mm, 0.07 kg/m, EA 1e5 N,
+/// The benchmark line (docs/equations.md, section 4): 20 m, d 8 mm, 0.07 kg/m, EA 1e5 N,
 /// Cdn 1.2, Cdt 0.008, Can 1 (kelp's TetherParameters defaults) with N segments.
 template <typename Scalar>
 kelp::tether::TetherParameters<Scalar> benchmark_line(int segments) {

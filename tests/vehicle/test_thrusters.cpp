@@ -16,7 +16,7 @@ TEST_CASE("BlueROV2 Heavy allocation matches ArduSub's vectored_6dof motor facto
   const kv::ThrusterAllocation<double> alloc(p.thruster_positions, p.thruster_directions);
   REQUIRE(alloc.size() == 8);
   CHECK(alloc.rank() == 6);
-  // ArduSub AP_Motors6DOF.cpp vectored_6dof factors (sitl.md §1.7), per motor:
+  // ArduSub AP_Motors6DOF.cpp vectored_6dof factors (ArduPilot, setup_motors), per motor:
   // roll, pitch, yaw, throttle (climb), forward, lateral. A positive factor means a positive
   // output pushes the vehicle along that demand: roll → +K, pitch → +M, yaw → +N,
   // climb → −Z (NED), forward → +X, lateral → +Y.
