@@ -46,7 +46,7 @@ void BM_Rk4Step(benchmark::State& st) {
   const kv::VehicleState<double> x0 = f.x;
   int k = 0;
   for (auto _ : st) {
-    kv::rk4_step(f.model, f.ws, f.x, 0.001, f.tau, f.tau_env, f.current);
+    kv::step_rk4(f.model, f.ws, f.x, 0.001, f.tau, f.tau_env, f.current);
     benchmark::DoNotOptimize(f.x);
     if (++k == 100000) {  // stay near the fixture's state
       f.x = x0;
@@ -61,7 +61,7 @@ void BM_SemiImplicitEulerStep(benchmark::State& st) {
   const kv::VehicleState<double> x0 = f.x;
   int k = 0;
   for (auto _ : st) {
-    kv::semi_implicit_euler_step(f.model, f.ws, f.x, 0.001, f.tau, f.tau_env, f.current);
+    kv::step_semi_implicit_euler(f.model, f.ws, f.x, 0.001, f.tau, f.tau_env, f.current);
     benchmark::DoNotOptimize(f.x);
     if (++k == 100000) {
       f.x = x0;

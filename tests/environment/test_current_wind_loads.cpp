@@ -225,7 +225,7 @@ TEST_CASE("wind loads: the constant-coefficient model reduces to the paper's for
     t.cy.push_back(ci(1));
     t.cn.push_back(ci(2));
   }
-  t.validate();
+  validate(t);
   for (const double a : {0.0, kelp::pi / 6, -kelp::pi / 3, kelp::pi})
     CHECK((t(a) - c(a)).norm() < 1e-12);
   CHECK((t(0.25) - c(0.25)).norm() < 0.01);  // linear interpolation over 10° steps
@@ -234,7 +234,7 @@ TEST_CASE("wind loads: the constant-coefficient model reduces to the paper's for
   CHECK((ft - fc).norm() < 0.02 * fc.norm());
   TabulatedWindCoefficients bad = t;
   bad.cy.pop_back();
-  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("cx, cy, cn"));
+  CHECK_THROWS_WITH(validate(bad), Catch::Contains("cx, cy, cn"));
   // A malformed table is refused at evaluation too, never read out of bounds.
   CHECK_THROWS_WITH(bad(0.3), Catch::Contains("cx, cy, cn"));
   CHECK_THROWS_AS(TabulatedWindCoefficients{}(0.3), kelp::invalid_argument);

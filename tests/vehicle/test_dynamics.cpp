@@ -57,7 +57,7 @@ TEMPLATE_TEST_CASE("without damping or forcing, RK4 conserves the kinetic energy
   const Vector6<S> zero = Vector6<S>::Zero();
   double worst = 0;
   for (int k = 0; k < 10000; ++k) {  // 10 s at 1 ms
-    kv::rk4_step(model, ws, x, S(0.001), zero, zero);
+    kv::step_rk4(model, ws, x, S(0.001), zero, zero);
     worst = std::max(worst, std::abs(energy(x) - e0) / e0);
   }
   // double: the issue's 1e-6 (RK4 error at 1 ms is ~1e-12 here); float: rounding of 1e4 steps.
@@ -90,7 +90,7 @@ TEST_CASE("without damping, kinetic + hydrostatic potential energy is conserved"
   double worst = 0;
   const Vector6<double> zero = Vector6<double>::Zero();
   for (int k = 0; k < 10000; ++k) {
-    kv::rk4_step(model, ws, x, 0.001, zero, zero);
+    kv::step_rk4(model, ws, x, 0.001, zero, zero);
     worst = std::max(worst, std::abs(energy(x) - e0) / scale);
   }
   CHECK(worst < 1e-6);
@@ -106,13 +106,13 @@ TEMPLATE_TEST_CASE("BlueROV2 Heavy at constant surge thrust reaches the speed wh
   tau(0) = S(40);
   // 40 = 13.7 u + 141 u² ⇒ u = 0.4862 m/s (von Benzon 2022 damping).
   const double u_ss = steady_speed(13.7, 141, 40);
-  for (int k = 0; k < 2000; ++k) kv::rk4_step(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 2000; ++k) kv::step_rk4(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
   CHECK(double(x.nu(0)) == Approx(u_ss).epsilon(0.01));
   CHECK(double(x.position(0)) > 0.9 * u_ss * 19);
   // The semi-implicit Euler integrator reaches the same steady state.
   kv::VehicleState<S> y;
   for (int k = 0; k < 20000; ++k)
-    kv::semi_implicit_euler_step(model, ws, y, S(0.001), tau, Vector6<S>::Zero());
+    kv::step_semi_implicit_euler(model, ws, y, S(0.001), tau, Vector6<S>::Zero());
   CHECK(double(y.nu(0)) == Approx(u_ss).epsilon(0.01));
   CHECK(double(y.attitude.norm()) == Approx(1.0).epsilon(1e-6));
 }
@@ -131,7 +131,7 @@ TEMPLATE_TEST_CASE("BlueBoat at full thrust reaches its top speed near 3 m/s",
   const Vector6<S> tau = thrusters.wrench(f);
   CHECK(double(tau(0)) == Approx(60.8).epsilon(1e-6));
   CHECK(std::abs(double(tau(5))) < 1e-6);
-  for (int k = 0; k < 6000; ++k) kv::rk4_step(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
   // Pure surge balance: 5 u + 5 u² = 60.8 ⇒ 3.023 m/s. The thrusters sit 0.10 m below the CO, so
   // the boat trims bow-up (≈ 0.03 rad) and the heave restoring force then has a surge component:
   // the simulated top speed is ≈ 2 % lower (2.966 m/s when this test was written).
@@ -154,7 +154,7 @@ TEMPLATE_TEST_CASE("a heave step settles", "[vehicle][behaviour]", double, float
   kv::VehicleState<S> x;
   Vector6<S> tau = Vector6<S>::Zero();
   tau(2) = S(50);
-  for (int k = 0; k < 2000; ++k) kv::rk4_step(boat, ws, x, S(0.005), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 2000; ++k) kv::step_rk4(boat, ws, x, S(0.005), tau, Vector6<S>::Zero());
   CHECK(double(x.position(2)) == Approx(50 / (1025 * 9.80665 * 0.19)).epsilon(0.01));
   CHECK(std::abs(double(x.nu(2))) < 1e-3);
 
@@ -162,7 +162,7 @@ TEMPLATE_TEST_CASE("a heave step settles", "[vehicle][behaviour]", double, float
   const kv::VehicleModel<S> rov(neutral_rov<S>());
   kv::VehicleState<S> y;
   tau(2) = S(20);
-  for (int k = 0; k < 1000; ++k) kv::rk4_step(rov, ws, y, S(0.01), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 1000; ++k) kv::step_rk4(rov, ws, y, S(0.01), tau, Vector6<S>::Zero());
   CHECK(double(y.nu(2)) == Approx(steady_speed(33, 190, 20)).epsilon(0.01));
 }
 
@@ -202,7 +202,7 @@ TEST_CASE("BlueBoat heave, roll and pitch oscillate with the linear natural peri
     std::vector<double> crossings;
     double prev = coordinate();
     for (int k = 1; k < 40000 && crossings.size() < 2; ++k) {
-      kv::rk4_step(boat, ws, x, dt, Vector6<double>::Zero(), Vector6<double>::Zero());
+      kv::step_rk4(boat, ws, x, dt, Vector6<double>::Zero(), Vector6<double>::Zero());
       const double now = coordinate();
       if (prev < 0 && now >= 0) crossings.push_back((k - now / (now - prev)) * dt);
       prev = now;
@@ -225,7 +225,7 @@ TEMPLATE_TEST_CASE("a passive neutrally buoyant vehicle ends up moving with a un
   x.attitude = kelp::quaternion_from_euler(S(0), S(0), S(0.7));  // yawed: the current is rotated
   const Vector3<S> current(S(0.5), S(-0.2), S(0.05));
   const Vector6<S> zero = Vector6<S>::Zero();
-  for (int k = 0; k < 6000; ++k) kv::rk4_step(model, ws, x, S(0.01), zero, zero, current);
+  for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, S(0.01), zero, zero, current);
   const Vector3<S> v_ned = x.attitude * Vector3<S>(x.nu.template head<3>());
   CHECK((v_ned - current).norm() < S(2e-3));
   // The transient spin decays slowly (roll and yaw have quadratic damping only).
@@ -249,7 +249,7 @@ TEST_CASE("a body spinning while drifting with the current keeps drifting with i
   x.nu.head<3>() = x.attitude.conjugate() * current;
   x.nu(5) = 0.8;
   const Vector6<double> zero = Vector6<double>::Zero();
-  for (int k = 0; k < 5000; ++k) kv::rk4_step(model, ws, x, 0.002, zero, zero, current);
+  for (int k = 0; k < 5000; ++k) kv::step_rk4(model, ws, x, 0.002, zero, zero, current);
   const Vector3<double> v_ned = x.attitude * Vector3<double>(x.nu.head<3>());
   CHECK((v_ned - current).norm() < 1e-9);
   CHECK((x.position - 10.0 * current).norm() < 1e-8);
@@ -304,13 +304,13 @@ TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage"
   CHECK((model.mass_inverse() * model.mass_matrix() - Matrix6<double>::Identity()).norm() < 1e-12);
   CHECK((model.mass_inverse() * ws.rhs - model.mass_ldlt().solve(ws.rhs)).norm() < 1e-12);
 
-  // A callable that returns the same constant wrench reproduces rk4_step, and it is called at the
+  // A callable that returns the same constant wrench reproduces step_rk4, and it is called at the
   // classical RK4 stage offsets 0, dt/2, dt/2, dt.
   kv::VehicleState<double> y = x, z = x;
-  kv::rk4_step(model, ws, y, 0.01, t1, t2);
+  kv::step_rk4(model, ws, y, 0.01, t1, t2);
   int calls = 0;
   double offsets[4] = {-1, -1, -1, -1};
-  kv::rk4_step_with(
+  kv::step_rk4_with(
       model, ws, z, 0.01,
       [&](const kv::VehicleState<double>&, double t) -> Vector6<double> {
         if (calls < 4) offsets[calls] = t;
@@ -354,15 +354,15 @@ TEST_CASE("a failed step throws and leaves the state unchanged", "[vehicle][inte
   const kv::VehicleState<double> before = x;
   Vector6<double> bad = Vector6<double>::Zero();
   bad(0) = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_AS(kv::rk4_step(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
+  CHECK_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
                   kelp::numerical_error);
-  CHECK_THROWS_AS(kv::semi_implicit_euler_step(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
+  CHECK_THROWS_AS(kv::step_semi_implicit_euler(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
                   kelp::numerical_error);
   CHECK(x.position == before.position);
   CHECK(x.nu == before.nu);
   CHECK(x.attitude.coeffs() == before.attitude.coeffs());
   CHECK_THROWS_WITH(
-      kv::rk4_step(model, ws, x, 0.0, Vector6<double>::Zero(), Vector6<double>::Zero()),
+      kv::step_rk4(model, ws, x, 0.0, Vector6<double>::Zero(), Vector6<double>::Zero()),
       Catch::Contains("dt"));
 }
 
@@ -385,8 +385,8 @@ TEMPLATE_TEST_CASE("forward dynamics and steps do not allocate", "[vehicle][mall
   thrusters.distribute(tau, f);
   tau = thrusters.wrench(f);
   const Vector6<S> a = kv::forward_dynamics(model, ws, x, tau, tau_env, current);
-  kv::rk4_step(model, ws, x, S(0.01), tau, tau_env, current);
-  kv::semi_implicit_euler_step(model, ws, x, S(0.01), tau, tau_env, current);
+  kv::step_rk4(model, ws, x, S(0.01), tau, tau_env, current);
+  kv::step_semi_implicit_euler(model, ws, x, S(0.01), tau, tau_env, current);
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(a.allFinite());
   CHECK(x.nu.allFinite());

@@ -32,8 +32,8 @@ TEST_CASE("presets are valid", "[vehicle][parameters]") {
   CHECK_NOTHROW(kv::VehicleModel<double>(kv::blueboat<double>().parameters));
   CHECK_NOTHROW(kv::VehicleModel<float>(kv::bluerov2_heavy<float>().parameters));
   CHECK_NOTHROW(kv::VehicleModel<float>(kv::blueboat<float>().parameters));
-  CHECK_NOTHROW(kv::bluerov2_heavy<double>().pwm.validate());
-  CHECK_NOTHROW(kv::blueboat<double>().pwm.validate());
+  CHECK_NOTHROW(kv::validate(kv::bluerov2_heavy<double>().pwm));
+  CHECK_NOTHROW(kv::validate(kv::blueboat<double>().pwm));
 }
 
 TEST_CASE("bad vehicle parameters name the field", "[vehicle][parameters]") {
@@ -126,13 +126,13 @@ TEST_CASE("steps refuse a non-unit attitude or a non-finite state, leaving it un
   kv::VehicleStated zero_q;
   zero_q.attitude.coeffs().setZero();
   const kv::VehicleStated before = zero_q;
-  CHECK_THROWS_WITH(kv::rk4_step(model, ws, zero_q, 1e-3, tau, tau), Catch::Contains("attitude"));
-  CHECK_THROWS_WITH(kv::semi_implicit_euler_step(model, ws, zero_q, 1e-3, tau, tau),
+  CHECK_THROWS_WITH(kv::step_rk4(model, ws, zero_q, 1e-3, tau, tau), Catch::Contains("attitude"));
+  CHECK_THROWS_WITH(kv::step_semi_implicit_euler(model, ws, zero_q, 1e-3, tau, tau),
                     Catch::Contains("attitude"));
   CHECK(zero_q.attitude.coeffs() == before.attitude.coeffs());
   kv::VehicleStated nan_nu;
   nan_nu.nu(2) = kNan;
-  CHECK_THROWS_WITH(kv::rk4_step(model, ws, nan_nu, 1e-3, tau, tau), Catch::Contains("state.nu"));
+  CHECK_THROWS_WITH(kv::step_rk4(model, ws, nan_nu, 1e-3, tau, tau), Catch::Contains("state.nu"));
   kv::VehicleStated ok;
-  CHECK_NOTHROW(kv::rk4_step(model, ws, ok, 1e-3, tau, tau));
+  CHECK_NOTHROW(kv::step_rk4(model, ws, ok, 1e-3, tau, tau));
 }

@@ -117,7 +117,7 @@ TEMPLATE_TEST_CASE("T200 curve, its peak and its inverse", "[vehicle][thrusters]
 TEMPLATE_TEST_CASE("PWM <-> command mapping with deadband", "[vehicle][thrusters]", double, float) {
   using S = TestType;
   const kv::PwmMapping<S> m;  // 1100-1500-1900, ±25 µs
-  m.validate();
+  kv::validate(m);
   CHECK(kv::command_from_pwm(S(1900), m) == S(1));
   CHECK(kv::command_from_pwm(S(1100), m) == S(-1));
   CHECK(kv::command_from_pwm(S(1500), m) == S(0));
@@ -135,8 +135,8 @@ TEMPLATE_TEST_CASE("PWM <-> command mapping with deadband", "[vehicle][thrusters
   }
   kv::PwmMapping<S> bad;
   bad.deadband_us = S(450);
-  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("deadband_us"));
+  CHECK_THROWS_WITH(kv::validate(bad), Catch::Contains("deadband_us"));
   bad = kv::PwmMapping<S>();
   bad.max_us = S(1400);
-  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("max_us"));
+  CHECK_THROWS_WITH(kv::validate(bad), Catch::Contains("max_us"));
 }

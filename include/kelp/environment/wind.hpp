@@ -199,20 +199,10 @@ struct TabulatedWindCoefficients {
   std::vector<double> angle;       ///< γ_rw [rad], strictly increasing, from 0 to π
   std::vector<double> cx, cy, cn;  ///< coefficients at those angles [-]
 
-  /// \brief Throws `kelp::invalid_argument` unless the table is well formed.
-  void validate() const {
-    KELP_CHECK(angle.size() >= 2, "wind table angle needs at least 2 entries");
-    KELP_CHECK(cx.size() == angle.size() && cy.size() == angle.size() && cn.size() == angle.size(),
-               "wind table cx, cy, cn must have as many entries as angle");
-    KELP_CHECK(std::abs(angle.front()) < 1e-9 && std::abs(angle.back() - kelp::pi) < 1e-6,
-               "wind table angle must run from 0 to pi");
-    for (std::size_t i = 1; i < angle.size(); ++i)
-      KELP_CHECK(angle[i] > angle[i - 1], "wind table angle must be strictly increasing");
-  }
   /// \brief (C_X, C_Y, C_N) at γ_rw [rad] (any value; wrapped to (−π, π]).
   /// \throws kelp::invalid_argument when the table is too short or its columns differ in length
-  /// (the O(1) part of validate(), checked on every call so a malformed table never reads out of
-  /// bounds).
+  /// (the O(1) part of `validate(const TabulatedWindCoefficients&)`, checked on every call so a
+  /// malformed table never reads out of bounds).
   Eigen::Vector3d operator()(double gamma) const {
     KELP_CHECK(angle.size() >= 2, "wind table angle needs at least 2 entries");
     KELP_CHECK(cx.size() == angle.size() && cy.size() == angle.size() && cn.size() == angle.size(),
@@ -228,6 +218,19 @@ struct TabulatedWindCoefficients {
     return Eigen::Vector3d(lerp(cx), sign * lerp(cy), sign * lerp(cn));
   }
 };
+
+/// \brief Throws `kelp::invalid_argument` unless the table `t` is well formed: at least two
+/// angles, running strictly increasing from 0 to π, and as many cx, cy, cn entries as angles.
+inline void validate(const TabulatedWindCoefficients& t) {
+  KELP_CHECK(t.angle.size() >= 2, "wind table angle needs at least 2 entries");
+  KELP_CHECK(t.cx.size() == t.angle.size() && t.cy.size() == t.angle.size() &&
+                 t.cn.size() == t.angle.size(),
+             "wind table cx, cy, cn must have as many entries as angle");
+  KELP_CHECK(std::abs(t.angle.front()) < 1e-9 && std::abs(t.angle.back() - kelp::pi) < 1e-6,
+             "wind table angle must run from 0 to pi");
+  for (std::size_t i = 1; i < t.angle.size(); ++i)
+    KELP_CHECK(t.angle[i] > t.angle[i - 1], "wind table angle must be strictly increasing");
+}
 
 /// \brief Wind force and yaw moment (X, Y, N) on a surface vessel, body frame [N, N, N·m]
 /// (Fossen 2021 §10.1.1):

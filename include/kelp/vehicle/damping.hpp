@@ -25,16 +25,6 @@ struct DampingParameters {
   /// d [N s²/m², N m s²]: quadratic damping magnitudes (−X_{u|u|}, −Y_{v|v|}, …, −N_{r|r|}).
   Vector6<Scalar> quadratic = Vector6<Scalar>::Zero();
 
-  /// \brief Throws kelp::invalid_argument naming `linear_damping` or `quadratic_damping` unless
-  /// the coefficients are finite, the quadratic ones ≥ 0 and ½(D_L + D_Lᵀ) is positive
-  /// semi-definite.
-  void validate() const {
-    const Matrix6<Scalar> sym = Scalar(0.5) * (linear + linear.transpose());
-    check_all_finite(linear, "linear_damping");
-    check_symmetric_definite(sym, "linear_damping", true);
-    for (int i = 0; i < 6; ++i) check_non_negative(quadratic(i), "quadratic_damping");
-  }
-
   /// \brief The same coefficients in another scalar type.
   template <typename T>
   DampingParameters<T> cast() const {
@@ -44,6 +34,17 @@ struct DampingParameters {
     return out;
   }
 };
+
+/// \brief Throws kelp::invalid_argument naming `linear_damping` or `quadratic_damping` unless
+/// the coefficients are finite, the quadratic ones ≥ 0 and ½(D_L + D_Lᵀ) is positive
+/// semi-definite.
+template <typename Scalar>
+void validate(const DampingParameters<Scalar>& d) {
+  const Matrix6<Scalar> sym = Scalar(0.5) * (d.linear + d.linear.transpose());
+  check_all_finite(d.linear, "linear_damping");
+  check_symmetric_definite(sym, "linear_damping", true);
+  for (int i = 0; i < 6; ++i) check_non_negative(d.quadratic(i), "quadratic_damping");
+}
 
 /// \brief Damping matrix D(ν_r) = D_L + diag(d ∘ |ν_r|) (Fossen 2021, §6.4:
 /// linear plus quadratic "|ν|ν" drag).

@@ -1,7 +1,14 @@
 /// \file
-/// \brief Fixed-step integrators for a VehicleState: classical RK4 and semi-implicit
-/// (symplectic) Euler. Both are allocation-free, renormalise the attitude quaternion and leave the
-/// state unchanged (throwing kelp::numerical_error) when a step produces a non-finite value.
+/// \brief Fixed-step integrators for a VehicleState: classical RK4 (`step_rk4`, `step_rk4_with`)
+/// and semi-implicit (symplectic) Euler (`step_semi_implicit_euler`); kelp names every integrator
+/// step `step_<scheme>`, as the tether's. Both are allocation-free, renormalise the attitude
+/// quaternion and leave the state unchanged (throwing kelp::numerical_error) when a step produces a
+/// non-finite value.
+///
+/// `dt` is a non-deduced parameter (`kelp::identity_t<Scalar>`): Scalar comes from the model and
+/// state, so `step_rk4(model, ws, x, 0.01, ...)` compiles for a float model too.
+/// After a step the workspace holds the terms of the step's last evaluation, not of the committed
+/// state (see `VehicleWorkspace`).
 ///
 /// The external wrench is either held constant over the step (zero-order hold: the usual coupling
 /// with a controller or a tether solved once per step) or given as a callable evaluated at every
@@ -72,7 +79,7 @@ void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& n
 /// Checks what a step takes from the caller: dt > 0, a finite state and a unit attitude (a zero or
 /// badly scaled quaternion would otherwise be silently read as some rotation by Eigen).
 template <typename Scalar>
-void check_step_input(const VehicleState<Scalar>& state, const Scalar& dt) {
+void check_step_input(const VehicleState<Scalar>& state, identity_t<Scalar> dt) {
   check_positive(dt, "dt");
   check_all_finite(state.position, "state.position");
   check_all_finite(state.nu, "state.nu");
@@ -95,8 +102,8 @@ void check_step_input(const VehicleState<Scalar>& state, const Scalar& dt) {
 /// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
 /// kelp::numerical_error on a non-finite result.
 template <typename Scalar, typename WrenchFn, typename DC>
-void rk4_step_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                   VehicleState<Scalar>& state, const Scalar& dt, WrenchFn&& wrench,
+void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                   VehicleState<Scalar>& state, identity_t<Scalar> dt, WrenchFn&& wrench,
                    const Eigen::MatrixBase<DC>& current_ned) {
   detail::check_step_input(state, dt);
   const Scalar half = Scalar(0.5) * dt;
@@ -116,7 +123,7 @@ void rk4_step_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
   k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
                         two * k3.pose.attitude_dot + k4.pose.attitude_dot;
   k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
-  detail::commit_if_finite(state, detail::advance(state, k, sixth), "rk4_step");
+  detail::commit_if_finite(state, detail::advance(state, k, sixth), "step_rk4");
 }
 
 /// \brief One RK4 step with τ and τ_env held constant over the step (zero-order hold).
@@ -126,11 +133,11 @@ void rk4_step_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
 /// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
 /// kelp::numerical_error on a non-finite result.
 template <typename Scalar, typename DT, typename DE, typename DC>
-void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-              VehicleState<Scalar>& state, const Scalar& dt, const Eigen::MatrixBase<DT>& tau,
+void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+              VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<DT>& tau,
               const Eigen::MatrixBase<DE>& tau_env, const Eigen::MatrixBase<DC>& current_ned) {
   const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_env);
-  rk4_step_with(
+  step_rk4_with(
       model, ws, state, dt,
       [&total](const VehicleState<Scalar>&, const Scalar&) -> const Vector6<Scalar>& {
         return total;
@@ -140,10 +147,10 @@ void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 
 /// \brief One RK4 step without current.
 template <typename Scalar, typename DT, typename DE>
-void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-              VehicleState<Scalar>& state, const Scalar& dt, const Eigen::MatrixBase<DT>& tau,
+void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+              VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<DT>& tau,
               const Eigen::MatrixBase<DE>& tau_env) {
-  rk4_step(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+  step_rk4(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
 }
 
 /// \brief One semi-implicit (symplectic) Euler step: ν_{k+1} = ν_k + dt ν̇(x_k), then the pose is
@@ -156,8 +163,8 @@ void rk4_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 /// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
 /// kelp::numerical_error on a non-finite result.
 template <typename Scalar, typename DT, typename DE, typename DC>
-void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                              VehicleState<Scalar>& state, const Scalar& dt,
+void step_semi_implicit_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                              VehicleState<Scalar>& state, identity_t<Scalar> dt,
                               const Eigen::MatrixBase<DT>& tau,
                               const Eigen::MatrixBase<DE>& tau_env,
                               const Eigen::MatrixBase<DC>& current_ned) {
@@ -182,16 +189,16 @@ void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspac
   }
   next.attitude = state.attitude * dq;
   renormalize(next.attitude);
-  detail::commit_if_finite(state, next, "semi_implicit_euler_step");
+  detail::commit_if_finite(state, next, "step_semi_implicit_euler");
 }
 
 /// \brief One semi-implicit Euler step without current.
 template <typename Scalar, typename DT, typename DE>
-void semi_implicit_euler_step(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                              VehicleState<Scalar>& state, const Scalar& dt,
+void step_semi_implicit_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                              VehicleState<Scalar>& state, identity_t<Scalar> dt,
                               const Eigen::MatrixBase<DT>& tau,
                               const Eigen::MatrixBase<DE>& tau_env) {
-  semi_implicit_euler_step(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+  step_semi_implicit_euler(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
 }
 
 }  // namespace kelp::vehicle

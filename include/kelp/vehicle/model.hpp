@@ -76,27 +76,6 @@ struct VehicleParameters {
   /// \brief B = ρ g ∇ [N].
   Scalar buoyancy() const { return density * gravity * displaced_volume; }
 
-  /// \brief Throws kelp::invalid_argument naming the first offending field (`mass`, `inertia`,
-  /// `r_g`, `r_b`, `displaced_volume`, `density`, `gravity`, `added_mass`, `linear_damping`,
-  /// `quadratic_damping`, `waterplane_area`, `gm_transverse`, `gm_longitudinal`).
-  void validate() const {
-    check_positive(mass, "mass");
-    check_symmetric_definite(inertia, "inertia", false);
-    check_all_finite(r_g, "r_g");
-    check_all_finite(r_b, "r_b");
-    check_non_negative(displaced_volume, "displaced_volume");
-    check_positive(density, "density");
-    check_positive(gravity, "gravity");
-    check_added_mass(added_mass);
-    damping.validate();
-    if (hydrostatics == Hydrostatics::surface) {
-      check_positive(waterplane_area, "waterplane_area");
-      check_positive(displaced_volume, "displaced_volume");
-      check_finite(gm_transverse, "gm_transverse");
-      check_finite(gm_longitudinal, "gm_longitudinal");
-    }
-  }
-
   /// \brief The same parameters in another scalar type (e.g. double → ceres::Jet).
   template <typename T>
   VehicleParameters<T> cast() const {
@@ -118,6 +97,29 @@ struct VehicleParameters {
   }
 };
 
+/// \brief Throws kelp::invalid_argument naming the first offending field of `p` (`mass`,
+/// `inertia`, `r_g`, `r_b`, `displaced_volume`, `density`, `gravity`, `added_mass`,
+/// `linear_damping`, `quadratic_damping`, `waterplane_area`, `gm_transverse`, `gm_longitudinal`).
+/// `VehicleModel`'s constructor calls it.
+template <typename Scalar>
+void validate(const VehicleParameters<Scalar>& p) {
+  check_positive(p.mass, "mass");
+  check_symmetric_definite(p.inertia, "inertia", false);
+  check_all_finite(p.r_g, "r_g");
+  check_all_finite(p.r_b, "r_b");
+  check_non_negative(p.displaced_volume, "displaced_volume");
+  check_positive(p.density, "density");
+  check_positive(p.gravity, "gravity");
+  check_added_mass(p.added_mass);
+  validate(p.damping);
+  if (p.hydrostatics == Hydrostatics::surface) {
+    check_positive(p.waterplane_area, "waterplane_area");
+    check_positive(p.displaced_volume, "displaced_volume");
+    check_finite(p.gm_transverse, "gm_transverse");
+    check_finite(p.gm_longitudinal, "gm_longitudinal");
+  }
+}
+
 /// \brief A vehicle model built once from VehicleParameters: validated parameters, M_RB, M_A
 /// (symmetrised), M = M_RB + M_A and its LDLT factorisation. Immutable after construction, so one
 /// model can be shared by many simulations (each with its own VehicleWorkspace).
@@ -128,7 +130,7 @@ class VehicleModel {
   /// \brief Validates `parameters` and factors the mass matrix.
   /// \throws kelp::invalid_argument naming the offending field.
   explicit VehicleModel(const VehicleParameters<Scalar>& parameters)
-      : parameters_((parameters.validate(), parameters)) {
+      : parameters_((validate(parameters), parameters)) {
     const Scalar h(0.5);
     rigid_body_mass_ =
         rigid_body_mass_matrix(parameters_.mass, parameters_.inertia, parameters_.r_g);
@@ -190,6 +192,17 @@ class VehicleModel {
 
 /// \brief Mutable per-simulation buffers of the forward dynamics. After each call they hold the
 /// terms of the last evaluation (useful to log loads or to couple a tether in `system/`).
+///
+/// After a step they hold the terms of the step's LAST EVALUATION, not of the committed state:
+/// - `step_rk4` / `step_rk4_with`: the fourth stage, evaluated at the predictor
+///   x₄ = x_k + dt·k₃ (with the stage-4 wrench), which differs from x_{k+1} by O(dt²);
+/// - `step_semi_implicit_euler`: the state at the START of the step, x_k.
+///
+/// The workspace is scratch and outputs only (nothing in it feeds the next step). To log the
+/// terms of the committed state, call `forward_dynamics(model, ws, state, tau, tau_env,
+/// current)` after the step: one evaluation, paid only by callers who need it (recomputing them
+/// inside every RK4 step would cost a fifth evaluation, +25 %, and for `step_rk4_with` a fifth
+/// call of the user's wrench at a time that belongs to the next step).
 /// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 struct VehicleWorkspace {

@@ -173,21 +173,22 @@ struct PwmMapping {
   Scalar max_us = Scalar(1900);
   /// Half-width of the dead band around neutral [µs]; |pwm − neutral| ≤ deadband gives 0.
   Scalar deadband_us = Scalar(25);
-
-  /// \brief Throws kelp::invalid_argument naming the field unless min < neutral < max and
-  /// 0 ≤ deadband < min(max − neutral, neutral − min).
-  void validate() const {
-    check_finite(min_us, "min_us");
-    check_finite(neutral_us, "neutral_us");
-    check_finite(max_us, "max_us");
-    check_non_negative(deadband_us, "deadband_us");
-    KELP_CHECK(value_of(min_us) < value_of(neutral_us), "min_us must be < neutral_us");
-    KELP_CHECK(value_of(neutral_us) < value_of(max_us), "max_us must be > neutral_us");
-    KELP_CHECK(value_of(deadband_us) < value_of(max_us) - value_of(neutral_us) &&
-                   value_of(deadband_us) < value_of(neutral_us) - value_of(min_us),
-               "deadband_us must be smaller than both PWM half-ranges");
-  }
 };
+
+/// \brief Throws kelp::invalid_argument naming the field unless min < neutral < max and
+/// 0 ≤ deadband < min(max − neutral, neutral − min).
+template <typename Scalar>
+void validate(const PwmMapping<Scalar>& m) {
+  check_finite(m.min_us, "min_us");
+  check_finite(m.neutral_us, "neutral_us");
+  check_finite(m.max_us, "max_us");
+  check_non_negative(m.deadband_us, "deadband_us");
+  KELP_CHECK(value_of(m.min_us) < value_of(m.neutral_us), "min_us must be < neutral_us");
+  KELP_CHECK(value_of(m.neutral_us) < value_of(m.max_us), "max_us must be > neutral_us");
+  KELP_CHECK(value_of(m.deadband_us) < value_of(m.max_us) - value_of(m.neutral_us) &&
+                 value_of(m.deadband_us) < value_of(m.neutral_us) - value_of(m.min_us),
+             "deadband_us must be smaller than both PWM half-ranges");
+}
 
 /// \brief Normalised command u ∈ [−1, 1] of a pulse width [µs]: 0 inside the dead band, else
 /// (pwm − neutral)/(max − neutral) above neutral and (pwm − neutral)/(neutral − min) below,
