@@ -2,19 +2,31 @@
 /// \brief The environment facade: one object that vehicles and tether nodes query for the water
 /// current, the wave orbital kinematics, the free-surface elevation and the wind.
 ///
+/// One water: the `Environment` is the single source of truth for the water density, gravity and
+/// air density. Models that carry their own copy (they need it inside their force laws) are
+/// checked against it where they meet it, with `check_same_water`: here for the pieces of the
+/// environment layer (`SurfaceHydrostatics`, `PaperWave`; a `WaveField`'s gravity is checked by
+/// `set_waves` / `set_gravity`), in `kelp/vehicle/water.hpp` for vehicle models. A mismatch throws
+/// `kelp::invalid_argument` naming both values. Build such a model from the environment (e.g.
+/// `h.rho = env.water_density(); h.gravity = env.gravity();`) and the check passes.
+///
 /// Frames and signs: world NED (x north, y east, z down, mean sea surface at z = 0). The surface
 /// elevation ζ is positive UP, so the free surface lies at NED z = −ζ. Units SI.
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/current.hpp"
+#include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/waves.hpp"
 #include "kelp/environment/wind.hpp"
 
@@ -213,6 +225,58 @@ class Environment {
   WaveField<Scalar> waves_;
   WindField<Scalar> wind_;
 };
+
+/// \brief Throws `kelp::invalid_argument` unless a model's water density and gravity are those of
+/// the environment (to 1e-6 relative: a single-precision copy of the same number passes).
+///
+/// The one check every "model meets environment" path uses (the vehicle and tether layers and the
+/// system layer call it, or an overload of it, when they combine a model with an environment).
+/// \param[in] density the model's water density [kg/m³] \param[in] gravity the model's g [m/s²]
+/// \param[in] env the environment (the source of truth)
+/// \param[in] who the model's name for the message (e.g. "vehicle 'BlueROV2 Heavy'")
+template <typename Scalar>
+void check_same_water(double density, double gravity, const Environment<Scalar>& env,
+                      const std::string& who) {
+  const auto differs = [](double a, double b) {
+    return !(std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)));
+  };
+  const double rho_env = value_of(env.water_density()), g_env = value_of(env.gravity());
+  if (differs(density, rho_env) || differs(gravity, g_env)) {
+    std::ostringstream msg;
+    msg.precision(9);
+    msg << who << ": water does not match the environment: ";
+    if (differs(density, rho_env))
+      msg << "density " << density << " kg/m^3 but the environment's water_density is " << rho_env
+          << " kg/m^3";
+    if (differs(density, rho_env) && differs(gravity, g_env)) msg << "; ";
+    if (differs(gravity, g_env))
+      msg << "gravity " << gravity << " m/s^2 but the environment's gravity is " << g_env
+          << " m/s^2";
+    msg << " (build the model from env.water_density() and env.gravity())";
+    ::kelp::detail::throw_invalid_argument(msg.str());
+  }
+}
+
+/// \brief Checks a surface vessel's hydrostatics (`rho`, `gravity`) against the environment.
+/// \throws kelp::invalid_argument naming both values when they differ.
+template <typename Scalar>
+void check_same_water(const SurfaceHydrostatics& h, const Environment<Scalar>& env) {
+  check_same_water(h.rho, h.gravity, env, "SurfaceHydrostatics");
+}
+
+/// \brief Checks the paper's wave-load parameters (`rho`, `gravity`) against the environment.
+/// \throws kelp::invalid_argument naming both values when they differ.
+template <typename Scalar>
+void check_same_water(const PaperWave& w, const Environment<Scalar>& env) {
+  check_same_water(w.rho, w.gravity, env, "PaperWave");
+}
+
+/// \brief Checks a wave field's gravity (its dispersion relation) against the environment (the
+/// same test `Environment::set_waves` makes). \throws kelp::invalid_argument
+template <typename Scalar>
+void check_same_water(const WaveField<Scalar>& waves, const Environment<Scalar>& env) {
+  check_same_water(value_of(env.water_density()), waves.parameters().gravity, env, "WaveField");
+}
 
 /// \brief Double-precision environment.
 using Environmentd = Environment<double>;
