@@ -108,8 +108,6 @@ TEST_CASE("the Gauss-Markov current stays within its bounds and is reproducible"
   p.direction = 1.0;
   p.speed_variation = {300.0, 0.02, 0.3, 0.7};
   p.direction_variation = {600.0, 0.01, 0.8, 1.2};
-  p.duration = 36000.0;  // 10 h
-  p.time_step = 1.0;
   p.seed = 5;
   const CurrentModel<double> a(p), b(p);
   p.seed = 6;

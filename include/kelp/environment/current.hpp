@@ -1,7 +1,7 @@
 /// \file
 /// \brief Ocean current: the paper's formula, Fossen's 3-D current vector, depth profiles
 /// (uniform, power-law, linear) and a seeded, bounded first-order Gauss–Markov variation of speed
-/// and direction.
+/// and direction that keeps varying for any run length.
 ///
 /// Frames: world NED, z down, mean sea surface at z = 0. Angles: β_c is the horizontal direction
 /// the current flows TOWARDS (NED azimuth from north, clockwise) and α_c the vertical angle of
@@ -20,6 +20,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/fast_math.hpp"
 
 namespace kelp {
 namespace environment {
@@ -89,7 +90,8 @@ Scalar profile_factor(const CurrentProfile& p, const Scalar& z) {
 
 /// \brief A first-order Gauss–Markov process x with bounds (Fossen 2021, §8.3.1:
 /// V̇_c + μ V_c = w with V_min ≤ V_c ≤ V_max), written about its nominal value x̄:
-/// \f$ \dot x = -\mu (x - \bar x) + w \f$, w white noise of intensity σ².
+/// \f$ \dot x = -\mu (x - \bar x) + w \f$, w white noise of intensity σ². Stationary: mean x̄,
+/// variance σ²/(2μ) = σ² T/2, autocorrelation e^{−|τ|/T} (T = 1/μ the time constant).
 struct GaussMarkov {
   double time_constant = 600.0;  ///< 1/μ [s] (> 0)
   double sigma = 0.0;            ///< σ [unit/√s] (≥ 0; 0 disables the variation)
@@ -105,9 +107,12 @@ struct CurrentParameters {
   CurrentProfile profile;           ///< depth profile
   GaussMarkov speed_variation;      ///< slow variation of V_c (bounds in m/s)
   GaussMarkov direction_variation;  ///< slow variation of β_c (bounds in rad, absolute)
-  double duration = 3600.0;         ///< length of the precomputed variation [s] (held after)
-  double time_step = 1.0;           ///< sampling step of the variation [s]
-  std::uint64_t seed = 1;           ///< seed of the variation (std::mt19937_64, portable)
+  /// Number N of harmonics of each variation (≥ 1); more makes it closer to Gaussian.
+  int n_harmonics = 128;
+  /// Highest angular frequency [rad/s] (> 0) the variation contains (the Lorentzian spectrum is
+  /// cut there; the default π rad/s keeps periods ≥ 2 s, far faster than any current changes).
+  double max_frequency = kelp::pi;
+  std::uint64_t seed = 1;  ///< seed of the variation (std::mt19937_64, portable)
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the bad field of `p`.
@@ -127,52 +132,45 @@ inline void validate(const CurrentParameters& p) {
                is_speed ? "speed_variation bounds must satisfy lower <= speed <= upper"
                         : "direction_variation bounds must satisfy lower <= direction <= upper");
   }
-  check_positive(p.duration, "duration");
-  check_positive(p.time_step, "time_step");
+  KELP_CHECK(p.n_harmonics >= 1, "n_harmonics must be >= 1");
+  check_positive(p.max_frequency, "max_frequency");
 }
 
 /// \brief A current evaluable at any NED point and time: nominal speed and direction, depth
 /// profile and an optional slow, bounded Gauss–Markov variation.
 ///
-/// The variation is simulated once at construction (exact discretisation of the
-/// Ornstein–Uhlenbeck process at `time_step`, clamped to the bounds after each step) and
-/// linearly interpolated in time, so queries are `const`, deterministic and allocation-free;
-/// after `duration` the last value is held. The current is treated as quasi-steady: its slow
-/// time derivative is not reported as a fluid acceleration.
-/// \tparam Scalar double, float or ceres::Jet (derivatives flow through position; the time
-/// interpolation uses the value part of t).
+/// The variation is a spectral representation of the Gauss–Markov process (Shinozuka & Deodatis
+/// 1991, "Simulation of stochastic processes by spectral representation", Appl. Mech. Rev.
+/// 44(4)): x(t) = x̄ + a Σ_k cos(ω_k t + φ_k), k = 1…N, a = √(2 σ_x²/N), σ_x² = σ²T/2, with
+/// seeded phases φ_k ~ U[0, 2π) and frequencies drawn from the process's own (Lorentzian)
+/// spectrum S(ω) ∝ 1/(μ² + ω²) by stratified inverse-CDF sampling, ω_k = μ tan(u_k atan(ω_max/μ)),
+/// u_k ∈ [k/N, (k+1)/N). Then E[x] = x̄, Var x = σ_x² and, since the Cauchy distribution's
+/// characteristic function is e^{−μ|τ|}, the autocorrelation is e^{−|τ|/T} (up to the cut at
+/// ω_max, a relative O(μ/ω_max) change); by the central limit theorem x is close to Gaussian for
+/// large N. The value is then clamped to [lower, upper].
+///
+/// This form has no state: any time can be evaluated directly (forwards, backwards, from many
+/// simulations sharing one const model), the same seed gives bit-identical values, and the
+/// random, incommensurate frequencies never repeat, so the current keeps varying for any run
+/// length. Queries are `const`, thread-safe and allocation-free (O(N) per evaluation; the phase
+/// is formed in double and reduced before the cosine). The current is treated as quasi-steady:
+/// its slow time derivative is not reported as a fluid acceleration.
+/// \tparam Scalar double, float or ceres::Jet (derivatives flow through position; time is a
+/// double).
 template <typename Scalar>
 class CurrentModel {
  public:
   /// \brief No current.
   CurrentModel() = default;
 
-  /// \brief Builds the current (and its variation record). \throws kelp::invalid_argument
+  /// \brief Builds the current and draws its harmonics. \throws kelp::invalid_argument
   explicit CurrentModel(const CurrentParameters& p) : params_(p) {
     validate(p);
     varying_ = p.speed_variation.sigma > 0.0 || p.direction_variation.sigma > 0.0;
     if (!varying_) return;
-    const auto n = static_cast<std::size_t>(std::ceil(p.duration / p.time_step)) + 1;
-    speed_.resize(n);
-    direction_.resize(n);
     std::mt19937_64 rng(p.seed);
-    auto uniform = [&rng]() { return (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53; };
-    auto normal = [&uniform]() {  // Box–Muller: portable, unlike std::normal_distribution
-      return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * kelp::pi * uniform());
-    };
-    auto step = [&](const GaussMarkov& g, double nominal, double x) {
-      const double mu = 1.0 / g.time_constant;
-      const double decay = std::exp(-mu * p.time_step);
-      const double sd = g.sigma * std::sqrt((1.0 - decay * decay) / (2.0 * mu));
-      x = nominal + (x - nominal) * decay + sd * normal();
-      return std::min(std::max(x, g.lower), g.upper);
-    };
-    speed_[0] = p.speed;
-    direction_[0] = p.direction;
-    for (std::size_t i = 1; i < n; ++i) {
-      speed_[i] = step(p.speed_variation, p.speed, speed_[i - 1]);
-      direction_[i] = step(p.direction_variation, p.direction, direction_[i - 1]);
-    }
+    draw(p.speed_variation, rng, speed_);
+    draw(p.direction_variation, rng, direction_);
   }
 
   /// \brief A constant current of the given NED velocity [m/s], uniform in depth.
@@ -197,11 +195,14 @@ class CurrentModel {
   /// \brief True when the current is zero everywhere and always.
   bool is_zero() const { return params_.speed == 0.0 && !varying_; }
 
-  /// \brief Surface speed V_c(t) [m/s].
-  double speed_at(double t) const { return varying_ ? interpolate(speed_, t) : params_.speed; }
-  /// \brief Direction β_c(t) [rad].
+  /// \brief Surface speed V_c(t) [m/s] at time t [s].
+  double speed_at(double t) const {
+    return varying_ ? speed_.value(t, params_.speed, params_.speed_variation) : params_.speed;
+  }
+  /// \brief Direction β_c(t) [rad] at time t [s].
   double direction_at(double t) const {
-    return varying_ ? interpolate(direction_, t) : params_.direction;
+    return varying_ ? direction_.value(t, params_.direction, params_.direction_variation)
+                    : params_.direction;
   }
   /// \brief Current velocity at the surface, NED [m/s], at time t [s].
   Vector3<Scalar> surface_velocity(double t) const {
@@ -216,18 +217,43 @@ class CurrentModel {
   }
 
  private:
-  double interpolate(const std::vector<double>& v, double t) const {
-    if (!(t > 0.0)) return v.front();
-    const double s = t / params_.time_step;
-    const auto i = static_cast<std::size_t>(s);
-    if (i + 1 >= v.size()) return v.back();
-    const double f = s - static_cast<double>(i);
-    return v[i] + f * (v[i + 1] - v[i]);
+  /// The harmonics of one variation.
+  struct Harmonics {
+    std::vector<double> omega, phase;  ///< ω_k [rad/s], φ_k [rad]
+    double amplitude = 0.0;            ///< a = √(2 σ_x² / N)
+    /// x̄ + a Σ cos(ω_k t + φ_k), clamped to the bounds (x̄ when there are no harmonics).
+    double value(double t, double nominal, const GaussMarkov& g) const {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < omega.size(); ++k) {
+        double s, c;
+        detail::fast_sincos(detail::wrap_two_pi(omega[k] * t + phase[k]), s, c);
+        sum += c;
+      }
+      const double x = nominal + amplitude * sum;
+      return std::min(std::max(x, g.lower), g.upper);
+    }
+  };
+
+  void draw(const GaussMarkov& g, std::mt19937_64& rng, Harmonics& h) const {
+    if (g.sigma == 0.0) return;
+    const auto n = static_cast<std::size_t>(params_.n_harmonics);
+    auto uniform = [&rng]() { return (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53; };
+    const double mu = 1.0 / g.time_constant;
+    const double variance = 0.5 * g.sigma * g.sigma * g.time_constant;
+    const double span = std::atan(params_.max_frequency / mu);
+    h.omega.resize(n);
+    h.phase.resize(n);
+    h.amplitude = std::sqrt(2.0 * variance / static_cast<double>(n));
+    for (std::size_t k = 0; k < n; ++k) {
+      const double u = (static_cast<double>(k) + uniform()) / static_cast<double>(n);
+      h.omega[k] = mu * std::tan(u * span);
+      h.phase[k] = 2.0 * kelp::pi * uniform();
+    }
   }
 
   CurrentParameters params_;
   bool varying_ = false;
-  std::vector<double> speed_, direction_;
+  Harmonics speed_, direction_;
 };
 
 /// \brief Double-precision current model.
