@@ -29,7 +29,7 @@ TEST_CASE("Ceres path: ::ceres is not shadowed inside namespace kelp", "[catenar
       ::ceres::Jet<double, 2>(std::numeric_limits<double>::quiet_NaN(), 0)));
 }
 
-TEST_CASE("Ceres path: reference case of tether.md", "[catenary][ceres]") {
+TEST_CASE("Ceres path: reference case D = 10 m, dz = 5 m, L = 20 m", "[catenary][ceres]") {
   const auto r = kc::solve_catenary(10.0, 5.0, 20.0);
   REQUIRE(r.status == CatenaryStatus::converged);
   CHECK(r.a == Approx(2.358583).epsilon(5e-7));

@@ -2,7 +2,8 @@
 /// \brief Sea-state presets `calm`, `moderate` and `rough` from the paper's evaluation, and a
 /// builder that turns a sea state into an `Environment`.
 ///
-/// The paper's table (see reference/vehicles.md) gives "wave height" 3 and 4.5 (written with the
+/// The paper's evaluation table (Buchholz et al., "Tethered Multi-Robot Systems in Marine
+/// Environments", Heriot-Watt University) gives "wave height" 3 and 4.5 (written with the
 /// unit m/s), wind 3 and 4.5 m/s and current 0.5 and 1.0 m/s. kelp reads the wave height as the
 /// SIGNIFICANT wave height Hs [m]. The paper gives no period; kelp picks Tp = 4.5 √Hs (Tp in s,
 /// Hs in m), inside the range 3.6 √Hs ≤ Tp ≤ 5 √Hs where DNV-RP-C205 (2010) §3.5.5.5 recommends

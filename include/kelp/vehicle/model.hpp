@@ -2,7 +2,8 @@
 /// \brief Fossen 6-DOF vehicle model: parameters, the model built from them once (mass matrix and
 /// its LDLT factorisation) and the allocation-free forward dynamics.
 ///
-/// Equation of motion with an irrotational ocean current (Fossen 2021, §10.3; DESIGN.md):
+/// Equation of motion with an irrotational ocean current (Fossen 2021, Handbook of Marine
+/// Craft Hydrodynamics and Motion Control, 2nd ed., §10.3):
 /// \f[ M_{RB}\dot\nu + C_{RB}(\nu)\nu + M_A\dot\nu_r + C_A(\nu_r)\nu_r + D(\nu_r)\nu_r + g(\eta)
 ///     = \tau + \tau_{env}, \f]
 /// with ν_r = ν − ν_c, ν_c = (Rᵀ v_c^n, 0) and, for a current constant in NED,

@@ -42,17 +42,17 @@ struct VehiclePreset {
 /// kelp defaults to seawater (ρ = 1025, g = 9.80665: B − W = 2.3 N, slightly buoyant, as a
 /// trimmed ROV is). Pass the paper's values to reproduce it.
 ///
-/// Thrusters (8 × T200), in ArduSub's vectored_6dof motor order (AP_Motors6DOF.cpp,
-/// sitl.md §1.7): 1 front-right, 2 front-left, 3 rear-right, 4 rear-left (horizontal, vectored
-/// 45°), 5 front-right, 6 front-left, 7 rear-right, 8 rear-left (vertical). Positions from von
-/// Benzon 2022: horizontals at (±0.156, ±0.111, 0.085) m, verticals at (±0.12, ±0.218, 0) m (the
-/// paper writes them as Rz(α) of the front-right one; the mirrored values are used exactly).
-/// Directions are the thrust of a *positive* ArduSub output, derived from the motor factor signs
-/// (forward/lateral/throttle and yaw/roll/pitch): e.g. motor 1 has forward −1, lateral +1, so its
-/// positive thrust points aft-starboard, (−1, 1, 0)/√2; vertical thrusters push down (+z) for
-/// PWM > 1500. They are the opposite of von Benzon's drawn directions, which is the same as
-/// flipping the sign of an odd thrust curve.
-/// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
+/// Thrusters (8 × T200), in ArduSub's vectored_6dof motor order (ArduPilot
+/// libraries/AP_Motors/AP_Motors6DOF.cpp): 1 front-right, 2 front-left, 3 rear-right, 4 rear-left
+/// (horizontal, vectored 45°), 5 front-right, 6 front-left, 7 rear-right, 8 rear-left (vertical).
+/// Positions from von Benzon 2022: horizontals at (±0.156, ±0.111, 0.085) m, verticals at (±0.12,
+/// ±0.218, 0) m (the paper writes them as Rz(α) of the front-right one; the mirrored values are
+/// used exactly). Directions are the thrust of a *positive* ArduSub output, derived from the motor
+/// factor signs (forward/lateral/throttle and yaw/roll/pitch): e.g. motor 1 has forward −1, lateral
+/// +1, so its positive thrust points aft-starboard, (−1, 1, 0)/√2; vertical thrusters push down
+/// (+z) for PWM > 1500. They are the opposite of von Benzon's drawn directions, which is the same
+/// as flipping the sign of an odd thrust curve. \param[in] density ρ [kg/m³]. \param[in] gravity g
+/// [m/s²].
 template <typename Scalar>
 VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_density),
                                      const Scalar& gravity = Scalar(standard_gravity)) {
@@ -91,7 +91,9 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 
 /// \brief BlueBoat (Blue Robotics ASV), 6-DOF with surface hydrostatics.
 ///
-/// Few parameters are published (vehicles.md); the preset states each choice:
+/// Few parameters are published (Blue Robotics product data; Buchholz et al., "Tethered
+/// Multi-Robot Systems in Marine Environments", and its simulation framework); the preset states
+/// each choice:
 /// - m = 15 kg (Blue Robotics product data: 14–15 kg without payload).
 /// - Inertia about the CG diag(1.21, 1.96, 2.82) kg m²: assumed, the paper framework's Gazebo
 ///   model (m 30 kg, 2.42/3.92/5.64) scaled by the mass ratio 15/30.
@@ -101,7 +103,7 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   draft ∇/A_wp ≈ 7.7 cm. Metacentric heights (assumed, hull geometry): GM_T ≈ 2.0 m (hulls
 ///   ≈ ±0.4 m apart give BM_T = I_T/∇ ≈ 2.1 m), GM_L ≈ 1.3 m.
 /// - Added mass: surge 2.25 kg, sway 23.13 kg, yaw 2.79 kg m² (Heron-class 3-DOF model of the
-///   paper's framework, vehicles.md; the unsymmetric sway–yaw coupling is dropped); heave 15 kg
+///   paper's framework; the unsymmetric sway–yaw coupling is dropped); heave 15 kg
 ///   (assumed ≈ m), roll 0.12, pitch 0.2 kg m² (assumed ≈ 10 % of the inertia).
 /// - Damping: surge linear 5 N s/m, quadratic 5 N s²/m² (assumed, chosen so that two T200 at
 ///   full command, 2 × 30.4 N = 60.8 N, give a top speed 5u + 5u² = 60.8 ⇒ u ≈ 3.0 m/s, the Blue
@@ -109,7 +111,8 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   100, roll 8, pitch 8 (assumed, ≈ 0.2 of critical damping), quadratic heave 50, roll 2,
 ///   pitch 2 (assumed); yaw linear 10 (assumed) and quadratic 3.49 (Heron model).
 /// - Thrusters: 2 × T200, left (port) first then right, as ArduRover's skid steering outputs
-///   ThrottleLeft (SERVO1) and ThrottleRight (SERVO3) (sitl.md §1.6). Positions (−0.488, ∓0.295)
+///   ThrottleLeft (SERVO1) and ThrottleRight (SERVO3) (ArduPilot
+///   Tools/autotest/default_params/rover-skid.parm). Positions (−0.488, ∓0.295)
 ///   m from the paper framework's Gazebo model (converted from its y-left axes); depth 0.10 m
 ///   below the waterline (assumed). Directions +x. PWM 1000–1500–2000 µs (rover.parm SERVO
 ///   limits) with the ±25 µs dead band.

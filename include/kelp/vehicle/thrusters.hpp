@@ -160,7 +160,8 @@ Scalar t200_command(const Scalar& force) {
 
 /// \brief PWM pulse-width ↔ normalised command mapping of a bidirectional ESC.
 ///
-/// Defaults: 1100–1500–1900 µs (ArduSub `MOT_PWM_MIN`/`MOT_PWM_MAX`, sitl.md §1.7) and a ±25 µs
+/// Defaults: 1100–1500–1900 µs (ArduSub `MOT_PWM_MIN`/`MOT_PWM_MAX`, ArduPilot
+/// Tools/autotest/default_params/sub-6dof.parm) and a ±25 µs
 /// deadband around neutral (1475…1525 µs, ArduPilot's SITL submarine, SIM_Submarine.cpp).
 /// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
@@ -207,7 +208,8 @@ Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmM
 
 /// \brief Pulse width [µs] for a normalised command u (clamped to [−1, 1]):
 /// neutral + u (max − neutral) for u > 0, neutral + u (neutral − min) otherwise (ArduSub's
-/// `AP_Motors6DOF::calc_thrust_to_pwm`, sitl.md §1.7). The dead band is not skipped.
+/// `AP_Motors6DOF::calc_thrust_to_pwm`, ArduPilot libraries/AP_Motors/AP_Motors6DOF.cpp). The dead
+/// band is not skipped.
 template <typename Scalar>
 Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
   check_finite(u_in, "thruster command u");
