@@ -21,3 +21,4 @@
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/state.hpp"
 #include "kelp/vehicle/thrusters.hpp"
+#include "kelp/vehicle/water.hpp"

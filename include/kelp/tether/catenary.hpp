@@ -10,7 +10,7 @@
 /// Subtracting the squares gives \f$ \sqrt{L^2 - \Delta z^2} = 2a\sinh(D/(2a)) \f$ and dividing
 /// them \f$ \Delta z / L = \tanh((D-2c)/(2a)) \f$, so with \f$ u = D/(2a) \f$ the problem is the
 /// 1-D equation \f$ \sinh(u)/u = \sqrt{L^2-\Delta z^2}/D \f$ and
-/// \f$ c = D/2 - a\,\mathrm{atanh}(\Delta z/L) \f$ (see `reference/tether.md`).
+/// \f$ c = D/2 - a\,\mathrm{atanh}(\Delta z/L) \f$ (derivation in docs/equations.md).
 ///
 /// **How it is solved.** The 1-D equation is solved in its logarithmic form
 /// \f$ h(u) = \ln(\sinh(u)/u) = \lambda \f$, which never overflows and keeps full relative
@@ -67,8 +67,9 @@ inline const char* to_string(CatenaryStatus status) {
   return "unknown";
 }
 
-/// \brief Controls of the catenary solvers (the fast path here and `kelp::ceres::solve_catenary`).
-/// \tparam Scalar double, float or `ceres::Jet` (EA may carry derivative parts).
+/// \brief Controls of the catenary solvers (the fast path here and
+/// `kelp::ceres_solver::solve_catenary`). \tparam Scalar double, float or `ceres::Jet` (EA may
+/// carry derivative parts).
 template <typename Scalar>
 struct CatenaryOptions {
   /// Target relative accuracy of u = D/(2a) (dimensionless): the 1-D solve stops after a step δ
@@ -467,9 +468,9 @@ inline GroundedSolution solve_grounded(double D, double L, double h1, double h2,
 ///
 /// Solves \f$ a[\cosh((D-c)/a) - \cosh(c/a)] = \Delta z \f$ and
 /// \f$ a[\sinh((D-c)/a) + \sinh(c/a)] = L \f$ through \f$ \sqrt{L^2-\Delta z^2} = 2a\sinh(D/(2a))
-/// \f$ and \f$ c = D/2 - a\,\mathrm{atanh}(\Delta z/L) \f$ (paper; `reference/tether.md`).
-/// Never throws and never allocates.
-/// \tparam Scalar double, float or `ceres::Jet<double, N>` (derivatives of a, c with respect to
+/// \f$ and \f$ c = D/2 - a\,\mathrm{atanh}(\Delta z/L) \f$ (paper; derivation in
+/// docs/equations.md). Never throws and never allocates. \tparam Scalar double, float or
+/// `ceres::Jet<double, N>` (derivatives of a, c with respect to
 ///   D, Δz and L by the implicit function theorem).
 /// \param[in] D horizontal distance between the ends [m], ≥ 0.
 /// \param[in] dz height of the end above the start, z_end − z_start with z up [m].
