@@ -1,4 +1,4 @@
-// Lumped-mass tether benchmarks on the benchmark line of shared/reference/tether.md (20 m,
+// Lumped-mass tether benchmarks on kelp's benchmark line (TetherParameters defaults: 20 m,
 // d 8 mm, 0.07 kg/m, EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1, no internal damping), ends 10 m apart
 // horizontally and 5 m vertically in still seawater, started from static equilibrium with the
 // far (AUV) end heaving 0.1 m at 0.2 Hz so that every step works on a moving line.
@@ -14,6 +14,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
@@ -33,7 +34,8 @@ struct Setup {
   Vector3<double> a{0, 0, 0}, b{10, 0, 5};
 
   explicit Setup(int n) : model(params(n)), ws(model) {
-    kt::static_initial_state(model, ws, env, a, b, state);
+    if (!kt::static_initial_state(model, ws, env, a, b, state).converged)
+      throw std::runtime_error("bench_tether: static equilibrium did not converge");
   }
   static kt::TetherParametersd params(int n) {
     kt::TetherParametersd p;

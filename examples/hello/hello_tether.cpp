@@ -15,8 +15,8 @@ int main() {
   const kt::TetherModeld tether(p);
   kt::TetherWorkspaced ws(tether);
   const kelp::Vector3<double> asv(0, 0, 0), auv(10, 0, 5);  // NED [m]
-  kt::TetherStated s;
-  kt::static_initial_state(tether, ws, sea, asv, auv, s);  // catenary, then static equilibrium
+  kt::TetherStated s;                                       // catenary, then static equilibrium:
+  if (!kt::static_initial_state(tether, ws, sea, asv, auv, s).converged) return 1;
   auto ends = kt::TetherBoundaryd::fixed(asv, auv);
   ends.end.velocity = {0.5, 0, 0};
   for (int k = 0; k < 1000; ++k) {  // 10 s at 10 ms

@@ -85,7 +85,7 @@ TEST_CASE("tether between two vehicles: loads balance the line and follow the ve
   // submerged weight of the line; the horizontal ones are equal and opposite (H).
   const auto loads = ks::advance_attached_tether(model, ws, env, state, asv, r_asv, auv, r_auv, 0.1,
                                                  0.01, kt::Integrator::bdf2);
-  CHECK(loads.substeps == 10);
+  CHECK(loads.report.substeps == 10);
   const double w = model.submerged_weight_per_length(env.water_density(), env.gravity());
   CHECK(loads.force_start_ned.z() + loads.force_end_ned.z() == Approx(w * p.length).epsilon(1e-4));
   CHECK(loads.force_start_ned.x() == Approx(-loads.force_end_ned.x()).epsilon(1e-4));

@@ -42,13 +42,22 @@ template struct kt::StaticResult<float>;
 TEST_CASE("bad tether parameters throw invalid_argument naming the field", "[tether][errors]") {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto p = kelp_test::benchmark_line<double>(10);
+  // The free validate() (the library's one validation style) and the model's constructor agree.
   const auto expect = [](kt::TetherParametersd q, const char* field) {
     CHECK_THROWS_AS(kt::TetherModeld(q), kelp::invalid_argument);
     CHECK_THROWS_WITH(kt::TetherModeld(q), Catch::Contains(field));
+    CHECK_THROWS_WITH(kt::validate(q), Catch::Contains(field));
   };
+  CHECK_NOTHROW(kt::validate(p));
   auto q = p;
   q.segments = 0;
   expect(q, "segments");
+  q = p;
+  q.seabed_damping_depth = -1e-3;
+  expect(q, "seabed_damping_depth");
+  q = p;
+  q.end_mode = static_cast<kt::EndMode>(7);
+  expect(q, "end_mode");
   q = p;
   q.length = 0;
   expect(q, "length");
@@ -108,7 +117,7 @@ TEST_CASE("node masses, volumes and lumped lengths", "[tether][model]") {
   double total_volume = 0;
   for (int i = 0; i < 5; ++i) total_volume += m.node_volume(i);
   CHECK(total_volume == Approx(kelp::pi * 0.008 * 0.008 / 4 * 20));
-  // w = (μ − ρA) g: tether.md gives 0.181268 N/m with g = 9.81.
+  // w = (μ − ρA) g = 0.181268 N/m with g = 9.81 (docs/equations.md).
   CHECK(m.submerged_weight_per_length(1025.0, 9.81) == Approx(0.181268).epsilon(1e-5));
   CHECK(m.first_free_node() == 1);
   CHECK(m.last_free_node() == 3);
@@ -139,22 +148,49 @@ TEST_CASE(
   CHECK(ws.tension(0) == 0.0);
   CHECK(ws.force.norm() == 0.0);
 
-  // With internal damping BA = 50 N s the dashpot adds BA·ε̇ at any length (as MoorDyn's Td).
+  // With internal damping BA = 50 N s the dashpot adds BA·ε̇ at any length, and the total is
+  // clamped at zero: a cable never pushes.
   p.internal_damping = 50.0;
   const kt::TetherModeld md(p);
   x.col(1) = 2.001 * u;
   v.col(1) = 0.2 * u;  // separating at 0.2 m/s: ε̇ = 0.1 1/s → +5 N
   kt::compute_forces(md, ws, env, 0.0, x, v);
   CHECK(ws.tension(0) == Approx(55.0).epsilon(1e-9));
-  // Slack and closing at 0.4 m/s: the dashpot alone resists, −10 N, the elastic part is zero.
+  // Taut but closing fast (ε̇ = −1.5 1/s → −75 N): 50 − 75 < 0, clamped to zero.
+  v.col(1) = -3.0 * u;
+  kt::compute_forces(md, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == 0.0);
+  CHECK(ws.force.norm() == 0.0);
+  // Taut and closing slowly (−25 N): 25 N remain.
+  v.col(1) = -1.0 * u;
+  kt::compute_forces(md, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(25.0).epsilon(1e-9));
+  // Slack and separating at 0.4 m/s: the dashpot alone pulls, +10 N.
   x.col(1) = 1.5 * u;
+  v.col(1) = 0.4 * u;
+  kt::compute_forces(md, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(10.0).epsilon(1e-9));
+  // Slack and closing at 0.4 m/s: the dashpot would push (−10 N); clamped to zero.
   v.col(1) = -0.4 * u;
   kt::compute_forces(md, ws, env, 0.0, x, v);
-  CHECK(ws.tension(0) == Approx(-10.0).epsilon(1e-9));
+  CHECK(ws.tension(0) == 0.0);
+  CHECK(ws.force.norm() == 0.0);
   // Slack and at rest: nothing.
   v.col(1).setZero();
   kt::compute_forces(md, ws, env, 0.0, x, v);
   CHECK(ws.tension(0) == 0.0);
+
+  // compressive_damping (MoorDyn's Line.cpp): the dashpot acts in compression, unclamped.
+  p.compressive_damping = true;
+  const kt::TetherModeld mm(p);
+  v.col(1) = -0.4 * u;
+  kt::compute_forces(mm, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(-10.0).epsilon(1e-9));
+  CHECK((ws.force.col(1) - 10.0 * u).norm() < 1e-9);  // pushes the far node away
+  x.col(1) = 2.001 * u;
+  v.col(1) = -3.0 * u;
+  kt::compute_forces(mm, ws, env, 0.0, x, v);
+  CHECK(ws.tension(0) == Approx(-25.0).epsilon(1e-9));
 }
 
 TEST_CASE("weight, buoyancy, drag and fluid inertia on a node", "[tether][forces]") {
@@ -441,7 +477,7 @@ TEST_CASE("stable-dt estimate follows the axial frequency 2 sqrt(EA/(l m))", "[t
   CHECK(kt::estimate_stable_dt(model, kt::Integrator::rk4, 1025.0, 1.0) ==
         Approx(2 * std::sqrt(2.0) / w));
   CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2)));
-  // tether.md: explicit schemes need dt ≲ 0.1 ms on this line.
+  // Explicit schemes need dt ≲ 0.1 ms on this line.
   CHECK(kt::estimate_stable_dt(model, kt::Integrator::rk4) < 2e-4);
   // Internal damping shrinks it by √(1 + ζ²) − ζ, ζ = (4 BA/l)/(2 m ω): BA = 100 N s → ζ ≈ 5.98.
   auto pd = kelp_test::benchmark_line<double>(100);
@@ -648,14 +684,14 @@ TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is
     o.max_iterations = 0;
     expect(o, "max_iterations");
     o = {};
-    o.velocity_tolerance = 0.0;
-    expect(o, "velocity_tolerance");
-    o.velocity_tolerance = -1e-6;
-    expect(o, "velocity_tolerance");
-    o.velocity_tolerance = nan;
-    expect(o, "velocity_tolerance");
-    o.velocity_tolerance = inf;
-    expect(o, "velocity_tolerance");
+    o.acceleration_tolerance = 0.0;
+    expect(o, "acceleration_tolerance");
+    o.acceleration_tolerance = -1e-6;
+    expect(o, "acceleration_tolerance");
+    o.acceleration_tolerance = nan;
+    expect(o, "acceleration_tolerance");
+    o.acceleration_tolerance = inf;
+    expect(o, "acceleration_tolerance");
     o = {};
     o.slack_band = -0.1;
     expect(o, "slack_band");
@@ -667,6 +703,9 @@ TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is
     o = {};
     o.max_backtracks = -1;
     expect(o, "max_backtracks");
+    o = {};
+    o.max_step_halvings = -1;
+    expect(o, "max_step_halvings");
   }
 
   SECTION("non-finite state") {

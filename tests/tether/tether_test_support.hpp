@@ -19,8 +19,8 @@ struct Vacuum {
   Scalar water_density() const { return Scalar(0); }
   Scalar gravity() const { return g; }
   Scalar seabed_depth() const { return Scalar(std::numeric_limits<double>::infinity()); }
-  Scalar surface_elevation(Scalar, Scalar, Scalar) const { return Scalar(0); }
-  void sample_water(const Eigen::Ref<const kelp::Matrix3X<Scalar>>&, Scalar,
+  Scalar surface_elevation(Scalar, Scalar, double) const { return Scalar(0); }
+  void sample_water(const Eigen::Ref<const kelp::Matrix3X<Scalar>>&, double,
                     Eigen::Ref<kelp::Matrix3X<Scalar>> velocity,
                     Eigen::Ref<kelp::Matrix3X<Scalar>> acceleration) const {
     velocity.setZero();
@@ -41,8 +41,8 @@ struct TestWater {
   Scalar water_density() const { return rho; }
   Scalar gravity() const { return g; }
   Scalar seabed_depth() const { return bed; }
-  Scalar surface_elevation(Scalar, Scalar, Scalar) const { return -surface_z; }
-  void sample_water(const Eigen::Ref<const kelp::Matrix3X<Scalar>>& points, Scalar,
+  Scalar surface_elevation(Scalar, Scalar, double) const { return -surface_z; }
+  void sample_water(const Eigen::Ref<const kelp::Matrix3X<Scalar>>& points, double,
                     Eigen::Ref<kelp::Matrix3X<Scalar>> velocity,
                     Eigen::Ref<kelp::Matrix3X<Scalar>> acceleration) const {
     for (Eigen::Index i = 0; i < points.cols(); ++i) {

@@ -1,7 +1,7 @@
 /// \file
 /// \brief Attaching the ends of a lumped-mass tether to points on vehicles: the end motion from a
 /// vehicle state, and the tether force turned into a body-frame wrench the vehicle dynamics can
-/// take. `vehicle` and `tether` do not include each other; they meet here (DESIGN.md).
+/// take. `vehicle` and `tether` do not include each other; they meet here, in `system/`.
 ///
 /// Frames: world NED; body x forward, y starboard, z down. A point r_b fixed in the body moves
 /// with p = p_CO + R r_b, ṗ = R (v + ω × r_b) (Fossen 2021, eq. 2.106 form).
@@ -68,15 +68,16 @@ struct TetherLoads {
   Vector6<Scalar> tau_start = Vector6<Scalar>::Zero();
   /// Generalized force on the far vehicle, body frame (N, N m).
   Vector6<Scalar> tau_end = Vector6<Scalar>::Zero();
-  /// Sub-steps taken.
-  int substeps = 0;
+  /// What the tether integration did: committed sub-steps, Newton iterations, worst residual,
+  /// retries (see tether::StepReport).
+  tether::StepReport<Scalar> report;
 };
 
 /// \brief Advances the tether by `dt` [s] (in sub-steps no longer than `max_dt`) with its ends
 /// attached to `r_start_body` on `start` and `r_end_body` on `end` (the vehicles are taken to
 /// move with their current velocities through the interval), and returns the loads on both
-/// vehicles from the last sub-step, ready to be added to their τ. The tether model's ends must be
-/// `kinematic`. No heap allocation.
+/// vehicles from the last sub-step, ready to be added to their τ, with the integration's report.
+/// The tether model's ends must be `kinematic`. No heap allocation.
 /// \throws kelp::invalid_argument for bad input or free tether ends; kelp::numerical_error (tether
 /// state unchanged) when a sub-step fails.
 template <typename Scalar, typename Env, typename D1, typename D2>
@@ -84,7 +85,7 @@ TetherLoads<Scalar> advance_attached_tether(
     const tether::TetherModel<Scalar>& model, tether::TetherWorkspace<Scalar>& ws, const Env& env,
     tether::TetherState<Scalar>& state, const vehicle::VehicleState<Scalar>& start,
     const Eigen::MatrixBase<D1>& r_start_body, const vehicle::VehicleState<Scalar>& end,
-    const Eigen::MatrixBase<D2>& r_end_body, Scalar dt, Scalar max_dt,
+    const Eigen::MatrixBase<D2>& r_end_body, double dt, double max_dt,
     tether::Integrator integrator, const tether::ImplicitOptions<Scalar>& options = {}) {
   KELP_CHECK(model.parameters().start_mode == tether::EndMode::kinematic &&
                  model.parameters().end_mode == tether::EndMode::kinematic,
@@ -93,7 +94,7 @@ TetherLoads<Scalar> advance_attached_tether(
   check_all_finite(r_end_body, "r_end_body");
   const tether::TetherBoundary<Scalar> b = tether_boundary(start, r_start_body, end, r_end_body);
   TetherLoads<Scalar> loads;
-  loads.substeps = tether::advance(model, ws, env, state, b, dt, max_dt, integrator, options);
+  loads.report = tether::advance(model, ws, env, state, b, dt, max_dt, integrator, options);
   loads.force_start_ned = ws.end_forces.on_start;
   loads.force_end_ned = ws.end_forces.on_end;
   loads.tau_start = attachment_wrench(start, r_start_body, loads.force_start_ned);

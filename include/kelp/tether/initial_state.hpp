@@ -58,15 +58,15 @@ TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, con
 }
 
 /// \brief Catenary initial state refined by `solve_static_equilibrium` with both ends fixed at
-/// `start_ned`, `end_ned` (free ends of the model stay free). Returns the solve's result; the
-/// state is written to `state`.
+/// `start_ned`, `end_ned` (free ends of the model stay free). Returns the solve's result (check
+/// `converged`); the state is written to `state`.
 template <typename Scalar, typename Env>
-StaticResult<Scalar> static_initial_state(const TetherModel<Scalar>& model,
-                                          TetherWorkspace<Scalar>& ws, const Env& env,
-                                          const Vector3<Scalar>& start_ned,
-                                          const Vector3<Scalar>& end_ned,
-                                          TetherState<Scalar>& state,
-                                          const StaticOptions<Scalar>& options = {}) {
+[[nodiscard]] StaticResult<Scalar> static_initial_state(const TetherModel<Scalar>& model,
+                                                        TetherWorkspace<Scalar>& ws, const Env& env,
+                                                        const Vector3<Scalar>& start_ned,
+                                                        const Vector3<Scalar>& end_ned,
+                                                        TetherState<Scalar>& state,
+                                                        const StaticOptions<Scalar>& options = {}) {
   state = catenary_initial_state(model, env, start_ned, end_ned);
   return solve_static_equilibrium(model, ws, env, state,
                                   TetherBoundary<Scalar>::fixed(start_ned, end_ned), options);

@@ -8,13 +8,17 @@
 /// report the end forces at the start of the step, implicit ones at its end.
 ///
 /// Every step works in preallocated workspace buffers (no heap allocation) and commits the new
-/// state only when it is finite: a failed step throws `kelp::numerical_error` and leaves the state
-/// as it was.
+/// state only when it is finite and, for the implicit schemes, when Newton's method met its
+/// tolerance: an implicit step that does not converge is retried in sub-steps (halving up to
+/// `ImplicitOptions::max_step_halvings` times), and a step that cannot be completed throws
+/// `kelp::numerical_error` and leaves the state as it was. Time steps and the clock are doubles
+/// for every Scalar; the integrator history (BDF2) lives in the TetherState.
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -61,14 +65,19 @@ template <typename Scalar>
 struct ImplicitOptions {
   /// Maximum Newton corrections per step (each: one Jacobian factorisation and solve).
   int max_iterations = 8;
-  /// Convergence when max_i |R_i| / a_i ≤ this [m/s], R_i the momentum residual of node i and
-  /// a_i its isotropic mass (an error ΔF in the node force shows up as γh ΔF / a_i). Default
-  /// 1.5e-6 m/s in double; 1e-3 m/s in single precision, whose rounding of ~10 m coordinates
-  /// already costs EA/l · 6e-7 m of tension (use a softer line or double for stiff tethers).
-  Scalar velocity_tolerance =
-      Scalar(std::numeric_limits<Scalar>::epsilon() > Scalar(1e-10) ? 1e-3 : 1.5e-6);
+  /// Newton converges when max_i |R_i| / a_i ≤ acceleration_tolerance · dt, R_i the momentum
+  /// residual of node i and a_i its isotropic mass: an error ΔF in the node force shows up as
+  /// γ dt ΔF / a_i, so this bounds the node forces' error per unit mass [m/s²] whatever the step,
+  /// and a smaller dt is never less accurate (a fixed velocity tolerance would let the error
+  /// grow as dt shrinks). At least one Newton correction is always made, so the velocity
+  /// predictor alone never makes a step. Default 1.5e-4 m/s² in double (1.5e-6 m/s at 10 ms, node
+  /// forces to ~3e-6 N on the benchmark line); 0.1 m/s² in single precision, whose rounding of
+  /// ~10 m coordinates already costs EA/l · 6e-7 m of tension (use a softer line or double for
+  /// stiff tethers).
+  Scalar acceleration_tolerance =
+      Scalar(std::numeric_limits<Scalar>::epsilon() > Scalar(1e-10) ? 0.1 : 1.5e-4);
   /// Segments at least (1 − band)·l long start each Newton iteration's active set in the taut
-  /// branch (see detail::active_set_direction); 0 starts from the stretched segments.
+  /// branch (see detail::active_set_direction); 0 starts from the branches at the current point.
   Scalar slack_band = Scalar(0);
   /// Maximum active-set passes (block-tridiagonal solves, no force evaluation) per Newton
   /// iteration; 1 is plain Newton on the current branch.
@@ -81,20 +90,40 @@ struct ImplicitOptions {
   /// Maximum line-search corrections (secant steps, each one force evaluation) per Newton
   /// iteration; 0 always takes the full Newton step.
   int max_backtracks = 6;
+  /// A step whose Newton iteration does not converge is retried as two half steps, each of
+  /// which may be halved again, down to dt / 2^max_step_halvings; if that fails too the step
+  /// throws kelp::numerical_error with the state unchanged. 0: no retry.
+  int max_step_halvings = 6;
 };
 
-/// \brief What one step did.
+/// \brief What one step (or one driver call) did.
 template <typename Scalar>
 struct StepReport {
-  /// Force evaluations used.
+  /// Steps committed (1 unless an implicit step was retried in sub-steps, or a driver took
+  /// several).
+  int substeps = 0;
+  /// Force evaluations used, failed attempts included.
   int force_evaluations = 0;
-  /// Newton corrections (0 for explicit schemes).
+  /// Newton corrections, failed attempts included (0 for explicit schemes).
   int newton_iterations = 0;
-  /// Final scaled Newton residual max_i |R_i|/a_i [m/s] (0 for explicit schemes).
+  /// Worst final scaled Newton residual max_i |R_i|/a_i over the committed steps [m/s] (0 for
+  /// explicit schemes).
   Scalar residual = Scalar(0);
-  /// False when an implicit step hit `max_iterations` before meeting the tolerance (the step is
-  /// still taken).
-  bool converged = true;
+  /// Implicit steps that did not converge at their first step length and were split.
+  int retries = 0;
+  /// Worst final residual of the attempts that did not converge and were split [m/s].
+  Scalar rejected_residual = Scalar(0);
+
+  /// \brief Adds another step's report: counts add up, the residual is the worst.
+  StepReport& operator+=(const StepReport& o) {
+    substeps += o.substeps;
+    force_evaluations += o.force_evaluations;
+    newton_iterations += o.newton_iterations;
+    residual = std::max(residual, o.residual);
+    retries += o.retries;
+    rejected_residual = std::max(rejected_residual, o.rejected_residual);
+    return *this;
+  }
 };
 
 namespace detail {
@@ -113,14 +142,19 @@ Matrix3<Scalar> segment_block(const TetherWorkspace<Scalar>& ws, int s, Scalar c
 /// off-diagonal block of segment s is −A_s with A_s = α_s u uᵀ + β_s I (α = c_v BA/l + c_x k_uu,
 /// β = c_x k_perp), so the Schur complements D'_i = D_i − A_{i−1} D'⁻¹_{i−1} A_{i−1} and the
 /// back substitution δ_i = z_i + D'⁻¹_i A_i δ_{i+1} are written with symmetric 3×3 algebra
-/// (6 stored entries, closed-form SPD inverse). Reads the Jacobian ingredients of the last
-/// compute_forces<true>; writes ws.delta (and ws.block_inv). O(N), no heap allocation.
+/// (6 stored entries). Each D'_i is factored as L D Lᵀ (3×3, no pivoting). In exact arithmetic
+/// every pivot is at least λ_min(J) ≥ c_m · min_node_mass (J − c_m M is positive semi-definite);
+/// a computed pivot below half that bound is round-off (e.g. (γh)² EA/l ≫ M at a very large
+/// step, or a very short segment) and is raised to it, which keeps the factor positive definite
+/// and the direction a descent direction for the line search. Reads the Jacobian ingredients of
+/// the last compute_forces<true>; writes ws.delta (and ws.block_inv). O(N), no heap allocation.
 template <typename Scalar>
 void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                              Scalar c_m, Scalar c_v, Scalar c_x) {
   using S = Scalar;
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  const S floor = S(0.5) * c_m * model.min_node_mass();
   // Segment coupling A_s = al u uᵀ + be I.
   const auto seg = [&](int s, S& al, S& be, S& ux, S& uy, S& uz) {
     al = c_v * ws.seg_c_uu(s) + c_x * ws.seg_k_uu(s);
@@ -180,20 +214,23 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
       d21 += al * uz * uy;
       d22 += al * uz * uz + be;
     }
-    // Closed-form inverse of the SPD block (Sylvester's criterion checked).
-    const S c00 = d11 * d22 - d21 * d21, c01 = d20 * d21 - d10 * d22, c02 = d10 * d21 - d20 * d11;
-    const S minor2 = d00 * d11 - d10 * d10;
-    const S det = d00 * c00 + d10 * c01 + d20 * c02;
-    if (!(d00 > S(0) && minor2 > S(0) && det > S(0)))
+    // D' = L diag(e0, e1, e2) Lᵀ, pivots floored at the exact lower bound (see above); then
+    // P = D'⁻¹ = L⁻ᵀ diag(1/e) L⁻¹ with L⁻¹ = [1 0 0; m10 1 0; m20 m21 1].
+    const S e0 = std::max(d00, floor), i0 = S(1) / e0;
+    const S l10 = d10 * i0, l20 = d20 * i0;
+    const S e1 = std::max(d11 - l10 * d10, floor), i1 = S(1) / e1;
+    const S l21 = (d21 - l20 * d10) * i1;
+    const S e2 = std::max(d22 - l20 * d20 - l21 * l21 * e1, floor), i2 = S(1) / e2;
+    if (!is_finite(i0 + i1 + i2 + l10 + l20 + l21))
       ::kelp::detail::throw_numerical_error(
-          "tether Newton step: Jacobian block not positive definite; the state is unchanged");
-    const S k = S(1) / det;
-    p00 = c00 * k;
-    p10 = c01 * k;
-    p20 = c02 * k;
-    p11 = (d00 * d22 - d20 * d20) * k;
-    p21 = (d10 * d20 - d00 * d21) * k;
-    p22 = minor2 * k;
+          "tether Newton step: non-finite Jacobian block; the state is unchanged");
+    const S m10 = -l10, m21 = -l21, m20 = l10 * l21 - l20;
+    p00 = i0 + m10 * m10 * i1 + m20 * m20 * i2;
+    p10 = m10 * i1 + m20 * m21 * i2;
+    p20 = m20 * i2;
+    p11 = i1 + m21 * m21 * i2;
+    p21 = m21 * i2;
+    p22 = i2;
     ws.delta(0, i) = p00 * r0 + p10 * r1 + p20 * r2;
     ws.delta(1, i) = p10 * r0 + p11 * r1 + p21 * r2;
     ws.delta(2, i) = p20 * r0 + p21 * r1 + p22 * r2;
@@ -224,74 +261,89 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
   }
 }
 
-/// Newton direction with a primal–dual active set for the kink of the elastic tension at
-/// l_s = l (semismooth Newton on T_el = EA·max(0, ε)): in the linear model each segment's elastic
-/// part is either on — T_el ≈ EA ε + (EA/l) u·Δδx, negative values allowed inside the linear
-/// model — or off. The set starts from the segments with l_s ≥ (1 − band)·l, and is updated from
-/// the predicted lengths until it repeats (at most `max_passes` solves). Reads ws.rhs (= −R) and
-/// the Jacobian terms of compute_forces<true>; writes ws.delta; ws.rhs is restored.
+/// Newton direction with a primal–dual active set for the kinks of the axial force (semismooth
+/// Newton on T = max(0, EA·max(0, ε) + BA·ε̇), or without the outer max when
+/// compressive_damping). Over a Newton correction δ (velocities; positions move by γh δ) a
+/// segment's force is a monotone piecewise-linear function of w = u·(δ_{s+1} − δ_s) with three
+/// branches: 2 elastic and dashpot (taut), 1 dashpot only (slack), 0 no force (clamped). In the
+/// linear model each segment sits on one branch, extended linearly beyond its kink (negative
+/// values allowed inside the linear model). The branches start from those at the current point
+/// (segments with l_s ≥ (1 − band)·l start taut) and are updated from the predicted extension
+/// and stretch rate until they repeat (at most `max_passes` solves). Reads ws.rhs (= −R) and the
+/// Jacobian terms of compute_forces<true>; writes ws.delta; ws.rhs and the Jacobian terms are
+/// restored.
 template <typename Scalar>
 void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
                           Scalar band, int max_passes) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  const Scalar l = model.segment_length(), inv_l = model.inverse_segment_length();
-  const Scalar ea = model.parameters().axial_stiffness, ea_l = model.axial_spring();
-  // Updates the active set from the lengths predicted by ws.delta; true if it changed.
+  const Scalar l = model.segment_length();
+  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
+  const bool clamp = !model.parameters().compressive_damping;
+  // Branch of a segment with extension e = l_s − l [m] and stretch rate r [m/s].
+  const auto branch_of = [&](Scalar e, Scalar r) {
+    const bool elastic = e > Scalar(0);
+    if (clamp && !((elastic ? ea_l * e : Scalar(0)) + ba_l * r > Scalar(0))) return Scalar(0);
+    return elastic ? Scalar(2) : Scalar(1);
+  };
+  const auto true_branch = [&](int s) {
+    return branch_of(ws.stretched_length(s) - l, ws.seg_rate(s));
+  };
+  // Updates the branches from the extension and rate predicted by ws.delta; true if any changed.
   const auto update = [&]() {
     bool changed = false;
     for (int s = 0; s < n; ++s) {
-      Scalar dl(0);
+      Scalar w(0);
       const auto u = ws.direction.col(s);
-      if (s >= f0 && s <= f1) dl -= gh * u.dot(ws.delta.col(s));
-      if (s + 1 >= f0 && s + 1 <= f1) dl += gh * u.dot(ws.delta.col(s + 1));
-      const bool now = ws.stretched_length(s) + dl > l;
-      if (now != (ws.seg_active(s) > Scalar(0))) {
+      if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
+      if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
+      const Scalar now = branch_of(ws.stretched_length(s) - l + gh * w, ws.seg_rate(s) + w);
+      if (now != ws.seg_branch(s)) {
         changed = true;
-        ws.seg_active(s) = now ? Scalar(1) : Scalar(0);
+        ws.seg_branch(s) = now;
       }
     }
     return changed;
   };
   bool on_true_branch = true;
   for (int s = 0; s < n; ++s) {
-    const bool active = ws.stretched_length(s) >= (Scalar(1) - band) * l;
-    ws.seg_active(s) = active ? Scalar(1) : Scalar(0);
-    if (active != (ws.stretched_length(s) > l)) on_true_branch = false;
+    const Scalar bt = true_branch(s);
+    const bool banded = band > Scalar(0) && ws.stretched_length(s) >= (Scalar(1) - band) * l;
+    ws.seg_branch(s) = banded ? Scalar(2) : bt;
+    if (ws.seg_branch(s) != bt) on_true_branch = false;
   }
   int pass = 0;
   if (on_true_branch) {
-    // Common case: plain Newton; done unless the predicted lengths cross l.
+    // Common case: plain Newton; done unless the prediction crosses a kink.
     solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
     if (max_passes <= 1 || !update()) return;
     pass = 1;
   }
   ws.rhs_true = ws.rhs;
   ws.seg_true_k_uu = ws.seg_k_uu;
+  ws.seg_true_c_uu = ws.seg_c_uu;
   for (;; ++pass) {
     ws.rhs = ws.rhs_true;
     for (int s = 0; s < n; ++s) {
-      const bool stretched = ws.stretched_length(s) > l;
-      const bool active = ws.seg_active(s) > Scalar(0);
       ws.seg_k_uu(s) = ws.seg_true_k_uu(s);
-      if (active == stretched) continue;
-      const auto u = ws.direction.col(s);
-      // Elastic force of the taut branch at the current point (negative when slack).
-      const Scalar te = ea * (ws.stretched_length(s) - l) * inv_l;
-      if (active) {  // slack, modelled taut: add the (compressive) branch value and stiffness
-        ws.rhs.col(s) += (gh * te) * u;
-        ws.rhs.col(s + 1) -= (gh * te) * u;
-        ws.seg_k_uu(s) += ea_l;
-      } else {  // stretched, modelled slack: remove its elastic force and stiffness
-        ws.rhs.col(s) -= (gh * te) * u;
-        ws.rhs.col(s + 1) += (gh * te) * u;
-        ws.seg_k_uu(s) -= ea_l;
-      }
+      ws.seg_c_uu(s) = ws.seg_true_c_uu(s);
+      const Scalar b = ws.seg_branch(s);
+      if (b == true_branch(s)) continue;
+      // The branch's force at the current point replaces the true one, its slopes the true ones.
+      const Scalar e = ws.stretched_length(s) - l, r = ws.seg_rate(s);
+      const Scalar tb =
+          (b == Scalar(2) ? ea_l * e : Scalar(0)) + (b > Scalar(0) ? ba_l * r : Scalar(0));
+      const Vector3<Scalar> df = (gh * (tb - ws.tension(s))) * ws.direction.col(s);
+      ws.rhs.col(s) += df;
+      ws.rhs.col(s + 1) -= df;
+      ws.seg_k_uu(s) = (b == Scalar(2) ? ea_l : Scalar(0)) - ws.seg_k_perp(s);
+      ws.seg_c_uu(s) = b > Scalar(0) ? ba_l : Scalar(0);
     }
     solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
     if (pass + 1 >= max_passes || !update()) break;
   }
   ws.seg_k_uu = ws.seg_true_k_uu;
+  ws.seg_c_uu = ws.seg_true_c_uu;
   ws.rhs.swap(ws.rhs_true);
 }
 
@@ -301,63 +353,106 @@ bool all_finite_fast(const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v) {
   return isfinite(value_of(x.sum() + v.sum()));
 }
 
-/// Commits (x, v) as the state at t + dt if finite; keeps the state before the step in
-/// ws.x_prev / ws.v_prev (BDF2 history, and the undo point of solve_static_equilibrium) with its
-/// step and the time of the committed state, so that a later step can tell whether the history
-/// belongs to the state it is given (see history_matches).
+/// Commits (x, v) as the state at t + dt if finite; the state before the step becomes the
+/// state's history (BDF2, velocity predictor).
 template <typename Scalar>
-void commit(TetherWorkspace<Scalar>& ws, TetherState<Scalar>& state, const Matrix3X<Scalar>& x,
-            const Matrix3X<Scalar>& v, Scalar dt, const char* who) {
+void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v, double dt,
+            const char* who) {
   if (!all_finite_fast(x, v))
     ::kelp::detail::throw_numerical_error(std::string(who) +
                                           ": non-finite node state; the state is unchanged");
-  ws.x_prev = state.position;
-  ws.v_prev = state.velocity;
-  ws.previous_dt = dt;
-  ws.has_previous = true;
-  state.position = x;
-  state.velocity = v;
+  // Three O(1) swaps instead of copies: the old state goes to the history, the new one in, and
+  // x, v (workspace scratch) get the old history's buffers.
+  state.previous_position.swap(state.position);
+  state.previous_velocity.swap(state.velocity);
+  state.position.swap(x);
+  state.velocity.swap(v);
+  state.previous_dt = dt;
   state.time += dt;
-  ws.history_time = state.time;
 }
 
-/// True when the workspace's history (x_prev, v_prev) is the step just before `state` with the
-/// same step `dt`: it was committed by the last step and the state's time is still the time of
-/// that commit (a state reset, or a workspace shared between states, fails the test).
+/// True when the state's history is the step just before it with the same step `dt`.
 template <typename Scalar>
-bool history_matches(const TetherWorkspace<Scalar>& ws, const TetherState<Scalar>& state,
-                     Scalar dt) {
-  return ws.has_previous && ws.previous_dt == dt && state.time == ws.history_time;
+bool history_matches(const TetherState<Scalar>& state, double dt) {
+  return state.previous_dt == dt;
 }
 
 /// Checks the Newton settings. \throws kelp::invalid_argument naming the field.
 template <typename Scalar>
 void check_implicit_options(const ImplicitOptions<Scalar>& o) {
   KELP_CHECK(o.max_iterations >= 1, "ImplicitOptions::max_iterations must be >= 1");
-  check_positive(o.velocity_tolerance, "ImplicitOptions::velocity_tolerance");
+  check_positive(o.acceleration_tolerance, "ImplicitOptions::acceleration_tolerance");
   check_non_negative(o.slack_band, "ImplicitOptions::slack_band");
   KELP_CHECK(o.max_active_set_passes >= 1, "ImplicitOptions::max_active_set_passes must be >= 1");
   KELP_CHECK(o.max_backtracks >= 0, "ImplicitOptions::max_backtracks must be >= 0");
+  KELP_CHECK(o.max_step_halvings >= 0 && o.max_step_halvings <= 30,
+             "ImplicitOptions::max_step_halvings must be in [0, 30]");
 }
 
+/// Checks a step's inputs; gives a state whose history buffers do not fit the model (a state
+/// assembled by hand) fitting ones and no history.
 template <typename Scalar>
 void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
-                       const TetherState<Scalar>& state, const TetherBoundary<Scalar>& b,
-                       Scalar dt) {
+                       TetherState<Scalar>& state, const TetherBoundary<Scalar>& b, double dt) {
   check_positive(dt, "dt");
   KELP_CHECK(ws.force.cols() == model.nodes(), "workspace was built for a different tether");
   KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
              "state.position and state.velocity must have segments + 1 columns");
+  if (state.previous_position.cols() != model.nodes() ||
+      state.previous_velocity.cols() != model.nodes()) {
+    state.previous_position.setZero(3, model.nodes());
+    state.previous_velocity.setZero(3, model.nodes());
+    state.previous_dt = 0.0;
+  }
   // One pass over the state; the named check runs only to build the message.
-  if (!(all_finite_fast(state.position, state.velocity) && is_finite(state.time)))
+  if (!(all_finite_fast(state.position, state.velocity) && std::isfinite(state.time) &&
+        state.previous_dt >= 0.0 &&
+        (!state.has_history() ||
+         all_finite_fast(state.previous_position, state.previous_velocity))))
     check_state(model, state);
   check_boundary(b);
+}
+
+/// `x` in %g format, for error messages.
+inline std::string format_g(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+/// Refuses a Newton tolerance that the arithmetic cannot resolve: positions of magnitude |x| are
+/// rounded to ε|x| (ε of double), which rounds each segment's axial force EA/l·Δl by about
+/// EA/l·ε|x|; when that is above a thousand times the tolerance a_min·acceleration_tolerance on
+/// the lightest node, no step can converge (e.g. a 1 cm line cut into 200 segments: EA/l = 2e9 N/m
+/// at 5 m depth rounds the force to 2e-6 N against a tolerance of 3e-10 N). |x| is bounded by the
+/// end nodes' distance from the origin plus the line's length. O(1).
+/// \throws kelp::invalid_argument saying what to change.
+template <typename Scalar>
+void check_resolvable(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
+                      const ImplicitOptions<Scalar>& options) {
+  const int n = model.segments();
+  const double reach = std::max(double(value_of(state.position.col(0).norm())),
+                                double(value_of(state.position.col(n).norm()))) +
+                       double(value_of(model.parameters().length));
+  const double rounding =
+      double(value_of(model.axial_spring())) * std::numeric_limits<double>::epsilon() * reach;
+  const double tolerance =
+      double(value_of(model.min_node_mass())) * double(value_of(options.acceleration_tolerance));
+  if (rounding > 1000.0 * tolerance)
+    ::kelp::detail::throw_invalid_argument(
+        "step_implicit: this tether cannot be resolved to the Newton tolerance: segments of " +
+        format_g(double(value_of(model.segment_length()))) + " m (EA/l = " +
+        format_g(double(value_of(model.axial_spring()))) + " N/m) at coordinates up to " +
+        format_g(reach) + " m round the axial force to ~" + format_g(rounding) +
+        " N, over 1000 times the tolerance of the lightest node (" + format_g(tolerance) +
+        " N); use fewer, longer segments, coordinates nearer the origin, or a larger "
+        "ImplicitOptions::acceleration_tolerance");
 }
 
 /// Acceleration of every node at (x, v) [boundary already applied] into `acc`.
 template <typename Scalar, typename Env>
 void derivative(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
-                Scalar t, const TetherBoundary<Scalar>& b, const Matrix3X<Scalar>& x,
+                double t, const TetherBoundary<Scalar>& b, const Matrix3X<Scalar>& x,
                 const Matrix3X<Scalar>& v, Matrix3X<Scalar>& acc) {
   compute_forces<false>(model, ws, env, t, x, v);
   accelerations_from_forces(model, ws, b.start.acceleration, b.end.acceleration, acc);
@@ -367,8 +462,8 @@ void derivative(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, c
 /// the prescribed end motion at the start of the step applied.
 template <typename Scalar>
 void begin_explicit_step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
-                         const TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
-                         Scalar dt) {
+                         TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
+                         double dt) {
   check_step_inputs(model, ws, state, boundary, dt);
   ws.x0 = state.position;
   ws.v0 = state.velocity;
@@ -386,16 +481,18 @@ template <typename Scalar, typename Env>
 StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
                                          TetherWorkspace<Scalar>& ws, const Env& env,
                                          TetherState<Scalar>& state,
-                                         const TetherBoundary<Scalar>& boundary, Scalar dt) {
+                                         const TetherBoundary<Scalar>& boundary, double dt) {
   detail::begin_explicit_step(model, ws, state, boundary, dt);
-  const Scalar t = state.time;
+  const double t = state.time;
+  const Scalar h = Scalar(dt);
   detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
-  ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
-  ws.x1.noalias() = ws.x0 + dt * ws.v1;
-  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_symplectic_euler");
+  ws.v1.noalias() = ws.v0 + h * ws.acceleration;
+  ws.x1.noalias() = ws.x0 + h * ws.v1;
+  detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
+  detail::commit(state, ws.x1, ws.v1, dt, "step_symplectic_euler");
   StepReport<Scalar> r;
+  r.substeps = 1;
   r.force_evaluations = 1;
   return r;
 }
@@ -405,20 +502,22 @@ StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
-                            const TetherBoundary<Scalar>& boundary, Scalar dt) {
+                            const TetherBoundary<Scalar>& boundary, double dt) {
   detail::begin_explicit_step(model, ws, state, boundary, dt);
-  const Scalar t = state.time, h2 = Scalar(0.5) * dt;
+  const double t = state.time;
+  const Scalar h = Scalar(dt), h2 = Scalar(0.5) * h;
   detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
   ws.xs.noalias() = ws.x0 + h2 * ws.v0;
   ws.vs.noalias() = ws.v0 + h2 * ws.acceleration;
   detail::apply_boundary(model, boundary, h2, ws.xs, ws.vs);
-  detail::derivative(model, ws, env, t + h2, boundary, ws.xs, ws.vs, ws.acceleration);
-  ws.x1.noalias() = ws.x0 + dt * ws.vs;
-  ws.v1.noalias() = ws.v0 + dt * ws.acceleration;
-  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_rk2");
+  detail::derivative(model, ws, env, t + 0.5 * dt, boundary, ws.xs, ws.vs, ws.acceleration);
+  ws.x1.noalias() = ws.x0 + h * ws.vs;
+  ws.v1.noalias() = ws.v0 + h * ws.acceleration;
+  detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
+  detail::commit(state, ws.x1, ws.v1, dt, "step_rk2");
   StepReport<Scalar> r;
+  r.substeps = 1;
   r.force_evaluations = 2;
   return r;
 }
@@ -428,68 +527,70 @@ StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Sc
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
-                            const TetherBoundary<Scalar>& boundary, Scalar dt) {
+                            const TetherBoundary<Scalar>& boundary, double dt) {
   detail::begin_explicit_step(model, ws, state, boundary, dt);
-  const Scalar t = state.time;
+  const double t = state.time;
   ws.xs = ws.x0;
   ws.vs = ws.v0;
   ws.x1 = ws.x0;
   ws.v1 = ws.v0;
+  const Scalar h = Scalar(dt);
   const Scalar c[4] = {Scalar(0), Scalar(0.5), Scalar(0.5), Scalar(1)};
-  const Scalar w[4] = {dt / Scalar(6), dt / Scalar(3), dt / Scalar(3), dt / Scalar(6)};
+  const Scalar w[4] = {h / Scalar(6), h / Scalar(3), h / Scalar(3), h / Scalar(6)};
+  const double tc[4] = {t, t + 0.5 * dt, t + 0.5 * dt, t + dt};
   for (int k = 0; k < 4; ++k) {
-    detail::derivative(model, ws, env, t + c[k] * dt, boundary, ws.xs, ws.vs, ws.acceleration);
+    detail::derivative(model, ws, env, tc[k], boundary, ws.xs, ws.vs, ws.acceleration);
     if (k == 0) ws.end_forces = end_forces_from_workspace(model, ws, boundary);
     ws.x1.noalias() += w[k] * ws.vs;
     ws.v1.noalias() += w[k] * ws.acceleration;
     if (k < 3) {
-      const Scalar ch = c[k + 1] * dt;
+      const Scalar ch = c[k + 1] * h;
       ws.xs.noalias() = ws.x0 + ch * ws.vs;
       ws.vs.noalias() = ws.v0 + ch * ws.acceleration;
       detail::apply_boundary(model, boundary, ch, ws.xs, ws.vs);
     }
   }
-  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_rk4");
+  detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
+  detail::commit(state, ws.x1, ws.v1, dt, "step_rk4");
   StepReport<Scalar> r;
+  r.substeps = 1;
   r.force_evaluations = 4;
   return r;
 }
 
-/// \brief One implicit step (backward Euler, or BDF2 when `bdf2` is true and the previous step
-/// had the same dt) solved by Newton's method.
-///
-/// With x = x̂ + γh v (backward Euler: γ = 1, x̂ = x_n, v̂ = v_n; BDF2: γ = 2/3,
-/// x̂ = (4x_n − x_{n−1})/3, v̂ = (4v_n − v_{n−1})/3) the unknown node velocities solve
-/// R(v) = M (v − v̂) − γh F(x̂ + γh v, v) = 0. The Jacobian J = M + γh D_v + (γh)² D_x
-/// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
-/// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
-/// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
-/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
-/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
-/// the direction dependence of the dashpot, bending (EI). Each Newton direction settles which
-/// segments are taut with a primal–dual active set (detail::active_set_direction) and is
-/// shortened by a secant line search on the slope R·δ when it overshoots. The initial guess
-/// extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt. Up to
-/// `options.max_iterations` corrections; the step is taken even if the tolerance is not met
-/// (see StepReport::converged). End forces are those of the final iterate, at t + dt.
-/// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
-/// the result is not finite.
+namespace detail {
+
+/// Seabed normal force of every node of `state` into ws.friction_normal (as compute_forces).
+template <typename Scalar>
+void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                             Scalar bed, const TetherState<Scalar>& state) {
+  const TetherParameters<Scalar>& p = model.parameters();
+  const Scalar k = p.seabed_stiffness * p.diameter, c = p.seabed_damping * p.diameter;
+  for (int i = 0; i < model.nodes(); ++i) {
+    const Scalar pen = state.position(2, i) - bed;
+    const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
+    const Scalar normal = (pen * k + state.velocity(2, i) * c * ramp) * model.node_length(i);
+    ws.friction_normal(i) = pen > Scalar(0) && normal > Scalar(0) ? normal : Scalar(0);
+  }
+}
+
+/// One attempt at an implicit step of length dt (see step_implicit): commits the new state and
+/// returns true when Newton's method converged (or options.check_convergence is false); returns
+/// false with the state untouched otherwise. Adds its work to `report`. Inputs already checked.
 template <typename Scalar, typename Env>
-StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
-                                 const Env& env, TetherState<Scalar>& state,
-                                 const TetherBoundary<Scalar>& boundary, Scalar dt,
-                                 bool bdf2 = false, const ImplicitOptions<Scalar>& options = {}) {
+bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                      TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
+                      bool bdf2, const ImplicitOptions<Scalar>& options,
+                      StepReport<Scalar>& report) {
   using std::abs;
-  detail::check_step_inputs(model, ws, state, boundary, dt);
-  detail::check_implicit_options(options);
-  const Scalar t1 = state.time + dt;
+  const double t1 = state.time + dt;
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   // The history (BDF2, velocity predictor) is used only if it is this state's previous step.
-  const bool history = detail::history_matches(ws, state, dt);
+  const bool history = history_matches(state, dt);
   const bool use_bdf2 = bdf2 && history;
   const Scalar gamma = use_bdf2 ? Scalar(2) / Scalar(3) : Scalar(1);
-  const Scalar gh = gamma * dt;
+  const Scalar gh = gamma * Scalar(dt);
+  const Scalar tolerance = options.acceleration_tolerance * Scalar(dt);
   // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
   // One pass over the nodes for the history, the predictor and its positions.
   const int cols = model.nodes();
@@ -497,7 +598,8 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
     for (int i = 0; i < cols; ++i) {
       const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
-      const Vector3<Scalar> xp = ws.x_prev.col(i), vp = ws.v_prev.col(i);
+      const Vector3<Scalar> xp = state.previous_position.col(i);
+      const Vector3<Scalar> vp = state.previous_velocity.col(i);
       const Vector3<Scalar> xh = four_thirds * xn - third * xp;
       const Vector3<Scalar> v1 = Scalar(2) * vn - vp;
       ws.x0.col(i) = xh;
@@ -511,27 +613,36 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
     for (int i = 0; i < cols; ++i) {
       const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
       const Vector3<Scalar> v1 =
-          extrapolate ? Vector3<Scalar>(Scalar(2) * vn - ws.v_prev.col(i)) : vn;
+          extrapolate ? Vector3<Scalar>(Scalar(2) * vn - state.previous_velocity.col(i)) : vn;
       ws.x0.col(i) = xn;
       ws.v0.col(i) = vn;
       ws.v1.col(i) = v1;
       ws.x1.col(i) = xn + gh * v1;
     }
   }
-  detail::apply_boundary(model, boundary, dt, ws.x1, ws.v1);
-
-  StepReport<Scalar> report;
-  report.converged = false;
+  apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
+  // Seabed friction limit from the normal force at the start of the step, for the whole Newton
+  // iteration (TetherWorkspace::frozen_friction); reset on every exit.
+  struct FrictionGuard {
+    TetherWorkspace<Scalar>& w;
+    ~FrictionGuard() { w.frozen_friction = false; }
+  } friction_guard{ws};
+  if (model.parameters().seabed_friction > Scalar(0)) {
+    freeze_friction_normals(model, ws, Scalar(env.seabed_depth()), state);
+    ws.frozen_friction = true;
+  }
+  bool converged = false;
+  Scalar res(0);
   // Evaluates F at (x, v), writes rhs = −R = γh F − M (v − v̂) on the free nodes and sets `res`
   // to the scaled max-norm max_i |R_i|/a_i.
-  const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& res,
+  const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& r_max,
                             bool with_jacobian) {
     if (with_jacobian)
       compute_forces<true>(model, ws, env, t1, x, v);
     else
       compute_forces<false>(model, ws, env, t1, x, v);
     ++report.force_evaluations;
-    res = Scalar(0);
+    r_max = Scalar(0);
     Scalar sum(0);
     using std::abs;
     for (int i = f0; i <= f1; ++i) {
@@ -545,7 +656,7 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       ws.rhs(0, i) = r0;
       ws.rhs(1, i) = r1;
       ws.rhs(2, i) = r2;
-      res = std::max(res, Scalar(std::max(std::max(abs(r0), abs(r1)), abs(r2)) / a));
+      r_max = std::max(r_max, Scalar(std::max(std::max(abs(r0), abs(r1)), abs(r2)) / a));
       sum += (r0 + r1) + r2;
     }
     // NaN fails every comparison and std::max keeps its first argument: test the sum instead.
@@ -553,7 +664,6 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       ::kelp::detail::throw_numerical_error(
           "step_implicit: non-finite residual; the state is unchanged");
   };
-  Scalar res(0);
   evaluate(ws.x1, ws.v1, res, true);
   bool have_jacobian = true;
   // The trial iterates take the kinematic end nodes from here (the free ones are overwritten).
@@ -566,9 +676,9 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
     ws.vs.col(i) = ws.v1.col(i);
   }
   for (int it = 0;; ++it) {
-    report.residual = res;
-    if (res <= options.velocity_tolerance) {
-      report.converged = true;
+    // At least one correction: the predictor alone never makes a step.
+    if (it >= 1 && res <= tolerance) {
+      converged = true;
       break;
     }
     if (it >= options.max_iterations) break;
@@ -576,7 +686,7 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       evaluate(ws.x1, ws.v1, res, true);
       have_jacobian = true;
     }
-    detail::active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+    active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
     ++report.newton_iterations;
     if (!options.check_convergence && it + 1 >= options.max_iterations) {
       // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
@@ -588,12 +698,13 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       ws.end_forces = end_forces_from_workspace(model, ws, boundary);
       const int n = model.segments();
       if (f0 == 1 && n >= 2)
-        ws.end_forces.on_start += detail::segment_block(ws, 0, Scalar(1), gh) * ws.delta.col(1);
+        ws.end_forces.on_start += segment_block(ws, 0, Scalar(1), gh) * ws.delta.col(1);
       if (f1 == n - 1 && n >= 2)
-        ws.end_forces.on_end +=
-            detail::segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
-      detail::commit(ws, state, ws.x1, ws.v1, dt, "step_implicit");
-      return report;
+        ws.end_forces.on_end += segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
+      commit(state, ws.x1, ws.v1, dt, "step_implicit");
+      report.residual = std::max(report.residual, res);
+      ++report.substeps;
+      return true;
     }
     // Line search. R is the gradient of the step's incremental potential
     // Φ(v) = ½(v − v̂)ᵀM(v − v̂) + U(x̂ + γh v) + γh·(dissipation potential), which is convex for
@@ -632,17 +743,116 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
     ws.v1.swap(ws.vs);
     res = trial_res;
   }
+  if (!converged) {
+    report.rejected_residual = std::max(report.rejected_residual, res);
+    return false;
+  }
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
-  // commit() stores the pre-step state as BDF2 history.
-  detail::commit(ws, state, ws.x1, ws.v1, dt, "step_implicit");
+  // commit() turns the pre-step state into the history.
+  commit(state, ws.x1, ws.v1, dt, "step_implicit");
+  report.residual = std::max(report.residual, res);
+  ++report.substeps;
+  return true;
+}
+
+/// implicit_attempt, with a non-finite iterate (numerical_error) counted as not converged: a
+/// shorter step may well succeed. Nothing is committed when it returns false.
+template <typename Scalar, typename Env>
+bool try_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                  TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
+                  bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report) {
+  try {
+    return implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report);
+  } catch (const kelp::numerical_error&) {
+    report.rejected_residual = std::numeric_limits<Scalar>::infinity();
+    return false;
+  }
+}
+
+/// Step of length dt split into two halves, each retried in halves again up to `depth_left`
+/// more times; the boundary motion is the step's, taken τ into it. True when all were committed.
+template <typename Scalar, typename Env>
+bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                     TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double tau,
+                     double dt, bool bdf2, const ImplicitOptions<Scalar>& options, int depth_left,
+                     StepReport<Scalar>& report) {
+  const double half = 0.5 * dt;
+  for (int k = 0; k < 2; ++k) {
+    const double t_k = tau + k * half;
+    const TetherBoundary<Scalar> b = boundary.after(Scalar(t_k));
+    if (try_implicit(model, ws, env, state, b, half, bdf2, options, report)) continue;
+    if (depth_left <= 0) return false;
+    ++report.retries;
+    if (!implicit_halves(model, ws, env, state, boundary, t_k, half, bdf2, options, depth_left - 1,
+                         report))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace detail
+
+/// \brief One implicit step (backward Euler, or BDF2 when `bdf2` is true and the state's previous
+/// step had the same dt) solved by Newton's method.
+///
+/// With x = x̂ + γh v (backward Euler: γ = 1, x̂ = x_n, v̂ = v_n; BDF2: γ = 2/3,
+/// x̂ = (4x_n − x_{n−1})/3, v̂ = (4v_n − v_{n−1})/3) the unknown node velocities solve
+/// R(v) = M (v − v̂) − γh F(x̂ + γh v, v) = 0. The Jacobian J = M + γh D_v + (γh)² D_x
+/// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
+/// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
+/// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
+/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
+/// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
+/// direction settles which segments are taut, slack or clamped with a primal–dual active set
+/// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
+/// when it overshoots. The initial guess extrapolates the velocity (2v_n − v_{n−1}) when the
+/// previous step had the same dt. At least one and up to `options.max_iterations` corrections,
+/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt. A step that does not converge is not
+/// committed: it is retried as two half steps, each halved again if needed, at most
+/// `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of step);
+/// if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
+/// (`ws.end_forces`) are those of the final iterate, at t + dt.
+/// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
+/// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
+/// the result is not finite or Newton's method does not converge.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                                 const Env& env, TetherState<Scalar>& state,
+                                 const TetherBoundary<Scalar>& boundary, double dt,
+                                 bool bdf2 = false, const ImplicitOptions<Scalar>& options = {}) {
+  detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::check_implicit_options(options);
+  detail::check_resolvable(model, state, options);
+  StepReport<Scalar> report;
+  if (detail::try_implicit(model, ws, env, state, boundary, dt, bdf2, options, report))
+    return report;
+  // Not converged, nothing committed: retry in halves from a backup.
+  ws.retry_backup.save(state);
+  bool done = false;
+  if (options.max_step_halvings > 0) {
+    ++report.retries;
+    done = detail::implicit_halves(model, ws, env, state, boundary, 0.0, dt, bdf2, options,
+                                   options.max_step_halvings - 1, report);
+  }
+  if (!done) {
+    ws.retry_backup.restore(state);
+    ::kelp::detail::throw_numerical_error(
+        "step_implicit: Newton's method did not converge at dt = " + detail::format_g(dt) +
+        " s, nor in sub-steps down to dt/2^" + std::to_string(options.max_step_halvings) +
+        " (worst residual " + detail::format_g(double(value_of(report.rejected_residual))) +
+        " m/s); the state is unchanged");
+  }
   return report;
 }
 
-/// \brief One step with the chosen integrator (dispatch). \throws as the individual steps.
+/// \brief One step of length `dt` [s] with the chosen integrator (dispatch).
+/// \throws as the individual steps; kelp::invalid_argument for an Integrator value outside the
+/// enumeration.
 template <typename Scalar, typename Env>
 StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                         const Env& env, TetherState<Scalar>& state,
-                        const TetherBoundary<Scalar>& boundary, Scalar dt, Integrator integrator,
+                        const TetherBoundary<Scalar>& boundary, double dt, Integrator integrator,
                         const ImplicitOptions<Scalar>& options = {}) {
   switch (integrator) {
     case Integrator::symplectic_euler:
@@ -656,7 +866,7 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
     case Integrator::bdf2:
       return step_implicit(model, ws, env, state, boundary, dt, true, options);
   }
-  return {};
+  ::kelp::detail::throw_invalid_argument("integrator is not a kelp::tether::Integrator value");
 }
 
 namespace detail {
@@ -735,42 +945,32 @@ Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrato
 /// \brief Sub-stepping driver: advances `state` by `duration` [s] in n = ⌈duration/max_dt⌉ equal
 /// steps of the chosen integrator; the kinematic ends follow `boundary` (given at the current
 /// time) through the interval. `ws.end_forces` holds the forces of the last sub-step. If any
-/// sub-step fails the state is restored to its value at entry. No heap allocation.
-/// \returns the number of sub-steps taken.
+/// sub-step fails (after its own retries, for the implicit schemes) the state is restored to its
+/// value at entry, history included, and the error rethrown. No heap allocation.
+/// \returns the sum of the sub-steps' reports (committed steps, Newton iterations, worst
+/// residual, retries).
 template <typename Scalar, typename Env>
-int advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
-            TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, Scalar duration,
-            Scalar max_dt, Integrator integrator, const ImplicitOptions<Scalar>& options = {}) {
-  using std::ceil;
+StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                           const Env& env, TetherState<Scalar>& state,
+                           const TetherBoundary<Scalar>& boundary, double duration, double max_dt,
+                           Integrator integrator, const ImplicitOptions<Scalar>& options = {}) {
   check_positive(duration, "duration");
   check_positive(max_dt, "max_dt");
-  const double ratio = ceil(value_of(duration / max_dt));
+  const double ratio = std::ceil(duration / max_dt);
   KELP_CHECK(ratio <= double(std::numeric_limits<int>::max()),
              "max_dt too small for duration: more than INT_MAX sub-steps");
   const int n = std::max(1, static_cast<int>(ratio));
-  const Scalar h = duration / Scalar(n);
-  // Entry backup in kx/kv (no single step uses them).
-  ws.kx = state.position;
-  ws.kv = state.velocity;
-  const Scalar t_entry = state.time;
+  const double h = duration / n;
+  ws.entry_backup.save(state);
+  StepReport<Scalar> report;
   try {
-    for (int k = 0; k < n; ++k) {
-      const Scalar tau = Scalar(k) * h;
-      TetherBoundary<Scalar> b = boundary;
-      b.start.position = boundary.start.position_at(tau);
-      b.start.velocity = boundary.start.velocity_at(tau);
-      b.end.position = boundary.end.position_at(tau);
-      b.end.velocity = boundary.end.velocity_at(tau);
-      step(model, ws, env, state, b, h, integrator, options);
-    }
+    for (int k = 0; k < n; ++k)
+      report += step(model, ws, env, state, boundary.after(Scalar(k * h)), h, integrator, options);
   } catch (const kelp::numerical_error&) {
-    state.position = ws.kx;
-    state.velocity = ws.kv;
-    state.time = t_entry;
-    ws.has_previous = false;
+    ws.entry_backup.restore(state);
     throw;
   }
-  return n;
+  return report;
 }
 
 /// \brief Settings of the static-equilibrium solve.
@@ -804,11 +1004,10 @@ struct StaticResult {
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error if the iteration produces
 /// non-finite values (state unchanged).
 template <typename Scalar, typename Env>
-StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
-                                              TetherWorkspace<Scalar>& ws, const Env& env,
-                                              TetherState<Scalar>& state,
-                                              const TetherBoundary<Scalar>& boundary,
-                                              const StaticOptions<Scalar>& options = {}) {
+[[nodiscard]] StaticResult<Scalar> solve_static_equilibrium(
+    const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+    TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
+    const StaticOptions<Scalar>& options = {}) {
   check_state(model, state);
   check_boundary(boundary);
   check_positive(options.initial_pseudo_dt, "initial_pseudo_dt");
@@ -823,12 +1022,12 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
   b.end.velocity.setZero();
   b.start.acceleration.setZero();
   b.end.acceleration.setZero();
-  // Keep the entry state in kx/kv (no single step uses them) and iterate on `state` itself,
+  // Keep the entry state (no single step uses that backup) and iterate on `state` itself,
   // restoring it on error.
-  ws.kx = state.position;
-  ws.kv = state.velocity;
-  const Scalar t_entry = state.time;
+  ws.entry_backup.save(state);
+  const double t_entry = state.time;
   state.velocity.setZero();
+  state.clear_history();
   detail::apply_boundary(model, b, Scalar(0), state.position, state.velocity);
   ImplicitOptions<Scalar> inner;
   inner.max_iterations = 6;
@@ -854,28 +1053,29 @@ StaticResult<Scalar> solve_static_equilibrium(const TetherModel<Scalar>& model,
       // plus added mass), not m_ref: this tolerance asks for |F_i| ≤ ½·tol·a_i/m_ref, half the
       // force tolerance for an interior node in air, looser where added mass or a point mass
       // makes a_i > m_ref (the outer loop checks |F_i| ≤ tol itself).
-      inner.velocity_tolerance = Scalar(0.5) * tol * h / m_ref;
-      const StepReport<Scalar> r = step_implicit(model, ws, env, state, b, h, false, inner);
+      // (acceleration_tolerance · h is the inner velocity tolerance.)
+      inner.acceleration_tolerance = Scalar(0.5) * tol / m_ref;
+      StepReport<Scalar> r;
+      // A pseudo step that does not converge is not committed: retry it shorter.
+      const bool taken =
+          detail::try_implicit(model, ws, env, state, b, double(value_of(h)), false, inner, r);
       state.time = t_entry;
       state.velocity.setZero();
-      if (!r.converged && h > options.initial_pseudo_dt * Scalar(1e-6)) {
-        // Undo: commit() kept the position before the step in ws.x_prev, a buffer the Newton
-        // iteration does not touch (its trial buffers xs/vs do not survive the step).
-        state.position = ws.x_prev;
+      state.clear_history();
+      if (!taken) {
+        if (!(h > options.initial_pseudo_dt * Scalar(1e-6)))
+          ::kelp::detail::throw_numerical_error(
+              "solve_static_equilibrium: no pseudo step converges; the state is unchanged");
         h *= Scalar(0.25);
-      } else if (r.newton_iterations <= 3) {
+      } else if (r.newton_iterations <= 5) {  // an easy step: lengthen the next
         h = std::min(h_max, h * Scalar(2));
       }
     }
   } catch (const kelp::numerical_error&) {
-    state.position = ws.kx;
-    state.velocity = ws.kv;
-    state.time = t_entry;
-    ws.has_previous = false;
+    ws.entry_backup.restore(state);
     throw;
   }
   ws.end_forces = end_forces_from_workspace(model, ws, b);
-  ws.has_previous = false;
   return result;
 }
 

@@ -7,7 +7,9 @@
 /// (node 0 = start end, e.g. the ASV; node N = far end, e.g. the AUV). The model follows the
 /// lumped-mass formulation of Hall & Goupee (2015, "Validation of a lumped-mass mooring line
 /// model with DeepCwind semisubmersible model test data", Ocean Engineering 104) as implemented
-/// in MoorDyn v2 (source/Line.cpp; facts in shared/reference/tether.md); the code is kelp's own.
+/// in MoorDyn v2 (source/Line.cpp); the code is kelp's own. Two deliberate differences from
+/// MoorDyn: the added mass enters through the kinetic energy (its rate of change included, so the
+/// line is passive), and the axial force never pushes (see TetherParameters::compressive_damping).
 ///
 /// Frames and units: world NED (z down, mean sea surface at z = 0, free surface at z = −ζ), SI.
 /// Environments are duck-typed (`Env`): anything with `water_density()`, `gravity()`,
@@ -40,8 +42,9 @@ enum class EndMode {
 
 /// \brief User-facing physical description of a lumped-mass tether (all magnitudes positive).
 ///
-/// Defaults are the benchmark line of shared/reference/tether.md (20 m, d 8 mm, 0.07 kg/m,
-/// EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1) with 100 segments and MoorDyn's seabed constants.
+/// Defaults are a small ROV tether used as kelp's benchmark line (20 m, d 8 mm, 0.07 kg/m,
+/// EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1) with 100 segments and MoorDyn's seabed constants
+/// (MoorDyn v2 documentation: kBot 3e6 Pa/m, cBot 3e5 Pa s/m).
 /// \tparam Scalar double or float.
 template <typename Scalar>
 struct TetherParameters {
@@ -55,8 +58,15 @@ struct TetherParameters {
   Scalar mass_per_length = Scalar(0.07);
   /// Axial stiffness EA [N].
   Scalar axial_stiffness = Scalar(1e5);
-  /// Internal (axial) damping BA [N s]: the damping tension is BA · ε̇ (ε the strain).
+  /// Internal (axial) damping BA [N s]: the damping tension is BA · ε̇ (ε the strain). The total
+  /// axial force EA·max(0, ε) + BA·ε̇ is clamped at zero, so a contracting segment never pushes
+  /// (unless `compressive_damping`).
   Scalar internal_damping = Scalar(0);
+  /// When true, the internal dashpot acts in compression too, as in MoorDyn v2 (Line.cpp: the
+  /// damping tension is added whether or not the segment is stretched, and the sum is not
+  /// clamped): use it to reproduce MoorDyn. Default false: a cable cannot push, so the total
+  /// axial force is max(0, EA·max(0, ε) + BA·ε̇).
+  bool compressive_damping = false;
   /// Bending stiffness EI [N m²] (0: a perfectly flexible line). Discrete bending energy
   /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
   /// κ = θ/l. Enters the implicit schemes through the residual only (not the Jacobian: it would
@@ -76,6 +86,11 @@ struct TetherParameters {
   Scalar seabed_stiffness = Scalar(3e6);
   /// Seabed damping cb [Pa s/m]: contact damping ż·cb·d·l_i while in contact (MoorDyn's 3e5).
   Scalar seabed_damping = Scalar(3e5);
+  /// Penetration [m] over which the seabed damping ramps up from zero at first touch to its full
+  /// value, so that the normal contact force is continuous (MoorDyn switches the damping on at
+  /// once, a force step of cb·d·l_i·ż at touchdown that leaves Newton's method nothing to
+  /// converge to when a node lands in a step; 0 reproduces it).
+  Scalar seabed_damping_depth = Scalar(1e-3);
   /// Seabed Coulomb friction coefficient μ_f [-] (0 disables friction).
   Scalar seabed_friction = Scalar(0);
   /// Horizontal speed [m/s] below which seabed friction is viscous (saturated-viscous model).
@@ -92,6 +107,35 @@ struct TetherParameters {
   Scalar end_point_mass = Scalar(0);
 };
 
+/// \brief Checks tether parameters.
+/// \throws kelp::invalid_argument naming the offending field (segments ≥ 1; length, diameter,
+/// mass_per_length, axial_stiffness, friction_velocity > 0; the rest finite and ≥ 0).
+template <typename Scalar>
+void validate(const TetherParameters<Scalar>& p) {
+  KELP_CHECK(p.segments >= 1, "segments must be >= 1");
+  check_positive(p.length, "length");
+  check_positive(p.diameter, "diameter");
+  check_positive(p.mass_per_length, "mass_per_length");
+  check_positive(p.axial_stiffness, "axial_stiffness");
+  check_non_negative(p.internal_damping, "internal_damping");
+  check_non_negative(p.bending_stiffness, "bending_stiffness");
+  check_non_negative(p.normal_drag, "normal_drag");
+  check_non_negative(p.tangential_drag, "tangential_drag");
+  check_non_negative(p.normal_added_mass, "normal_added_mass");
+  check_non_negative(p.tangential_added_mass, "tangential_added_mass");
+  check_non_negative(p.seabed_stiffness, "seabed_stiffness");
+  check_non_negative(p.seabed_damping, "seabed_damping");
+  check_non_negative(p.seabed_damping_depth, "seabed_damping_depth");
+  check_non_negative(p.seabed_friction, "seabed_friction");
+  check_positive(p.friction_velocity, "friction_velocity");
+  check_non_negative(p.start_point_mass, "start_point_mass");
+  check_non_negative(p.end_point_mass, "end_point_mass");
+  KELP_CHECK(p.start_mode == EndMode::kinematic || p.start_mode == EndMode::free,
+             "start_mode must be EndMode::kinematic or EndMode::free");
+  KELP_CHECK(p.end_mode == EndMode::kinematic || p.end_mode == EndMode::free,
+             "end_mode must be EndMode::kinematic or EndMode::free");
+}
+
 /// \brief Validated tether parameters with the per-step constants precomputed.
 ///
 /// Build once from `TetherParameters`; constant afterwards.
@@ -99,27 +143,10 @@ struct TetherParameters {
 template <typename Scalar>
 class TetherModel {
  public:
-  /// \brief Validates `p` and precomputes constants.
-  /// \throws kelp::invalid_argument naming the offending field (segments ≥ 1; length, diameter,
-  /// mass_per_length, axial_stiffness > 0; the rest finite and ≥ 0).
+  /// \brief Validates `p` (see validate(const TetherParameters&)) and precomputes constants.
+  /// \throws kelp::invalid_argument naming the offending field.
   explicit TetherModel(const TetherParameters<Scalar>& p) : p_(p) {
-    KELP_CHECK(p.segments >= 1, "segments must be >= 1");
-    check_positive(p.length, "length");
-    check_positive(p.diameter, "diameter");
-    check_positive(p.mass_per_length, "mass_per_length");
-    check_positive(p.axial_stiffness, "axial_stiffness");
-    check_non_negative(p.internal_damping, "internal_damping");
-    check_non_negative(p.bending_stiffness, "bending_stiffness");
-    check_non_negative(p.normal_drag, "normal_drag");
-    check_non_negative(p.tangential_drag, "tangential_drag");
-    check_non_negative(p.normal_added_mass, "normal_added_mass");
-    check_non_negative(p.tangential_added_mass, "tangential_added_mass");
-    check_non_negative(p.seabed_stiffness, "seabed_stiffness");
-    check_non_negative(p.seabed_damping, "seabed_damping");
-    check_non_negative(p.seabed_friction, "seabed_friction");
-    check_positive(p.friction_velocity, "friction_velocity");
-    check_non_negative(p.start_point_mass, "start_point_mass");
-    check_non_negative(p.end_point_mass, "end_point_mass");
+    validate(p);
     const int n = p.segments;
     const Scalar N = Scalar(n);
     l_ = p.length / N;
@@ -138,6 +165,7 @@ class TetherModel {
     }
     if (p.start_mode == EndMode::free) node_mass_(0) += p.start_point_mass;
     if (p.end_mode == EndMode::free) node_mass_(n) += p.end_point_mass;
+    min_node_mass_ = node_mass_.minCoeff();
     first_free_ = p.start_mode == EndMode::kinematic ? 1 : 0;
     last_free_ = p.end_mode == EndMode::kinematic ? n - 1 : n;
   }
@@ -161,6 +189,9 @@ class TetherModel {
   /// \brief Structural mass of node i [kg] (μ times its share of length, plus the point mass of a
   /// free end).
   Scalar node_mass(int i) const { return node_mass_(i); }
+  /// \brief Smallest structural node mass [kg]: a lower bound on every eigenvalue of every node
+  /// mass matrix (added mass only adds to it).
+  Scalar min_node_mass() const { return min_node_mass_; }
   /// \brief Displaced volume of node i [m³] (A times its share of length).
   Scalar node_volume(int i) const { return node_volume_(i); }
   /// \brief Length of line lumped at node i [m] (l, or l/2 at the ends).
@@ -176,12 +207,18 @@ class TetherModel {
 
  private:
   TetherParameters<Scalar> p_;
-  Scalar l_, inv_l_, ea_over_l_, ba_over_l_, area_;
+  Scalar l_, inv_l_, ea_over_l_, ba_over_l_, area_, min_node_mass_;
   VectorX<Scalar> node_mass_, node_volume_, node_length_;
   int first_free_ = 1, last_free_ = 0;
 };
 
-/// \brief Positions and velocities of all N + 1 nodes, NED.
+/// \brief Everything that determines the tether's next step: positions and velocities of all
+/// N + 1 nodes (NED), the clock, and the integrator history (BDF2's previous step, also the
+/// implicit schemes' velocity predictor).
+///
+/// Saving a copy of a state and restoring it later reproduces the following steps bit for bit;
+/// the workspace holds scratch only. The clock is a double for every Scalar, so a float tether
+/// keeps exact time over any run length (10 ms steps for 24 h end within 1e-10 s relative).
 /// \tparam Scalar double or float.
 template <typename Scalar>
 struct TetherState {
@@ -189,14 +226,29 @@ struct TetherState {
   Matrix3X<Scalar> position;
   /// Node velocities, 3 × (N+1), NED [m/s].
   Matrix3X<Scalar> velocity;
-  /// Simulation time [s].
-  Scalar time = Scalar(0);
+  /// Simulation time [s] (double for every Scalar: one clock that does not drift).
+  double time = 0.0;
+  /// Positions one step before `position` (integrator history; valid when previous_dt > 0).
+  Matrix3X<Scalar> previous_position;
+  /// Velocities one step before `velocity` (integrator history; valid when previous_dt > 0).
+  Matrix3X<Scalar> previous_velocity;
+  /// Length of the step that led from the previous positions to `position` [s]; 0 when there
+  /// is no history (a new state, or one whose positions were set by hand: call clear_history()).
+  double previous_dt = 0.0;
 
   TetherState() = default;
-  /// \brief Zero state sized for `model`.
+  /// \brief Zero state sized for `model`, no history.
   explicit TetherState(const TetherModel<Scalar>& model)
       : position(Matrix3X<Scalar>::Zero(3, model.nodes())),
-        velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {}
+        velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        previous_position(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {}
+
+  /// \brief True when the state carries the previous step (BDF2 history).
+  bool has_history() const { return previous_dt > 0.0; }
+  /// \brief Forgets the integrator history: the next implicit step starts with backward Euler.
+  /// Call it after editing `position` or `velocity` by hand.
+  void clear_history() { previous_dt = 0.0; }
 };
 
 /// \brief Motion of a kinematic end point over a step, NED.
@@ -218,6 +270,8 @@ struct EndMotion {
   }
   /// \brief Velocity τ seconds into the step.
   Vector3<Scalar> velocity_at(Scalar tau) const { return velocity + tau * acceleration; }
+  /// \brief The same motion seen from τ seconds into the step (position and velocity at τ).
+  EndMotion after(Scalar tau) const { return {position_at(tau), velocity_at(tau), acceleration}; }
 };
 
 /// \brief Prescribed motion of both ends (an entry is ignored when that end is free).
@@ -228,6 +282,8 @@ struct TetherBoundary {
   /// Node N (far end, e.g. the AUV attachment point).
   EndMotion<Scalar> end;
 
+  /// \brief The same end motions seen from τ seconds into the step (for sub-steps).
+  TetherBoundary after(Scalar tau) const { return {start.after(tau), end.after(tau)}; }
   /// \brief Both ends fixed at the given NED points [m].
   template <typename D1, typename D2>
   static TetherBoundary fixed(const Eigen::MatrixBase<D1>& start_ned,
@@ -248,6 +304,38 @@ struct EndForces {
   Vector3<Scalar> on_end = Vector3<Scalar>::Zero();
 };
 
+/// \brief A copy of a TetherState kept in preallocated buffers (no allocation when saved or
+/// restored once sized), so that a failed driver or step can put the state back bit for bit.
+template <typename Scalar>
+struct StateBackup {
+  Matrix3X<Scalar> position, velocity, previous_position, previous_velocity;
+  double time = 0.0, previous_dt = 0.0;
+
+  /// \brief Sizes the buffers for `nodes` nodes.
+  void resize(int nodes) {
+    for (Matrix3X<Scalar>* m : {&position, &velocity, &previous_position, &previous_velocity})
+      m->setZero(3, nodes);
+  }
+  /// \brief Copies `s` (history included).
+  void save(const TetherState<Scalar>& s) {
+    position = s.position;
+    velocity = s.velocity;
+    previous_position = s.previous_position;
+    previous_velocity = s.previous_velocity;
+    time = s.time;
+    previous_dt = s.previous_dt;
+  }
+  /// \brief Puts the saved state back into `s`.
+  void restore(TetherState<Scalar>& s) const {
+    s.position = position;
+    s.velocity = velocity;
+    s.previous_position = previous_position;
+    s.previous_velocity = previous_velocity;
+    s.time = time;
+    s.previous_dt = previous_dt;
+  }
+};
+
 /// \brief Preallocated mutable buffers for force evaluation and integration (Pinocchio's `Data`).
 ///
 /// Built from a model; every step reuses these buffers, so no heap allocation happens in a step.
@@ -265,7 +353,14 @@ struct TetherWorkspace {
   VectorX<Scalar> mass_iso;             ///< a_i: M_i = a_i I + b_i q qᵀ [kg]
   VectorX<Scalar> mass_tan;             ///< b_i [kg]
   VectorX<Scalar> seabed_force;         ///< upward normal seabed contact force on node i [N]
-  VectorX<Scalar> submerged;            ///< 1 if node i is below the free surface, else 0
+  /// Seabed normal force that sets the friction limit μ_f N when `frozen_friction` [N]
+  VectorX<Scalar> friction_normal;
+  /// Set by the implicit steps for the duration of their Newton iteration: the friction limit
+  /// then uses the normal force at the start of the step (`friction_normal`), a first-order lag
+  /// that keeps the friction's dependence on the contact force (which is not symmetric, so not in
+  /// the block Jacobian) from stalling Newton's method at impacts.
+  bool frozen_friction = false;
+  VectorX<Scalar> submerged;  ///< submerged fraction φ_i of node i (1 wet, 0 in air)
   // --- per evaluation, per segment ------------------------------------------------------------
   Matrix3X<Scalar> direction;        ///< unit vector u_s from node s to s+1 (0 if zero length)
   VectorX<Scalar> tension;           ///< axial force T_s: elastic (≥ 0) plus dashpot [N]
@@ -273,7 +368,7 @@ struct TetherWorkspace {
   // --- Jacobian ingredients (filled when requested) --------------------------------------------
   VectorX<Scalar> seg_k_uu;  ///< axial stiffness minus geometric term: EA/l − T⁺/l_s or −T⁺/l_s
   VectorX<Scalar> seg_k_perp;  ///< geometric stiffness T/l_s [N/m]
-  VectorX<Scalar> seg_c_uu;    ///< BA/l [N s/m]
+  VectorX<Scalar> seg_c_uu;    ///< BA/l, or 0 while the axial force is clamped at zero [N s/m]
   /// −∂F_i/∂v_i from drag and seabed, symmetric (xx, yx, zx, yy, zy, zz) [N s/m]
   Eigen::Matrix<Scalar, 6, Eigen::Dynamic> node_dv;
   VectorX<Scalar> node_kz;  ///< −∂F_z/∂z from the seabed [N/m]
@@ -282,20 +377,20 @@ struct TetherWorkspace {
   Matrix3X<Scalar> rhs, delta;                         ///< Newton right-hand side and correction
   Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
   VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
-  VectorX<Scalar> seg_active;     ///< 1 if segment s is taut in the Newton step's linear model
+  VectorX<Scalar> seg_true_c_uu;  ///< seg_c_uu saved while the active-set passes modify it
+  VectorX<Scalar> seg_rate;       ///< segment stretch rate u_s·(v_{s+1} − v_s) [m/s]
+  /// Branch of segment s in the Newton step's linear model: 0 no force (slack, or clamped at
+  /// zero), 1 dashpot only (slack), 2 elastic plus dashpot (taut)
+  VectorX<Scalar> seg_branch;
   Matrix3X<Scalar> x0, v0, x1, v1, xs, vs;  ///< integrator stages and Newton/line-search iterates
-  /// State at entry of `advance` / `solve_static_equilibrium`, restored when they fail (not used
-  /// by the single steps)
-  Matrix3X<Scalar> kx, kv;
-  /// State before the last committed step (BDF2 history, velocity predictor)
-  Matrix3X<Scalar> x_prev, v_prev;
-  bool has_previous = false;        ///< x_prev, v_prev hold a committed step
-  Scalar history_time = Scalar(0);  ///< time of the state committed by the last step [s]
+  /// State at entry of a driver (`advance`, `solve_static_equilibrium`), restored if it fails
+  StateBackup<Scalar> entry_backup;
+  /// State at entry of an implicit step that is retried in sub-steps, restored if they fail
+  StateBackup<Scalar> retry_backup;
   /// water_velocity and water_acceleration hold zeros (set by resize and by compute_forces in a
   /// still environment, whose water query it then skips; cleared when the query runs)
   bool water_is_zero = false;
-  Scalar previous_dt = Scalar(0);  ///< step of the stored history [s]
-  EndForces<Scalar> end_forces;    ///< forces on the attachment points after the last step
+  EndForces<Scalar> end_forces;  ///< forces on the attachment points after the last step
 
   TetherWorkspace() = default;
   /// \brief Buffers sized for `model`.
@@ -304,20 +399,21 @@ struct TetherWorkspace {
   /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
   void resize(int nodes) {
     const int n = nodes, s = nodes - 1;
-    for (Matrix3X<Scalar>* m :
-         {&force, &bending, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs,
-          &delta, &x0, &v0, &x1, &v1, &xs, &vs, &kx, &kv, &x_prev, &v_prev})
+    for (Matrix3X<Scalar>* m : {&force, &bending, &acceleration, &tangent, &water_velocity,
+                                &water_acceleration, &rhs, &delta, &x0, &v0, &x1, &v1, &xs, &vs})
       m->setZero(3, n);
-    for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &submerged, &node_kz})
+    for (VectorX<Scalar>* v :
+         {&mass_iso, &mass_tan, &seabed_force, &friction_normal, &submerged, &node_kz})
       v->setZero(n);
     direction.setZero(3, s);
     rhs_true.setZero(3, n);
     for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu,
-                               &seg_true_k_uu, &seg_active})
+                               &seg_true_k_uu, &seg_true_c_uu, &seg_rate, &seg_branch})
       v->setZero(s);
     node_dv.setZero(6, n);
     block_inv.setZero(6, n);
-    has_previous = false;
+    entry_backup.resize(n);
+    retry_backup.resize(n);
     water_is_zero = true;
   }
 };
@@ -367,11 +463,27 @@ NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n) {
   return t;
 }
 
-/// True when a node at NED depth z [m] is in the water under a free surface at elevation ζ [m]
-/// (z ≥ −ζ; a node exactly at the surface counts as wet).
+/// Submerged fraction φ of a node at NED depth z [m] under a free surface at elevation ζ [m]:
+/// the cable's cross-section of diameter D goes under over one diameter, taken as a linear ramp
+/// φ = clamp(1 + (z + ζ)/D, 0, 1) (1: wet, a node at the surface included; 0: in air, at least
+/// one diameter above the surface). Buoyancy, drag, fluid inertia and
+/// added mass scale with φ, so the node forces are continuous in the positions (an on/off switch
+/// at the surface would leave Newton's method no solution to converge to when a floating line
+/// rests at the surface).
 template <typename Scalar>
-bool is_wet(Scalar z, Scalar zeta) {
-  return !(z < -zeta);
+Scalar submerged_fraction(Scalar z, Scalar zeta, Scalar diameter) {
+  const Scalar f = Scalar(1) + (z + zeta) / diameter;
+  return f >= Scalar(1) ? Scalar(1) : (f > Scalar(0) ? f : Scalar(0));
+}
+
+/// Antiderivative Φ of submerged_fraction in the depth d = z + ζ, zero in air and d + D/2 when
+/// wet: the buoyancy potential of a node is −ρ V g Φ [J].
+template <typename Scalar>
+Scalar submerged_depth_integral(Scalar z, Scalar zeta, Scalar diameter) {
+  const Scalar d = z + zeta;
+  if (d >= Scalar(0)) return d + Scalar(0.5) * diameter;
+  if (d <= -diameter) return Scalar(0);
+  return (d + diameter) * (d + diameter) / (Scalar(2) * diameter);
 }
 
 /// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.
@@ -397,23 +509,32 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 /// (`ws.mass_iso`, `ws.mass_tan`), plus tensions, tangents and seabed forces. Per node i:
 /// \f[ F_i = T_i u_i − T_{i−1} u_{i−1} + (m_i − ρ V_i) g e_z + F^{drag}_i + F^{FK}_i + F^{bed}_i
 /// \f]
-/// - axial: T_s = EA ε_s (only when l_s > l: the elastic force never compresses) + BA ε̇_s (the
-///   internal dashpot acts at any length, as in MoorDyn; with BA = 0 a slack segment carries no
-///   force);
+/// - axial: T_s = max(0, EA·max(0, ε_s) + BA ε̇_s): the elastic part acts only when l_s > l, the
+///   dashpot at any length, and the sum is clamped at zero so that a segment never pushes
+///   (`compressive_damping` drops the clamp, as MoorDyn does);
 /// - drag (Morison, on v_r = u_water − v_i): ½ρ d l_i Cdn |v_rn| v_rn + ½ρ π d l_i Cdt |v_rt| v_rt;
 /// - fluid inertia: ρ V_i [(1 + Can)(I − q qᵀ) + (1 + Cat) q qᵀ] a_water;
-/// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force);
+/// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force from a
+///   previous acceleration), with the terms of its rate of change: the added mass is part of the
+///   kinetic energy ½ v_rᵀ M_i v_r (v_r = v_i − u_water), and since M_i = a_i I + b_i q_i q_iᵀ
+///   turns with the tangent, Lagrange's equations add G_i = −b_i[(q̇_i·v_r) q_i + (q_i·v_r) q̇_i]
+///   on node i and ±b_i (q_i·v_r)(I − q_i q_iᵀ) v_r/|c_i| on the two nodes of its chord c_i
+///   (∂T/∂x). Without them the line gains energy whenever Cat ≠ Can; with them the model is
+///   passive (Lamb 1932, Hydrodynamics §137: fluid kinetic energy in Lagrange's equations);
 /// - seabed (z_i > h): upward (z_i − h) kb d l_i + ż_i cb d l_i (≥ 0), and saturated-viscous
 ///   friction −μ_f N v_h / max(|v_h|, v_f);
-/// - nodes above the free surface (z_i < −ζ) get no buoyancy, drag, fluid inertia or added mass.
+/// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,
+///   which goes from 1 to 0 as the node rises through the free surface over one cable diameter
+///   (detail::submerged_fraction): nodes in air get none.
 /// No heap allocation.
 /// \tparam WithJacobian also fill the Jacobian ingredients (`ws.seg_*`, `ws.node_dv`,
-/// `ws.node_kz`). \param[in] model the tether \param[in,out] ws workspace \param[in] env
-/// environment \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v
-/// velocities [m/s]
+/// `ws.node_kz`); the Jacobian leaves out the added-mass rate terms G_i (quadratic in the
+/// velocities, small beside the mass term M/h of a step).
+/// \param[in] model the tether \param[in,out] ws workspace \param[in] env environment
+/// \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v velocities [m/s]
 template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
 void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
-                    Scalar t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
+                    double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
   using std::abs;
   using std::sqrt;
   using V3 = Vector3<Scalar>;
@@ -438,16 +559,19 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     ws.water_is_zero = true;
   }
 
-  // Segments: elastic tension EA·ε when stretched (never compressive) plus the internal dashpot
-  // BA·ε̇, which, as in MoorDyn (Line.cpp: Td), acts whether or not the segment is stretched, so
-  // that the axial force is continuous in the node positions (a dashpot switched on at l_s = l
-  // would make it jump, which Newton's method cannot handle). Returns T_s u_s.
+  // Segments: elastic tension EA·ε when stretched plus the internal dashpot BA·ε̇, which acts
+  // whether or not the segment is stretched, so that the axial force is continuous in the node
+  // positions (a dashpot switched on at l_s = l would make it jump, which Newton's method cannot
+  // handle); the sum is clamped at zero (a cable cannot push) unless compressive_damping. The
+  // clamp is a kink like the one of the elastic force at l_s = l; the implicit schemes' active
+  // set handles both (detail::active_set_direction). Returns T_s u_s.
+  const bool clamp = !p.compressive_damping;
   const auto segment = [&](int s) -> V3 {
     const V3 d = x.col(s + 1) - x.col(s);
     const Scalar ls2 = d.squaredNorm();
     const Scalar ls = sqrt(ls2);
     ws.stretched_length(s) = ls;
-    Scalar tension(0), k_axial(0);
+    Scalar tension(0), k_axial(0), c_axial(ba_l);
     V3 u = V3::Zero();
     if (ls > Scalar(0)) {
       const Scalar inv_ls = Scalar(1) / ls;
@@ -456,7 +580,17 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
         tension = ea * (ls - l) * inv_l;
         k_axial = ea_l;
       }
-      if (ba != Scalar(0)) tension += ba * u.dot(v.col(s + 1) - v.col(s)) * inv_l;
+      if (ba != Scalar(0)) {
+        const Scalar rate = u.dot(v.col(s + 1) - v.col(s));
+        if constexpr (WithJacobian) ws.seg_rate(s) = rate;
+        tension += ba * rate * inv_l;
+        if (clamp && !(tension > Scalar(0))) {
+          tension = Scalar(0);
+          k_axial = c_axial = Scalar(0);
+        }
+      } else if constexpr (WithJacobian) {
+        ws.seg_rate(s) = Scalar(0);
+      }
       if constexpr (WithJacobian) {
         // ∂(T u)/∂x_{s+1} = k_axial u uᵀ + (T/l_s)(I − u uᵀ); the geometric term is kept only for
         // T > 0 so that the Jacobian stays positive semi-definite.
@@ -465,11 +599,11 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
         ws.seg_k_perp(s) = k_perp;
       }
     } else if constexpr (WithJacobian) {
-      ws.seg_k_uu(s) = ws.seg_k_perp(s) = Scalar(0);
+      ws.seg_k_uu(s) = ws.seg_k_perp(s) = ws.seg_rate(s) = Scalar(0);
     }
     ws.direction.col(s) = u;
     ws.tension(s) = tension;
-    if constexpr (WithJacobian) ws.seg_c_uu(s) = ba_l;
+    if constexpr (WithJacobian) ws.seg_c_uu(s) = c_axial;
     return tension * u;
   };
 
@@ -504,6 +638,17 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
   const Scalar bed_k = p.seabed_stiffness * p.diameter, bed_c = p.seabed_damping * p.diameter;
   struct NodeConstants {
     Scalar li, dry_weight, wet_weight, rho_vol, kn, kt, mass_dry, mass_iso_wet, mass_tan_wet;
+    // The constants of a node with submerged fraction φ (fluid terms scaled by φ).
+    NodeConstants submerged(Scalar phi) const {
+      NodeConstants c = *this;
+      c.wet_weight = dry_weight + phi * (wet_weight - dry_weight);
+      c.rho_vol = phi * rho_vol;
+      c.kn = phi * kn;
+      c.kt = phi * kt;
+      c.mass_iso_wet = mass_dry + phi * (mass_iso_wet - mass_dry);
+      c.mass_tan_wet = phi * mass_tan_wet;
+      return c;
+    }
   };
   const auto node_constants = [&](int i) {
     const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
@@ -519,7 +664,10 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
   };
   const NodeConstants kinds[3] = {node_constants(0), node_constants(n > 1 ? 1 : 0),
                                   node_constants(n)};
+  // Added-mass rate terms (see the function's documentation); none when Cat = Can (b = 0).
+  const bool mass_turns = cat != can;
   V3 tu_prev = V3::Zero();  // T_{i−1} u_{i−1}
+  V3 carry = V3::Zero();    // ∂T/∂x_{i} from node i − 1's tangent, added when node i is built
   for (int i = 0; i <= n; ++i) {
     // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends.
     // The drag below is written with the unnormalised chord and 1/|c|² so that its square root
@@ -539,12 +687,19 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       f = -tu_prev;
     }
     if (bending) f += ws.bending.col(i);
+    f += carry;
+    carry.setZero();
 
-    const NodeConstants& nc = kinds[i == 0 ? 0 : (i == n ? 2 : 1)];
-    const Scalar li = nc.li;
+    const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
+    const Scalar li = kinds[kind].li;
     const Scalar zeta = still ? Scalar(0) : Scalar(env.surface_elevation(x(0, i), x(1, i), t));
-    const bool wet = detail::is_wet(Scalar(x(2, i)), zeta);
-    ws.submerged(i) = wet ? Scalar(1) : Scalar(0);
+    const Scalar phi = detail::submerged_fraction(Scalar(x(2, i)), zeta, p.diameter);
+    ws.submerged(i) = phi;
+    const bool wet = phi > Scalar(0);
+    // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
+    NodeConstants band;
+    const bool in_band = wet && phi < Scalar(1);
+    const NodeConstants& nc = in_band ? (band = kinds[kind].submerged(phi)) : kinds[kind];
     // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
     Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
     if (wet) {
@@ -563,6 +718,25 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
         f += nc.rho_vol * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
       ws.mass_iso(i) = nc.mass_iso_wet;
       ws.mass_tan(i) = nc.mass_tan_wet;
+      if (mass_turns && inv_c > Scalar(0)) {
+        // Added-mass rate terms, written with w_r = u_water − v = −v_r (vr above; both factors
+        // of each term flip sign): G_i = b[(q̇·w_r) q + s q̇] and ∂T/∂x = ±b s P w_r/|c| with
+        // s = q·w_r = vq, P w_r = vn, q̇ = P (v_hi − v_lo)/|c|.
+        const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
+        const Scalar b = nc.mass_tan_wet;
+        const V3 dc = v.col(hi) - v.col(lo);
+        const V3 qdot = (dc - q.dot(dc) * q) * inv_c;
+        f += b * (qdot.dot(vn) * q + vq * qdot);
+        const V3 w = (b * vq * inv_c) * vn;
+        if (hi == i)
+          f += w;
+        else
+          carry = w;
+        if (lo == i)
+          f -= w;
+        else
+          ws.force.col(lo) -= w;
+      }
       if constexpr (WithJacobian) {
         // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ
         // = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
@@ -584,15 +758,22 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     Scalar normal(0), kz(0);
     const Scalar pen = x(2, i) - bed;
     if (pen > Scalar(0)) {
-      normal = (pen * bed_k + v(2, i) * bed_c) * li;
+      const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
+      normal = (pen * bed_k + v(2, i) * bed_c * ramp) * li;
       if (normal > Scalar(0)) {
         f(2) -= normal;
         kz = bed_k * li;
-        if constexpr (WithJacobian) dv[5] += bed_c * li;
+        // The ramp's ∂/∂z while landing (ż > 0); left out when rising, where it is negative.
+        if (ramp < Scalar(1) && v(2, i) > Scalar(0))
+          kz += v(2, i) * bed_c * li / p.seabed_damping_depth;
+        if constexpr (WithJacobian) dv[5] += bed_c * ramp * li;
         if (p.seabed_friction > Scalar(0)) {
           const Scalar vh2 = v(0, i) * v(0, i) + v(1, i) * v(1, i);
           const Scalar vf = p.friction_velocity;
-          const Scalar fmax = p.seabed_friction * normal;
+          // The implicit steps hold the normal force of the start of the step (see
+          // TetherWorkspace::frozen_friction).
+          const Scalar fmax =
+              p.seabed_friction * (ws.frozen_friction ? ws.friction_normal(i) : normal);
           const Scalar coef = vh2 > vf * vf ? fmax / sqrt(vh2) : fmax / vf;
           f(0) -= coef * v(0, i);
           f(1) -= coef * v(1, i);
@@ -606,6 +787,8 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       }
     }
     ws.seabed_force(i) = normal;
+    // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
+    if (in_band) kz += kinds[kind].rho_vol * g / p.diameter;
     if constexpr (WithJacobian) {
       for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
       ws.node_kz(i) = kz;
@@ -654,7 +837,8 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
 }
 
 /// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
-/// the submerged weight −Σ (mᵢ − ρVᵢ) g zᵢ (NED z down) + elastic ½ EA/l Σ (l_s − l)² over
+/// the weight −Σ mᵢ g zᵢ (NED z down) and of the buoyancy Σ ρVᵢ g Φ(zᵢ + ζ) (Φ the depth of a
+/// wet node plus D/2, see detail::submerged_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
 /// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
 /// tangents and wetness itself.
 template <typename Scalar, typename Env>
@@ -682,26 +866,39 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
     const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n).q;
     const Scalar zeta =
         Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
-    const bool wet = detail::is_wet(state.position(2, i), zeta);
-    const Scalar m = model.node_mass(i), rv = wet ? rho * model.node_volume(i) : Scalar(0);
+    const Scalar z = state.position(2, i);
+    const Scalar phi = detail::submerged_fraction(z, zeta, p.diameter);
+    const Scalar m = model.node_mass(i), rv = phi * rho * model.node_volume(i);
     const Vector3<Scalar> vi = state.velocity.col(i);
     const Scalar vq = vi.dot(q);
     e += Scalar(0.5) * ((m + rv * p.normal_added_mass) * vi.squaredNorm() +
                         rv * (p.tangential_added_mass - p.normal_added_mass) * vq * vq);
-    e -= (m - rv) * g * state.position(2, i);
+    e -= m * g * z -
+         rho * model.node_volume(i) * g * detail::submerged_depth_integral(z, zeta, p.diameter);
   }
   return e;
 }
 
-/// \brief Checks that a state fits the model and is finite.
-/// \throws kelp::invalid_argument naming `state.position` / `state.velocity`.
+/// \brief Checks that a state fits the model and is finite (its history too, when it has one).
+/// \throws kelp::invalid_argument naming `state.position` / `state.velocity` / `state.time` /
+/// `state.previous_position` / `state.previous_velocity` / `state.previous_dt`.
 template <typename Scalar>
 void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
-  KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
+  KELP_CHECK(state.position.rows() == 3 && state.velocity.rows() == 3 &&
+                 state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
              "state.position and state.velocity must have segments + 1 columns");
   check_all_finite(state.position, "state.position");
   check_all_finite(state.velocity, "state.velocity");
   check_finite(state.time, "state.time");
+  check_non_negative(state.previous_dt, "state.previous_dt");
+  if (state.has_history()) {
+    KELP_CHECK(state.previous_position.cols() == model.nodes() &&
+                   state.previous_velocity.cols() == model.nodes(),
+               "state.previous_position and state.previous_velocity must have segments + 1 "
+               "columns when state.previous_dt > 0");
+    check_all_finite(state.previous_position, "state.previous_position");
+    check_all_finite(state.previous_velocity, "state.previous_velocity");
+  }
 }
 
 /// \brief Checks that the boundary motion is finite.

@@ -1,0 +1,324 @@
+// Integrator contracts of the lumped-mass tether: a passive line with the default added mass, a
+// cable that never pushes, accuracy that does not fall as dt shrinks, steps that are never
+// committed unconverged, round-off that is not taken for a physical failure, the integrator
+// history in the state, and a clock that does not drift.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/environment/sea_state.hpp"
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+#include "tether_test_support.hpp"
+
+namespace kt = kelp::tether;
+using kelp::Vector3;
+
+namespace {
+
+// The benchmark line (N segments) hanging between (0, 0, 0) and (10, 0, 5) in still seawater,
+// rotated 60° about its chord so that it swings.
+kt::TetherStated swinging(const kt::TetherModeld& model) {
+  const kelp::environment::Environmentd water;
+  const Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  auto s = kt::catenary_initial_state(model, water, a, b);
+  const Eigen::AngleAxisd rot(kelp::pi / 3, (b - a).normalized());
+  for (int i = 0; i < model.nodes(); ++i) s.position.col(i) = a + rot * (s.position.col(i) - a);
+  return s;
+}
+
+bool bitwise_equal(const kelp::Matrix3X<double>& a, const kelp::Matrix3X<double>& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * std::size_t(a.size())) == 0;
+}
+
+bool bitwise_equal(const kt::TetherStated& a, const kt::TetherStated& b) {
+  return bitwise_equal(a.position, b.position) && bitwise_equal(a.velocity, b.velocity) &&
+         std::memcmp(&a.time, &b.time, sizeof(double)) == 0;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "added mass keeps the line passive: energy drift with Can = 1 within 2x that with Can = 0",
+    "[tether][energy][added_mass]") {
+  // 10 segments in deep still water, no drag, no internal damping, swinging from 60°; RK4 at
+  // 0.5× and 0.1× its stable step for 20 s. The node mass aI + b q qᵀ turns with the tangent:
+  // without the terms of its rate of change the line gained 0.22–0.27 J here (peak kinetic
+  // energy ≈ 4 J) with Can = 1, against ≤ 0.054 J with Can = 0.
+  const kelp::environment::Environmentd env;
+  const Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  const auto bnd = kt::TetherBoundaryd::fixed(a, b);
+  for (double fraction : {0.5, 0.1}) {
+    double drift[2] = {0, 0};
+    for (int with_added_mass = 0; with_added_mass < 2; ++with_added_mass) {
+      auto p = kelp_test::benchmark_line<double>(10);
+      p.normal_drag = p.tangential_drag = 0.0;
+      if (!with_added_mass) p.normal_added_mass = 0.0;  // else the default Can = 1
+      const kt::TetherModeld model(p);
+      kt::TetherWorkspaced ws(model);
+      auto s = swinging(model);
+      const double dt =
+          kt::estimate_stable_dt(model, kt::Integrator::rk4, env.water_density(), fraction);
+      const double e0 = kt::tether_energy(model, env, s);
+      while (s.time < 20.0) {
+        kt::step_rk4(model, ws, env, s, bnd, dt);
+        drift[with_added_mass] =
+            std::max(drift[with_added_mass], std::abs(kt::tether_energy(model, env, s) - e0));
+      }
+    }
+    INFO("stable-dt fraction " << fraction << ": drift Can = 0 " << drift[0] << " J, Can = 1 "
+                               << drift[1] << " J");
+    CHECK(drift[1] <= 2.0 * drift[0]);
+    CHECK(drift[1] < 0.06);
+  }
+}
+
+TEST_CASE("a cable never pushes: the axial force stays >= 0 with internal damping",
+          "[tether][clamp]") {
+  // 20 m line, 50 segments, BA = 100 N s; the ASV end rides the waves of the moderate preset
+  // 0.1 m below the surface, the AUV end is fixed at (10, 0, 5); BDF2 at 10 ms for 60 s. The
+  // unclamped dashpot (compressive_damping, MoorDyn's model) pushes here.
+  const auto env =
+      kelp::environment::make_environment<double>(kelp::environment::presets::moderate());
+  const Vector3<double> asv(0, 0, 0.1), auv(10, 0, 5);
+  double min_force[2] = {0, 0};
+  for (int compressive = 0; compressive < 2; ++compressive) {
+    auto p = kelp_test::benchmark_line<double>(50);
+    p.internal_damping = 100.0;
+    p.compressive_damping = compressive == 1;
+    const kt::TetherModeld model(p);
+    kt::TetherWorkspaced ws(model);
+    kt::TetherStated s = kt::catenary_initial_state(model, env, asv, auv);
+    const double dt = 0.01;
+    for (int k = 0; k < 6000; ++k) {
+      auto bnd = kt::TetherBoundaryd::fixed(asv, auv);
+      const double z0 = env.surface_elevation(0.0, 0.0, s.time);
+      const double z1 = env.surface_elevation(0.0, 0.0, s.time + dt);
+      bnd.start.position.z() = 0.1 - z0;
+      bnd.start.velocity.z() = -(z1 - z0) / dt;
+      kt::step(model, ws, env, s, bnd, dt, kt::Integrator::bdf2);  // throws if not converged
+      min_force[compressive] = std::min(min_force[compressive], ws.tension.minCoeff());
+    }
+  }
+  INFO("minimum segment force: clamped " << min_force[0] << " N, compressive " << min_force[1]
+                                         << " N");
+  CHECK(min_force[0] >= 0.0);
+  CHECK(min_force[1] < 0.0);  // the case does load the dashpot in compression
+}
+
+TEST_CASE("a smaller dt is never less accurate, at a cost linear in 1/dt",
+          "[tether][implicit][accuracy]") {
+  // Surge of the far end of the 50-segment benchmark line, x = A (1 − cos ωt)²/4 (smooth start:
+  // no axial ringing in the reference), A = 0.5 m, 0.2 Hz, 10 s; end tensions against RK4 at
+  // 0.1 ms. With a fixed velocity tolerance, BDF2 at 1 ms was 50× worse than at 10 ms.
+  const kelp::environment::Environmentd env;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(50));
+  const Vector3<double> a(0, 0, 0), b(10, 0, 5);
+  kt::TetherStated s0;
+  {
+    kt::TetherWorkspaced ws(model);
+    REQUIRE(kt::static_initial_state(model, ws, env, a, b, s0).converged);
+  }
+  const double amp = 0.5, w = 2 * kelp::pi * 0.2, duration = 10.0;
+  const auto boundary_at = [&](double t) {
+    kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(a, b);
+    const double c = std::cos(w * t), sn = std::sin(w * t);
+    bnd.end.position.x() += amp * (1 - c) * (1 - c) / 4;
+    bnd.end.velocity.x() = amp * w * (1 - c) * sn / 2;
+    bnd.end.acceleration.x() = amp * w * w * (sn * sn + (1 - c) * c) / 2;
+    return bnd;
+  };
+  struct Run {
+    std::vector<double> start, end;
+    int evaluations = 0;
+  };
+  // Tensions every 10 ms, at the end of the step.
+  const auto run = [&](double dt, kt::Integrator integ) {
+    kt::TetherWorkspaced ws(model);
+    auto s = s0;
+    Run r;
+    const int n = static_cast<int>(std::lround(duration / dt)), every = std::lround(0.01 / dt);
+    for (int k = 1; k <= n; ++k) {
+      r.evaluations +=
+          kt::step(model, ws, env, s, boundary_at(s.time), dt, integ).force_evaluations;
+      if (k % every) continue;
+      if (!kt::is_implicit(integ)) {  // explicit schemes report the start of the step
+        kt::compute_forces(model, ws, env, s.time, s.position, s.velocity);
+        ws.end_forces = kt::end_forces_from_workspace(model, ws, boundary_at(s.time));
+      }
+      r.start.push_back(ws.end_forces.on_start.norm());
+      r.end.push_back(ws.end_forces.on_end.norm());
+    }
+    return r;
+  };
+  const auto rms = [](const std::vector<double>& x, const std::vector<double>& ref) {
+    double se = 0, sr = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      se += (x[i] - ref[i]) * (x[i] - ref[i]);
+      sr += ref[i] * ref[i];
+    }
+    return std::sqrt(se / sr);
+  };
+  const Run ref = run(1e-4, kt::Integrator::rk4);
+  const Run coarse = run(0.01, kt::Integrator::bdf2), fine = run(0.001, kt::Integrator::bdf2);
+  const double e_start[2] = {rms(coarse.start, ref.start), rms(fine.start, ref.start)};
+  const double e_end[2] = {rms(coarse.end, ref.end), rms(fine.end, ref.end)};
+  INFO("relative RMS tension error, 10 ms / 1 ms: fixed end "
+       << e_start[0] << " / " << e_start[1] << ", moving end " << e_end[0] << " / " << e_end[1]);
+  INFO("force evaluations per simulated second: " << coarse.evaluations / duration << " / "
+                                                  << fine.evaluations / duration);
+  CHECK(e_start[0] < 1e-4);
+  CHECK(e_end[0] < 2e-4);
+  CHECK(e_start[1] <= e_start[0]);
+  CHECK(e_end[1] <= e_end[0]);
+  // Ten times the steps for at most 1.5 × ten times the work.
+  CHECK(fine.evaluations <= 15 * coarse.evaluations);
+}
+
+TEST_CASE("an implicit step that does not converge is retried in sub-steps, never committed",
+          "[tether][implicit][retry]") {
+  // A slack 50-segment line released at dt = 10 s: the full step's Newton iteration does not
+  // converge; the step is split and every committed piece meets the tolerance.
+  kelp_test::TestWater<double> env;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(50));
+  const Vector3<double> a(0, 0, 0), b(5, 0, 2);
+  const auto bnd = kt::TetherBoundaryd::fixed(a, b);
+  const kt::TetherStated s0 = kt::catenary_initial_state(model, env, a, b);
+  const double dt = 10.0;
+  kt::ImplicitOptionsd options;
+  SECTION("retried: several sub-steps, each converged") {
+    kt::TetherWorkspaced ws(model);
+    auto s = s0;
+    const auto r = kt::step(model, ws, env, s, bnd, dt, kt::Integrator::bdf2, options);
+    INFO("sub-steps " << r.substeps << ", retries " << r.retries << ", residual " << r.residual
+                      << ", rejected " << r.rejected_residual);
+    CHECK(r.retries >= 1);
+    CHECK(r.substeps > 1);
+    CHECK(r.residual <= options.acceleration_tolerance * dt);
+    CHECK(r.rejected_residual > options.acceleration_tolerance * dt);
+    CHECK(s.time == dt);
+    CHECK(kelp::all_finite(s.position));
+  }
+  SECTION("no retry allowed: throws, state unchanged bit for bit") {
+    kt::TetherWorkspaced ws(model);
+    auto s = s0;
+    options.max_step_halvings = 0;
+    CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, dt, kt::Integrator::bdf2, options),
+                    kelp::numerical_error);
+    CHECK(bitwise_equal(s, s0));
+    CHECK_FALSE(s.has_history());
+  }
+  SECTION("the drivers pass the report on") {
+    kt::TetherWorkspaced ws(model);
+    auto s = s0;
+    const auto r = kt::advance(model, ws, env, s, bnd, 2 * dt, dt, kt::Integrator::bdf2);
+    CHECK(r.substeps > 2);
+    CHECK(r.retries >= 1);
+    CHECK(r.residual <= options.acceleration_tolerance * dt);
+    CHECK(s.time == Approx(2 * dt));
+  }
+}
+
+TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]") {
+  kelp_test::TestWater<double> env;
+  SECTION("a slack 50-segment line steps with BDF2 at dt = 10 s") {
+    // (γh)² EA/l is 1e9 times the node mass: the block factorisation used to find a block
+    // 'not positive definite' here.
+    const kt::TetherModeld model(kelp_test::benchmark_line<double>(50));
+    const Vector3<double> a(0, 0, 0), b(5, 0, 2);
+    kt::TetherWorkspaced ws(model);
+    auto s = kt::catenary_initial_state(model, env, a, b);
+    for (int k = 0; k < 5; ++k)
+      kt::step(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), 10.0, kt::Integrator::bdf2);
+    CHECK(s.time == Approx(50.0));
+    // Settled: at rest, on the static shape the static solve finds.
+    CHECK(s.velocity.cwiseAbs().maxCoeff() < 1e-3);
+  }
+  SECTION("a 1 cm line cut into 200 segments is refused up front, naming the cause") {
+    auto p = kelp_test::benchmark_line<double>(200);
+    p.length = 0.01;
+    const kt::TetherModeld model(p);
+    const Vector3<double> a(0, 0, 5), b(0.008, 0, 5.003);
+    kt::TetherWorkspaced ws(model);
+    const auto s0 = kt::catenary_initial_state(model, env, a, b);
+    auto s = s0;
+    CHECK_THROWS_WITH(
+        kt::step(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), 0.01, kt::Integrator::bdf2),
+        Catch::Contains("cannot be resolved") && Catch::Contains("fewer, longer segments"));
+    CHECK(bitwise_equal(s, s0));
+    // The same line with 20 segments steps (and a looser tolerance is the user's other way out).
+    auto p20 = p;
+    p20.segments = 20;
+    const kt::TetherModeld model20(p20);
+    kt::TetherWorkspaced ws20(model20);
+    auto s20 = kt::catenary_initial_state(model20, env, a, b);
+    CHECK_NOTHROW(kt::step(model20, ws20, env, s20, kt::TetherBoundaryd::fixed(a, b), 1e-5,
+                           kt::Integrator::bdf2));
+  }
+  SECTION("a 10 km line with 200 segments reaches its static equilibrium") {
+    auto p = kelp_test::benchmark_line<double>(200);
+    p.length = 10000.0;
+    const kt::TetherModeld model(p);
+    kt::TetherWorkspaced ws(model);
+    kt::TetherStated s;
+    const auto r = kt::static_initial_state(model, ws, env, Vector3<double>(0, 0, 0),
+                                            Vector3<double>(5000, 0, 2500), s);
+    INFO("iterations " << r.iterations << ", residual " << r.residual << " N");
+    CHECK(r.converged);
+    // The vertical end loads carry the line's submerged weight.
+    const double w = model.submerged_weight_per_length(env.rho, env.g);
+    CHECK(ws.end_forces.on_start.z() + ws.end_forces.on_end.z() ==
+          Approx(w * p.length).epsilon(1e-3));
+  }
+}
+
+TEST_CASE("the integrator history lives in the state: save, step, restore, step is bitwise",
+          "[tether][state][history]") {
+  const kelp::environment::Environmentd env;
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(20));
+  const auto bnd = kt::TetherBoundaryd::fixed(Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
+  for (auto integ : {kt::Integrator::bdf2, kt::Integrator::implicit_euler, kt::Integrator::rk4}) {
+    INFO(kt::integrator_name(integ));
+    const double dt = kt::is_implicit(integ) ? 0.01 : 1e-4;
+    kt::TetherWorkspaced ws(model), other(model);
+    auto s = swinging(model);
+    for (int k = 0; k < 5; ++k) kt::step(model, ws, env, s, bnd, dt, integ);
+    const kt::TetherStated saved = s;
+    REQUIRE(saved.has_history());
+    std::vector<kt::TetherStated> first;
+    for (int k = 0; k < 3; ++k) {
+      kt::step(model, ws, env, s, bnd, dt, integ);
+      first.push_back(s);
+    }
+    // Restore, and step with a workspace that has meanwhile stepped another state.
+    auto unrelated = swinging(model);
+    kt::step(model, other, env, unrelated, bnd, 2 * dt, integ);
+    s = saved;
+    for (int k = 0; k < 3; ++k) {
+      kt::step(model, other, env, s, bnd, dt, integ);
+      CHECK(bitwise_equal(s, first[std::size_t(k)]));
+      CHECK(bitwise_equal(s.previous_position, first[std::size_t(k)].previous_position));
+    }
+  }
+}
+
+TEST_CASE("the clock is a double for every Scalar: 24 h of 10 ms steps end at 86400 s",
+          "[tether][clock]") {
+  // A float tether (one segment between two fixed points: the cheapest step there is) stepped
+  // 8.64 million times by 0.01 s. A float clock read 3603.2 s after one hour and stopped
+  // advancing at ~73 h.
+  kelp_test::Vacuum<float> env;
+  const kt::TetherModelf model(kelp_test::benchmark_line<float>(1));
+  kt::TetherWorkspacef ws(model);
+  const Vector3<float> a(0, 0, 0), b(20, 0, 0);
+  auto s = kt::straight_line_state(model, a, b);
+  const auto bnd = kt::TetherBoundaryf::fixed(a, b);
+  static_assert(std::is_same<decltype(s.time), double>::value, "time is a double");
+  const long steps = 8640000;
+  for (long k = 0; k < steps; ++k) kt::step_symplectic_euler(model, ws, env, s, bnd, 0.01);
+  CHECK(std::abs(s.time - 86400.0) <= 1e-9 * 86400.0);
+}
