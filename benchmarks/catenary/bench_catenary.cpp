@@ -35,7 +35,8 @@ void BM_CatenaryFastPathFloat(benchmark::State& state) {
 BENCHMARK(BM_CatenaryFastPathFloat);
 
 void BM_CatenaryReferenceCase(benchmark::State& state) {
-  // The reference case of docs/equations.md, with D varied in the last digits so that nothing can be hoisted.
+  // The reference case of docs/equations.md, with D varied in the last digits so that nothing can
+  // be hoisted.
   double D[8];
   for (int k = 0; k < 8; ++k) D[k] = 10.0 + 1e-9 * k;
   int k = 0;

@@ -30,8 +30,8 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 TEST_CASE("reference case of docs/equations.md to 6 digits", "[catenary]") {
-  // docs/equations.md: D = 10, dz = +5, L = 20 -> a = 2.358583, c = 4.397588 (MoorPy, FAST-v7 and an
-  // independent Newton solve agree).
+  // docs/equations.md: D = 10, dz = +5, L = 20 -> a = 2.358583, c = 4.397588 (MoorPy, FAST-v7 and
+  // an independent Newton solve agree).
   const auto r = solve_catenary(10.0, 5.0, 20.0);
   REQUIRE(r.status == CatenaryStatus::converged);
   CHECK(r.a == Approx(2.358583).epsilon(5e-7));

@@ -16,7 +16,8 @@ template struct kelp::tether::CatenaryResult<float>;
 template struct kelp::tether::CatenaryOptions<float>;
 
 namespace {
-// docs/equations.md (benchmark line): d = 8 mm, 0.07 kg/m, rho = 1025, g = 9.81 -> w = 0.181268 N/m.
+// docs/equations.md (benchmark line): d = 8 mm, 0.07 kg/m, rho = 1025, g = 9.81 -> w = 0.181268
+// N/m.
 const double kPi = 3.14159265358979323846;
 const double kW = (0.07 - 1025.0 * kPi * 0.004 * 0.004) * 9.81;
 
