@@ -471,8 +471,10 @@ NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n) {
 /// at the surface would leave Newton's method no solution to converge to when a floating line
 /// rests at the surface).
 template <typename Scalar>
-Scalar submerged_fraction(Scalar z, Scalar zeta, Scalar diameter) {
-  const Scalar f = Scalar(1) + (z + zeta) / diameter;
+Scalar submerged_fraction(Scalar z, Scalar zeta, Scalar diameter,
+                          Scalar inv_diameter = Scalar(-1)) {
+  if (inv_diameter < Scalar(0)) inv_diameter = Scalar(1) / diameter;
+  const Scalar f = Scalar(1) + (z + zeta) * inv_diameter;
   return f >= Scalar(1) ? Scalar(1) : (f > Scalar(0) ? f : Scalar(0));
 }
 
@@ -666,6 +668,7 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
                                   node_constants(n)};
   // Added-mass rate terms (see the function's documentation); none when Cat = Can (b = 0).
   const bool mass_turns = cat != can;
+  const Scalar inv_d = Scalar(1) / p.diameter;
   V3 tu_prev = V3::Zero();  // T_{i−1} u_{i−1}
   V3 carry = V3::Zero();    // ∂T/∂x_{i} from node i − 1's tangent, added when node i is built
   for (int i = 0; i <= n; ++i) {
@@ -687,13 +690,18 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       f = -tu_prev;
     }
     if (bending) f += ws.bending.col(i);
-    f += carry;
-    carry.setZero();
+    if (mass_turns) {
+      f += carry;
+      carry.setZero();
+    }
 
     const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
     const Scalar li = kinds[kind].li;
     const Scalar zeta = still ? Scalar(0) : Scalar(env.surface_elevation(x(0, i), x(1, i), t));
-    const Scalar phi = detail::submerged_fraction(Scalar(x(2, i)), zeta, p.diameter);
+    // (Below the surface φ = 1 without the ramp's arithmetic.)
+    const Scalar phi = x(2, i) + zeta >= Scalar(0)
+                           ? Scalar(1)
+                           : detail::submerged_fraction(Scalar(x(2, i)), zeta, p.diameter, inv_d);
     ws.submerged(i) = phi;
     const bool wet = phi > Scalar(0);
     // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
@@ -722,12 +730,12 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
         // Added-mass rate terms, written with w_r = u_water − v = −v_r (vr above; both factors
         // of each term flip sign): G_i = b[(q̇·w_r) q + s q̇] and ∂T/∂x = ±b s P w_r/|c| with
         // s = q·w_r = vq, P w_r = vn, q̇ = P (v_hi − v_lo)/|c|.
+        // With k = b/|c| and dc = v_hi − v_lo: G_i = k[s dc + (dc·vn − s q·dc) q], w = k s vn.
         const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
-        const Scalar b = nc.mass_tan_wet;
+        const Scalar k = nc.mass_tan_wet * inv_c, ks = k * vq;
         const V3 dc = v.col(hi) - v.col(lo);
-        const V3 qdot = (dc - q.dot(dc) * q) * inv_c;
-        f += b * (qdot.dot(vn) * q + vq * qdot);
-        const V3 w = (b * vq * inv_c) * vn;
+        f += ks * dc + (k * dc.dot(vn) - ks * q.dot(dc)) * q;
+        const V3 w = ks * vn;
         if (hi == i)
           f += w;
         else
