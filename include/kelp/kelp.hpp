@@ -16,6 +16,7 @@
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/presets.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 
 #include "kelp/core/scalar.hpp"
@@ -23,7 +24,9 @@ namespace kelp::tether {
 /// as well. When the environment has a finite seabed (`seabed_depth()`) and both ends are at or
 /// above it, the catenary is solved with that seabed (CatenaryOptions::seabed_depth), so a line
 /// long enough to touch down starts with its grounded part lying on the bed rather than below
-/// it. The status is reported through `status` when non-null.
+/// it. Likewise a buoyant line (w < 0) whose inverted catenary would rise above the still-water
+/// surface starts with those nodes on the surface (z = 0). The status is reported through `status`
+/// when non-null.
 /// \param[in] model the tether \param[in] env environment (water_density(), gravity(),
 /// seabed_depth())
 /// \param[in] start_ned node 0, NED [m] \param[in] end_ned node N, NED [m]
@@ -51,6 +54,10 @@ TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, con
   TetherState<Scalar> s(model);
   const int n = model.segments();
   for (int i = 0; i <= n; ++i) s.position.col(i) = shape.point_at(L * Scalar(i) / Scalar(n));
+  // A buoyant line's inverted catenary may rise out of the water, where the line would not float:
+  // such nodes start on the still-water surface instead.
+  if (w < Scalar(0) && value_of(start_ned.z()) >= 0 && value_of(end_ned.z()) >= 0)
+    for (int i = 0; i <= n; ++i) s.position(2, i) = std::max(s.position(2, i), Scalar(0));
   s.position.col(0) = start_ned;
   s.position.col(n) = end_ned;
   if (!all_finite(s.position)) return straight_line_state(model, start_ned, end_ned);

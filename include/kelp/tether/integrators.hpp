@@ -978,8 +978,10 @@ template <typename Scalar>
 struct StaticOptions {
   /// Converged when max_i |F_i| ≤ this [N]; ≤ 0 selects 1e-7 × the line's weight in air.
   Scalar force_tolerance = Scalar(0);
-  /// Maximum (pseudo-transient) Newton iterations.
-  int max_iterations = 200;
+  /// Maximum pseudo steps (each one implicit step solved by Newton). A line that settles in a few
+  /// dozen takes a few dozen; a buoyant line floating at the surface, whose nodes land there one
+  /// by one, can take several hundred (a 15 m ROV tether: ~650).
+  int max_iterations = 1000;
   /// First pseudo time step h [s] of the regularisation M/h² (grows as the residual falls).
   Scalar initial_pseudo_dt = Scalar(0.05);
 };
