@@ -128,6 +128,7 @@ TEMPLATE_TEST_CASE("a heavy vehicle sinks, a buoyant one rises", "[vehicle][rest
                    float) {
   using S = TestType;
   auto p = kv::bluerov2_heavy<S>().parameters;
+  p.hydrostatics = kv::Hydrostatics::submerged;  // deep water: the test starts at z = 0
   const S neutral_volume = p.mass / p.density;
   for (double factor : {0.98, 1.02}) {
     p.displaced_volume = S(factor) * neutral_volume;
@@ -151,7 +152,8 @@ TEMPLATE_TEST_CASE("a pitched vehicle with r_b above r_g rights itself", "[vehic
                    double, float) {
   using S = TestType;
   auto p = kv::bluerov2_heavy<S>().parameters;
-  p.displaced_volume = p.mass / p.density;  // neutral, so that only the righting moment acts
+  p.hydrostatics = kv::Hydrostatics::submerged;  // deep water: the test starts at z = 0
+  p.displaced_volume = p.mass / p.density;       // neutral, so that only the righting moment acts
   const kv::VehicleModel<S> model(p);
   kv::VehicleWorkspace<S> ws;
   for (double theta0 : {0.4, -0.4, 1.2}) {

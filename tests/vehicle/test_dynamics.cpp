@@ -29,6 +29,9 @@ template <typename S>
 kv::VehicleParameters<S> neutral_rov() {
   auto p = kv::bluerov2_heavy<S>().parameters;
   p.displaced_volume = p.mass / p.density;  // W = B
+  // Deep-water restoring: these tests start at z = 0 and test submerged physics; the free surface
+  // has its own tests (test_surroundings.cpp).
+  p.hydrostatics = kv::Hydrostatics::submerged;
   return p;
 }
 

@@ -26,6 +26,7 @@
 #include "kelp/vehicle/kinematics.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/state.hpp"
+#include "kelp/vehicle/surroundings.hpp"
 
 namespace kelp::vehicle {
 
@@ -151,6 +152,62 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
               VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<DT>& tau,
               const Eigen::MatrixBase<DE>& tau_env) {
   step_rk4(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+}
+
+/// \brief Surroundings a vehicle model needs at state `x` and time t: the full surroundings()
+/// for a surface vessel, without the surface slope (one wave pass fewer) for a submerged one,
+/// whose restoring reads only the elevation.
+template <typename Scalar, typename Env>
+Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& env,
+                                  const VehicleState<Scalar>& x, double t) {
+  if (model.parameters().hydrostatics == Hydrostatics::surface) return surroundings(env, x, t);
+  return surroundings_without_slope(env, x, t);
+}
+
+/// \brief One classical RK4 step of length `dt` in an environment: the surroundings (water
+/// velocity and acceleration, free surface, wind) are sampled at each stage's state and time
+/// (t, t + dt/2, t + dt/2, t + dt) and enter forward_dynamics(…, Surroundings); τ and τ_ext are
+/// held over the step (zero-order hold). Allocation-free. The caller owns the clock (advance t by
+/// dt after a successful step) and checks once that the model's water is the environment's
+/// (check_same_water in water.hpp).
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt on success, unchanged (bit for bit) on failure.
+/// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
+/// \param[in] tau_ext external wrench [N, N m], body (e.g. the tether's).
+/// \param[in] env environment (`kelp::environment::Environment` or any type with `sample(p, t)`
+/// and `surface_slope(x, y, t)`). \param[in] t time at the start of the step [s].
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
+/// kelp::numerical_error on a non-finite result.
+template <typename Scalar, typename Env, typename D1, typename D2>
+void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+              VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<D1>& tau,
+              const Eigen::MatrixBase<D2>& tau_ext, const Env& env, double t) {
+  detail::check_step_input(state, dt);
+  const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext);
+  const Vector6<Scalar> zero = Vector6<Scalar>::Zero();
+  const Scalar half = Scalar(0.5) * dt;
+  const double dt_d = value_of(dt), half_d = 0.5 * dt_d;
+  const auto deriv = [&](const VehicleState<Scalar>& x, double time) {
+    StateDerivative<Scalar> d;
+    d.pose = pose_rate(x.attitude, x.nu);
+    d.nu_dot = forward_dynamics(model, ws, x, total, zero, surroundings(model, env, x, time));
+    return d;
+  };
+  const StateDerivative<Scalar> k1 = deriv(state, t);
+  const VehicleState<Scalar> x2 = detail::advance(state, k1, half);
+  const StateDerivative<Scalar> k2 = deriv(x2, t + half_d);
+  const VehicleState<Scalar> x3 = detail::advance(state, k2, half);
+  const StateDerivative<Scalar> k3 = deriv(x3, t + half_d);
+  const VehicleState<Scalar> x4 = detail::advance(state, k3, dt);
+  const StateDerivative<Scalar> k4 = deriv(x4, t + dt_d);
+  StateDerivative<Scalar> k;
+  const Scalar two(2), sixth = dt / Scalar(6);
+  k.pose.position_dot = k1.pose.position_dot + two * k2.pose.position_dot +
+                        two * k3.pose.position_dot + k4.pose.position_dot;
+  k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
+                        two * k3.pose.attitude_dot + k4.pose.attitude_dot;
+  k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
+  detail::commit_if_finite(state, detail::advance(state, k, sixth), "step_rk4");
 }
 
 /// \brief One semi-implicit (symplectic) Euler step: ν_{k+1} = ν_k + dt ν̇(x_k), then the pose is

@@ -22,21 +22,32 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/wave_loads.hpp"
+#include "kelp/environment/wind.hpp"
 #include "kelp/vehicle/added_mass.hpp"
 #include "kelp/vehicle/coriolis.hpp"
 #include "kelp/vehicle/damping.hpp"
 #include "kelp/vehicle/restoring.hpp"
 #include "kelp/vehicle/rigid_body.hpp"
 #include "kelp/vehicle/state.hpp"
+#include "kelp/vehicle/surroundings.hpp"
 
 namespace kelp::vehicle {
 
 /// \brief Which hydrostatic model gives g(η).
 enum class Hydrostatics {
-  /// Fully submerged: constant weight and buoyancy, restoring_force() (rotation-matrix form).
+  /// Always fully submerged: constant weight and buoyancy, restoring_force() (rotation-matrix
+  /// form), whatever the depth (no free surface).
   submerged,
-  /// Floating at the surface: heave stiffness and metacentric heights, restoring_force_surface().
-  surface
+  /// Floating at the surface: heave stiffness and metacentric heights relative to the local wave
+  /// surface, bounded when the hull emerges or submerges (restoring_force_surface_following(),
+  /// with `hull_height` the hull depth D; D = 0 leaves the heave force unbounded), plus wind loads
+  /// from `wind_areas` and `wind_coefficients`.
+  surface,
+  /// Submerged vehicle that can reach the free surface: buoyancy B φ with φ the submerged
+  /// fraction of a box hull of height `hull_height` about the CB
+  /// (restoring_force_free_surface()); identical to `submerged` when fully under water.
+  submerged_free_surface
 };
 
 /// \brief Constant parameters of a rigid marine vehicle (Fossen 2021 notation, SI units, body axes
@@ -71,6 +82,14 @@ struct VehicleParameters {
   Scalar gm_transverse = Scalar(0);
   /// GM_L [m]: longitudinal metacentric height (surface model only).
   Scalar gm_longitudinal = Scalar(0);
+  /// Hull height [m]: for `submerged_free_surface` the vertical extent h of the box hull about the
+  /// CB (> 0); for `surface` the hull depth D from keel to deck (0: heave force unbounded; else
+  /// > the draft ∇/A_wp). Unused by `submerged`.
+  Scalar hull_height = Scalar(0);
+  /// Projected areas above water for the wind loads (surface model only; zero areas: no wind load).
+  environment::WindAreas wind_areas;
+  /// Wind-load coefficients c_x, c_y, c_n (surface model only), Fossen 2021 §10.1.1.
+  environment::ConstantWindCoefficients wind_coefficients;
 
   /// \brief W = m g [N].
   Scalar weight() const { return mass * gravity; }
@@ -94,13 +113,17 @@ struct VehicleParameters {
     o.waterplane_area = T(waterplane_area);
     o.gm_transverse = T(gm_transverse);
     o.gm_longitudinal = T(gm_longitudinal);
+    o.hull_height = T(hull_height);
+    o.wind_areas = wind_areas;
+    o.wind_coefficients = wind_coefficients;
     return o;
   }
 };
 
 /// \brief Throws kelp::invalid_argument naming the first offending field of `p` (`mass`,
 /// `inertia`, `r_g`, `r_b`, `displaced_volume`, `density`, `gravity`, `added_mass`,
-/// `linear_damping`, `quadratic_damping`, `waterplane_area`, `gm_transverse`, `gm_longitudinal`).
+/// `linear_damping`, `quadratic_damping`, `waterplane_area`, `gm_transverse`, `gm_longitudinal`,
+/// `hull_height`, `wind_areas`, `wind_coefficients`).
 /// `VehicleModel`'s constructor calls it.
 template <typename Scalar>
 void validate(const VehicleParameters<Scalar>& p) {
@@ -118,7 +141,19 @@ void validate(const VehicleParameters<Scalar>& p) {
     check_positive(p.displaced_volume, "displaced_volume");
     check_finite(p.gm_transverse, "gm_transverse");
     check_finite(p.gm_longitudinal, "gm_longitudinal");
+    check_non_negative(p.hull_height, "hull_height");
+    KELP_CHECK(value_of(p.hull_height) == 0.0 ||
+                   value_of(p.hull_height) > value_of(p.displaced_volume / p.waterplane_area),
+               "hull_height must be 0 or greater than the draft displaced_volume/waterplane_area");
+    check_non_negative(p.wind_areas.frontal_area, "wind_areas.frontal_area");
+    check_non_negative(p.wind_areas.lateral_area, "wind_areas.lateral_area");
+    check_non_negative(p.wind_areas.length_overall, "wind_areas.length_overall");
+    check_finite(p.wind_coefficients.cx, "wind_coefficients.cx");
+    check_finite(p.wind_coefficients.cy, "wind_coefficients.cy");
+    check_finite(p.wind_coefficients.cn, "wind_coefficients.cn");
   }
+  if (p.hydrostatics == Hydrostatics::submerged_free_surface)
+    check_positive(p.hull_height, "hull_height");
 }
 
 /// \brief A vehicle model built once from VehicleParameters: validated parameters, M_RB, M_A
@@ -165,19 +200,62 @@ class VehicleModel {
   /// \brief B = ρ g ∇ [N] (submerged model).
   const Scalar& buoyancy() const { return buoyancy_; }
 
-  /// \brief Restoring vector g(η) [N, N m], body axes, for the pose in `state` (rotation-matrix
-  /// form; see restoring_force() and restoring_force_surface()).
+  /// \brief Restoring vector g(η) [N, N m], body axes, in calm water (flat surface at z = 0).
   /// \param[in] state vehicle state. \param[in] R its rotation matrix body → NED.
   template <typename DerivedR>
   Vector6<Scalar> restoring(const VehicleState<Scalar>& state,
                             const Eigen::MatrixBase<DerivedR>& R) const {
-    if (parameters_.hydrostatics == Hydrostatics::surface) {
-      return restoring_force_surface(parameters_.density, parameters_.gravity,
-                                     parameters_.displaced_volume, parameters_.waterplane_area,
-                                     parameters_.gm_transverse, parameters_.gm_longitudinal,
-                                     state.position(2), R);
+    return restoring(state, R, Scalar(0), Eigen::Matrix<Scalar, 2, 1>::Zero());
+  }
+
+  /// \brief Restoring vector g(η) [N, N m], body axes, relative to the local free surface, by the
+  /// model's `Hydrostatics`: restoring_force() (`submerged`), restoring_force_free_surface()
+  /// (`submerged_free_surface`) or restoring_force_surface_following() (`surface`).
+  /// \param[in] state vehicle state \param[in] R its rotation body → NED
+  /// \param[in] zeta surface elevation ζ at the CO's (x, y) [m], up
+  /// \param[in] slope (∂ζ/∂x, ∂ζ/∂y) [-] (read by `surface` only)
+  /// \param[out] fraction submerged fraction φ (`submerged_free_surface`; 1 otherwise), if not null
+  template <typename DerivedR, typename DerivedS>
+  Vector6<Scalar> restoring(const VehicleState<Scalar>& state, const Eigen::MatrixBase<DerivedR>& R,
+                            const Scalar& zeta, const Eigen::MatrixBase<DerivedS>& slope,
+                            Scalar* fraction = nullptr) const {
+    const VehicleParameters<Scalar>& p = parameters_;
+    if (fraction != nullptr) *fraction = Scalar(1);
+    switch (p.hydrostatics) {
+      case Hydrostatics::surface:
+        return restoring_force_surface_following(
+            p.density, p.gravity, p.displaced_volume, p.waterplane_area, p.gm_transverse,
+            p.gm_longitudinal, p.hull_height, state.position(2), zeta, slope, R);
+      case Hydrostatics::submerged_free_surface:
+        return restoring_force_free_surface(weight_, buoyancy_, p.r_g, p.r_b, p.hull_height,
+                                            state.position(2), zeta, R, fraction);
+      case Hydrostatics::submerged:
+        break;
     }
-    return restoring_force(weight_, buoyancy_, parameters_.r_g, parameters_.r_b, R);
+    return restoring_force(weight_, buoyancy_, p.r_g, p.r_b, R);
+  }
+
+  /// \brief Hydrostatic potential energy U [J] of which restoring() is the gradient for a fixed
+  /// surface (ζ, slope): see restoring_potential_free_surface() and
+  /// restoring_potential_surface_following(); −W z_CG + B z_CB for `submerged`.
+  template <typename DerivedS>
+  Scalar restoring_potential(const VehicleState<Scalar>& state, const Scalar& zeta,
+                             const Eigen::MatrixBase<DerivedS>& slope) const {
+    const VehicleParameters<Scalar>& p = parameters_;
+    const Matrix3<Scalar> R = state.attitude.toRotationMatrix();
+    switch (p.hydrostatics) {
+      case Hydrostatics::surface:
+        return restoring_potential_surface_following(
+            p.density, p.gravity, p.displaced_volume, p.waterplane_area, p.gm_transverse,
+            p.gm_longitudinal, p.hull_height, state.position(2), zeta, slope, R);
+      case Hydrostatics::submerged_free_surface:
+        return restoring_potential_free_surface(weight_, buoyancy_, p.r_g, p.r_b, p.hull_height,
+                                                state.position(2), zeta, R);
+      case Hydrostatics::submerged:
+        break;
+    }
+    return -weight_ * (state.position(2) + R.row(2).dot(p.r_g)) +
+           buoyancy_ * (state.position(2) + R.row(2).dot(p.r_b));
   }
 
  private:
@@ -223,14 +301,96 @@ struct VehicleWorkspace {
   Vector6<Scalar> damping = Vector6<Scalar>::Zero();
   /// g(η) [N, N m].
   Vector6<Scalar> restoring = Vector6<Scalar>::Zero();
+  /// Froude–Krylov force of the accelerating water, (ρ ∇ φ Rᵀ a_w, 0) [N] (see forward_dynamics).
+  Vector6<Scalar> froude_krylov = Vector6<Scalar>::Zero();
+  /// Wind load (X, Y, 0, 0, 0, N) [N, N m] (surface vessels).
+  Vector6<Scalar> wind = Vector6<Scalar>::Zero();
+  /// Submerged fraction φ of the last evaluation (1 unless `submerged_free_surface`).
+  Scalar submerged_fraction = Scalar(1);
   /// Right-hand side M ν̇ [N, N m].
   Vector6<Scalar> rhs = Vector6<Scalar>::Zero();
   /// ν̇ [m/s², rad/s²].
   Vector6<Scalar> nu_dot = Vector6<Scalar>::Zero();
 };
 
+/// \brief Forward dynamics of a vehicle in its surroundings (water velocity and acceleration, free
+/// surface, wind), allocation-free:
+/// \f[ \dot\nu = M^{-1}\big(\tau + \tau_{ext} - C_{RB}(\nu)\nu - C_A(\nu_r)\nu_r - D(\nu_r)\nu_r
+///     - g(\eta, \zeta, \nabla\zeta) + M_A\dot\nu_w + \tau_{FK} + \tau_{wind}\big). \f]
+///
+/// Water motion (Fossen 2021, §10.3, extended to a non-uniform, unsteady flow as in Faltinsen
+/// 1990, ch. 3, for a body small against the wavelength): ν_w = (Rᵀ v_w, 0) with v_w the water
+/// velocity at the CO (current + wave orbital velocity), ν_r = ν − ν_w, and the body-frame rate
+/// of the water velocity seen by the vehicle ν̇_w = (ν_{w,1} × ν₂ + Rᵀ a_w, 0), where a_w is the
+/// water's local acceleration ∂v/∂t at the CO. The convective part (∇v_w) ṗ (second order in the
+/// wave steepness for orbital motion) and the slow time variation of the current are neglected.
+/// M_A ν̇_w is the added-mass (diffraction) force of the accelerating flow; τ_FK = (ρ ∇ φ Rᵀ a_w,
+/// 0) is the Froude–Krylov force (the pressure gradient of the undisturbed flow on the displaced
+/// volume, φ the submerged fraction), so the translational forcing is (ρ∇ I + M_A) Rᵀ a_w, the
+/// inertia term of Morison's equation with C_M = 1 + C_A. For a surface vessel only the
+/// horizontal part of a_w enters τ_FK: the vertical pressure of the wave is already in the
+/// restoring that follows the local surface. The moments of τ_FK are neglected (small body).
+/// Wind (surface vessels): environment::wind_load() with the model's `wind_areas` and
+/// `wind_coefficients`, on the heading ψ and the body velocity over ground (Fossen 2021,
+/// §10.1.1). With still water, no wind and a flat surface this is the irrotational-current
+/// model of the file comment.
+///
+/// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
+/// \param[in] state pose (NED, unit quaternion) and ν (body).
+/// \param[in] tau control wrench (thrusters) [N, N m], body axes about the CO.
+/// \param[in] tau_ext other external wrench [N, N m], body axes about the CO (e.g. the tether's).
+/// \param[in] s the surroundings at the vehicle's position (see surroundings()).
+/// \return ν̇ [m/s², rad/s²], body axes.
+template <typename Scalar, typename D1, typename D2>
+Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                                 const VehicleState<Scalar>& state,
+                                 const Eigen::MatrixBase<D1>& tau,
+                                 const Eigen::MatrixBase<D2>& tau_ext,
+                                 const Surroundings<Scalar>& s) {
+  const VehicleParameters<Scalar>& p = model.parameters();
+  ws.rotation = state.attitude.toRotationMatrix();
+  const Vector3<Scalar> vw = ws.rotation.transpose() * s.water_velocity;
+  const Vector3<Scalar> aw = ws.rotation.transpose() * s.water_acceleration;
+  ws.nu_c.template head<3>() = vw;
+  ws.nu_c.template tail<3>().setZero();
+  ws.nu_r = state.nu - ws.nu_c;
+  ws.nu_c_dot.template head<3>() = vw.cross(Vector3<Scalar>(state.nu.template tail<3>())) + aw;
+  ws.nu_c_dot.template tail<3>().setZero();
+  ws.coriolis_rigid_body = coriolis_force(model.rigid_body_mass(), state.nu);
+  ws.coriolis_added_mass = coriolis_force(model.added_mass(), ws.nu_r);
+  ws.damping = damping_force(p.damping, ws.nu_r);
+  ws.restoring = model.restoring(state, ws.rotation, s.surface_elevation, s.surface_slope,
+                                 &ws.submerged_fraction);
+  ws.froude_krylov.setZero();
+  ws.wind.setZero();
+  if (p.hydrostatics == Hydrostatics::surface) {
+    const Vector3<Scalar> ah(s.water_acceleration(0), s.water_acceleration(1), Scalar(0));
+    ws.froude_krylov.template head<3>() =
+        (p.density * p.displaced_volume) * (ws.rotation.transpose() * ah);
+    if (p.wind_areas.frontal_area > 0.0 || p.wind_areas.lateral_area > 0.0) {
+      using std::atan2;
+      const Scalar psi = atan2(ws.rotation(1, 0), ws.rotation(0, 0));
+      const Vector3<Scalar> w =
+          environment::wind_load(p.wind_coefficients, p.wind_areas, Scalar(kelp::air_density),
+                                 s.wind_velocity, psi, state.nu(0), state.nu(1));
+      ws.wind(0) = w(0);
+      ws.wind(1) = w(1);
+      ws.wind(5) = w(2);
+    }
+  } else {
+    ws.froude_krylov.template head<3>() =
+        (p.density * p.displaced_volume * ws.submerged_fraction) * aw;
+  }
+  ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext) - ws.coriolis_rigid_body -
+           ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot +
+           ws.froude_krylov + ws.wind;
+  ws.nu_dot.noalias() = model.mass_inverse() * ws.rhs;
+  return ws.nu_dot;
+}
+
 /// \brief Forward dynamics ν̇ = M⁻¹(τ + τ_env − C_RB(ν)ν − C_A(ν_r)ν_r − D(ν_r)ν_r − g + M_A ν̇_c)
-/// (see the file comment; Fossen 2021, eqs. of §6 and §10.3). Allocation-free.
+/// in a uniform current, flat calm surface at z = 0, no wind (see the file comment; Fossen 2021,
+/// §10.3). Same as the Surroundings overload with water_velocity = current_ned. Allocation-free.
 ///
 /// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
 /// \param[in] state pose (NED, unit quaternion) and ν (body).
@@ -245,21 +405,9 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
                                  const Eigen::MatrixBase<DT>& tau,
                                  const Eigen::MatrixBase<DE>& tau_env,
                                  const Eigen::MatrixBase<DC>& current_ned) {
-  ws.rotation = state.attitude.toRotationMatrix();
-  const Vector3<Scalar> vc = ws.rotation.transpose() * Vector3<Scalar>(current_ned);
-  ws.nu_c.template head<3>() = vc;
-  ws.nu_c.template tail<3>().setZero();
-  ws.nu_r = state.nu - ws.nu_c;
-  ws.nu_c_dot.template head<3>() = vc.cross(Vector3<Scalar>(state.nu.template tail<3>()));
-  ws.nu_c_dot.template tail<3>().setZero();
-  ws.coriolis_rigid_body = coriolis_force(model.rigid_body_mass(), state.nu);
-  ws.coriolis_added_mass = coriolis_force(model.added_mass(), ws.nu_r);
-  ws.damping = damping_force(model.parameters().damping, ws.nu_r);
-  ws.restoring = model.restoring(state, ws.rotation);
-  ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_env) - ws.coriolis_rigid_body -
-           ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot;
-  ws.nu_dot.noalias() = model.mass_inverse() * ws.rhs;
-  return ws.nu_dot;
+  Surroundings<Scalar> s;
+  s.water_velocity = current_ned;
+  return forward_dynamics(model, ws, state, tau, tau_env, s);
 }
 
 /// \brief Forward dynamics without current: ν̇ = M⁻¹(τ + τ_env − C_RB ν − C_A ν − D ν − g).
@@ -269,6 +417,35 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
                                  const Eigen::MatrixBase<DT>& tau,
                                  const Eigen::MatrixBase<DE>& tau_env) {
   return forward_dynamics(model, ws, state, tau, tau_env, Vector3<Scalar>::Zero());
+}
+
+/// \brief Mechanical energy [J] of a vehicle: kinetic ½ νᵀ (M_RB + M_A) ν plus the hydrostatic
+/// potential U of VehicleModel::restoring_potential() for the surface in `s` (elevation and slope
+/// at the CO). U is the integral of the restoring force, so without damping, forcing, current or
+/// waves (flat surface) the energy is conserved: e.g. for `submerged_free_surface`
+/// U = −W z_CG + B h Φ(s) with Φ the integral of the submerged fraction (see
+/// restoring_potential_free_surface()). The added-mass kinetic energy uses the velocity over
+/// ground (the fluid at rest).
+template <typename Scalar>
+Scalar energy(const VehicleModel<Scalar>& model, const VehicleState<Scalar>& state,
+              const Surroundings<Scalar>& s = Surroundings<Scalar>()) {
+  const Scalar kinetic = Scalar(0.5) * state.nu.dot(model.mass_matrix() * state.nu);
+  return kinetic + model.restoring_potential(state, s.surface_elevation, s.surface_slope);
+}
+
+/// \brief The hull data of a surface-vessel model as the environment layer's
+/// environment::SurfaceHydrostatics (for its wave_restoring()/surface_following_restoring()),
+/// so that the vehicle preset stays the one copy of the hull data.
+template <typename Scalar>
+environment::SurfaceHydrostatics surface_hydrostatics(const VehicleParameters<Scalar>& p) {
+  environment::SurfaceHydrostatics h;
+  h.rho = value_of(p.density);
+  h.gravity = value_of(p.gravity);
+  h.waterplane_area = value_of(p.waterplane_area);
+  h.displaced_volume = value_of(p.displaced_volume);
+  h.gm_transverse = value_of(p.gm_transverse);
+  h.gm_longitudinal = value_of(p.gm_longitudinal);
+  return h;
 }
 
 /// \brief Vehicle parameters in double precision.

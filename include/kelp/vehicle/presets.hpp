@@ -51,8 +51,13 @@ struct VehiclePreset {
 /// factor signs (forward/lateral/throttle and yaw/roll/pitch): e.g. motor 1 has forward −1, lateral
 /// +1, so its positive thrust points aft-starboard, (−1, 1, 0)/√2; vertical thrusters push down
 /// (+z) for PWM > 1500. They are the opposite of von Benzon's drawn directions, which is the same
-/// as flipping the sign of an odd thrust curve. \param[in] density ρ [kg/m³]. \param[in] gravity g
-/// [m/s²].
+/// as flipping the sign of an odd thrust curve.
+///
+/// Free surface (Hydrostatics::submerged_free_surface): the hull is a box of height 0.254 m about
+/// the CB (Blue Robotics BlueROV2 Heavy technical details: height 254 mm); its buoyancy falls
+/// linearly with the emerged fraction. With the seawater defaults the unpowered vehicle floats at
+/// φ = W/B ≈ 0.983, its top ≈ 4 mm above the surface.
+/// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
 template <typename Scalar>
 VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_density),
                                      const Scalar& gravity = Scalar(standard_gravity)) {
@@ -73,7 +78,8 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
   v.added_mass = ma.asDiagonal();
   v.damping.linear = dl.asDiagonal();
   v.damping.quadratic = dq;
-  v.hydrostatics = Hydrostatics::submerged;
+  v.hydrostatics = Hydrostatics::submerged_free_surface;
+  v.hull_height = Scalar(0.254);
 
   const Scalar xh(0.156), yh(0.111), zh(0.085), xv(0.12), yv(0.218);
   const Scalar s = Scalar(1) / Scalar(std::sqrt(2.0));
@@ -116,6 +122,13 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   m from the paper framework's Gazebo model (converted from its y-left axes); depth 0.10 m
 ///   below the waterline (assumed). Directions +x. PWM 1000–1500–2000 µs (rover.parm SERVO
 ///   limits) with the ±25 µs dead band.
+/// - Hull depth keel to deck 0.20 m (assumed; product height ≈ 0.33 m including the deck
+///   electronics): the heave force saturates at the draft (fully emerged, net force = weight) and
+///   at 0.20 m (fully submerged, reserve buoyancy ρ g A_wp 0.20 − W ≈ 235 N).
+/// - Wind: frontal area 0.15 m² (1.0 m beam × 0.15 m above water), lateral area 0.25 m² (1.2 m ×
+///   ≈ 0.2 m hulls and deck box), L_oa = 1.2 m (assumed from the product dimensions); constant
+///   coefficients c_x = 0.6, c_y = 0.8 (assumed, mid-range of Fossen 2021 §10.1.1's values for
+///   small craft), c_n = 0 (fore-aft symmetric profile assumed: no wind yaw moment).
 /// Resulting behaviour (checked by tests/vehicle): top speed 2.97 m/s at full command (the
 /// thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against the pure surge
 /// balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch 0.68 s.
@@ -137,6 +150,13 @@ VehiclePreset<Scalar> blueboat(const Scalar& density = Scalar(seawater_density),
   v.waterplane_area = Scalar(0.19);
   v.gm_transverse = Scalar(2.0);
   v.gm_longitudinal = Scalar(1.3);
+  v.hull_height = Scalar(0.20);
+  v.wind_areas.frontal_area = 0.15;
+  v.wind_areas.lateral_area = 0.25;
+  v.wind_areas.length_overall = 1.2;
+  v.wind_coefficients.cx = 0.6;
+  v.wind_coefficients.cy = 0.8;
+  v.wind_coefficients.cn = 0.0;
   Vector6<Scalar> ma, dl, dq;
   ma << Scalar(2.25), Scalar(23.13), Scalar(15.0), Scalar(0.12), Scalar(0.2), Scalar(2.79);
   dl << Scalar(5.0), Scalar(20.0), Scalar(100.0), Scalar(8.0), Scalar(8.0), Scalar(10.0);

@@ -1,0 +1,66 @@
+/// \file
+/// \brief What a vehicle senses of the sea at its own position: water velocity and acceleration
+/// (current with its depth profile and time variation, plus wave orbital motion), the free
+/// surface (elevation and slope) and the wind, sampled from an environment at a time t.
+///
+/// Frames: NED (x north, y east, z down); the elevation ζ is positive UP, so the free surface lies
+/// at NED z = −ζ. Units SI. Time is a `double` for every Scalar (one clock).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "kelp/core/types.hpp"
+#include "kelp/vehicle/state.hpp"
+
+namespace kelp::vehicle {
+
+/// \brief What a vehicle senses of its surroundings at one instant, NED.
+/// A default-constructed value is still water with no wind and a flat surface at z = 0.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct Surroundings {
+  /// Current + wave orbital velocity at the vehicle's CO, NED [m/s].
+  Vector3<Scalar> water_velocity = Vector3<Scalar>::Zero();
+  /// Water acceleration at the CO (wave orbital ∂v/∂t), NED [m/s²].
+  Vector3<Scalar> water_acceleration = Vector3<Scalar>::Zero();
+  /// ζ at the CO's (x, y) [m], positive up; the surface is at NED z = −ζ.
+  Scalar surface_elevation = Scalar(0);
+  /// (∂ζ/∂x, ∂ζ/∂y) [-] at the CO's (x, y): rise of the surface per metre north and east.
+  Eigen::Matrix<Scalar, 2, 1> surface_slope = Eigen::Matrix<Scalar, 2, 1>::Zero();
+  /// Wind (air motion) at 10 m above the sea, or the environment's reference height, NED [m/s].
+  Vector3<Scalar> wind_velocity = Vector3<Scalar>::Zero();
+};
+
+/// \brief Samples `env` at the vehicle's CO at time t (no allocation): `env.sample(p, t)` gives
+/// current, wave orbital velocity and acceleration, elevation and wind; `env.surface_slope(x, y,
+/// t)` the slope. `Env` is `kelp::environment::Environment` or any type with those two queries.
+/// \param[in] env environment \param[in] x vehicle state (its CO position is used)
+/// \param[in] t time [s]
+template <typename Scalar, typename Env>
+Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x, double t) {
+  Surroundings<Scalar> s;
+  const auto e = env.sample(x.position, t);
+  s.water_velocity = e.current + e.wave_velocity;
+  s.water_acceleration = e.wave_acceleration;
+  s.surface_elevation = e.surface_elevation;
+  s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
+  s.wind_velocity = e.wind;
+  return s;
+}
+
+/// \brief Surroundings of a vehicle that does not need the surface slope (a submerged vehicle's
+/// restoring reads only the elevation): as `surroundings()` with the slope left at zero, which
+/// saves one pass over the wave components.
+template <typename Scalar, typename Env>
+Surroundings<Scalar> surroundings_without_slope(const Env& env, const VehicleState<Scalar>& x,
+                                                double t) {
+  Surroundings<Scalar> s;
+  const auto e = env.sample(x.position, t);
+  s.water_velocity = e.current + e.wave_velocity;
+  s.water_acceleration = e.wave_acceleration;
+  s.surface_elevation = e.surface_elevation;
+  s.wind_velocity = e.wind;
+  return s;
+}
+
+}  // namespace kelp::vehicle
