@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include "kelp/core/rotation.hpp"
+#include "kelp/environment/sea_state.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"
@@ -55,6 +56,36 @@ void BM_Rk4Step(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_Rk4Step);
+
+// One RK4 step in the environment: the surroundings (current, 64-component JONSWAP orbital
+// velocity and acceleration, elevation, wind; the slope too for the boat) sampled at each of the
+// four stages, in the paper's moderate sea state. Arg 0: BlueROV2 Heavy at 5 m; 1: BlueBoat.
+void BM_Rk4StepInEnvironment(benchmark::State& st) {
+  Fixture f;
+  const auto env =
+      kelp::environment::make_environment<double>(kelp::environment::presets::moderate());
+  const bool boat = st.range(0) == 1;
+  const kv::VehiclePreset<double> preset = boat ? kv::blueboat<double>() : f.preset;
+  const kv::VehicleModel<double> model(preset.parameters);
+  if (boat) {
+    f.x.position.z() = 0.0;
+    f.x.attitude = kelp::quaternion_from_euler(0.0, 0.0, 0.7);
+    f.x.nu.setZero();
+  }
+  const kv::VehicleState<double> x0 = f.x;
+  double t = 0.0;
+  int k = 0;
+  for (auto _ : st) {
+    kv::step_rk4(model, f.ws, f.x, 0.01, f.tau, f.tau_env, env, t);
+    t += 0.01;
+    benchmark::DoNotOptimize(f.x);
+    if (++k == 10000) {  // stay near the fixture's state
+      f.x = x0;
+      k = 0;
+    }
+  }
+}
+BENCHMARK(BM_Rk4StepInEnvironment)->Arg(0)->Arg(1);
 
 void BM_SemiImplicitEulerStep(benchmark::State& st) {
   Fixture f;
