@@ -186,8 +186,14 @@ struct ConstantWindCoefficients {
   double cy = 0.0;  ///< c_y [-] (≥ 0)
   double cn = 0.0;  ///< c_n [-]
   /// \brief (C_X, C_Y, C_N) at the relative wind angle γ_rw [rad].
-  Eigen::Vector3d operator()(double gamma) const {
-    return Eigen::Vector3d(-cx * std::cos(gamma), cy * std::sin(gamma), cn * std::sin(2 * gamma));
+  Eigen::Vector3d operator()(double gamma) const { return at(gamma); }
+  /// \brief The same for any scalar (a `ceres::Jet` γ keeps its derivatives).
+  template <typename Scalar>
+  Vector3<Scalar> at(const Scalar& gamma) const {
+    using std::cos;
+    using std::sin;
+    return Vector3<Scalar>(Scalar(-cx) * cos(gamma), Scalar(cy) * sin(gamma),
+                           Scalar(cn) * sin(Scalar(2) * gamma));
   }
 };
 
@@ -259,12 +265,17 @@ Vector3<Scalar> wind_load(const Coefficients& coefficients, const WindAreas& are
   const Scalar v2 = u_rw * u_rw + v_rw * v_rw;
   if (value_of(v2) == 0.0) return Vector3<Scalar>::Zero();
   const Scalar gamma = -atan2(v_rw, u_rw);
-  // Coefficients are read at the value of γ (tabulated data carry no derivative).
-  const Eigen::Vector3d c = coefficients(value_of(gamma));
+  // Constant coefficients are differentiated through γ; any other model (a table) is read at the
+  // value of γ and carries no derivative with respect to it.
+  Vector3<Scalar> c;
+  if constexpr (std::is_same<Coefficients, ConstantWindCoefficients>::value)
+    c = coefficients.at(gamma);
+  else
+    c = coefficients(value_of(gamma)).template cast<Scalar>();
   const Scalar q = Scalar(0.5) * rho_air * v2;
-  return Vector3<Scalar>(q * Scalar(c(0) * areas.frontal_area),
-                         q * Scalar(c(1) * areas.lateral_area),
-                         q * Scalar(c(2) * areas.lateral_area * areas.length_overall));
+  return Vector3<Scalar>(q * c(0) * Scalar(areas.frontal_area),
+                         q * c(1) * Scalar(areas.lateral_area),
+                         q * c(2) * Scalar(areas.lateral_area * areas.length_overall));
 }
 
 }  // namespace environment
