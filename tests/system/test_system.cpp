@@ -1,0 +1,214 @@
+// The coupled system: construction checks, failure leaves the state bit-identical, no allocation,
+// equal and opposite forces as momentum balance, energy with the dissipation off.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/system/system.hpp"
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/presets.hpp"
+#include "kelp/vehicle/presets.hpp"
+
+namespace ks = kelp::system;
+namespace kt = kelp::tether;
+namespace kv = kelp::vehicle;
+using kelp::Vector3;
+using kelp::Vector6;
+
+namespace {
+
+// BlueBoat at the surface, BlueROV2 Heavy 5 m down and 6 m north, a 10 m ROV tether from the
+// boat's stern to the ROV's top, started from the tether's static shape.
+struct World {
+  kelp::environment::Environmentd env;
+  ks::SystemParametersd params;
+  World() {
+    params.asv = kv::blueboat<double>().parameters;
+    params.auv = kv::bluerov2_heavy<double>().parameters;
+    params.asv_attachment = Vector3<double>(-0.5, 0, 0);
+    params.auv_attachment = Vector3<double>(0, 0, -0.15);
+    params.tether = kt::presets::rov_tether(10.0, 0.5);
+  }
+};
+
+ks::SystemStated initial_state(const ks::SystemModeld& model, ks::SystemWorkspaced& ws) {
+  ks::SystemStated s;
+  s.asv.position = Vector3<double>(0, 0, 0);
+  s.auv.position = Vector3<double>(6, 0, 5);
+  const Vector3<double> a = s.asv.point_position(model.parameters().asv_attachment);
+  const Vector3<double> b = s.auv.point_position(model.parameters().auv_attachment);
+  REQUIRE(kt::static_initial_state(model.tether(), ws.tether, model.environment(), a, b, s.tether)
+              .converged);
+  return s;
+}
+
+bool same_bits(const void* a, const void* b, std::size_t n) { return std::memcmp(a, b, n) == 0; }
+
+bool bitwise_equal(const ks::SystemStated& a, const ks::SystemStated& b) {
+  const auto m = [](const kelp::Matrix3X<double>& x, const kelp::Matrix3X<double>& y) {
+    return x.cols() == y.cols() && same_bits(x.data(), y.data(), sizeof(double) * x.size());
+  };
+  return same_bits(a.asv.position.data(), b.asv.position.data(), 3 * sizeof(double)) &&
+         same_bits(a.asv.attitude.coeffs().data(), b.asv.attitude.coeffs().data(),
+                   4 * sizeof(double)) &&
+         same_bits(a.asv.nu.data(), b.asv.nu.data(), 6 * sizeof(double)) &&
+         same_bits(a.auv.position.data(), b.auv.position.data(), 3 * sizeof(double)) &&
+         same_bits(a.auv.nu.data(), b.auv.nu.data(), 6 * sizeof(double)) &&
+         same_bits(a.asv_nu_dot.data(), b.asv_nu_dot.data(), 6 * sizeof(double)) &&
+         same_bits(a.auv_nu_dot.data(), b.auv_nu_dot.data(), 6 * sizeof(double)) &&
+         m(a.tether.position, b.tether.position) && m(a.tether.velocity, b.tether.velocity) &&
+         m(a.tether.previous_position, b.tether.previous_position) &&
+         a.tether.time == b.tether.time && a.tether.previous_dt == b.tether.previous_dt;
+}
+
+// Horizontal (x, y) generalized momentum of everything: each vehicle's R (M ν)_linear (its
+// Kirchhoff impulse, added mass included) and each tether node's M_i v_i.
+Vector3<double> momentum(const ks::SystemModeld& model, ks::SystemWorkspaced& ws,
+                         const ks::SystemStated& s) {
+  const auto body = [](const kv::VehicleModeld& m, const kv::VehicleStated& x) {
+    const Vector6<double> p = m.mass_matrix() * x.nu;
+    return Vector3<double>(x.attitude * Vector3<double>(p.head<3>()));
+  };
+  Vector3<double> total = body(model.asv(), s.asv) + body(model.auv(), s.auv);
+  kt::compute_forces(model.tether(), ws.tether, model.environment(), s.time(), s.tether.position,
+                     s.tether.velocity);
+  for (int i = 0; i < model.tether().nodes(); ++i) {
+    const Vector3<double> q = ws.tether.tangent.col(i), v = s.tether.velocity.col(i);
+    total += ws.tether.mass_iso(i) * v + ws.tether.mass_tan(i) * q.dot(v) * q;
+  }
+  return total;
+}
+
+// No drag, damping, air drag, thrust, current, waves or wind. The line is heavier than the ROV
+// tether and attached below the boat's waterline so that it stays under water: a node crossing
+// the surface changes its added mass with its submerged fraction, which the model does not count
+// as momentum or kinetic energy.
+World conservative_world() {
+  World w;
+  w.params.asv.damping = kv::DampingParameters<double>{};
+  w.params.asv.wind_areas = kelp::environment::WindAreas{};
+  w.params.auv.damping = kv::DampingParameters<double>{};
+  w.params.tether.normal_drag = w.params.tether.tangential_drag = 0;
+  w.params.tether.internal_damping = 0;
+  w.params.tether.mass_per_length = 0.07;
+  w.params.asv_attachment = Vector3<double>(-0.5, 0, 0.3);
+  return w;
+}
+
+double total_energy(const ks::SystemModeld& model, const ks::SystemStated& s) {
+  return kv::energy(model.asv(), s.asv) + kv::energy(model.auv(), s.auv) +
+         kt::tether_energy(model.tether(), model.environment(), s.tether);
+}
+
+}  // namespace
+
+TEST_CASE("a system refuses parts that do not fit together", "[system]") {
+  World w;
+  const ks::SystemModeld ok(w.params, w.env);
+  CHECK(ok.tether().segments() == 20);
+  auto fresh = w.env;
+  fresh.set_water_density(1000.0);
+  CHECK_THROWS_WITH(ks::SystemModeld(w.params, fresh), Catch::Contains("asv"));
+  auto p = w.params;
+  p.tether.end_mode = kt::EndMode::free;
+  CHECK_THROWS_WITH(ks::SystemModeld(p, w.env), Catch::Contains("kinematic"));
+  p = w.params;
+  p.max_tether_dt = 0;
+  CHECK_THROWS_WITH(ks::SystemModeld(p, w.env), Catch::Contains("max_tether_dt"));
+}
+
+TEST_CASE("a failed system step throws and leaves every part of the state bit-identical",
+          "[system][errors]") {
+  World w;
+  const ks::SystemModeld model(w.params, w.env);
+  ks::SystemWorkspaced ws(model);
+  auto s = initial_state(model, ws);
+  ks::SystemInputsd in;
+  for (int k = 0; k < 20; ++k) ks::step(model, ws, s, in, 0.01);
+  const ks::SystemStated before = s;
+  ks::SystemInputsd bad = in;
+  bad.auv.control(2) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(ks::step(model, ws, s, bad, 0.01), kelp::invalid_argument);
+  CHECK(bitwise_equal(s, before));
+  // A numerical failure inside (a huge command sends the ROV off; the tether cannot follow in
+  // one step without its retries): thrown after the tether has moved, and still restored.
+  auto p = w.params;
+  p.tether_options.max_step_halvings = 0;
+  p.tether_options.max_iterations = 1;
+  const ks::SystemModeld strict(p, w.env);
+  ks::SystemInputsd wild;
+  wild.auv.control << 1e7, 0, 0, 0, 0, 0;
+  s.auv_nu_dot << 1e5, 0, 0, 0, 0, 0;
+  const ks::SystemStated before2 = s;
+  CHECK_THROWS_AS(ks::step(strict, ws, s, wild, 0.01), kelp::numerical_error);
+  CHECK(bitwise_equal(s, before2));
+}
+
+TEST_CASE("a system step allocates nothing", "[system][malloc]") {
+  World w;
+  const ks::SystemModeld model(w.params, w.env);
+  ks::SystemWorkspaced ws(model);
+  auto s = initial_state(model, ws);
+  ks::SystemInputsd in;
+  in.auv.control << 20, 0, 5, 0, 0, 1;
+  in.asv.control << 10, 0, 0, 0, 0, 0;
+  ks::step(model, ws, s, in, 0.01);
+  Eigen::internal::set_is_malloc_allowed(false);
+  for (int k = 0; k < 10; ++k) ks::step(model, ws, s, in, 0.01);
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(s.time() == Approx(0.11));
+}
+
+TEST_CASE("equal and opposite: horizontal momentum of vehicles and tether is conserved",
+          "[system][momentum]") {
+  // No drag, damping, thrust, current, waves or wind: only internal (tether) forces act
+  // horizontally (restoring forces are vertical in a flat, still sea). The AUV is sent away
+  // from the boat at 1 m/s; the tether goes taut and pulls the boat.
+  const ks::SystemModeld model(conservative_world().params, kelp::environment::Environmentd{});
+  ks::SystemWorkspaced ws(model);
+  auto s = initial_state(model, ws);
+  s.auv.nu(0) = 1.0;
+  const Vector3<double> p0 = momentum(model, ws, s);
+  double worst = 0, f_max = 0;
+  ks::SystemInputsd in;
+  for (int k = 0; k < 2000; ++k) {  // 20 s
+    const auto r = ks::step(model, ws, s, in, 0.01);
+    f_max = std::max(f_max, r.force_on_auv.norm());
+    const Vector3<double> p = momentum(model, ws, s);
+    worst = std::max(worst, (p - p0).head<2>().norm());
+  }
+  INFO("initial horizontal momentum " << p0.head<2>().norm() << " kg m/s, worst change " << worst
+                                      << ", peak tether force " << f_max << " N");
+  CHECK(f_max > 1.0);  // the tether did pull
+  CHECK(worst <= 0.01 * p0.head<2>().norm());
+}
+
+TEST_CASE("energy: with every dissipation on and no forcing the system never gains energy",
+          "[system][energy]") {
+  // Default presets (vehicle damping, tether drag and internal damping), still water; the AUV
+  // is sent away from the boat at 1 m/s and the tether snaps taut.
+  World w;
+  const ks::SystemModeld damped(w.params, w.env);
+  ks::SystemWorkspaced wd(damped);
+  auto sd = initial_state(damped, wd);
+  sd.auv.nu(0) = 1.0;
+  const double kinetic0 = 0.5 * sd.auv.nu.dot(damped.auv().mass_matrix() * sd.auv.nu);
+  double e_prev = total_energy(damped, sd);
+  const double ed0 = e_prev;
+  double rise = 0, f_max = 0;
+  ks::SystemInputsd in;
+  for (int k = 0; k < 3000; ++k) {
+    const auto r = ks::step(damped, wd, sd, in, 0.01);
+    f_max = std::max(f_max, r.force_on_auv.norm());
+    const double e = total_energy(damped, sd);
+    rise = std::max(rise, e - e_prev);
+    e_prev = e;
+  }
+  INFO("E0 " << ed0 << " J, E(30 s) " << e_prev << " J, largest rise in a step " << rise
+             << " J, peak tether force " << f_max << " N");
+  CHECK(f_max > 1.0);
+  CHECK(e_prev < ed0 - 0.5 * kinetic0);
+  CHECK(rise <= 1e-3 * kinetic0);
+}
