@@ -199,30 +199,19 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
                              vehicle::VehicleState<Scalar>& x, const Env& env, double t, double dt,
                              const VehicleInput<Scalar>& in, const Vector3<Scalar>& r,
                              const Vector3<Scalar>& f_ned) {
-  using D = vehicle::StateDerivative<Scalar>;
-  const auto derivative = [&](const vehicle::VehicleState<Scalar>& s, double ts) {
-    D d;
-    d.pose = vehicle::pose_rate(s.attitude, s.nu);
-    const Vector6<Scalar> tau_ext = in.external + attachment_wrench(s, r, f_ned);
-    d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.control, tau_ext,
-                                         vehicle::surroundings(env, s, ts));
-    return d;
-  };
-  const Scalar h = Scalar(dt), half = Scalar(0.5) * h;
-  const D k1 = derivative(x, t);
-  const D k2 = derivative(vehicle::detail::advance(x, k1, half), t + 0.5 * dt);
-  const D k3 = derivative(vehicle::detail::advance(x, k2, half), t + 0.5 * dt);
-  const D k4 = derivative(vehicle::detail::advance(x, k3, h), t + dt);
-  D k;
-  const Scalar two(2);
-  k.pose.position_dot = k1.pose.position_dot + two * k2.pose.position_dot +
-                        two * k3.pose.position_dot + k4.pose.position_dot;
-  k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
-                        two * k3.pose.attitude_dot + k4.pose.attitude_dot;
-  k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
-  vehicle::detail::commit_if_finite(x, vehicle::detail::advance(x, k, h / Scalar(6)),
-                                    "system::step (vehicle)");
-  return k4.nu_dot;
+  return vehicle::detail::rk4(
+             x, Scalar(dt),
+             [&](const vehicle::VehicleState<Scalar>& s, double c) {
+               vehicle::StateDerivative<Scalar> d;
+               d.pose = vehicle::pose_rate(s.attitude, s.nu);
+               const Vector6<Scalar> tau_ext = in.external + attachment_wrench(s, r, f_ned);
+               d.nu_dot =
+                   vehicle::forward_dynamics(model, ws, s, in.control, tau_ext,
+                                             vehicle::surroundings(model, env, s, t + c * dt));
+               return d;
+             },
+             "system::step (vehicle)")
+      .nu_dot;
 }
 
 }  // namespace detail

@@ -77,6 +77,29 @@ void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& n
   state = next;
 }
 
+/// Classical RK4 over dt from `state`: `deriv(x, c)` returns the StateDerivative at the stage state
+/// x, c ∈ {0, ½, ½, 1} being the stage's fraction of the step (for stage times and wrenches).
+/// Commits a finite result (else throws numerical_error naming `who`, state unchanged) and returns
+/// the last stage's derivative. The one RK4 of the vehicle steps and of the coupled system.
+template <typename Scalar, typename Deriv>
+StateDerivative<Scalar> rk4(VehicleState<Scalar>& state, const Scalar& dt, Deriv&& deriv,
+                            const char* who) {
+  const Scalar half = Scalar(0.5) * dt;
+  const StateDerivative<Scalar> k1 = deriv(state, 0.0);
+  const StateDerivative<Scalar> k2 = deriv(advance(state, k1, half), 0.5);
+  const StateDerivative<Scalar> k3 = deriv(advance(state, k2, half), 0.5);
+  const StateDerivative<Scalar> k4 = deriv(advance(state, k3, dt), 1.0);
+  StateDerivative<Scalar> k;
+  const Scalar two(2);
+  k.pose.position_dot = k1.pose.position_dot + two * k2.pose.position_dot +
+                        two * k3.pose.position_dot + k4.pose.position_dot;
+  k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
+                        two * k3.pose.attitude_dot + k4.pose.attitude_dot;
+  k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
+  commit_if_finite(state, advance(state, k, dt / Scalar(6)), who);
+  return k4;
+}
+
 /// Checks what a step takes from the caller: dt > 0, a finite state and a unit attitude (a zero or
 /// badly scaled quaternion would otherwise be silently read as some rotation by Eigen).
 template <typename Scalar>
@@ -107,24 +130,13 @@ void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
                    VehicleState<Scalar>& state, identity_t<Scalar> dt, WrenchFn&& wrench,
                    const Eigen::MatrixBase<DC>& current_ned) {
   detail::check_step_input(state, dt);
-  const Scalar half = Scalar(0.5) * dt;
   const Vector3<Scalar> vc(current_ned);
-  const StateDerivative<Scalar> k1 =
-      state_derivative(model, ws, state, wrench(state, Scalar(0)), vc);
-  const VehicleState<Scalar> x2 = detail::advance(state, k1, half);
-  const StateDerivative<Scalar> k2 = state_derivative(model, ws, x2, wrench(x2, half), vc);
-  const VehicleState<Scalar> x3 = detail::advance(state, k2, half);
-  const StateDerivative<Scalar> k3 = state_derivative(model, ws, x3, wrench(x3, half), vc);
-  const VehicleState<Scalar> x4 = detail::advance(state, k3, dt);
-  const StateDerivative<Scalar> k4 = state_derivative(model, ws, x4, wrench(x4, dt), vc);
-  StateDerivative<Scalar> k;
-  const Scalar two(2), sixth = dt / Scalar(6);
-  k.pose.position_dot = k1.pose.position_dot + two * k2.pose.position_dot +
-                        two * k3.pose.position_dot + k4.pose.position_dot;
-  k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
-                        two * k3.pose.attitude_dot + k4.pose.attitude_dot;
-  k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
-  detail::commit_if_finite(state, detail::advance(state, k, sixth), "step_rk4");
+  detail::rk4(
+      state, dt,
+      [&](const VehicleState<Scalar>& x, double c) {
+        return state_derivative(model, ws, x, wrench(x, Scalar(c) * dt), vc);
+      },
+      "step_rk4");
 }
 
 /// \brief One RK4 step with τ and τ_env held constant over the step (zero-order hold).
@@ -185,29 +197,17 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
   detail::check_step_input(state, dt);
   const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext);
   const Vector6<Scalar> zero = Vector6<Scalar>::Zero();
-  const Scalar half = Scalar(0.5) * dt;
-  const double dt_d = value_of(dt), half_d = 0.5 * dt_d;
-  const auto deriv = [&](const VehicleState<Scalar>& x, double time) {
-    StateDerivative<Scalar> d;
-    d.pose = pose_rate(x.attitude, x.nu);
-    d.nu_dot = forward_dynamics(model, ws, x, total, zero, surroundings(model, env, x, time));
-    return d;
-  };
-  const StateDerivative<Scalar> k1 = deriv(state, t);
-  const VehicleState<Scalar> x2 = detail::advance(state, k1, half);
-  const StateDerivative<Scalar> k2 = deriv(x2, t + half_d);
-  const VehicleState<Scalar> x3 = detail::advance(state, k2, half);
-  const StateDerivative<Scalar> k3 = deriv(x3, t + half_d);
-  const VehicleState<Scalar> x4 = detail::advance(state, k3, dt);
-  const StateDerivative<Scalar> k4 = deriv(x4, t + dt_d);
-  StateDerivative<Scalar> k;
-  const Scalar two(2), sixth = dt / Scalar(6);
-  k.pose.position_dot = k1.pose.position_dot + two * k2.pose.position_dot +
-                        two * k3.pose.position_dot + k4.pose.position_dot;
-  k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
-                        two * k3.pose.attitude_dot + k4.pose.attitude_dot;
-  k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
-  detail::commit_if_finite(state, detail::advance(state, k, sixth), "step_rk4");
+  const double dt_d = value_of(dt);
+  detail::rk4(
+      state, dt,
+      [&](const VehicleState<Scalar>& x, double c) {
+        StateDerivative<Scalar> d;
+        d.pose = pose_rate(x.attitude, x.nu);
+        d.nu_dot =
+            forward_dynamics(model, ws, x, total, zero, surroundings(model, env, x, t + c * dt_d));
+        return d;
+      },
+      "step_rk4");
 }
 
 /// \brief One semi-implicit (symplectic) Euler step: ν_{k+1} = ν_k + dt ν̇(x_k), then the pose is
