@@ -160,6 +160,18 @@ Scalar restoring_potential_free_surface(const Scalar& weight, const Scalar& buoy
   return -weight * z_cg + buoyancy * hull_height * big_phi;
 }
 
+/// \brief The local surface's downward normal n_s = (ζ_x, ζ_y, 1)/√(1 + ζ_x² + ζ_y²) in body axes,
+/// d = Rᵀ n_s ((R₃₁, R₃₂, R₃₃) on calm water), from the slope (∂ζ/∂x, ∂ζ/∂y) and R (body → NED).
+template <typename Scalar, typename DS, typename DR>
+Vector3<Scalar> surface_normal_in_body(const Eigen::MatrixBase<DS>& slope,
+                                       const Eigen::MatrixBase<DR>& R) {
+  using std::sqrt;
+  const Scalar sx = slope(0), sy = slope(1);
+  const Vector3<Scalar> n =
+      Vector3<Scalar>(sx, sy, Scalar(1)) / sqrt(Scalar(1) + sx * sx + sy * sy);
+  return R.transpose() * n;
+}
+
 /// \brief Restoring vector of a surface vessel relative to the local wave surface, bounded when
 /// the hull emerges or submerges.
 ///
@@ -187,7 +199,6 @@ Vector6<Scalar> restoring_force_surface_following(
     const Scalar& waterplane_area, const Scalar& gm_transverse, const Scalar& gm_longitudinal,
     const Scalar& hull_depth, const Scalar& z, const Scalar& zeta,
     const Eigen::MatrixBase<DS>& slope, const Eigen::MatrixBase<DR>& R) {
-  using std::sqrt;
   const Scalar rho_g = density * gravity;
   Scalar e = z + zeta;
   if (hull_depth > Scalar(0)) {
@@ -196,10 +207,7 @@ Vector6<Scalar> restoring_force_surface_following(
     if (e > hull_depth - draft) e = hull_depth - draft;
   }
   const Vector3<Scalar> down = R.template bottomRows<1>().transpose();
-  const Scalar sx = slope(0), sy = slope(1);
-  const Vector3<Scalar> n =
-      Vector3<Scalar>(sx, sy, Scalar(1)) / sqrt(Scalar(1) + sx * sx + sy * sy);
-  const Vector3<Scalar> d = R.transpose() * n;
+  const Vector3<Scalar> d = surface_normal_in_body<Scalar>(slope, R);
   const Scalar ct = rho_g * displaced_volume * gm_transverse;
   const Scalar cl = rho_g * displaced_volume * gm_longitudinal;
   Vector6<Scalar> g;
@@ -219,7 +227,6 @@ Scalar restoring_potential_surface_following(
     const Scalar& waterplane_area, const Scalar& gm_transverse, const Scalar& gm_longitudinal,
     const Scalar& hull_depth, const Scalar& z, const Scalar& zeta,
     const Eigen::MatrixBase<DS>& slope, const Eigen::MatrixBase<DR>& R) {
-  using std::sqrt;
   const Scalar rho_g = density * gravity;
   const Scalar e = z + zeta;
   Scalar p = Scalar(0.5) * e * e;
@@ -228,10 +235,7 @@ Scalar restoring_potential_surface_following(
     if (e < lo) p = Scalar(0.5) * lo * lo + lo * (e - lo);
     if (e > hi) p = Scalar(0.5) * hi * hi + hi * (e - hi);
   }
-  const Scalar sx = slope(0), sy = slope(1);
-  const Vector3<Scalar> n =
-      Vector3<Scalar>(sx, sy, Scalar(1)) / sqrt(Scalar(1) + sx * sx + sy * sy);
-  const Vector3<Scalar> d = R.transpose() * n;
+  const Vector3<Scalar> d = surface_normal_in_body<Scalar>(slope, R);
   return rho_g * waterplane_area * p +
          Scalar(0.5) * rho_g * displaced_volume *
              (gm_transverse * d(1) * d(1) + gm_longitudinal * d(0) * d(0));
