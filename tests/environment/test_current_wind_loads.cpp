@@ -377,16 +377,30 @@ TEMPLATE_TEST_CASE("the full environment's batch query matches sample() without 
   const int n = 50;
   Matrix3X<S> pts(3, n), vel(3, n), acc(3, n);
   for (int i = 0; i < n; ++i) pts.col(i) << S(0.2 * i), S(0.1 * i), S(-0.5 + 0.4 * i);
+  pts(2, 0) = S(-20);  // in the air
+  Matrix3X<S> vel2(3, n), acc2(3, n);
+  kelp::VectorX<S> zeta(n);
   Eigen::internal::set_is_malloc_allowed(false);
   env.sample_water(pts, S(7.0), vel, acc);
+  env.sample_water(pts, S(7.0), vel2, acc2, zeta);
   const auto probe = env.sample(Vector3<S>(pts.col(3)), S(7.0));
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(probe.wind.norm() > S(0));
+  int above = 0;
   for (int i = 0; i < n; ++i) {
     const auto s = env.sample(Vector3<S>(pts.col(i)), S(7.0));
     CHECK((vel.col(i) - s.current - s.wave_velocity).norm() <= S(1e-5));
     CHECK((acc.col(i) - s.wave_acceleration).norm() <= S(1e-5));
     CHECK(s.surface_elevation ==
           Approx(env.surface_elevation(pts(0, i), pts(1, i), S(7.0))).margin(1e-5));
+    // The query with elevations: the same kinematics, and ζ at every point, deep ones too.
+    CHECK((vel2.col(i) - vel.col(i)).norm() == S(0));
+    CHECK((acc2.col(i) - acc.col(i)).norm() == S(0));
+    CHECK(zeta(i) == Approx(env.surface_elevation(pts(0, i), pts(1, i), S(7.0))).margin(1e-5));
+    above += pts(2, i) < -zeta(i);
   }
+  CHECK(above >= 1);  // the first point is above the surface: no orbital motion there
+  CHECK(vel2.col(0).norm() == Approx(env.current().velocity(Vector3<S>(pts.col(0)), 7.0).norm()));
+  kelp::VectorX<S> short_zeta(n - 1);
+  CHECK_THROWS_AS(env.sample_water(pts, S(7.0), vel2, acc2, short_zeta), kelp::invalid_argument);
 }

@@ -201,6 +201,33 @@ class Environment {
       return;
     }
     waves_.kinematics(points, t, velocity, acceleration);
+    add_current(points, t, velocity);
+  }
+
+  /// \brief The same, plus the free-surface elevation ζ above each point [m] (positive up), from
+  /// the same wave sums: much cheaper than calling `surface_elevation` for each point.
+  /// \param[out] elevation n values [m]
+  void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
+                    Eigen::Ref<Matrix3X<Scalar>> velocity,
+                    Eigen::Ref<Matrix3X<Scalar>> acceleration,
+                    Eigen::Ref<VectorX<Scalar>> elevation) const {
+    KELP_CHECK(elevation.size() == points.cols(),
+               "sample_water: elevation must have one entry per point");
+    if (waves_.empty()) {
+      sample_water(points, t, velocity, acceleration);
+      elevation.setZero();
+      return;
+    }
+    KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
+               "sample_water: velocity and acceleration must have as many columns as points");
+    waves_.kinematics(points, t, velocity, acceleration, elevation);
+    add_current(points, t, velocity);
+  }
+
+ private:
+  /// Adds the current at each point to `velocity` (waves already written).
+  void add_current(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
+                   Eigen::Ref<Matrix3X<Scalar>> velocity) const {
     if (current_.is_zero()) return;
     const Vector3<Scalar> vs = current_.surface_velocity(t);
     if (current_.parameters().profile.kind == CurrentProfileKind::uniform) {
@@ -211,7 +238,6 @@ class Environment {
       velocity.col(i) += vs * profile_factor(current_.parameters().profile, points(2, i));
   }
 
- private:
   static void check_wave_gravity(const WaveField<Scalar>& waves, double g) {
     KELP_CHECK(waves.empty() || std::abs(waves.parameters().gravity - g) <= 1e-6 * g,
                "waves.gravity must equal the environment's gravity");

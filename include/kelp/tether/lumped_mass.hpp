@@ -14,7 +14,8 @@
 /// Frames and units: world NED (z down, mean sea surface at z = 0, free surface at z = −ζ), SI.
 /// Environments are duck-typed (`Env`): anything with `water_density()`, `gravity()`,
 /// `seabed_depth()`, `surface_elevation(x, y, t)` and `sample_water(points, t, vel, acc)` as
-/// `kelp::environment::Environment` has.
+/// `kelp::environment::Environment` has (its `sample_water(points, t, vel, acc, elevation)`, when
+/// present, saves the per-node elevation queries).
 #pragma once
 
 #include <Eigen/Core>
@@ -349,6 +350,7 @@ struct TetherWorkspace {
   Matrix3X<Scalar> tangent;             ///< unit node tangent q_i (zero if degenerate)
   Matrix3X<Scalar> water_velocity;      ///< current + wave orbital velocity at each node [m/s]
   Matrix3X<Scalar> water_acceleration;  ///< water acceleration at each node [m/s²]
+  VectorX<Scalar> surface_elevation;    ///< free-surface elevation ζ above each node [m]
   Matrix3X<Scalar> bending;             ///< bending force on each node (when EI > 0) [N]
   VectorX<Scalar> mass_iso;             ///< a_i: M_i = a_i I + b_i q qᵀ [kg]
   VectorX<Scalar> mass_tan;             ///< b_i [kg]
@@ -387,10 +389,23 @@ struct TetherWorkspace {
   StateBackup<Scalar> entry_backup;
   /// State at entry of an implicit step that is retried in sub-steps, restored if they fail
   StateBackup<Scalar> retry_backup;
-  /// water_velocity and water_acceleration hold zeros (set by resize and by compute_forces in a
-  /// still environment, whose water query it then skips; cleared when the query runs)
+  /// water_velocity, water_acceleration and surface_elevation hold zeros (set by resize and by
+  /// compute_forces in a still environment, whose water query it then skips; cleared when the
+  /// query runs)
   bool water_is_zero = false;
+  /// Set by the implicit steps after their first force evaluation (unless
+  /// ImplicitOptions::resample_water): compute_forces then reuses water_velocity,
+  /// water_acceleration and surface_elevation, sampled at the step's predicted node positions
+  /// at t + h, instead of querying the environment at every Newton iterate.
+  bool water_frozen = false;
   EndForces<Scalar> end_forces;  ///< forces on the attachment points after the last step
+  /// Impulse the tether delivered to its attachment points over the last step (the step
+  /// functions) or the last `advance` (summed over its sub-steps) [N s]: the end force weighted
+  /// as the integrator weights the node forces in its momentum update (symplectic Euler h F(t),
+  /// RK2 h F(t + h/2), RK4 h/6 (F₁ + 2F₂ + 2F₃ + F₄), implicit Euler and BDF2 h F(t + h)). A body
+  /// that carries an end and receives exactly this impulse keeps the momentum of body and tether
+  /// balanced whatever the integrator (kelp::system::step does so).
+  EndForces<Scalar> end_impulse;
 
   TetherWorkspace() = default;
   /// \brief Buffers sized for `model`.
@@ -402,8 +417,8 @@ struct TetherWorkspace {
     for (Matrix3X<Scalar>* m : {&force, &bending, &acceleration, &tangent, &water_velocity,
                                 &water_acceleration, &rhs, &delta, &x0, &v0, &x1, &v1, &xs, &vs})
       m->setZero(3, n);
-    for (VectorX<Scalar>* v :
-         {&mass_iso, &mass_tan, &seabed_force, &friction_normal, &submerged, &node_kz})
+    for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &friction_normal, &submerged,
+                               &node_kz, &surface_elevation})
       v->setZero(n);
     direction.setZero(3, s);
     rhs_true.setZero(3, n);
@@ -429,6 +444,32 @@ template <typename Env>
 struct has_still_water_query<
     Env, std::void_t<decltype(bool(std::declval<const Env&>().is_still_water()))>>
     : std::true_type {};
+
+/// True for environments that sample the free-surface elevation along with the water
+/// kinematics: `sample_water(points, t, velocity, acceleration, elevation)`, as
+/// kelp::environment::Environment can. Other environments are asked `surface_elevation(x, y, t)`
+/// node by node.
+template <typename Env, typename Scalar, typename = void>
+struct has_batch_surface : std::false_type {};
+template <typename Env, typename Scalar>
+struct has_batch_surface<
+    Env, Scalar,
+    std::void_t<decltype(std::declval<const Env&>().sample_water(
+        std::declval<const Matrix3X<Scalar>&>(), 0.0, std::declval<Matrix3X<Scalar>&>(),
+        std::declval<Matrix3X<Scalar>&>(), std::declval<VectorX<Scalar>&>()))>> : std::true_type {};
+
+/// Water velocity, acceleration and surface elevation at the points `x` into the workspace.
+template <typename Scalar, typename Env, typename DX>
+void sample_water_at_nodes(const Env& env, const Eigen::MatrixBase<DX>& x, double t,
+                           TetherWorkspace<Scalar>& ws) {
+  if constexpr (has_batch_surface<Env, Scalar>::value) {
+    env.sample_water(x, t, ws.water_velocity, ws.water_acceleration, ws.surface_elevation);
+  } else {
+    env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
+    for (Eigen::Index i = 0; i < x.cols(); ++i)
+      ws.surface_elevation(i) = Scalar(env.surface_elevation(x(0, i), x(1, i), t));
+  }
+}
 
 /// True when `env` reports still water: its water velocity and acceleration are zero everywhere
 /// and at all times.
@@ -553,11 +594,14 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
   // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
   const bool still = detail::is_still_water(env);
   if (!still) {
-    ws.water_is_zero = false;
-    env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
+    if (!ws.water_frozen) {
+      ws.water_is_zero = false;
+      detail::sample_water_at_nodes(env, x, t, ws);
+    }
   } else if (!ws.water_is_zero) {
     ws.water_velocity.setZero();
     ws.water_acceleration.setZero();
+    ws.surface_elevation.setZero();
     ws.water_is_zero = true;
   }
 
@@ -697,7 +741,7 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
 
     const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
     const Scalar li = kinds[kind].li;
-    const Scalar zeta = still ? Scalar(0) : Scalar(env.surface_elevation(x(0, i), x(1, i), t));
+    const Scalar zeta = still ? Scalar(0) : ws.surface_elevation(i);
     // (Below the surface φ = 1 without the ramp's arithmetic.)
     const Scalar phi = x(2, i) + zeta >= Scalar(0)
                            ? Scalar(1)
