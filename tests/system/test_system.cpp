@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kelp/environment/environment.hpp"
+#include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
@@ -258,4 +259,58 @@ TEST_CASE("energy: with every dissipation on and no forcing the system never gai
   CHECK(f_max > 1.0);
   CHECK(e_prev < ed0 - 0.5 * kinetic0);
   CHECK(rise <= 1e-3 * kinetic0);
+}
+
+TEST_CASE("the paper's system presets build, start from a static tether and step in every sea",
+          "[system][presets]") {
+  namespace sp = ks::presets;
+  for (const double length : {5.0, 10.0, 15.0})
+    for (const auto kind : {sp::TetherKind::rov_tether, sp::TetherKind::bead_chain}) {
+      sp::PaperWorld<double> w(length, sp::Sea::moderate, kind);
+      INFO("tether " << length << " m, kind " << int(kind));
+      const auto& p = w.model.parameters();
+      // The start state: the chord between the tether points is 80 % of the length.
+      const Vector3<double> a = w.state.asv.point_position(p.asv_attachment);
+      const Vector3<double> b = w.state.auv.point_position(p.auv_attachment);
+      CHECK((b - a).norm() == Approx(0.8 * w.model.tether().parameters().length).epsilon(1e-9));
+      CHECK((w.state.tether.position.col(0) - a).norm() < 1e-12);
+      CHECK((w.state.tether.position.col(w.model.tether().segments()) - b).norm() < 1e-12);
+      ks::SystemInputsd in;
+      for (int k = 0; k < 200; ++k) ks::step(w.model, w.workspace, w.state, in, 0.01);
+      CHECK(w.state.time() == Approx(2.0));
+      CHECK(w.state.tether.position.allFinite());
+    }
+  CHECK(sp::paper_system<double>(10.0).tether.segments == 20);
+  CHECK_THROWS_AS(sp::paper_system<double>(-1.0), kelp::invalid_argument);
+  CHECK_THROWS_AS(sp::sea_state(static_cast<sp::Sea>(7)), kelp::invalid_argument);
+}
+
+TEST_CASE("0.5 m tether segments resolve the paper's static shape as well as 0.25 m",
+          "[system][presets]") {
+  // The default configuration's static tether with the preset's 0.5 m segments and with 0.25 m:
+  // the shape (compared at the coarse nodes) and the end tensions.
+  namespace sp = ks::presets;
+  const auto start = sp::paper_start<double>(10.0);
+  auto fine_params = sp::paper_system<double>(10.0);
+  fine_params.tether = kt::presets::rov_tether(10.0, 0.25);
+  const ks::SystemModeld coarse(sp::paper_system<double>(10.0), kelp::environment::Environmentd{});
+  const ks::SystemModeld fine(fine_params, kelp::environment::Environmentd{});
+  ks::SystemWorkspaced wc(coarse), wf(fine);
+  const auto sc = ks::initial_state(coarse, wc, start.asv, start.auv);
+  const auto sf = ks::initial_state(fine, wf, start.asv, start.auv);
+  double dx = 0;
+  for (int i = 0; i <= coarse.tether().segments(); ++i)
+    dx = std::max(dx, (sc.tether.position.col(i) - sf.tether.position.col(2 * i)).norm());
+  kt::compute_forces(coarse.tether(), wc.tether, coarse.environment(), 0.0, sc.tether.position,
+                     sc.tether.velocity);
+  const auto fc = kt::end_forces_from_workspace(coarse.tether(), wc.tether, {});
+  kt::compute_forces(fine.tether(), wf.tether, fine.environment(), 0.0, sf.tether.position,
+                     sf.tether.velocity);
+  const auto ff = kt::end_forces_from_workspace(fine.tether(), wf.tether, {});
+  INFO("shape difference " << dx << " m; end forces " << fc.on_start.norm() << " / "
+                           << ff.on_start.norm() << " N and " << fc.on_end.norm() << " / "
+                           << ff.on_end.norm() << " N");
+  CHECK(dx < 0.03);
+  CHECK(fc.on_start.norm() == Approx(ff.on_start.norm()).epsilon(0.01));
+  CHECK(fc.on_end.norm() == Approx(ff.on_end.norm()).epsilon(0.01));
 }

@@ -50,6 +50,7 @@
 #include "kelp/core/types.hpp"
 #include "kelp/environment/environment.hpp"
 #include "kelp/system/tether_attachment.hpp"
+#include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/vehicle/integrators.hpp"
@@ -317,6 +318,47 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     throw;
   }
   return report;
+}
+
+/// \brief A system state with the vehicles at `asv` and `auv` and the tether at its static
+/// equilibrium between their attachment points in still water (its own weight, buoyancy and
+/// elasticity; waves and current are left to the first steps), at rest, at time `t` [s].
+/// Unless `options` says otherwise, the static solve stops at a residual of 1e-4 × the line's
+/// weight in air (a neutrally buoyant slack line has no unique static shape, and a start state
+/// needs no more).
+/// \throws kelp::invalid_argument for bad vehicle states; kelp::numerical_error when the tether's
+/// static solve does not converge.
+template <typename Scalar>
+SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
+                                  const vehicle::VehicleState<Scalar>& asv,
+                                  const vehicle::VehicleState<Scalar>& auv, double t = 0.0,
+                                  tether::StaticOptions<Scalar> options = {}) {
+  check_all_finite(asv.position, "asv.position");
+  check_all_finite(auv.position, "auv.position");
+  check_all_finite(asv.nu, "asv.nu");
+  check_all_finite(auv.nu, "auv.nu");
+  SystemState<Scalar> s;
+  s.asv = asv;
+  s.auv = auv;
+  const Vector3<Scalar> a = asv.point_position(model.parameters().asv_attachment);
+  const Vector3<Scalar> b = auv.point_position(model.parameters().auv_attachment);
+  environment::Environment<Scalar> still;
+  still.set_water_density(model.environment().water_density());
+  still.set_gravity(model.environment().gravity());
+  still.set_seabed_depth(model.environment().seabed_depth());
+  if (!(options.force_tolerance > Scalar(0))) {
+    const tether::TetherParameters<Scalar>& tp = model.tether().parameters();
+    options.force_tolerance =
+        Scalar(1e-4) * tp.mass_per_length * tp.length * Scalar(model.environment().gravity());
+  }
+  const tether::StaticResult<Scalar> r =
+      tether::static_initial_state(model.tether(), ws.tether, still, a, b, s.tether, options);
+  if (!r.converged)
+    ::kelp::detail::throw_numerical_error(
+        "system::initial_state: the tether's static shape did not converge (residual " +
+        std::to_string(double(value_of(r.residual))) + " N)");
+  s.tether.time = t;
+  return s;
 }
 
 using SystemParametersd = SystemParameters<double>;  ///< SystemParameters<double>

@@ -1,0 +1,143 @@
+/// \file
+/// \brief The paper's configuration as a system preset: a BlueBoat, a BlueROV2 Heavy, a 5, 10 or
+/// 15 m tether (a Fathom-class ROV tether, or the lumped-mass equivalent of the paper's Gazebo
+/// bead chain) attached to both, in the calm, moderate or rough sea of the paper's evaluation
+/// (Buchholz, Carlucho, Grimaldi, Petillot 2025, "Tethered Multi-Robot Systems in Marine
+/// Environments", arXiv:2508.02264).
+///
+/// Attachment points (assumed; neither vehicle has a standard tow point):
+/// - BlueBoat: on the transom at the keel, (−0.5, 0, 0.08) m from the CO (which is on the still
+///   waterline; hull length ≈ 1.2 m, draft 7.7 cm, see vehicle::blueboat), so the line leaves
+///   the hull under water;
+/// - BlueROV2 Heavy: the tether penetrator on the aft end cap of the electronics enclosure,
+///   (−0.2, 0, −0.05) m from the CO (frame length 457 mm; Blue Robotics BlueROV2 technical
+///   details).
+///
+/// Tether discretisation: 0.5 m segments, the spacing of the paper's Gazebo beads (20 segments
+/// for 10 m). Against 0.25 m segments, the static shape of the default configuration moves by
+/// 2 cm (the nearly neutral line hangs under forces of a few centinewtons) and the end tensions
+/// by under 1 % (tests/system/test_system.cpp), for half the cost.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/environment/sea_state.hpp"
+#include "kelp/system/system.hpp"
+#include "kelp/tether/presets.hpp"
+#include "kelp/vehicle/presets.hpp"
+
+namespace kelp::system::presets {
+
+/// \brief Which line joins the vehicles.
+enum class TetherKind {
+  rov_tether,  ///< Fathom-class 7.6 mm ROV tether (tether::presets::rov_tether)
+  bead_chain  ///< the paper's Gazebo bead chain as a lumped-mass line (tether::presets::bead_chain)
+};
+
+/// \brief The paper's sea states.
+enum class Sea { calm, moderate, rough };
+
+/// \brief The sea state of `sea` (environment::presets).
+inline environment::SeaState sea_state(Sea sea) {
+  switch (sea) {
+    case Sea::calm:
+      return environment::presets::calm();
+    case Sea::moderate:
+      return environment::presets::moderate();
+    case Sea::rough:
+      return environment::presets::rough();
+  }
+  ::kelp::detail::throw_invalid_argument("sea is not a kelp::system::presets::Sea value");
+}
+
+/// \brief The environment of `sea`: JONSWAP waves with the default number of components, wind
+/// with gusts and current, in seawater (environment::make_environment).
+template <typename Scalar>
+environment::Environment<Scalar> environment(Sea sea,
+                                             const environment::SeaStateOptions& options = {}) {
+  return environment::make_environment<Scalar>(sea_state(sea), options);
+}
+
+/// \brief BlueBoat tether point, body axes [m] (see the file comment).
+template <typename Scalar>
+Vector3<Scalar> blueboat_attachment() {
+  return Vector3<Scalar>(Scalar(-0.5), Scalar(0), Scalar(0.08));
+}
+
+/// \brief BlueROV2 Heavy tether point, body axes [m] (see the file comment).
+template <typename Scalar>
+Vector3<Scalar> bluerov2_attachment() {
+  return Vector3<Scalar>(Scalar(-0.2), Scalar(0), Scalar(-0.05));
+}
+
+/// \brief The paper's system: BlueBoat (ASV), BlueROV2 Heavy (AUV) and a tether of
+/// `tether_length` [m] (the paper evaluates 5, 10 and 15 m), in seawater; BDF2 tether steps of at
+/// most 10 ms.
+/// \throws kelp::invalid_argument for a non-positive length.
+template <typename Scalar>
+SystemParameters<Scalar> paper_system(Scalar tether_length = Scalar(10),
+                                      TetherKind kind = TetherKind::rov_tether) {
+  check_positive(tether_length, "tether_length");
+  SystemParameters<Scalar> p;
+  p.asv = vehicle::blueboat<Scalar>().parameters;
+  p.auv = vehicle::bluerov2_heavy<Scalar>().parameters;
+  p.asv_attachment = blueboat_attachment<Scalar>();
+  p.auv_attachment = bluerov2_attachment<Scalar>();
+  switch (kind) {
+    case TetherKind::rov_tether:
+      p.tether = tether::presets::rov_tether(tether_length, Scalar(0.5));
+      break;
+    case TetherKind::bead_chain:
+      p.tether = tether::presets::bead_chain(tether_length);
+      break;
+    default:
+      ::kelp::detail::throw_invalid_argument("kind is not a TetherKind value");
+  }
+  return p;
+}
+
+/// \brief Where the paper's vehicles start: the boat at the origin heading north, the ROV
+/// straight astern of it at 5 m depth (0.6 L for tethers shorter than 8.3 m), at a distance
+/// between the tether points of 80 % of the tether length, both at rest.
+template <typename Scalar>
+struct StartPoses {
+  vehicle::VehicleState<Scalar> asv, auv;  ///< the vehicles' states
+};
+
+/// \brief The start poses of `paper_system(tether_length)` (see StartPoses).
+template <typename Scalar>
+StartPoses<Scalar> paper_start(Scalar tether_length = Scalar(10)) {
+  using std::sqrt;
+  check_positive(tether_length, "tether_length");
+  StartPoses<Scalar> s;
+  const Vector3<Scalar> a = s.asv.point_position(blueboat_attachment<Scalar>());
+  const Scalar depth = std::min(Scalar(5), Scalar(0.6) * tether_length);
+  const Scalar chord = Scalar(0.8) * tether_length;
+  // The ROV's tether point at (a.x − d, 0, depth) with |chord| = 0.8 L.
+  const Scalar dz = depth - a(2);
+  const Scalar d = sqrt(std::max(Scalar(0), chord * chord - dz * dz));
+  const Vector3<Scalar> b(a(0) - d, Scalar(0), depth);
+  s.auv.position = b - bluerov2_attachment<Scalar>();
+  return s;
+}
+
+/// \brief The paper's system built in the sea `sea`, its workspace and its start state.
+template <typename Scalar>
+struct PaperWorld {
+  SystemModel<Scalar> model;          ///< the system
+  SystemWorkspace<Scalar> workspace;  ///< its buffers
+  SystemState<Scalar> state;          ///< the start state (paper_start, static tether)
+
+  PaperWorld(Scalar tether_length, Sea sea, TetherKind kind = TetherKind::rov_tether,
+             const environment::SeaStateOptions& options = {})
+      : model(paper_system(tether_length, kind), environment<Scalar>(sea, options)),
+        workspace(model) {
+    const StartPoses<Scalar> p = paper_start(tether_length);
+    state = initial_state(model, workspace, p.asv, p.auv);
+  }
+};
+
+}  // namespace kelp::system::presets
