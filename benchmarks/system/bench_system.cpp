@@ -1,22 +1,24 @@
-// The coupled system near issue 10's default configuration: BlueBoat at the surface, BlueROV2
-// Heavy 5 m down, a 10 m ROV tether (40 segments; made heavier so that it stays under water, see
-// params()), the moderate sea of the paper with the default wave components, both vehicles
-// holding a constant thrust; steps of 10 ms.
+// The coupled system in issue 10's default configuration (kelp::system::presets): BlueBoat at the
+// surface, BlueROV2 Heavy 5 m down, a 10 m Fathom-class ROV tether (20 segments of 0.5 m), the
+// paper's moderate sea with the default wave components (64), wind and current; both vehicles
+// hold a constant thrust; steps of 10 ms.
 //
-//   BM_SystemStep               one full system step (counter realtime_factor = simulated seconds
-//                               per CPU second)
-//   BM_SystemTetherPart         the tether's share: its BDF2 advance over the step
-//   BM_SystemVehiclePart        the vehicles' share: two RK4 steps in the environment
-//   BM_SystemSurroundings       the environment sampling inside those: 2 vehicles × 4 stages
+//   BM_SystemStep         one full system step; counter realtime_factor = simulated seconds per
+//                         CPU second
+//   BM_SystemStepSplit    the same step written out with a clock around each part (the timer
+//                         costs ~50 ns a step): counters tether_us (tether advance, its water
+//                         sampling included), vehicles_us (two RK4 steps in the environment, their
+//                         sampling included), and, measured separately on the same states, what
+//                         the environment sampling inside those costs: tether_water_us (one batch
+//                         query of water and surface at the nodes, as each tether step makes) and
+//                         vehicle_water_us (2 vehicles × 2 samples of their surroundings)
+//   BM_SystemStepCorrected one step with one corrector pass (coupling_corrections = 1)
 #include <benchmark/benchmark.h>
 
-#include <stdexcept>
+#include <chrono>
 
-#include "kelp/environment/sea_state.hpp"
+#include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
-#include "kelp/tether/initial_state.hpp"
-#include "kelp/tether/presets.hpp"
-#include "kelp/vehicle/presets.hpp"
 
 namespace ks = kelp::system;
 namespace kt = kelp::tether;
@@ -26,96 +28,91 @@ using kelp::Vector3;
 namespace {
 
 struct Setup {
-  ks::SystemModeld model;
-  ks::SystemWorkspaced ws;
-  ks::SystemStated state;
+  ks::presets::PaperWorld<double> world{10.0, ks::presets::Sea::moderate};
   ks::SystemInputsd inputs;
 
-  static ks::SystemParametersd params() {
-    ks::SystemParametersd p;
-    p.asv = kv::blueboat<double>().parameters;
-    p.auv = kv::bluerov2_heavy<double>().parameters;
-    p.asv_attachment = Vector3<double>(-0.5, 0, 0);
-    p.auv_attachment = Vector3<double>(0, 0, -0.15);
-    p.tether = kt::presets::rov_tether(10.0);
-    // Heavier than the Fathom-class line (0.0454 kg/m, buoyant in seawater): a line floating at
-    // the surface in the moderate sea still stalls Newton's method (open in issue 10).
-    p.tether.mass_per_length = 0.07;
-    return p;
-  }
-  Setup()
-      : model(params(),
-              kelp::environment::make_environment<double>(kelp::environment::presets::moderate())),
-        ws(model) {
-    state.auv.position = Vector3<double>(6, 0, 5);
-    const Vector3<double> a = state.asv.point_position(model.parameters().asv_attachment);
-    const Vector3<double> b = state.auv.point_position(model.parameters().auv_attachment);
-    if (!kt::static_initial_state(model.tether(), ws.tether, kelp::environment::Environmentd{}, a,
-                                  b, state.tether)
-             .converged)
-      throw std::runtime_error("bench_system: static initial state did not converge");
+  explicit Setup(int corrections = 0) {
+    if (corrections > 0) {
+      auto p = world.model.parameters();
+      p.coupling_corrections = corrections;
+      world.model = ks::SystemModeld(p, world.model.environment());
+    }
     inputs.auv.control << 10, 0, 0, 0, 0, 0;
     inputs.asv.control << 5, 0, 0, 0, 0, 0;
-    for (int k = 0; k < 100; ++k) ks::step(model, ws, state, inputs, 0.01);  // settle in
+    for (int k = 0; k < 200; ++k) step();  // settle in
+  }
+  ks::SystemReportd step() {
+    return ks::step(world.model, world.workspace, world.state, inputs, 0.01);
   }
 };
 
 void BM_SystemStep(benchmark::State& st) {
   Setup s;
   for (auto _ : st) {
-    ks::step(s.model, s.ws, s.state, s.inputs, 0.01);
-    benchmark::DoNotOptimize(s.state.auv.position.data());
+    s.step();
+    benchmark::DoNotOptimize(s.world.state.auv.position.data());
   }
   st.counters["realtime_factor"] =
       benchmark::Counter(0.01 * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
 }
 
-void BM_SystemTetherPart(benchmark::State& st) {
-  Setup s;
-  const auto& p = s.model.parameters();
+void BM_SystemStepCorrected(benchmark::State& st) {
+  Setup s(1);
   for (auto _ : st) {
+    s.step();
+    benchmark::DoNotOptimize(s.world.state.auv.position.data());
+  }
+  st.counters["realtime_factor"] =
+      benchmark::Counter(0.01 * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_SystemStepSplit(benchmark::State& st) {
+  Setup s;
+  auto& w = s.world;
+  const auto& p = w.model.parameters();
+  const auto& env = w.model.environment();
+  const double dt = 0.01;
+  using clock = std::chrono::steady_clock;
+  double tether = 0, vehicles = 0, tether_water = 0, vehicle_water = 0;
+  kelp::Matrix3X<double> vel(3, w.model.tether().nodes()), acc(3, w.model.tether().nodes());
+  kelp::VectorX<double> zeta(w.model.tether().nodes());
+  for (auto _ : st) {
+    const double t = w.state.time();
+    const auto t0 = clock::now();
     kt::TetherBoundaryd ends;
-    ends.start = ks::detail::predicted_end(s.state.asv, s.state.asv_nu_dot, p.asv_attachment);
-    ends.end = ks::detail::predicted_end(s.state.auv, s.state.auv_nu_dot, p.auv_attachment);
-    // The vehicles stay put, the tether goes on moving in the waves.
-    kt::advance(s.model.tether(), s.ws.tether, s.model.environment(), s.state.tether, ends, 0.01,
+    ends.start = ks::detail::predicted_end(w.state.asv, w.state.asv_nu_dot, p.asv_attachment);
+    ends.end = ks::detail::predicted_end(w.state.auv, w.state.auv_nu_dot, p.auv_attachment);
+    kt::advance(w.model.tether(), w.workspace.tether, env, w.state.tether, ends, dt,
                 p.max_tether_dt, p.tether_integrator, p.tether_options);
-    benchmark::DoNotOptimize(s.state.tether.position.data());
-  }
-}
-
-void BM_SystemVehiclePart(benchmark::State& st) {
-  Setup s;
-  const auto& p = s.model.parameters();
-  const Vector3<double> f(0, 0, 1);
-  double t = s.state.time();
-  for (auto _ : st) {
-    ks::detail::step_vehicle(s.model.asv(), s.ws.asv, s.state.asv, s.model.environment(), t, 0.01,
-                             s.inputs.asv, p.asv_attachment, f);
-    ks::detail::step_vehicle(s.model.auv(), s.ws.auv, s.state.auv, s.model.environment(), t, 0.01,
-                             s.inputs.auv, p.auv_attachment, f);
-    t += 0.01;
-    benchmark::DoNotOptimize(s.state.auv.position.data());
-  }
-}
-
-void BM_SystemSurroundings(benchmark::State& st) {
-  Setup s;
-  double t = s.state.time();
-  for (auto _ : st) {
-    for (int stage = 0; stage < 4; ++stage) {
-      auto a = kv::surroundings(s.model.environment(), s.state.asv, t);
-      auto b = kv::surroundings(s.model.environment(), s.state.auv, t);
-      benchmark::DoNotOptimize(a.water_velocity.data());
-      benchmark::DoNotOptimize(b.water_velocity.data());
+    const Vector3<double> fa = w.workspace.tether.end_impulse.on_start / dt;
+    const Vector3<double> fb = w.workspace.tether.end_impulse.on_end / dt;
+    const auto t1 = clock::now();
+    w.state.asv_nu_dot = ks::detail::step_vehicle(w.model.asv(), w.workspace.asv, w.state.asv, env,
+                                                  t, dt, s.inputs.asv, p.asv_attachment, fa);
+    w.state.auv_nu_dot = ks::detail::step_vehicle(w.model.auv(), w.workspace.auv, w.state.auv, env,
+                                                  t, dt, s.inputs.auv, p.auv_attachment, fb);
+    const auto t2 = clock::now();
+    env.sample_water(w.state.tether.position, t, vel, acc, zeta);
+    const auto t3 = clock::now();
+    for (int sample = 0; sample < 2; ++sample) {
+      benchmark::DoNotOptimize(kv::surroundings(w.model.asv(), env, w.state.asv, t));
+      benchmark::DoNotOptimize(kv::surroundings(w.model.auv(), env, w.state.auv, t));
     }
-    t += 0.01;
+    const auto t4 = clock::now();
+    tether += std::chrono::duration<double, std::micro>(t1 - t0).count();
+    vehicles += std::chrono::duration<double, std::micro>(t2 - t1).count();
+    tether_water += std::chrono::duration<double, std::micro>(t3 - t2).count();
+    vehicle_water += std::chrono::duration<double, std::micro>(t4 - t3).count();
   }
+  const double n = static_cast<double>(st.iterations());
+  st.counters["tether_us"] = tether / n;
+  st.counters["vehicles_us"] = vehicles / n;
+  st.counters["tether_water_us"] = tether_water / n;
+  st.counters["vehicle_water_us"] = vehicle_water / n;
 }
 
 }  // namespace
 
 BENCHMARK(BM_SystemStep)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SystemTetherPart)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SystemVehiclePart)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SystemSurroundings)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SystemStepSplit)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SystemStepCorrected)->Unit(benchmark::kMicrosecond);
