@@ -186,6 +186,40 @@ TEST_CASE("equal and opposite: horizontal momentum of vehicles and tether is con
   CHECK(worst <= 0.01 * p0.head<2>().norm());
 }
 
+TEST_CASE("momentum balance: the momentum grows by the impulse of the external forces",
+          "[system][momentum]") {
+  // The undamped world with constant surge thrust on both vehicles (10 N on the AUV, 5 N on the
+  // boat, body axes): the horizontal momentum must grow by the thrusts' horizontal impulse,
+  // ∫ R(t) f dt (trapezoidal in the attitudes of each step's ends), while the tether goes slack,
+  // taut and slack again and tilts the vehicles.
+  const ks::SystemModeld model(conservative_world().params, kelp::environment::Environmentd{});
+  ks::SystemWorkspaced ws(model);
+  auto s = initial_state(model, ws);
+  ks::SystemInputsd in;
+  in.auv.control << 10, 0, 0, 0, 0, 0;
+  in.asv.control << 5, 0, 0, 0, 0, 0;
+  const Vector3<double> p0 = momentum(model, ws, s);
+  const auto thrust_ned = [&](const ks::SystemStated& x) {
+    return Vector3<double>(x.auv.attitude * Vector3<double>(10, 0, 0) +
+                           x.asv.attitude * Vector3<double>(5, 0, 0));
+  };
+  Vector3<double> impulse = Vector3<double>::Zero();
+  double worst = 0, f_max = 0;
+  for (int k = 1; k <= 2000; ++k) {  // 20 s
+    const Vector3<double> before = thrust_ned(s);
+    const auto r = ks::step(model, ws, s, in, 0.01);
+    impulse += 0.005 * (before + thrust_ned(s));
+    f_max = std::max(f_max, r.force_on_auv.norm());
+    const Vector3<double> p = momentum(model, ws, s);
+    worst = std::max(worst, (p - p0 - impulse).head<2>().norm());
+  }
+  INFO("thrust impulse " << impulse.head<2>().transpose() << " N s; largest |ΔP − impulse| "
+                         << worst << " N s; peak tether force " << f_max << " N");
+  CHECK(f_max > 1.0);
+  CHECK(impulse.x() > 50.0);  // the thrust acted (the vehicles pitch, so less than 300 N s)
+  CHECK(worst <= 0.01 * impulse.head<2>().norm());
+}
+
 TEST_CASE("energy: with no dissipation and no forcing the total energy is conserved",
           "[system][energy]") {
   // The AUV is sent away from the boat at 1 m/s; the tether goes taut and slack again and again
