@@ -48,6 +48,14 @@ TEST_CASE("wave kinematics: Jet derivatives match finite differences", "[environ
         CHECK(kj.velocity(r).v(d) == Approx(dv(r)).margin(1e-7));
       }
     }
+    // The generic path's velocity gradient: the Jet derivative of the velocity, and the double
+    // (SIMD) path's gradient.
+    const auto kd = wd.kinematics(x0, t);
+    for (int r = 0; r < 3; ++r)
+      for (int d = 0; d < 3; ++d) {
+        CHECK(kj.velocity_gradient(r, d).a == Approx(kj.velocity(r).v(d)).margin(1e-12));
+        CHECK(kd.velocity_gradient(r, d) == Approx(kj.velocity(r).v(d)).margin(1e-12));
+      }
     // Elevation gradient = slope.
     const Jet z = wj.elevation(xj(0), xj(1), t);
     const auto s = wd.slope(x0(0), x0(1), t);

@@ -217,6 +217,37 @@ TEST_CASE("kinematics satisfy the free-surface condition, continuity and d/dt",
   }
 }
 
+TEST_CASE("the velocity gradient matches finite differences and is symmetric and trace-free",
+          "[environment][waves]") {
+  // Point queries (the SIMD single-point kernel) and the generic (automatic-differentiation) path
+  // of the same field, deep and finite depth, against central differences of the velocity.
+  for (const double depth : {std::numeric_limits<double>::infinity(), 15.0}) {
+    auto p = sea(2.0, 7.0, SpectrumKind::jonswap);
+    p.spreading = 2.0;
+    p.depth = depth;
+    const WaveField<double> w(p);
+    const double h = 1e-5;
+    for (const double t : {0.5, 3.0, 11.0}) {
+      const Vector3<double> q(4.0, -3.0, 2.5);
+      const auto k = w.kinematics(q, t);
+      Eigen::Matrix3d fd;
+      for (int d = 0; d < 3; ++d) {
+        Vector3<double> e = Vector3<double>::Zero();
+        e(d) = h;
+        fd.col(d) = (w.kinematics(q + e, t).velocity - w.kinematics(q - e, t).velocity) / (2 * h);
+      }
+      INFO("depth " << depth << ", t " << t);
+      CHECK((k.velocity_gradient - fd).norm() < 1e-6);
+      CHECK(fd.norm() > 1e-2);  // the gradient is not trivially zero here
+      CHECK((k.velocity_gradient - k.velocity_gradient.transpose()).norm() < 1e-12);
+      CHECK(std::abs(k.velocity_gradient.trace()) < 1e-12);
+    }
+    // Above the free surface: no water, no gradient.
+    const auto air = w.kinematics(Vector3<double>(4.0, -3.0, -50.0), 3.0);
+    CHECK(air.velocity_gradient.norm() == 0.0);
+  }
+}
+
 TEST_CASE("same seed gives the identical sea, another seed a different one",
           "[environment][waves]") {
   auto p = sea(2.0, 8.0, SpectrumKind::jonswap);

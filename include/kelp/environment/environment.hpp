@@ -42,8 +42,13 @@ struct EnvironmentSample {
   Vector3<Scalar> current = Vector3<Scalar>::Zero();
   /// Wave orbital velocity, NED [m/s] (zero above the free surface and in a calm sea).
   Vector3<Scalar> wave_velocity = Vector3<Scalar>::Zero();
-  /// Wave orbital acceleration, NED [m/s²].
+  /// Wave orbital acceleration ∂v/∂t (local), NED [m/s²].
   Vector3<Scalar> wave_acceleration = Vector3<Scalar>::Zero();
+  /// Wave velocity gradient ∂v_i/∂x_k, NED [1/s]: (v·∇)v = wave_velocity_gradient ·
+  /// wave_velocity is the convective part of the material acceleration Dv/Dt a body moving
+  /// with the water feels (second order in the wave amplitude; its mean, k a²ω² e^{−2kz} upwards
+  /// for a regular deep-water wave, keeps a neutrally buoyant body from sinking).
+  Eigen::Matrix<Scalar, 3, 3> wave_velocity_gradient = Eigen::Matrix<Scalar, 3, 3>::Zero();
   /// Free-surface elevation ζ above the mean level at the point's (x, y) [m], positive UP.
   Scalar surface_elevation = Scalar(0);
   /// Wind velocity at 10 m above the sea (the direction the air moves towards), NED [m/s].
@@ -156,6 +161,7 @@ class Environment {
       const WaveKinematics<Scalar> k = waves_.kinematics(p_ned, t);
       s.wave_velocity = k.velocity;
       s.wave_acceleration = k.acceleration;
+      s.wave_velocity_gradient = k.velocity_gradient;
       s.surface_elevation = k.elevation;
     }
     s.wind = wind_.velocity(t);

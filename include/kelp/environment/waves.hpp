@@ -24,7 +24,9 @@
 /// between the mean level and a crest (−ζ ≤ z < 0) the kinematics are those at z = 0 (constant
 /// extrapolation, no Wheeler stretching); above the free surface (z < −ζ) velocity and
 /// acceleration are zero; below a finite seabed they are those at the seabed. Acceleration is the
-/// local (Eulerian) ∂v/∂t; the convective term is second order and dropped.
+/// local (Eulerian) ∂v/∂t; the single-point query also returns the velocity gradient ∇v, from
+/// which a body forms the convective part (v·∇)v of the material acceleration (second order in
+/// the wave amplitude, but with a non-zero mean: vehicle::surroundings uses it).
 #pragma once
 
 #include <Eigen/Core>
@@ -51,6 +53,8 @@ namespace detail {
 /// Per-component constants of a wave field, as plain arrays (see `WaveField`).
 struct WaveComponentsView {
   const double *omega, *k, *amp, *phase, *kx, *ky, *aw, *aw2, *awc, *aws, *aw2c, *aw2s, *q, *e2h;
+  /// k a ω times cos²β, cos β sin β, sin²β, cos β, sin β: the velocity gradient's constants.
+  const double *gcc, *gcs, *gss, *gc, *gs;
   std::size_t n;
   double two_h;  ///< twice the water depth (finite depth only)
   /// A depth no trough reaches: (Σ a_j)(1 + 1e-9) ≥ |ζ| with room for rounding. The batch
@@ -69,6 +73,9 @@ struct WaveBlock {
       ay[kWaveBlock], az[kWaveBlock];
   /// Sum the elevation of every point (else only of points that may be above a trough).
   bool need_zeta = false;
+  /// Velocity gradient ∂v_i/∂x_k of a single-point query (point 0): xx, xy, yy, xz, yz
+  /// (symmetric; zz = −xx − yy).
+  double gxx, gxy, gyy, gxz, gyz;
 };
 
 /// Accumulators of elevation, velocity and acceleration for kLanes lanes.
@@ -76,6 +83,7 @@ template <int kLanes>
 struct WaveLanes {
   double zeta[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, ax[kLanes] = {},
          ay[kLanes] = {}, az[kLanes] = {};
+  double gxx[kLanes] = {}, gxy[kLanes] = {}, gyy[kLanes] = {}, gxz[kLanes] = {}, gyz[kLanes] = {};
 };
 
 /// Adds component j's contribution at (x, y, −nze), phase alpha = φ_j − ω_j t, to lane l of
@@ -83,8 +91,11 @@ struct WaveLanes {
 /// and the direction cosines folded into the per-component constants (a ω cos β, a ω sin β,
 /// a ω² cos β, a ω² sin β). The common sign of (sin θ, cos θ) is applied once, to the depth
 /// factor. Without kZeta the elevation is not summed (the caller knows every
-/// lane is below any trough).
-template <bool kFinite, bool kZeta, int kLanes>
+/// lane is below any trough). With kGrad the velocity gradient is summed too: for one component
+/// (c = cos θ, s = sin θ) ∂v/∂x_k = a ω k [−F_h s cos²β, −F_h s cos β sin β, −F_v c cos β; ·,
+/// −F_h s sin²β, −F_v c sin β; ·, ·, F_h s] (symmetric: the flow is irrotational; trace-free:
+/// incompressible), using ∂F_h/∂z = −k F_v and ∂F_v/∂z = −k F_h.
+template <bool kFinite, bool kZeta, int kLanes, bool kGrad = false>
 KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::size_t j,
                                              double alpha, double x, double y, double nze,
                                              WaveLanes<kLanes>& acc, int l) {
@@ -116,6 +127,14 @@ KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::s
   } else {  // F_v = F_h in deep water
     acc.vz[l] -= c.aw[j] * hs;
     acc.az[l] += c.aw2[j] * hc;
+  }
+  if constexpr (kGrad) {
+    const double fvc = kFinite ? fv * cs : hc;
+    acc.gxx[l] -= c.gcc[j] * hs;
+    acc.gxy[l] -= c.gcs[j] * hs;
+    acc.gyy[l] -= c.gss[j] * hs;
+    acc.gxz[l] -= c.gc[j] * fvc;
+    acc.gyz[l] -= c.gs[j] * fvc;
   }
 }
 
@@ -197,9 +216,13 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
       std::size_t j = 0;
       for (; j + kLanes <= nj; j += kLanes)
         for (int l = 0; l < kLanes; ++l)
-          wave_term<kFinite, true>(c, j0 + j + l, alpha[j + l], x, y, nze, acc, l);
-      for (; j < nj; ++j) wave_term<kFinite, true>(c, j0 + j, alpha[j], x, y, nze, acc, 0);
-      if (j0 == 0) b.zeta[0] = b.vx[0] = b.vy[0] = b.vz[0] = b.ax[0] = b.ay[0] = b.az[0] = 0.0;
+          wave_term<kFinite, true, kLanes, true>(c, j0 + j + l, alpha[j + l], x, y, nze, acc, l);
+      for (; j < nj; ++j)
+        wave_term<kFinite, true, kLanes, true>(c, j0 + j, alpha[j], x, y, nze, acc, 0);
+      if (j0 == 0) {
+        b.zeta[0] = b.vx[0] = b.vy[0] = b.vz[0] = b.ax[0] = b.ay[0] = b.az[0] = 0.0;
+        b.gxx = b.gxy = b.gyy = b.gxz = b.gyz = 0.0;
+      }
       for (int l = 0; l < kLanes; ++l) {
         b.zeta[0] += acc.zeta[l];
         b.vx[0] += acc.vx[l];
@@ -208,6 +231,11 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
         b.ax[0] += acc.ax[l];
         b.ay[0] += acc.ay[l];
         b.az[0] += acc.az[l];
+        b.gxx += acc.gxx[l];
+        b.gxy += acc.gxy[l];
+        b.gyy += acc.gyy[l];
+        b.gxz += acc.gxz[l];
+        b.gyz += acc.gyz[l];
       }
       continue;
     }
@@ -326,6 +354,10 @@ struct WaveKinematics {
   Scalar elevation = Scalar(0);                            ///< ζ at the point's (x, y) [m], up
   Vector3<Scalar> velocity = Vector3<Scalar>::Zero();      ///< orbital velocity, NED [m/s]
   Vector3<Scalar> acceleration = Vector3<Scalar>::Zero();  ///< ∂v/∂t, NED [m/s²]
+  /// ∂v_i/∂x_k, NED [1/s] (symmetric and trace-free; zero above the free surface). Filled by the
+  /// single-point query only; (v·∇)v = velocity_gradient · velocity is the convective part of
+  /// the water's material acceleration.
+  Eigen::Matrix<Scalar, 3, 3> velocity_gradient = Eigen::Matrix<Scalar, 3, 3>::Zero();
 };
 
 /// \brief A linear irregular sea: N regular components with precomputed constants.
@@ -358,8 +390,9 @@ class WaveField {
     const double wp = 2.0 * kelp::pi / p.spectrum.peak_period;
     const double w_lo = p.omega_min_factor * wp, w_hi = p.omega_max_factor * wp;
     const double dw = (w_hi - w_lo) / static_cast<double>(n);
-    for (auto* v : {&omega_, &k_, &amp_, &phase_, &dir_, &kx_, &ky_, &cosb_, &sinb_, &aw_, &aw2_,
-                    &awc_, &aws_, &aw2c_, &aw2s_, &q_, &e2h_})
+    for (auto* v :
+         {&omega_, &k_,   &amp_,  &phase_, &dir_, &kx_,  &ky_,  &cosb_, &sinb_, &aw_, &aw2_,
+          &awc_,   &aws_, &aw2c_, &aw2s_,  &q_,   &e2h_, &gcc_, &gcs_,  &gss_,  &gc_, &gs_})
       v->resize(n);
     for (std::size_t j = 0; j < n; ++j) {
       const double u = p.jitter ? uniform() : 0.5;
@@ -394,6 +427,11 @@ class WaveField {
       aws_[j] = aw_[j] * sinb_[j];
       aw2c_[j] = aw2_[j] * cosb_[j];
       aw2s_[j] = aw2_[j] * sinb_[j];
+      gc_[j] = k * awc_[j];
+      gs_[j] = k * aws_[j];
+      gcc_[j] = gc_[j] * cosb_[j];
+      gcs_[j] = gc_[j] * sinb_[j];
+      gss_[j] = gs_[j] * sinb_[j];
       // 1 / (1 − e^{−2kh}): the common factor of cosh/sinh ratios written with decaying
       // exponentials only (no overflow for large k h).
       q_[j] = std::isinf(p.depth) ? 1.0 : 1.0 / (-std::expm1(-2.0 * k * p.depth));
@@ -506,6 +544,10 @@ class WaveField {
           static_cast<Scalar>(b.vz[0]);
       out.acceleration << static_cast<Scalar>(b.ax[0]), static_cast<Scalar>(b.ay[0]),
           static_cast<Scalar>(b.az[0]);
+      if (!(b.z[0] < -b.zeta[0])) {
+        const double gzz = -b.gxx - b.gyy;
+        out.velocity_gradient << b.gxx, b.gxy, b.gxz, b.gxy, b.gyy, b.gyz, b.gxz, b.gyz, gzz;
+      }
     } else {
       generic_point(Vector3<Scalar>(p(0), p(1), p(2)), t, out);
     }
@@ -640,17 +682,26 @@ class WaveField {
           Vector3<Scalar>(hv * Scalar(cosb_[j]), hv * Scalar(sinb_[j]), -Scalar(aw_[j]) * fv * s);
       out.acceleration +=
           Vector3<Scalar>(ha * Scalar(cosb_[j]), ha * Scalar(sinb_[j]), Scalar(aw2_[j]) * fv * c);
+      const Scalar hs = fh * s, fvc = fv * c;
+      const Scalar gxx = -Scalar(gcc_[j]) * hs, gxy = -Scalar(gcs_[j]) * hs;
+      const Scalar gyy = -Scalar(gss_[j]) * hs, gxz = -Scalar(gc_[j]) * fvc;
+      const Scalar gyz = -Scalar(gs_[j]) * fvc;
+      Eigen::Matrix<Scalar, 3, 3> g;
+      g << gxx, gxy, gxz, gxy, gyy, gyz, gxz, gyz, -gxx - gyy;
+      out.velocity_gradient += g;
     }
     if (value_of(p(2)) < -value_of(out.elevation)) {
       out.velocity.setZero();
       out.acceleration.setZero();
+      out.velocity_gradient.setZero();
     }
   }
 
   detail::WaveComponentsView view() const {
     return {omega_.data(),       k_.data(),    amp_.data(), phase_.data(), kx_.data(),
             ky_.data(),          aw_.data(),   aw2_.data(), awc_.data(),   aws_.data(),
-            aw2c_.data(),        aw2s_.data(), q_.data(),   e2h_.data(),   omega_.size(),
+            aw2c_.data(),        aw2s_.data(), q_.data(),   e2h_.data(),   gcc_.data(),
+            gcs_.data(),         gss_.data(),  gc_.data(),  gs_.data(),    omega_.size(),
             2.0 * params_.depth, trough_bound_};
   }
 
@@ -660,7 +711,7 @@ class WaveField {
   double z_exp_limit_ = std::numeric_limits<double>::infinity();
   double trough_bound_ = 0.0;  ///< see `detail::WaveComponentsView::trough_bound`
   std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, awc_, aws_,
-      aw2c_, aw2s_, q_, e2h_;
+      aw2c_, aw2s_, q_, e2h_, gcc_, gcs_, gss_, gc_, gs_;
 };
 
 /// \brief Double-precision wave field.

@@ -169,11 +169,37 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 /// \brief Surroundings a vehicle model needs at state `x` and time t: the full surroundings()
 /// for a surface vessel, without the surface slope (one wave pass fewer) for a submerged one,
 /// whose restoring reads only the elevation.
+///
+/// The water that moves a hull is the water around its submerged part, not at its CO, which for
+/// a floating hull lies on the waterline and so above the local surface about half the time
+/// (where the wave kinematics are zero). The water velocity and acceleration are therefore
+/// taken no higher than the centroid of the submerged part: for a surface vessel half its
+/// still-water draft ∇/A_wp below the local surface; for a submerged vehicle whose hull box
+/// (`hull_height`, Hydrostatics::submerged_free_surface) pierces the surface, halfway between
+/// the surface and the bottom of the box. One more environment sample when that applies.
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& env,
                                   const VehicleState<Scalar>& x, double t) {
-  if (model.parameters().hydrostatics == Hydrostatics::surface) return surroundings(env, x, t);
-  return surroundings_without_slope(env, x, t);
+  const VehicleParameters<Scalar>& p = model.parameters();
+  Surroundings<Scalar> s = p.hydrostatics == Hydrostatics::surface
+                               ? surroundings(env, x, t)
+                               : surroundings_without_slope(env, x, t);
+  const Scalar z = x.position(2), z_surface = -s.surface_elevation;
+  Scalar z_wet = z;
+  if (p.hydrostatics == Hydrostatics::surface && value_of(p.waterplane_area) > 0.0) {
+    const Scalar centroid = z_surface + Scalar(0.5) * p.displaced_volume / p.waterplane_area;
+    if (value_of(centroid) > value_of(z)) z_wet = centroid;
+  } else if (p.hydrostatics == Hydrostatics::submerged_free_surface &&
+             value_of(p.hull_height) > 0.0) {
+    const Scalar half = Scalar(0.5) * p.hull_height;
+    if (value_of(z - half) < value_of(z_surface)) {  // the box pierces the surface
+      const Scalar bottom = z + half;
+      z_wet =
+          value_of(bottom) > value_of(z_surface) ? Scalar(0.5) * (z_surface + bottom) : z_surface;
+    }
+  }
+  if (value_of(z_wet) > value_of(z)) resample_water(env, x, t, z_wet, s);
+  return s;
 }
 
 /// \brief One classical RK4 step of length `dt` in an environment: the surroundings (water

@@ -322,8 +322,12 @@ struct VehicleWorkspace {
 /// 1990, ch. 3, for a body small against the wavelength): ν_w = (Rᵀ v_w, 0) with v_w the water
 /// velocity at the CO (current + wave orbital velocity), ν_r = ν − ν_w, and the body-frame rate
 /// of the water velocity seen by the vehicle ν̇_w = (ν_{w,1} × ν₂ + Rᵀ a_w, 0), where a_w is the
-/// water's local acceleration ∂v/∂t at the CO. The convective part (∇v_w) ṗ (second order in the
-/// wave steepness for orbital motion) and the slow time variation of the current are neglected.
+/// water's material acceleration Dv/Dt = ∂v/∂t + (v·∇)v at the CO (Surroundings::
+/// water_acceleration: the convective part from the wave velocity gradient; without it a
+/// neutrally buoyant body sinks under waves, pushed by the mean (m + A₃₃) k a²ω² e^{−2kz}). The
+/// difference (∇v_w)(ṗ − v_w) between the rate along the body's path and along the water's
+/// (second order in the wave steepness times the relative velocity) and the slow time variation
+/// of the current are neglected.
 /// M_A ν̇_w is the added-mass (diffraction) force of the accelerating flow; τ_FK = (ρ ∇ φ Rᵀ a_w,
 /// 0) is the Froude–Krylov force (the pressure gradient of the undisturbed flow on the displaced
 /// volume, φ the submerged fraction), so the translational forcing is (ρ∇ I + M_A) Rᵀ a_w, the

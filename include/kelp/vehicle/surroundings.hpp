@@ -8,6 +8,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <type_traits>
+#include <utility>
 
 #include "kelp/core/types.hpp"
 #include "kelp/vehicle/state.hpp"
@@ -21,7 +23,7 @@ template <typename Scalar>
 struct Surroundings {
   /// Current + wave orbital velocity at the vehicle's CO, NED [m/s].
   Vector3<Scalar> water_velocity = Vector3<Scalar>::Zero();
-  /// Water acceleration at the CO (wave orbital ∂v/∂t), NED [m/s²].
+  /// Water acceleration at the CO: the waves' material acceleration ∂v/∂t + (v·∇)v, NED [m/s²].
   Vector3<Scalar> water_acceleration = Vector3<Scalar>::Zero();
   /// ζ at the CO's (x, y) [m], positive up; the surface is at NED z = −ζ.
   Scalar surface_elevation = Scalar(0);
@@ -31,9 +33,33 @@ struct Surroundings {
   Vector3<Scalar> wind_velocity = Vector3<Scalar>::Zero();
 };
 
+namespace detail {
+
+template <typename Sample, typename = void>
+struct has_velocity_gradient : std::false_type {};
+template <typename Sample>
+struct has_velocity_gradient<
+    Sample, std::void_t<decltype(std::declval<const Sample&>().wave_velocity_gradient)>>
+    : std::true_type {};
+
+/// The water's material acceleration Dv/Dt = ∂v/∂t + (v·∇)v of the waves in an environment
+/// sample (∂v/∂t alone when the sample has no velocity gradient). The current's advection of the
+/// wave field is left out: the waves are defined in the earth frame.
+template <typename Scalar, typename Sample>
+Vector3<Scalar> material_acceleration(const Sample& e) {
+  if constexpr (has_velocity_gradient<Sample>::value)
+    return e.wave_acceleration + e.wave_velocity_gradient * e.wave_velocity;
+  else
+    return e.wave_acceleration;
+}
+
+}  // namespace detail
+
 /// \brief Samples `env` at the vehicle's CO at time t (no allocation): `env.sample(p, t)` gives
 /// current, wave orbital velocity and acceleration, elevation and wind; `env.surface_slope(x, y,
 /// t)` the slope. `Env` is `kelp::environment::Environment` or any type with those two queries.
+/// The water acceleration is the material one, ∂v/∂t + (v·∇)v, when the sample carries the
+/// wave velocity gradient (as Environment's does).
 /// \param[in] env environment \param[in] x vehicle state (its CO position is used)
 /// \param[in] t time [s]
 template <typename Scalar, typename Env>
@@ -41,7 +67,7 @@ Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x,
   Surroundings<Scalar> s;
   const auto e = env.sample(x.position, t);
   s.water_velocity = e.current + e.wave_velocity;
-  s.water_acceleration = e.wave_acceleration;
+  s.water_acceleration = detail::material_acceleration<Scalar>(e);
   s.surface_elevation = e.surface_elevation;
   s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
   s.wind_velocity = e.wind;
@@ -57,10 +83,20 @@ Surroundings<Scalar> surroundings_without_slope(const Env& env, const VehicleSta
   Surroundings<Scalar> s;
   const auto e = env.sample(x.position, t);
   s.water_velocity = e.current + e.wave_velocity;
-  s.water_acceleration = e.wave_acceleration;
+  s.water_acceleration = detail::material_acceleration<Scalar>(e);
   s.surface_elevation = e.surface_elevation;
   s.wind_velocity = e.wind;
   return s;
+}
+
+/// \brief Replaces the water velocity and acceleration of `s` by those at depth `z` [m, NED]
+/// under the vehicle's CO (x, y), keeping the surface and the wind.
+template <typename Scalar, typename Env>
+void resample_water(const Env& env, const VehicleState<Scalar>& x, double t, const Scalar& z,
+                    Surroundings<Scalar>& s) {
+  const auto e = env.sample(Vector3<Scalar>(x.position(0), x.position(1), z), t);
+  s.water_velocity = e.current + e.wave_velocity;
+  s.water_acceleration = detail::material_acceleration<Scalar>(e);
 }
 
 }  // namespace kelp::vehicle
