@@ -153,8 +153,10 @@ class Environment {
   const WindField<Scalar>& wind() const { return wind_; }
 
   /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
-  /// and acceleration (zero above the free surface), surface elevation at (x, y), wind at 10 m.
-  EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t) const {
+  /// and acceleration (zero above the free surface), surface elevation at (x, y), wind at 10 m
+  /// (left at zero when `with_wind` is false: the gust sum costs as much as the waves at a point).
+  EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t,
+                                   bool with_wind = true) const {
     EnvironmentSample<Scalar> s;
     if (!current_.is_zero()) s.current = current_.velocity(p_ned, t);
     if (!waves_.empty()) {
@@ -164,7 +166,7 @@ class Environment {
       s.wave_velocity_gradient = k.velocity_gradient;
       s.surface_elevation = k.elevation;
     }
-    s.wind = wind_.velocity(t);
+    if (with_wind) s.wind = wind_.velocity(t);
     return s;
   }
 

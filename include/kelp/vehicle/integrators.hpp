@@ -166,9 +166,9 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
   step_rk4(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
 }
 
-/// \brief Surroundings a vehicle model needs at state `x` and time t: the full surroundings()
-/// for a surface vessel, without the surface slope (one wave pass fewer) for a submerged one,
-/// whose restoring reads only the elevation.
+/// \brief Surroundings a vehicle model needs at state `x` and time t: the surface slope only for
+/// a surface vessel (a submerged one's restoring reads only the elevation), the wind only for a
+/// model with wind areas (else zero; forward_dynamics does not read it then).
 ///
 /// The water that moves a hull is the water around its submerged part, not at its CO, which for
 /// a floating hull lies on the waterline and so above the local surface about half the time
@@ -181,9 +181,10 @@ template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& env,
                                   const VehicleState<Scalar>& x, double t) {
   const VehicleParameters<Scalar>& p = model.parameters();
-  Surroundings<Scalar> s = p.hydrostatics == Hydrostatics::surface
-                               ? surroundings(env, x, t)
-                               : surroundings_without_slope(env, x, t);
+  // The wind only for a hull with areas above water; the slope only for a surface vessel.
+  const bool wind = p.wind_areas.frontal_area > 0.0 || p.wind_areas.lateral_area > 0.0;
+  Surroundings<Scalar> s =
+      detail::sample_surroundings(env, x, t, p.hydrostatics == Hydrostatics::surface, wind);
   const Scalar z = x.position(2), z_surface = -s.surface_elevation;
   Scalar z_wet = z;
   if (p.hydrostatics == Hydrostatics::surface && value_of(p.waterplane_area) > 0.0) {

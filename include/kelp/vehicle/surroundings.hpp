@@ -53,6 +53,37 @@ Vector3<Scalar> material_acceleration(const Sample& e) {
     return e.wave_acceleration;
 }
 
+template <typename Env, typename P, typename = void>
+struct has_windless_sample : std::false_type {};
+template <typename Env, typename P>
+struct has_windless_sample<
+    Env, P,
+    std::void_t<decltype(std::declval<const Env&>().sample(std::declval<const P&>(), 0.0, false))>>
+    : std::true_type {};
+
+/// env.sample(p, t), told to skip the wind when it can be (`sample(p, t, false)`).
+template <typename Env, typename P>
+auto sample(const Env& env, const P& p, double t, bool wind) {
+  if constexpr (has_windless_sample<Env, P>::value)
+    return env.sample(p, t, wind);
+  else
+    return env.sample(p, t);
+}
+
+/// The surroundings at the CO, with or without the slope and the wind.
+template <typename Scalar, typename Env>
+Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scalar>& x, double t,
+                                         bool slope, bool wind) {
+  Surroundings<Scalar> s;
+  const auto e = detail::sample(env, x.position, t, wind);
+  s.water_velocity = e.current + e.wave_velocity;
+  s.water_acceleration = detail::material_acceleration<Scalar>(e);
+  s.surface_elevation = e.surface_elevation;
+  if (slope) s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
+  if (wind) s.wind_velocity = e.wind;
+  return s;
+}
+
 }  // namespace detail
 
 /// \brief Samples `env` at the vehicle's CO at time t (no allocation): `env.sample(p, t)` gives
@@ -64,14 +95,7 @@ Vector3<Scalar> material_acceleration(const Sample& e) {
 /// \param[in] t time [s]
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x, double t) {
-  Surroundings<Scalar> s;
-  const auto e = env.sample(x.position, t);
-  s.water_velocity = e.current + e.wave_velocity;
-  s.water_acceleration = detail::material_acceleration<Scalar>(e);
-  s.surface_elevation = e.surface_elevation;
-  s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
-  s.wind_velocity = e.wind;
-  return s;
+  return detail::sample_surroundings(env, x, t, true, true);
 }
 
 /// \brief Surroundings of a vehicle that does not need the surface slope (a submerged vehicle's
@@ -80,13 +104,7 @@ Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x,
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings_without_slope(const Env& env, const VehicleState<Scalar>& x,
                                                 double t) {
-  Surroundings<Scalar> s;
-  const auto e = env.sample(x.position, t);
-  s.water_velocity = e.current + e.wave_velocity;
-  s.water_acceleration = detail::material_acceleration<Scalar>(e);
-  s.surface_elevation = e.surface_elevation;
-  s.wind_velocity = e.wind;
-  return s;
+  return detail::sample_surroundings(env, x, t, false, true);
 }
 
 /// \brief Replaces the water velocity and acceleration of `s` by those at depth `z` [m, NED]
@@ -94,7 +112,7 @@ Surroundings<Scalar> surroundings_without_slope(const Env& env, const VehicleSta
 template <typename Scalar, typename Env>
 void resample_water(const Env& env, const VehicleState<Scalar>& x, double t, const Scalar& z,
                     Surroundings<Scalar>& s) {
-  const auto e = env.sample(Vector3<Scalar>(x.position(0), x.position(1), z), t);
+  const auto e = detail::sample(env, Vector3<Scalar>(x.position(0), x.position(1), z), t, false);
   s.water_velocity = e.current + e.wave_velocity;
   s.water_acceleration = detail::material_acceleration<Scalar>(e);
 }
