@@ -99,8 +99,7 @@ World conservative_world() {
 }
 
 double total_energy(const ks::SystemModeld& model, const ks::SystemStated& s) {
-  return kv::energy(model.asv(), s.asv) + kv::energy(model.auv(), s.auv) +
-         kt::tether_energy(model.tether(), model.environment(), s.tether);
+  return ks::energy(model, s).total();
 }
 
 }  // namespace
@@ -158,8 +157,10 @@ TEST_CASE("a system step allocates nothing", "[system][malloc]") {
   ks::step(model, ws, s, in, 0.01);
   Eigen::internal::set_is_malloc_allowed(false);
   for (int k = 0; k < 10; ++k) ks::step(model, ws, s, in, 0.01);
+  const auto r = ks::step(model, ws, s, in, 0.01, true);  // the energy terms too
   Eigen::internal::set_is_malloc_allowed(true);
-  CHECK(s.time() == Approx(0.11));
+  CHECK(s.time() == Approx(0.12));
+  CHECK(r.energy.total() != 0.0);
 }
 
 TEST_CASE("equal and opposite: horizontal momentum of vehicles and tether is conserved",
@@ -282,9 +283,10 @@ TEST_CASE("energy: with every dissipation on and no forcing the system never gai
   double rise = 0, f_max = 0;
   ks::SystemInputsd in;
   for (int k = 0; k < 3000; ++k) {
-    const auto r = ks::step(damped, wd, sd, in, 0.01);
+    const auto r = ks::step(damped, wd, sd, in, 0.01, true);  // with the energy terms
     f_max = std::max(f_max, r.force_on_auv.norm());
-    const double e = total_energy(damped, sd);
+    const double e = r.energy.total();
+    REQUIRE(e == total_energy(damped, sd));
     rise = std::max(rise, e - e_prev);
     e_prev = e;
   }

@@ -173,6 +173,32 @@ struct SystemInputs {
   VehicleInput<Scalar> auv;  ///< the AUV's wrenches
 };
 
+/// \brief The mechanical energy of a system [J], part by part.
+template <typename Scalar>
+struct SystemEnergy {
+  /// ASV: kinetic ½νᵀMν (added mass included) plus its hydrostatic potential (vehicle::energy).
+  Scalar asv = Scalar(0);
+  Scalar auv = Scalar(0);     ///< AUV, as `asv`
+  Scalar tether = Scalar(0);  ///< tether: kinetic + elastic + weight and buoyancy (tether_energy)
+  /// \brief The sum of the parts.
+  Scalar total() const { return asv + auv + tether; }
+};
+
+/// \brief The energy of `state` (the hydrostatic potentials relative to the environment's free
+/// surface at the vehicles and the nodes). Allocation-free; costs about one tether force
+/// evaluation plus a surface query per node.
+template <typename Scalar>
+SystemEnergy<Scalar> energy(const SystemModel<Scalar>& model, const SystemState<Scalar>& state) {
+  const auto& env = model.environment();
+  SystemEnergy<Scalar> e;
+  e.asv = vehicle::energy(model.asv(), state.asv,
+                          vehicle::surroundings(model.asv(), env, state.asv, state.time()));
+  e.auv = vehicle::energy(model.auv(), state.auv,
+                          vehicle::surroundings(model.auv(), env, state.auv, state.time()));
+  e.tether = tether::tether_energy(model.tether(), env, state.tether);
+  return e;
+}
+
 /// \brief What one system step did.
 template <typename Scalar>
 struct SystemReport {
@@ -182,6 +208,8 @@ struct SystemReport {
   /// delivered to that end divided by dt (for BDF2, the end force at t + h).
   Vector3<Scalar> force_on_asv = Vector3<Scalar>::Zero();
   Vector3<Scalar> force_on_auv = Vector3<Scalar>::Zero();  ///< see force_on_asv
+  /// The energy terms after the step, when the step was asked for them (else all zero).
+  SystemEnergy<Scalar> energy;
 };
 
 /// \brief Preallocated buffers of a system step.
@@ -288,14 +316,15 @@ struct CouplingSnapshot {
 
 /// \brief Advances the whole system by `dt` [s] (see the file's coupling scheme). No heap
 /// allocation.
+/// \param[in] with_energy also fill `SystemReport::energy` (energy(model, state) after the step).
 /// \returns the tether's integration report and the forces applied to the vehicles.
 /// \throws kelp::invalid_argument for bad input (dt, non-finite inputs); kelp::numerical_error
 /// when a part cannot be advanced. After any throw every part of `state` is bit-identical to
 /// what it was.
 template <typename Scalar>
 SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
-                          SystemState<Scalar>& state, const SystemInputs<Scalar>& inputs,
-                          double dt) {
+                          SystemState<Scalar>& state, const SystemInputs<Scalar>& inputs, double dt,
+                          bool with_energy = false) {
   check_positive(dt, "dt");
   check_all_finite(inputs.asv.control, "inputs.asv.control");
   check_all_finite(inputs.asv.external, "inputs.asv.external");
@@ -341,6 +370,7 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     ws.tether_backup.restore(state.tether);
     throw;
   }
+  if (with_energy) report.energy = energy(model, state);
   return report;
 }
 
@@ -391,11 +421,13 @@ using SystemStated = SystemState<double>;            ///< SystemState<double>
 using SystemWorkspaced = SystemWorkspace<double>;    ///< SystemWorkspace<double>
 using SystemInputsd = SystemInputs<double>;          ///< SystemInputs<double>
 using SystemReportd = SystemReport<double>;          ///< SystemReport<double>
+using SystemEnergyd = SystemEnergy<double>;          ///< SystemEnergy<double>
 using SystemParametersf = SystemParameters<float>;   ///< SystemParameters<float>
 using SystemModelf = SystemModel<float>;             ///< SystemModel<float>
 using SystemStatef = SystemState<float>;             ///< SystemState<float>
 using SystemWorkspacef = SystemWorkspace<float>;     ///< SystemWorkspace<float>
 using SystemInputsf = SystemInputs<float>;           ///< SystemInputs<float>
 using SystemReportf = SystemReport<float>;           ///< SystemReport<float>
+using SystemEnergyf = SystemEnergy<float>;           ///< SystemEnergy<float>
 
 }  // namespace kelp::system
