@@ -3,6 +3,8 @@
 /// (`kelp/ceres/catenary_solver.hpp`, target `kelp::ceres`) is included separately.
 #pragma once
 
+#include "kelp/control/controllers.hpp"
+#include "kelp/control/pid.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
@@ -11,6 +13,7 @@
 #include "kelp/environment/environment.hpp"
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/environment/wave_loads.hpp"
+#include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/system/tether_attachment.hpp"
 #include "kelp/tether/catenary.hpp"

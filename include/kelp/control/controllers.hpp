@@ -1,0 +1,391 @@
+/// \file
+/// \brief Controllers for the tethered pair: an AUV controller (depth, heading and position hold,
+/// waypoint following) through an eight-thruster allocation and the T200 curve, and an ASV
+/// controller (station keeping, follow the AUV) through two skid-steering thrusters with the
+/// PID gains of Buchholz et al. (2025, arXiv:2508.02264). Both can add the paper's
+/// "disturbance-aware" feedforward.
+///
+/// What a controller sees (`Navigation`): the vehicle's own NED position, attitude and body
+/// velocity over ground (a navigation solution: GNSS or USBL, AHRS, DVL), and for the ASV the
+/// AUV's position (USBL). Never the true current, waves, wind or tether force. The disturbance
+/// feedforward estimates the disturbance wrench from the vehicle's own model and what it senses
+/// (a momentum-based disturbance observer): d̂ = LPF[M (ν_k − ν_{k−1})/T − M ν̇_model(τ_applied)],
+/// where ν̇_model is the vehicle's forward dynamics in still water under the wrench it applied,
+/// and feeds −d̂ forward. Everything it cannot explain with its model (current, waves, wind,
+/// tether pull) ends up in d̂.
+///
+/// Controllers run at their own period (zero-order hold between updates) in double precision and
+/// allocate nothing after construction.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "kelp/control/pid.hpp"
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/rotation.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/state.hpp"
+#include "kelp/vehicle/thrusters.hpp"
+
+namespace kelp::control {
+
+/// \brief What a vehicle knows of itself.
+struct Navigation {
+  Vector3<double> position = Vector3<double>::Zero();            ///< NED [m]
+  Quaternion<double> attitude = Quaternion<double>::Identity();  ///< body → NED
+  Vector6<double> nu = Vector6<double>::Zero();  ///< body velocity over ground [m/s, rad/s]
+};
+
+/// \brief A perfect navigation solution from a simulated state.
+inline Navigation navigation_of(const vehicle::VehicleState<double>& x) {
+  return {x.position, x.attitude, x.nu};
+}
+
+/// \brief Heading ψ [rad] of an attitude (yaw of the ZYX Euler angles).
+inline double heading_of(const Quaternion<double>& q) {
+  const Matrix3<double> R = q.toRotationMatrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
+/// \brief Angle wrapped to (−π, π].
+inline double wrap_angle(double a) {
+  a = std::fmod(a + kelp::pi, 2.0 * kelp::pi);
+  if (a <= 0.0) a += 2.0 * kelp::pi;
+  return a - kelp::pi;
+}
+
+/// \brief Momentum-based disturbance observer (see the file comment).
+class DisturbanceObserver {
+ public:
+  DisturbanceObserver() = default;
+  /// \param[in] model the vehicle's own model \param[in] time_constant of the low-pass [s]
+  DisturbanceObserver(const vehicle::VehicleModel<double>& model, double time_constant)
+      : model_(&model), tau_(time_constant) {
+    check_positive(time_constant, "observer time_constant");
+  }
+  /// \brief Updates the estimate from the navigation at this update, the wrench applied since
+  /// the last one and the time since [s]. Returns d̂ (body wrench [N, N m]).
+  const Vector6<double>& update(const Navigation& nav, const Vector6<double>& applied, double dt) {
+    if (model_ == nullptr) return estimate_;
+    if (has_last_) {
+      vehicle::VehicleState<double> x;
+      x.position = last_.position;
+      x.attitude = last_.attitude;
+      x.nu = last_.nu;
+      const Vector6<double> predicted =
+          vehicle::forward_dynamics(*model_, ws_, x, applied, Vector6<double>::Zero());
+      const Vector6<double> measured = (nav.nu - last_.nu) / dt;
+      const Vector6<double> d = model_->mass_matrix() * (measured - predicted);
+      const double a = dt / (tau_ + dt);
+      estimate_ += a * (d - estimate_);
+    }
+    last_ = nav;
+    has_last_ = true;
+    return estimate_;
+  }
+  /// \brief The current estimate d̂.
+  const Vector6<double>& estimate() const { return estimate_; }
+
+ private:
+  const vehicle::VehicleModel<double>* model_ = nullptr;
+  vehicle::VehicleWorkspace<double> ws_;
+  double tau_ = 1.0;
+  Navigation last_;
+  bool has_last_ = false;
+  Vector6<double> estimate_ = Vector6<double>::Zero();
+};
+
+/// \brief Settings of the AUV controller. Force PIDs act on position errors in the heading frame
+/// [m → N], the yaw PID on the heading error [rad → N m], roll and pitch PIDs keep the vehicle
+/// level. Defaults tuned for the BlueROV2 Heavy preset (surge mass with added mass ≈ 20 kg, heave
+/// ≈ 32 kg): natural frequencies ≈ 1.4 rad/s, about critically damped.
+struct AuvControllerSettings {
+  PidGains surge{40.0, 4.0, 56.0, 80.0, 10.0};   ///< x error → X [N]
+  PidGains sway{40.0, 4.0, 56.0, 80.0, 10.0};    ///< y error → Y [N]
+  PidGains heave{60.0, 8.0, 88.0, 100.0, 10.0};  ///< z error → Z [N]
+  PidGains roll{5.0, 0.0, 2.0, 10.0};            ///< roll → K [N m]
+  PidGains pitch{5.0, 0.0, 2.0, 10.0};           ///< pitch → M [N m]
+  PidGains yaw{5.0, 0.2, 3.4, 15.0, 2.0};        ///< heading error → N [N m]
+  double period = 0.02;                          ///< update period [s] (50 Hz)
+  double max_thrust = vehicle::t200_max_thrust;  ///< per thruster [N]
+  /// Largest horizontal error fed to the PIDs [m]: a far waypoint is approached at a steady
+  /// pace instead of with the full error (a carrot on the line to it).
+  double max_horizontal_error = 2.0;
+  double acceptance_radius = 0.5;       ///< a waypoint is reached within this distance [m]
+  bool compensate = false;              ///< feed the estimated disturbance forward
+  double observer_time_constant = 1.0;  ///< [s]
+};
+
+/// \brief One AUV controller output.
+struct AuvCommand {
+  Vector6<double> wrench = Vector6<double>::Zero();  ///< body wrench the thrusters deliver
+  Eigen::VectorXd thrust;                            ///< per thruster [N], after saturation
+  Eigen::VectorXd command;  ///< normalised T200 commands (t200_command of thrust)
+  Vector3<double> position_error = Vector3<double>::Zero();  ///< target − position, NED [m]
+  double heading_error = 0.0;                                ///< [rad]
+  bool saturated = false;  ///< the allocation had to scale the thrust down
+};
+
+/// \brief Depth, heading and position hold and waypoint following for an AUV with a fully
+/// actuated thruster set (e.g. vehicle::bluerov2_heavy).
+class AuvController {
+ public:
+  /// \param[in] model the AUV's own model (for the disturbance observer; kept by reference)
+  /// \param[in] thrusters its allocation \param[in] s settings
+  AuvController(const vehicle::VehicleModel<double>& model,
+                const vehicle::ThrusterAllocation<double>& thrusters,
+                const AuvControllerSettings& s = {})
+      : settings_(s),
+        thrusters_(thrusters),
+        surge_(s.surge, "surge"),
+        sway_(s.sway, "sway"),
+        heave_(s.heave, "heave"),
+        roll_(s.roll, "roll"),
+        pitch_(s.pitch, "pitch"),
+        yaw_(s.yaw, "yaw"),
+        observer_(model, s.observer_time_constant) {
+    check_positive(s.period, "period");
+    check_positive(s.max_thrust, "max_thrust");
+    check_positive(s.max_horizontal_error, "max_horizontal_error");
+    check_positive(s.acceptance_radius, "acceptance_radius");
+    command_.thrust = Eigen::VectorXd::Zero(thrusters.size());
+    command_.command = Eigen::VectorXd::Zero(thrusters.size());
+    force_ = Eigen::VectorXd::Zero(thrusters.size());
+  }
+
+  /// \brief Hold this NED position and heading [rad].
+  void hold(const Vector3<double>& position, double heading) {
+    check_all_finite(position, "hold position");
+    check_finite(heading, "hold heading");
+    waypoints_.clear();
+    target_ = position;
+    heading_ = heading;
+  }
+  /// \brief Follow these NED waypoints in order, facing the direction of travel; hold the last.
+  /// \throws kelp::invalid_argument for an empty list or a non-finite point.
+  void follow(const std::vector<Vector3<double>>& waypoints) {
+    KELP_CHECK(!waypoints.empty(), "follow: the waypoint list is empty");
+    for (const auto& w : waypoints) check_all_finite(w, "waypoint");
+    waypoints_ = waypoints;
+    next_ = 0;
+    target_ = waypoints_.front();
+  }
+  /// \brief Index of the waypoint being flown to (== count when all are reached).
+  std::size_t next_waypoint() const { return waypoints_.empty() ? 0 : next_; }
+  /// \brief The current target position, NED [m].
+  const Vector3<double>& target() const { return target_; }
+
+  /// \brief The command at time t [s] for navigation `nav`: recomputed every `period`, held in
+  /// between. No allocation.
+  const AuvCommand& update(const Navigation& nav, double t) {
+    if (has_run_ && t < next_time_ - 1e-9) return command_;
+    const double dt = has_run_ ? std::max(t - last_time_, 1e-6) : settings_.period;
+    last_time_ = t;
+    next_time_ = (has_run_ ? next_time_ : t) + settings_.period;
+    if (next_time_ <= t) next_time_ = t + settings_.period;
+    if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
+    has_run_ = true;
+    // Waypoints: advance when within the acceptance radius; face the direction of travel.
+    if (!waypoints_.empty()) {
+      while (next_ < waypoints_.size() &&
+             (waypoints_[next_] - nav.position).norm() < settings_.acceptance_radius)
+        ++next_;
+      target_ = waypoints_[std::min(next_, waypoints_.size() - 1)];
+      const Vector3<double> d = target_ - nav.position;
+      if (d.head<2>().norm() > 2.0 * settings_.acceptance_radius)
+        heading_ = std::atan2(d.y(), d.x());
+    }
+    const double psi = heading_of(nav.attitude);
+    Vector3<double> e = target_ - nav.position;
+    command_.position_error = e;
+    const double h = e.head<2>().norm();
+    if (h > settings_.max_horizontal_error) e.head<2>() *= settings_.max_horizontal_error / h;
+    // Error in the heading frame (yaw only); its rate is minus the body velocity (level flight).
+    const double c = std::cos(psi), s = std::sin(psi);
+    const Vector3<double> eb(c * e.x() + s * e.y(), -s * e.x() + c * e.y(), e.z());
+    const Vector3<double> rpy = euler_from_quaternion(nav.attitude);
+    const double e_psi = wrap_angle(heading_ - psi);
+    command_.heading_error = e_psi;
+    const double i_saved[4] = {surge_.integral(), sway_.integral(), heave_.integral(),
+                               yaw_.integral()};
+    Vector6<double> tau;
+    tau << surge_.update(eb.x(), dt, -nav.nu(0)), sway_.update(eb.y(), dt, -nav.nu(1)),
+        heave_.update(eb.z(), dt, -nav.nu(2)), roll_.update(-rpy(0), dt, -nav.nu(3)),
+        pitch_.update(-rpy(1), dt, -nav.nu(4)), yaw_.update(e_psi, dt, -nav.nu(5));
+    if (settings_.compensate) tau -= observer_.estimate();
+    // Allocation, then uniform scaling so that no thruster exceeds max_thrust.
+    thrusters_.distribute(tau, force_);
+    const double peak = force_.cwiseAbs().maxCoeff();
+    command_.saturated = peak > settings_.max_thrust;
+    if (command_.saturated) {
+      force_ *= settings_.max_thrust / peak;
+      // Anti-windup: the allocation could not deliver: keep the integrals where they were.
+      surge_.set_integral(i_saved[0]);
+      sway_.set_integral(i_saved[1]);
+      heave_.set_integral(i_saved[2]);
+      yaw_.set_integral(i_saved[3]);
+    }
+    for (Eigen::Index i = 0; i < force_.size(); ++i) {
+      command_.command(i) = vehicle::t200_command(force_(i));
+      command_.thrust(i) = vehicle::t200_thrust(command_.command(i));
+    }
+    command_.wrench = thrusters_.wrench(command_.thrust);
+    return command_;
+  }
+  /// \brief The last command.
+  const AuvCommand& command() const { return command_; }
+  /// \brief The disturbance estimate (zero unless compensating).
+  const Vector6<double>& disturbance_estimate() const { return observer_.estimate(); }
+
+ private:
+  AuvControllerSettings settings_;
+  vehicle::ThrusterAllocation<double> thrusters_;
+  Pid surge_, sway_, heave_, roll_, pitch_, yaw_;
+  DisturbanceObserver observer_;
+  std::vector<Vector3<double>> waypoints_;
+  std::size_t next_ = 0;
+  Vector3<double> target_ = Vector3<double>::Zero();
+  double heading_ = 0.0;
+  AuvCommand command_;
+  Eigen::VectorXd force_;
+  double last_time_ = 0.0, next_time_ = 0.0;
+  bool has_run_ = false;
+};
+
+/// \brief Settings of the ASV controller. Defaults: the paper's gains (Buchholz et al. 2025):
+/// follow the AUV with a linear PID (0.5, 0.1, 0.05) on the distance and an angular PID
+/// (4.0, 2.0, 1.0) on the bearing error at 10 Hz, thrust clipped at 15; yaw PID (2.0, 0, 0.5)
+/// for the heading once there. Read here (the paper gives no units) as thrust per side [N]:
+/// port = linear + angular, starboard = linear − angular (a positive bearing error, target to
+/// starboard, turns the bow to starboard), each clipped to ±thrust_clip.
+struct AsvControllerSettings {
+  PidGains linear{0.5, 0.1, 0.05, 15.0, 100.0};  ///< distance [m] → common thrust [N]
+  PidGains angular{4.0, 2.0, 1.0, 15.0, 5.0};    ///< bearing error [rad] → differential [N]
+  PidGains yaw{2.0, 0.0, 0.5, 15.0};             ///< heading error [rad] → differential [N]
+  double period = 0.1;                           ///< update period [s] (10 Hz)
+  double thrust_clip = 15.0;                     ///< per thruster [N]
+  double arrive_radius = 1.0;  ///< within this distance the boat only holds its heading [m]
+  /// Follow offset: the boat's target is the AUV's horizontal position plus this NED offset [m].
+  Vector3<double> follow_offset = Vector3<double>::Zero();
+  bool compensate = false;              ///< feed the estimated disturbance forward
+  double observer_time_constant = 2.0;  ///< [s]
+};
+
+/// \brief One ASV controller output.
+struct AsvCommand {
+  double left = 0.0, right = 0.0;  ///< thrust of the port and starboard thrusters [N]
+  Eigen::Vector2d command = Eigen::Vector2d::Zero();         ///< normalised T200 commands
+  Vector6<double> wrench = Vector6<double>::Zero();          ///< body wrench delivered
+  Vector3<double> position_error = Vector3<double>::Zero();  ///< target − position, NED [m]
+  double heading_error = 0.0;  ///< bearing (or heading, once there) error [rad]
+};
+
+/// \brief Station keeping and follow-the-AUV for a skid-steered ASV (vehicle::blueboat).
+class AsvController {
+ public:
+  /// \param[in] model the ASV's own model (for the observer; kept by reference)
+  /// \param[in] thrusters its two thrusters (port first) \param[in] s settings
+  AsvController(const vehicle::VehicleModel<double>& model,
+                const vehicle::ThrusterAllocation<double>& thrusters,
+                const AsvControllerSettings& s = {})
+      : settings_(s),
+        thrusters_(thrusters),
+        linear_(s.linear, "linear"),
+        angular_(s.angular, "angular"),
+        yaw_(s.yaw, "yaw"),
+        observer_(model, s.observer_time_constant) {
+    KELP_CHECK(thrusters.size() == 2, "AsvController: needs two thrusters (port, starboard)");
+    check_positive(s.period, "period");
+    check_positive(s.thrust_clip, "thrust_clip");
+    check_positive(s.arrive_radius, "arrive_radius");
+    check_all_finite(s.follow_offset, "follow_offset");
+    // Lever arm of the differential thrust: half the thrusters' lateral distance.
+    half_track_ = 0.5 * std::abs(thrusters.positions()(1, 1) - thrusters.positions()(1, 0));
+    KELP_CHECK(half_track_ > 0.0, "AsvController: the thrusters must be side by side");
+  }
+
+  /// \brief Keep station at this NED point (z ignored) and heading [rad].
+  void station(const Vector3<double>& point, double heading) {
+    check_all_finite(point, "station point");
+    check_finite(heading, "station heading");
+    follow_ = false;
+    target_ = point;
+    heading_ = heading;
+  }
+  /// \brief Follow the AUV (its position given to each update) at `follow_offset`.
+  void follow_auv() { follow_ = true; }
+
+  /// \brief The command at time t [s] from the boat's navigation and the AUV's position (USBL).
+  const AsvCommand& update(const Navigation& nav, const Vector3<double>& auv_position, double t) {
+    if (has_run_ && t < next_time_ - 1e-9) return command_;
+    const double dt = has_run_ ? std::max(t - last_time_, 1e-6) : settings_.period;
+    last_time_ = t;
+    next_time_ = (has_run_ ? next_time_ : t) + settings_.period;
+    if (next_time_ <= t) next_time_ = t + settings_.period;
+    if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
+    has_run_ = true;
+    if (follow_) {
+      target_ = auv_position + settings_.follow_offset;
+      heading_ = heading_of(nav.attitude);  // hold whatever heading it arrives with
+    }
+    const double psi = heading_of(nav.attitude);
+    Vector3<double> e = target_ - nav.position;
+    e.z() = 0.0;
+    command_.position_error = e;
+    const double distance = e.norm();
+    double common = 0.0, differential = 0.0;
+    if (distance > settings_.arrive_radius) {
+      const double bearing = wrap_angle(std::atan2(e.y(), e.x()) - psi);
+      command_.heading_error = bearing;
+      // Push forward only as far as the bow points at the target.
+      common = linear_.update(distance, dt) * std::max(0.0, std::cos(bearing));
+      differential = angular_.update(bearing, dt, -nav.nu(5));
+      yaw_.reset();
+    } else {
+      const double e_psi = wrap_angle(heading_ - psi);
+      command_.heading_error = e_psi;
+      differential = yaw_.update(e_psi, dt, -nav.nu(5));
+      linear_.reset();
+      angular_.reset();
+    }
+    if (settings_.compensate) {
+      // Feed forward −d̂ through the same mix: surge and yaw moment.
+      const Vector6<double>& d = observer_.estimate();
+      common -= 0.5 * d(0);
+      differential -= 0.5 * d(5) / half_track_;
+    }
+    const double clip = settings_.thrust_clip;
+    // More thrust on the port side turns the bow to starboard (positive yaw, NED).
+    command_.left = std::clamp(common + differential, -clip, clip);
+    command_.right = std::clamp(common - differential, -clip, clip);
+    command_.command << vehicle::t200_command(command_.left), vehicle::t200_command(command_.right);
+    const Eigen::Vector2d f(vehicle::t200_thrust(command_.command(0)),
+                            vehicle::t200_thrust(command_.command(1)));
+    command_.wrench = thrusters_.wrench(f);
+    return command_;
+  }
+  /// \brief The last command.
+  const AsvCommand& command() const { return command_; }
+  /// \brief The current target position, NED [m].
+  const Vector3<double>& target() const { return target_; }
+
+ private:
+  AsvControllerSettings settings_;
+  vehicle::ThrusterAllocation<double> thrusters_;
+  Pid linear_, angular_, yaw_;
+  DisturbanceObserver observer_;
+  Vector3<double> target_ = Vector3<double>::Zero();
+  double heading_ = 0.0, half_track_ = 0.0;
+  bool follow_ = false;
+  AsvCommand command_;
+  double last_time_ = 0.0, next_time_ = 0.0;
+  bool has_run_ = false;
+};
+
+}  // namespace kelp::control
