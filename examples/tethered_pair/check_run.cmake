@@ -1,0 +1,28 @@
+# Runs kelp-tethered-pair twice on a short default scenario (run by CTest): both runs must succeed,
+# write every output (non-empty PNG plots included) and give bit-identical time series.
+foreach(run a b)
+  file(REMOVE_RECURSE "${OUT}/${run}")
+  execute_process(COMMAND "${PROGRAM}" --duration 20 --seed 3 --quiet --out "${OUT}/${run}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "run ${run} failed (${rc}):\n${out}\n${err}")
+  endif()
+  message(STATUS "${out}")
+  foreach(f timeseries.csv nodes.csv summary.json trajectories.png depth.png tension.png
+            errors.png tether.png)
+    if(NOT EXISTS "${OUT}/${run}/${f}")
+      message(FATAL_ERROR "run ${run} did not write ${f}")
+    endif()
+    file(SIZE "${OUT}/${run}/${f}" size)
+    if(size LESS 100)
+      message(FATAL_ERROR "run ${run}: ${f} is nearly empty (${size} bytes)")
+    endif()
+  endforeach()
+endforeach()
+foreach(f timeseries.csv nodes.csv)
+  file(SHA256 "${OUT}/a/${f}" ha)
+  file(SHA256 "${OUT}/b/${f}" hb)
+  if(NOT ha STREQUAL hb)
+    message(FATAL_ERROR "the same seed gave different ${f}")
+  endif()
+endforeach()

@@ -1,0 +1,235 @@
+// kelp-tethered-pair: a BlueBoat and a BlueROV2 Heavy joined by a 10 m tether in the paper's
+// moderate sea. The ROV flies a 10 m square survey at 5 m depth; the boat follows it. Writes a
+// time series (CSV), tether node positions (CSV), a JSON summary and, through plot_run.py, PNG
+// plots into the output directory.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "kelp/control/controllers.hpp"
+#include "kelp/core/rotation.hpp"
+#include "kelp/system/presets.hpp"
+
+namespace fs = std::filesystem;
+namespace kc = kelp::control;
+namespace ks = kelp::system;
+namespace kv = kelp::vehicle;
+using kelp::Vector3;
+
+namespace {
+
+struct Options {
+  double duration = 120.0;
+  std::uint64_t seed = 1;
+  std::string out = "kelp-run";
+  bool quiet = false;
+  bool no_plots = false;
+  bool compensate = false;
+  double tether_length = 10.0;
+  double log_rate = 10.0;  // time series [Hz]
+  double node_rate = 1.0;  // tether node snapshots [Hz]
+};
+
+// Distance from p to the segment a–b.
+double distance_to_segment(const Vector3<double>& p, const Vector3<double>& a,
+                           const Vector3<double>& b) {
+  const Vector3<double> ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + s * ab - p).norm();
+}
+
+std::string plot_script() {
+  if (const char* env = std::getenv("KELP_PLOT_SCRIPT")) return env;
+  // Installed next to the program's prefix, else the source tree of this build.
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = self.parent_path().parent_path() / "share/kelp/plot_run.py";
+    if (fs::exists(installed)) return installed.string();
+  }
+  return KELP_PLOT_SCRIPT_SOURCE;
+}
+
+int run(const Options& o) {
+  namespace sp = ks::presets;
+  kelp::environment::SeaStateOptions sea;
+  sea.seed = o.seed;
+  sp::PaperWorld<double> w(o.tether_length, sp::Sea::moderate, sp::TetherKind::rov_tether, sea);
+  const auto rov = kv::bluerov2_heavy<double>();
+  const auto boat = kv::blueboat<double>();
+  const kv::ThrusterAllocationd rov_thrusters(rov.thruster_positions, rov.thruster_directions);
+  const kv::ThrusterAllocationd boat_thrusters(boat.thruster_positions, boat.thruster_directions);
+  kc::AuvControllerSettings auv_settings;
+  auv_settings.compensate = o.compensate;
+  kc::AsvControllerSettings asv_settings;
+  asv_settings.compensate = o.compensate;
+  kc::AuvController auv(w.model.auv(), rov_thrusters, auv_settings);
+  kc::AsvController asv(w.model.asv(), boat_thrusters, asv_settings);
+  const Vector3<double> start = w.state.auv.position;
+  const Vector3<double> s0(start.x(), start.y(), 5.0);
+  const std::vector<Vector3<double>> square{s0 + Vector3<double>(10, 0, 0),
+                                            s0 + Vector3<double>(10, 10, 0),
+                                            s0 + Vector3<double>(0, 10, 0), s0};
+  auv.follow(square);
+  asv.follow_auv();
+
+  fs::create_directories(o.out);
+  std::ofstream ts(fs::path(o.out) / "timeseries.csv"), nodes(fs::path(o.out) / "nodes.csv");
+  ts << "t,asv_x,asv_y,asv_z,asv_roll,asv_pitch,asv_yaw,asv_u,asv_v,asv_r,"
+        "auv_x,auv_y,auv_z,auv_roll,auv_pitch,auv_yaw,auv_u,auv_v,auv_w,"
+        "auv_target_x,auv_target_y,auv_target_z,auv_error,asv_error,"
+        "asv_thrust_port,asv_thrust_starboard";
+  for (int i = 1; i <= 8; ++i) ts << ",auv_thrust_" << i;
+  ts << ",tension_asv,tension_auv\n";
+  nodes << "t,node,x,y,z\n";
+  char buf[64];
+  const auto num = [&](double v) {
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
+
+  const double dt = 0.01;
+  const long steps = std::lround(o.duration / dt);
+  const long log_every = std::max(1L, std::lround(1.0 / (o.log_rate * dt)));
+  const long node_every = std::max(1L, std::lround(1.0 / (o.node_rate * dt)));
+  double auv_se = 0, auv_max = 0, asv_se = 0, asv_max = 0, t_max = 0, t_sum = 0;
+  long samples = 0, slack = 0;
+  const bool bar = !o.quiet && isatty(2);
+  const auto wall0 = std::chrono::steady_clock::now();
+  ks::SystemInputsd in;
+  ks::SystemReportd rep;
+  for (long k = 0; k <= steps; ++k) {
+    const double t = w.state.time();
+    const kc::AuvCommand& ac = auv.update(kc::navigation_of(w.state.auv), t);
+    const kc::AsvCommand& bc = asv.update(kc::navigation_of(w.state.asv), w.state.auv.position, t);
+    if (k % log_every == 0) {
+      // The AUV's error: distance from the survey path (the leg it is on); the boat's: its
+      // horizontal distance from the AUV.
+      const std::size_t leg = std::min(auv.next_waypoint(), square.size() - 1);
+      const Vector3<double> from = leg == 0 ? s0 : square[leg - 1];
+      const double e_auv = distance_to_segment(w.state.auv.position, from, square[leg]);
+      const double e_asv = (w.state.asv.position - w.state.auv.position).head<2>().norm();
+      const double ta = rep.force_on_asv.norm(), tb = rep.force_on_auv.norm();
+      if (k > 0) {
+        auv_se += e_auv * e_auv;
+        asv_se += e_asv * e_asv;
+        auv_max = std::max(auv_max, e_auv);
+        asv_max = std::max(asv_max, e_asv);
+        t_max = std::max(t_max, std::max(ta, tb));
+        t_sum += tb;
+        slack += tb < 0.1;
+        ++samples;
+      }
+      const Vector3<double> ea = kelp::euler_from_quaternion(w.state.asv.attitude);
+      const Vector3<double> eb = kelp::euler_from_quaternion(w.state.auv.attitude);
+      const auto& a = w.state.asv;
+      const auto& b = w.state.auv;
+      ts << num(t);
+      for (double v :
+           {a.position.x(),   a.position.y(), a.position.z(), ea.x(),           ea.y(),
+            ea.z(),           a.nu(0),        a.nu(1),        a.nu(5),          b.position.x(),
+            b.position.y(),   b.position.z(), eb.x(),         eb.y(),           eb.z(),
+            b.nu(0),          b.nu(1),        b.nu(2),        auv.target().x(), auv.target().y(),
+            auv.target().z(), e_auv,          e_asv,          bc.left,          bc.right})
+        ts << ',' << num(v);
+      for (Eigen::Index i = 0; i < ac.thrust.size(); ++i) ts << ',' << num(ac.thrust(i));
+      ts << ',' << num(ta) << ',' << num(tb) << '\n';
+    }
+    if (k % node_every == 0)
+      for (int i = 0; i < w.model.tether().nodes(); ++i)
+        nodes << num(t) << ',' << i << ',' << num(w.state.tether.position(0, i)) << ','
+              << num(w.state.tether.position(1, i)) << ',' << num(w.state.tether.position(2, i))
+              << '\n';
+    if (k == steps) break;
+    in.auv.control = ac.wrench;
+    in.asv.control = bc.wrench;
+    rep = ks::step(w.model, w.workspace, w.state, in, dt);
+    if (bar && k % 500 == 0)
+      std::fprintf(stderr, "\r[%-40s] %5.1f / %.0f s",
+                   std::string(static_cast<std::size_t>(40.0 * k / steps), '#').c_str(), t,
+                   o.duration);
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (bar) std::fprintf(stderr, "\n");
+  ts.close();
+  nodes.close();
+
+  nlohmann::json summary;
+  const double n = std::max<double>(1, samples);
+  summary["kelp_version"] = KELP_VERSION_STRING;
+  summary["simulated_s"] = o.duration;
+  summary["wall_s"] = wall;
+  summary["realtime_factor"] = o.duration / wall;
+  summary["auv"] = {{"rms_path_error_m", std::sqrt(auv_se / n)},
+                    {"max_path_error_m", auv_max},
+                    {"waypoints_reached", auv.next_waypoint()}};
+  summary["asv"] = {{"rms_distance_to_auv_m", std::sqrt(asv_se / n)},
+                    {"max_distance_to_auv_m", asv_max}};
+  summary["tether"] = {
+      {"max_tension_n", t_max}, {"mean_tension_auv_n", t_sum / n}, {"slack_fraction", slack / n}};
+  summary["energy_j"] = ks::energy(w.model, w.state).total();
+  summary["scenario"] = {{"tether_length_m", o.tether_length},
+                         {"sea", "moderate"},
+                         {"seed", o.seed},
+                         {"compensation", o.compensate},
+                         {"duration_s", o.duration},
+                         {"survey", "10 m square at 5 m depth"},
+                         {"log_rate_hz", o.log_rate},
+                         {"node_rate_hz", o.node_rate}};
+  std::ofstream(fs::path(o.out) / "summary.json") << summary.dump(2) << '\n';
+
+  std::string plots;
+  if (!o.no_plots) {
+    const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string cmd = python + " '" + plot_script() + "' '" + o.out + "'";
+    if (std::system(cmd.c_str()) != 0) {
+      std::fprintf(stderr, "kelp-tethered-pair: the plotting script failed (%s)\n", cmd.c_str());
+      return 2;
+    }
+    plots = ", plots";
+  }
+  std::printf(
+      "kelp-tethered-pair: %.0f s simulated in %.2f s (%.0fx real time); AUV path error RMS "
+      "%.2f m, boat %.2f m from the AUV RMS, peak tension %.1f N; outputs in %s (timeseries.csv, "
+      "nodes.csv, summary.json%s)\n",
+      o.duration, wall, o.duration / wall, std::sqrt(auv_se / n), std::sqrt(asv_se / n), t_max,
+      o.out.c_str(), plots.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "kelp-tethered-pair: a BlueBoat and a BlueROV2 Heavy joined by a tether, "
+      "in the paper's moderate sea"};
+  app.add_option("--duration", o.duration, "simulated time [s]")->check(CLI::PositiveNumber);
+  app.add_option("--seed", o.seed, "seed of the waves and gusts");
+  app.add_option("--out", o.out, "output directory");
+  app.add_option("--tether-length", o.tether_length, "tether length [m] (paper: 5, 10, 15)")
+      ->check(CLI::Range(2.0, 100.0));
+  app.add_flag("--compensate", o.compensate, "disturbance-aware controllers (feedforward)");
+  app.add_flag("--quiet", o.quiet, "no progress bar");
+  app.add_flag("--no-plots", o.no_plots, "do not run the plotting script");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    return run(o);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "kelp-tethered-pair: %s\n", e.what());
+    return 1;
+  }
+}
