@@ -20,6 +20,8 @@
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/system/presets.hpp"
+#include "kelp/tether/presets.hpp"
+#include "scenario.hpp"
 
 namespace fs = std::filesystem;
 namespace kc = kelp::control;
@@ -30,15 +32,11 @@ using kelp::Vector3;
 namespace {
 
 struct Options {
-  double duration = 120.0;
-  std::uint64_t seed = 1;
+  tethered_pair::Scenario scenario;
+  std::string scenario_file = "(embedded default)";
   std::string out = "kelp-run";
   bool quiet = false;
   bool no_plots = false;
-  bool compensate = false;
-  double tether_length = 10.0;
-  double log_rate = 10.0;  // time series [Hz]
-  double node_rate = 1.0;  // tether node snapshots [Hz]
 };
 
 // Distance from p to the segment a–b.
@@ -64,24 +62,77 @@ std::string plot_script() {
 
 int run(const Options& o) {
   namespace sp = ks::presets;
-  kelp::environment::SeaStateOptions sea;
-  sea.seed = o.seed;
-  sp::PaperWorld<double> w(o.tether_length, sp::Sea::moderate, sp::TetherKind::rov_tether, sea);
+  namespace ke = kelp::environment;
+  const tethered_pair::Scenario& sc = o.scenario;
+  // The system from the scenario.
+  const sp::TetherKind kind =
+      sc.tether_kind == "bead_chain" ? sp::TetherKind::bead_chain : sp::TetherKind::rov_tether;
+  ks::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
+  if (kind == sp::TetherKind::rov_tether)
+    params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
+  params.asv_attachment = sc.asv_attachment;
+  params.auv_attachment = sc.auv_attachment;
+  ke::SeaStateOptions sea_options;
+  sea_options.seed = sc.seed;
+  sea_options.wave_components = sc.wave_components;
+  ke::SeaState sea = ke::presets::calm();
+  if (sc.sea == "moderate") sea = ke::presets::moderate();
+  if (sc.sea == "rough") sea = ke::presets::rough();
+  if (sc.sea == "custom") {
+    sea = ke::presets::paper_sea_state(sc.significant_height, sc.wind_speed, sc.current_speed);
+    sea.peak_period = sc.peak_period;
+    sea.wave_direction = sc.wave_direction;
+    sea.wind_direction = sc.wind_direction;
+    sea.current_direction = sc.current_direction;
+  }
+  const ks::SystemModeld model(params, ke::make_environment<double>(sea, sea_options));
+  ks::SystemWorkspaced ws(model);
+  sp::StartPoses<double> start_poses = sp::paper_start(sc.tether_length);
+  if (!sc.auv_start.empty())
+    start_poses.auv.position = Vector3<double>(sc.auv_start[0], sc.auv_start[1], sc.auv_start[2]);
+  const double span = (start_poses.auv.point_position(params.auv_attachment) -
+                       start_poses.asv.point_position(params.asv_attachment))
+                          .norm();
+  if (span > sc.tether_length)
+    throw tethered_pair::scenario_error(
+        o.scenario_file + ": /tether/length: " + std::to_string(sc.tether_length) +
+        " m is shorter than the initial distance between its ends (" + std::to_string(span) +
+        " m)");
+  struct World {
+    const ks::SystemModeld& model;
+    ks::SystemWorkspaced& workspace;
+    ks::SystemStated state;
+  } w{model, ws, ks::initial_state(model, ws, start_poses.asv, start_poses.auv)};
   const auto rov = kv::bluerov2_heavy<double>();
   const auto boat = kv::blueboat<double>();
   const kv::ThrusterAllocationd rov_thrusters(rov.thruster_positions, rov.thruster_directions);
   const kv::ThrusterAllocationd boat_thrusters(boat.thruster_positions, boat.thruster_directions);
   kc::AuvControllerSettings auv_settings;
-  auv_settings.compensate = o.compensate;
+  auv_settings.compensate = sc.compensation;
+  auv_settings.period = 1.0 / sc.auv_rate;
   kc::AsvControllerSettings asv_settings;
-  asv_settings.compensate = o.compensate;
+  asv_settings.compensate = sc.compensation;
+  asv_settings.period = 1.0 / sc.asv_rate;
+  asv_settings.thrust_clip = sc.asv_thrust_clip;
+  const auto set = [&](kc::PidGains& g, const tethered_pair::Gains& x) {
+    g.kp = x.kp;
+    g.ki = x.ki;
+    g.kd = x.kd;
+    g.output_limit = sc.asv_thrust_clip;
+  };
+  set(asv_settings.linear, sc.asv_linear);
+  set(asv_settings.angular, sc.asv_angular);
+  set(asv_settings.yaw, sc.asv_yaw);
   kc::AuvController auv(w.model.auv(), rov_thrusters, auv_settings);
   kc::AsvController asv(w.model.asv(), boat_thrusters, asv_settings);
   const Vector3<double> start = w.state.auv.position;
-  const Vector3<double> s0(start.x(), start.y(), 5.0);
-  const std::vector<Vector3<double>> square{s0 + Vector3<double>(10, 0, 0),
-                                            s0 + Vector3<double>(10, 10, 0),
-                                            s0 + Vector3<double>(0, 10, 0), s0};
+  const Vector3<double> s0(start.x(), start.y(), sc.depth);
+  std::vector<Vector3<double>> square = sc.waypoints;
+  if (square.empty()) {
+    const double a = sc.square_side;
+    square = {s0 + Vector3<double>(a, 0, 0), s0 + Vector3<double>(a, a, 0),
+              s0 + Vector3<double>(0, a, 0), s0};
+  }
   auv.follow(square);
   asv.follow_auv();
 
@@ -101,11 +152,14 @@ int run(const Options& o) {
   };
 
   const double dt = 0.01;
-  const long steps = std::lround(o.duration / dt);
-  const long log_every = std::max(1L, std::lround(1.0 / (o.log_rate * dt)));
-  const long node_every = std::max(1L, std::lround(1.0 / (o.node_rate * dt)));
+  const double duration = sc.duration;
+  const long steps = std::lround(duration / dt);
+  const long log_every = std::max(1L, std::lround(1.0 / (sc.log_rate * dt)));
+  const long node_every = std::max(1L, std::lround(1.0 / (sc.node_rate * dt)));
   double auv_se = 0, auv_max = 0, asv_se = 0, asv_max = 0, t_max = 0, t_sum = 0;
   long samples = 0, slack = 0;
+  // Over the second half of the run (after settling).
+  double late_depth = 0, late_auv = 0, late_asv = 0;
   const bool bar = !o.quiet && isatty(2);
   const auto wall0 = std::chrono::steady_clock::now();
   ks::SystemInputsd in;
@@ -118,7 +172,7 @@ int run(const Options& o) {
       // The AUV's error: distance from the survey path (the leg it is on); the boat's: its
       // horizontal distance from the AUV.
       const std::size_t leg = std::min(auv.next_waypoint(), square.size() - 1);
-      const Vector3<double> from = leg == 0 ? s0 : square[leg - 1];
+      const Vector3<double> from = leg == 0 ? start : square[leg - 1];
       const double e_auv = distance_to_segment(w.state.auv.position, from, square[leg]);
       const double e_asv = (w.state.asv.position - w.state.auv.position).head<2>().norm();
       const double ta = rep.force_on_asv.norm(), tb = rep.force_on_auv.norm();
@@ -131,6 +185,11 @@ int run(const Options& o) {
         t_sum += tb;
         slack += tb < 0.1;
         ++samples;
+        if (t >= 0.5 * duration) {
+          late_depth = std::max(late_depth, std::abs(w.state.auv.position.z() - auv.target().z()));
+          late_auv = std::max(late_auv, e_auv);
+          late_asv = std::max(late_asv, e_asv);
+        }
       }
       const Vector3<double> ea = kelp::euler_from_quaternion(w.state.asv.attitude);
       const Vector3<double> eb = kelp::euler_from_quaternion(w.state.auv.attitude);
@@ -159,7 +218,7 @@ int run(const Options& o) {
     if (bar && k % 500 == 0)
       std::fprintf(stderr, "\r[%-40s] %5.1f / %.0f s",
                    std::string(static_cast<std::size_t>(40.0 * k / steps), '#').c_str(), t,
-                   o.duration);
+                   duration);
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -170,25 +229,22 @@ int run(const Options& o) {
   nlohmann::json summary;
   const double n = std::max<double>(1, samples);
   summary["kelp_version"] = KELP_VERSION_STRING;
-  summary["simulated_s"] = o.duration;
+  summary["simulated_s"] = duration;
   summary["wall_s"] = wall;
-  summary["realtime_factor"] = o.duration / wall;
+  summary["realtime_factor"] = duration / wall;
   summary["auv"] = {{"rms_path_error_m", std::sqrt(auv_se / n)},
                     {"max_path_error_m", auv_max},
-                    {"waypoints_reached", auv.next_waypoint()}};
+                    {"waypoints_reached", auv.next_waypoint()},
+                    {"second_half_max_depth_error_m", late_depth},
+                    {"second_half_max_path_error_m", late_auv}};
   summary["asv"] = {{"rms_distance_to_auv_m", std::sqrt(asv_se / n)},
-                    {"max_distance_to_auv_m", asv_max}};
+                    {"max_distance_to_auv_m", asv_max},
+                    {"second_half_max_distance_to_auv_m", late_asv}};
   summary["tether"] = {
       {"max_tension_n", t_max}, {"mean_tension_auv_n", t_sum / n}, {"slack_fraction", slack / n}};
   summary["energy_j"] = ks::energy(w.model, w.state).total();
-  summary["scenario"] = {{"tether_length_m", o.tether_length},
-                         {"sea", "moderate"},
-                         {"seed", o.seed},
-                         {"compensation", o.compensate},
-                         {"duration_s", o.duration},
-                         {"survey", "10 m square at 5 m depth"},
-                         {"log_rate_hz", o.log_rate},
-                         {"node_rate_hz", o.node_rate}};
+  summary["scenario_file"] = o.scenario_file;
+  summary["scenario"] = tethered_pair::to_json(sc);
   std::ofstream(fs::path(o.out) / "summary.json") << summary.dump(2) << '\n';
 
   std::string plots;
@@ -205,7 +261,7 @@ int run(const Options& o) {
       "kelp-tethered-pair: %.0f s simulated in %.2f s (%.0fx real time); AUV path error RMS "
       "%.2f m, boat %.2f m from the AUV RMS, peak tension %.1f N; outputs in %s (timeseries.csv, "
       "nodes.csv, summary.json%s)\n",
-      o.duration, wall, o.duration / wall, std::sqrt(auv_se / n), std::sqrt(asv_se / n), t_max,
+      duration, wall, duration / wall, std::sqrt(auv_se / n), std::sqrt(asv_se / n), t_max,
       o.out.c_str(), plots.c_str());
   return 0;
 }
@@ -215,19 +271,32 @@ int run(const Options& o) {
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{
-      "kelp-tethered-pair: a BlueBoat and a BlueROV2 Heavy joined by a tether, "
-      "in the paper's moderate sea"};
-  app.add_option("--duration", o.duration, "simulated time [s]")->check(CLI::PositiveNumber);
-  app.add_option("--seed", o.seed, "seed of the waves and gusts");
+      "kelp-tethered-pair: a BlueBoat and a BlueROV2 Heavy joined by a tether in waves, "
+      "wind and current (the embedded default: the paper's moderate sea, a square "
+      "survey)"};
+  std::string file;
+  double duration = -1;
+  std::int64_t seed = -1;
+  app.add_option("--scenario", file, "scenario file (JSON; see examples/tethered_pair/README.md)");
+  app.add_option("--duration", duration, "simulated time [s] (overrides the scenario)")
+      ->check(CLI::Range(1e-3, 1e7));
+  app.add_option("--seed", seed, "seed of the waves and gusts (overrides the scenario)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--out", o.out, "output directory");
-  app.add_option("--tether-length", o.tether_length, "tether length [m] (paper: 5, 10, 15)")
-      ->check(CLI::Range(2.0, 100.0));
-  app.add_flag("--compensate", o.compensate, "disturbance-aware controllers (feedforward)");
   app.add_flag("--quiet", o.quiet, "no progress bar");
   app.add_flag("--no-plots", o.no_plots, "do not run the plotting script");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (!file.empty()) {
+      o.scenario = tethered_pair::load_scenario(file);
+      o.scenario_file = file;
+    }
+    if (duration > 0) o.scenario.duration = duration;
+    if (seed >= 0) o.scenario.seed = static_cast<std::uint64_t>(seed);
     return run(o);
+  } catch (const tethered_pair::scenario_error& e) {
+    std::fprintf(stderr, "kelp-tethered-pair: invalid scenario: %s\n", e.what());
+    return 3;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "kelp-tethered-pair: %s\n", e.what());
     return 1;

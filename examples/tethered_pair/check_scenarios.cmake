@@ -1,0 +1,64 @@
+# Scenario files of kelp-tethered-pair (run by CTest):
+#  - each kind of bad scenario is refused with a non-zero exit, a message naming the JSON path, and
+#    no output directory;
+#  - the calm hold scenario: after settling the AUV holds its depth within 5 cm and the boat keeps
+#    within 1 m of its target (above the AUV).
+cmake_minimum_required(VERSION 3.19)  # string(JSON)
+
+set(bad_unknown_key [=[{"tether": {"length": 10, "colour": "yellow"}}]=])
+set(path_unknown_key "/tether/colour")
+set(bad_wrong_type [=[{"duration": "long"}]=])
+set(path_wrong_type "/duration")
+set(bad_out_of_range [=[{"tether": {"length": -3}}]=])
+set(path_out_of_range "/tether/length")
+set(bad_non_finite [=[{"output": {"log_rate": 1e999}}]=])
+# JSON has no NaN or infinity; a number beyond double is refused by the parser, named by its text.
+set(path_non_finite "1e999")
+set(bad_empty_waypoints [=[{"mission": {"waypoints": []}}]=])
+set(path_empty_waypoints "/mission/waypoints")
+set(bad_short_tether [=[{"tether": {"length": 5}, "vehicles": {"auv_start": [-30, 0, 5]}}]=])
+set(path_short_tether "/tether/length")
+set(bad_choice [=[{"sea": "stormy"}]=])
+set(path_choice "/sea")
+set(bad_vector [=[{"vehicles": {"asv_attachment": [0, "x", 0]}}]=])
+set(path_vector "/vehicles/asv_attachment/1")
+set(bad_gains [=[{"control": {"asv": {"linear": [0.5, -0.1, 0.05]}}}]=])
+set(path_gains "/control/asv/linear")
+set(bad_not_json [=[{"duration": 10,]=])
+set(path_not_json "not valid JSON")
+
+foreach(kind unknown_key wrong_type out_of_range non_finite empty_waypoints short_tether choice
+             vector gains not_json)
+  set(file "${OUT}/${kind}.json")
+  file(WRITE "${file}" "${bad_${kind}}")
+  file(REMOVE_RECURSE "${OUT}/${kind}_out")
+  execute_process(COMMAND "${PROGRAM}" --scenario "${file}" --out "${OUT}/${kind}_out" --quiet
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0)
+    message(FATAL_ERROR "${kind}: the bad scenario was accepted")
+  endif()
+  string(FIND "${err}" "${path_${kind}}" at)
+  string(FIND "${err}" "${file}" at_file)
+  if(at EQUAL -1 OR at_file EQUAL -1)
+    message(FATAL_ERROR "${kind}: the message does not name the file and ${path_${kind}}: ${err}")
+  endif()
+  if(EXISTS "${OUT}/${kind}_out")
+    message(FATAL_ERROR "${kind}: outputs were written for a bad scenario")
+  endif()
+  message(STATUS "${kind}: ${err}")
+endforeach()
+
+file(REMOVE_RECURSE "${OUT}/calm")
+execute_process(COMMAND "${PROGRAM}" --scenario "${SCENARIOS}/calm_hold.json" --out "${OUT}/calm"
+                        --quiet --no-plots RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "calm_hold failed: ${out} ${err}")
+endif()
+file(READ "${OUT}/calm/summary.json" summary)
+string(JSON depth GET "${summary}" auv second_half_max_depth_error_m)
+string(JSON boat GET "${summary}" asv second_half_max_distance_to_auv_m)
+message(STATUS "calm hold, second half: AUV depth error up to ${depth} m, boat up to ${boat} m "
+               "from its target")
+if(depth GREATER 0.05 OR boat GREATER 1.0)
+  message(FATAL_ERROR "calm hold: depth error ${depth} m (limit 0.05), boat ${boat} m (limit 1)")
+endif()

@@ -1,0 +1,291 @@
+// Scenario files of kelp-tethered-pair (JSON, nlohmann-json): the schema, its defaults and its
+// validation. Every field is optional; the defaults are the embedded default run. Errors name the
+// file, the JSON path and what was expected (`scenario_error`). The schema is documented in
+// examples/tethered_pair/README.md.
+#pragma once
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kelp/core/types.hpp"
+
+namespace tethered_pair {
+
+/// A scenario that cannot be used: the message names the file and the JSON path.
+struct scenario_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Gains {
+  double kp, ki, kd;
+};
+
+struct Scenario {
+  double duration = 120.0;  // [s]
+  std::uint64_t seed = 1;
+  // Sea: a preset ("calm", "moderate", "rough") or explicit values.
+  std::string sea = "moderate";
+  double significant_height = 0, peak_period = 0, wave_direction = 0;
+  double wind_speed = 0, wind_direction = 0, current_speed = 0, current_direction = 0;
+  int wave_components = 64;
+  // Tether.
+  double tether_length = 10.0;
+  std::string tether_kind = "rov_tether";  // or "bead_chain"
+  double segment_length = 0.5;
+  // Vehicles: attachment points (body axes) and the AUV's start (NED; empty: the paper's start).
+  kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
+  std::vector<double> auv_start;
+  // Control.
+  bool compensation = false;
+  Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
+  double asv_thrust_clip = 15.0, asv_rate = 10.0;
+  double auv_rate = 50.0;
+  // Mission: NED waypoints; empty: a square of side `square_side` at `depth` from the start.
+  std::vector<kelp::Vector3<double>> waypoints;
+  double depth = 5.0, square_side = 10.0;
+  // Output.
+  double log_rate = 10.0, node_rate = 1.0;
+};
+
+namespace detail {
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw scenario_error(file_ + ": " + (path.empty() ? "/" : path) + ": " + what);
+  }
+  // Checks that `j` at `path` is an object with only the given keys.
+  void object(const nlohmann::json& j, const std::string& path,
+              const std::set<std::string>& keys) const {
+    if (!j.is_object()) fail(path, "expected an object, got " + type(j));
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (!keys.count(it.key())) {
+        std::string allowed;
+        for (const auto& k : keys) allowed += (allowed.empty() ? "" : ", ") + k;
+        fail(path + "/" + it.key(), "unknown key (allowed: " + allowed + ")");
+      }
+  }
+  void number(const nlohmann::json& j, const std::string& path, const std::string& key, double& out,
+              double lo, double hi) const {
+    if (!j.contains(key)) return;
+    const auto& v = j.at(key);
+    const std::string p = path + "/" + key;
+    if (!v.is_number()) fail(p, "expected a number, got " + type(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x) || x < lo || x > hi)
+      fail(p, "expected a number in [" + fmt(lo) + ", " + fmt(hi) + "], got " + v.dump());
+    out = x;
+  }
+  void integer(const nlohmann::json& j, const std::string& path, const std::string& key,
+               std::uint64_t& out, double lo, double hi) const {
+    if (!j.contains(key)) return;
+    const auto& v = j.at(key);
+    const std::string p = path + "/" + key;
+    if (!v.is_number_integer() || v.get<double>() < lo || v.get<double>() > hi)
+      fail(p, "expected an integer in [" + fmt(lo) + ", " + fmt(hi) + "], got " + v.dump());
+    out = v.get<std::uint64_t>();
+  }
+  void boolean(const nlohmann::json& j, const std::string& path, const std::string& key,
+               bool& out) const {
+    if (!j.contains(key)) return;
+    const auto& v = j.at(key);
+    if (!v.is_boolean()) fail(path + "/" + key, "expected true or false, got " + v.dump());
+    out = v.get<bool>();
+  }
+  void choice(const nlohmann::json& j, const std::string& path, const std::string& key,
+              std::string& out, const std::set<std::string>& options) const {
+    if (!j.contains(key)) return;
+    const auto& v = j.at(key);
+    std::string all;
+    for (const auto& o : options) all += (all.empty() ? "" : ", ") + ("\"" + o + "\"");
+    if (!v.is_string() || !options.count(v.get<std::string>()))
+      fail(path + "/" + key, "expected one of " + all + ", got " + v.dump());
+    out = v.get<std::string>();
+  }
+  kelp::Vector3<double> vec3(const nlohmann::json& v, const std::string& p) const {
+    if (!v.is_array() || v.size() != 3)
+      fail(p, "expected an array of 3 numbers [x, y, z], got " + v.dump());
+    kelp::Vector3<double> out;
+    for (int i = 0; i < 3; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) ||
+          std::abs(v[i].get<double>()) > 1e4)
+        fail(p + "/" + std::to_string(i),
+             "expected a finite number within ±1e4, got " + v[i].dump());
+      out(i) = v[i].get<double>();
+    }
+    return out;
+  }
+  void gains(const nlohmann::json& j, const std::string& path, const std::string& key,
+             Gains& out) const {
+    if (!j.contains(key)) return;
+    const kelp::Vector3<double> g = vec3(j.at(key), path + "/" + key);
+    if ((g.array() < 0).any())
+      fail(path + "/" + key, "expected non-negative gains [kp, ki, kd], got " + j.at(key).dump());
+    out = {g(0), g(1), g(2)};
+  }
+
+ private:
+  static std::string type(const nlohmann::json& j) { return std::string(j.type_name()); }
+  static std::string fmt(double x) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", x);
+    return b;
+  }
+  std::string file_;
+};
+
+}  // namespace detail
+
+/// Reads and validates a scenario from JSON text; `file` names it in error messages.
+inline Scenario parse_scenario(const std::string& text, const std::string& file) {
+  const detail::Reader r(file);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    // Includes numbers beyond double (JSON has no NaN or infinity: 1e999 fails here, named by
+    // its text).
+    r.fail("", std::string("not valid JSON: ") + e.what());
+  }
+  Scenario s;
+  r.object(j, "",
+           {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output"});
+  r.number(j, "", "duration", s.duration, 1e-3, 1e7);
+  r.integer(j, "", "seed", s.seed, 0, 1e18);
+  if (j.contains("sea")) {
+    const auto& sea = j.at("sea");
+    if (sea.is_string()) {
+      r.choice(j, "", "sea", s.sea, {"calm", "moderate", "rough"});
+    } else {
+      r.object(sea, "/sea",
+               {"significant_height", "peak_period", "wave_direction", "wind_speed",
+                "wind_direction", "current_speed", "current_direction", "wave_components"});
+      s.sea = "custom";
+      s.peak_period = 8.0;
+      r.number(sea, "/sea", "significant_height", s.significant_height, 0, 20);
+      r.number(sea, "/sea", "peak_period", s.peak_period, 1, 30);
+      r.number(sea, "/sea", "wave_direction", s.wave_direction, -10, 10);
+      r.number(sea, "/sea", "wind_speed", s.wind_speed, 0, 60);
+      r.number(sea, "/sea", "wind_direction", s.wind_direction, -10, 10);
+      r.number(sea, "/sea", "current_speed", s.current_speed, 0, 5);
+      r.number(sea, "/sea", "current_direction", s.current_direction, -10, 10);
+      double n = s.wave_components;
+      r.number(sea, "/sea", "wave_components", n, 1, 4096);
+      if (n != std::floor(n)) r.fail("/sea/wave_components", "expected an integer");
+      s.wave_components = static_cast<int>(n);
+    }
+  }
+  if (j.contains("tether")) {
+    const auto& t = j.at("tether");
+    r.object(t, "/tether", {"length", "kind", "segment_length"});
+    r.number(t, "/tether", "length", s.tether_length, 0.5, 1000);
+    r.choice(t, "/tether", "kind", s.tether_kind, {"rov_tether", "bead_chain"});
+    r.number(t, "/tether", "segment_length", s.segment_length, 0.05, 10);
+  }
+  if (j.contains("vehicles")) {
+    const auto& v = j.at("vehicles");
+    r.object(v, "/vehicles", {"asv_attachment", "auv_attachment", "auv_start"});
+    if (v.contains("asv_attachment"))
+      s.asv_attachment = r.vec3(v.at("asv_attachment"), "/vehicles/asv_attachment");
+    if (v.contains("auv_attachment"))
+      s.auv_attachment = r.vec3(v.at("auv_attachment"), "/vehicles/auv_attachment");
+    if (v.contains("auv_start")) {
+      const kelp::Vector3<double> p = r.vec3(v.at("auv_start"), "/vehicles/auv_start");
+      s.auv_start = {p(0), p(1), p(2)};
+    }
+  }
+  if (j.contains("control")) {
+    const auto& c = j.at("control");
+    r.object(c, "/control", {"compensation", "asv", "auv"});
+    r.boolean(c, "/control", "compensation", s.compensation);
+    if (c.contains("asv")) {
+      const auto& a = c.at("asv");
+      r.object(a, "/control/asv", {"linear", "angular", "yaw", "thrust_clip", "rate"});
+      r.gains(a, "/control/asv", "linear", s.asv_linear);
+      r.gains(a, "/control/asv", "angular", s.asv_angular);
+      r.gains(a, "/control/asv", "yaw", s.asv_yaw);
+      r.number(a, "/control/asv", "thrust_clip", s.asv_thrust_clip, 0.1, 30.6);
+      r.number(a, "/control/asv", "rate", s.asv_rate, 0.1, 1000);
+    }
+    if (c.contains("auv")) {
+      r.object(c.at("auv"), "/control/auv", {"rate"});
+      r.number(c.at("auv"), "/control/auv", "rate", s.auv_rate, 0.1, 1000);
+    }
+  }
+  if (j.contains("mission")) {
+    const auto& m = j.at("mission");
+    r.object(m, "/mission", {"waypoints", "depth", "square_side"});
+    r.number(m, "/mission", "depth", s.depth, 0.5, 1000);
+    r.number(m, "/mission", "square_side", s.square_side, 0.5, 1000);
+    if (m.contains("waypoints")) {
+      const auto& w = m.at("waypoints");
+      if (!w.is_array()) r.fail("/mission/waypoints", "expected an array of [x, y, z]");
+      if (w.empty()) r.fail("/mission/waypoints", "expected at least one waypoint, got []");
+      for (std::size_t i = 0; i < w.size(); ++i)
+        s.waypoints.push_back(r.vec3(w[i], "/mission/waypoints/" + std::to_string(i)));
+    }
+  }
+  if (j.contains("output")) {
+    const auto& o = j.at("output");
+    r.object(o, "/output", {"log_rate", "node_rate"});
+    r.number(o, "/output", "log_rate", s.log_rate, 0.01, 100);
+    r.number(o, "/output", "node_rate", s.node_rate, 0.001, 100);
+  }
+  return s;
+}
+
+/// Reads a scenario file. \throws scenario_error naming the file.
+inline Scenario load_scenario(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw scenario_error(file + ": cannot be read");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_scenario(text, file);
+}
+
+/// The scenario as JSON, every field with its value (echoed in the summary).
+inline nlohmann::json to_json(const Scenario& s) {
+  const auto v3 = [](const kelp::Vector3<double>& v) {
+    return nlohmann::json::array({v(0), v(1), v(2)});
+  };
+  const auto g = [](const Gains& x) { return nlohmann::json::array({x.kp, x.ki, x.kd}); };
+  nlohmann::json j;
+  j["duration"] = s.duration;
+  j["seed"] = s.seed;
+  if (s.sea == "custom")
+    j["sea"] = {
+        {"significant_height", s.significant_height}, {"peak_period", s.peak_period},
+        {"wave_direction", s.wave_direction},         {"wind_speed", s.wind_speed},
+        {"wind_direction", s.wind_direction},         {"current_speed", s.current_speed},
+        {"current_direction", s.current_direction},   {"wave_components", s.wave_components}};
+  else
+    j["sea"] = s.sea;
+  j["tether"] = {
+      {"length", s.tether_length}, {"kind", s.tether_kind}, {"segment_length", s.segment_length}};
+  j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
+                   {"auv_attachment", v3(s.auv_attachment)}};
+  if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;
+  j["control"] = {{"compensation", s.compensation},
+                  {"asv",
+                   {{"linear", g(s.asv_linear)},
+                    {"angular", g(s.asv_angular)},
+                    {"yaw", g(s.asv_yaw)},
+                    {"thrust_clip", s.asv_thrust_clip},
+                    {"rate", s.asv_rate}}},
+                  {"auv", {{"rate", s.auv_rate}}}};
+  nlohmann::json wp = nlohmann::json::array();
+  for (const auto& w : s.waypoints) wp.push_back(v3(w));
+  j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
+  if (!s.waypoints.empty()) j["mission"]["waypoints"] = wp;
+  j["output"] = {{"log_rate", s.log_rate}, {"node_rate", s.node_rate}};
+  return j;
+}
+
+}  // namespace tethered_pair
