@@ -60,6 +60,27 @@ inline double wrap_angle(double a) {
   return a - kelp::pi;
 }
 
+/// \brief When a controller of period T runs: at its first call, then every T (zero-order hold
+/// in between; a late call runs at once and the schedule restarts from it).
+class SampleClock {
+ public:
+  /// \brief True when an update is due at time t [s]; `dt` is then the time since the last one
+  /// (T on the first).
+  bool due(double t, double period, double& dt) {
+    if (started_ && t < next_ - 1e-9) return false;
+    dt = started_ ? std::max(t - last_, 1e-6) : period;
+    next_ = (started_ ? next_ : t) + period;
+    if (next_ <= t) next_ = t + period;
+    last_ = t;
+    started_ = true;
+    return true;
+  }
+
+ private:
+  double last_ = 0.0, next_ = 0.0;
+  bool started_ = false;
+};
+
 /// \brief Momentum-based disturbance observer (see the file comment).
 class DisturbanceObserver {
  public:
@@ -184,13 +205,9 @@ class AuvController {
   /// \brief The command at time t [s] for navigation `nav`: recomputed every `period`, held in
   /// between. No allocation.
   const AuvCommand& update(const Navigation& nav, double t) {
-    if (has_run_ && t < next_time_ - 1e-9) return command_;
-    const double dt = has_run_ ? std::max(t - last_time_, 1e-6) : settings_.period;
-    last_time_ = t;
-    next_time_ = (has_run_ ? next_time_ : t) + settings_.period;
-    if (next_time_ <= t) next_time_ = t + settings_.period;
+    double dt = 0.0;
+    if (!clock_.due(t, settings_.period, dt)) return command_;
     if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
-    has_run_ = true;
     // Waypoints: advance when within the acceptance radius; face the direction of travel.
     if (!waypoints_.empty()) {
       while (next_ < waypoints_.size() &&
@@ -254,8 +271,7 @@ class AuvController {
   double heading_ = 0.0;
   AuvCommand command_;
   Eigen::VectorXd force_;
-  double last_time_ = 0.0, next_time_ = 0.0;
-  bool has_run_ = false;
+  SampleClock clock_;
 };
 
 /// \brief Settings of the ASV controller. Defaults: the paper's gains (Buchholz et al. 2025):
@@ -323,13 +339,9 @@ class AsvController {
 
   /// \brief The command at time t [s] from the boat's navigation and the AUV's position (USBL).
   const AsvCommand& update(const Navigation& nav, const Vector3<double>& auv_position, double t) {
-    if (has_run_ && t < next_time_ - 1e-9) return command_;
-    const double dt = has_run_ ? std::max(t - last_time_, 1e-6) : settings_.period;
-    last_time_ = t;
-    next_time_ = (has_run_ ? next_time_ : t) + settings_.period;
-    if (next_time_ <= t) next_time_ = t + settings_.period;
+    double dt = 0.0;
+    if (!clock_.due(t, settings_.period, dt)) return command_;
     if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
-    has_run_ = true;
     if (follow_) {
       target_ = auv_position + settings_.follow_offset;
       heading_ = heading_of(nav.attitude);  // hold whatever heading it arrives with
@@ -384,8 +396,7 @@ class AsvController {
   double heading_ = 0.0, half_track_ = 0.0;
   bool follow_ = false;
   AsvCommand command_;
-  double last_time_ = 0.0, next_time_ = 0.0;
-  bool has_run_ = false;
+  SampleClock clock_;
 };
 
 }  // namespace kelp::control
