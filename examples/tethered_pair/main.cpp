@@ -70,6 +70,13 @@ int run(const Options& o) {
   ks::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
   if (kind == sp::TetherKind::rov_tether)
     params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
+  auto& tp = params.tether;
+  if (sc.diameter > 0) tp.diameter = sc.diameter;
+  if (sc.mass_per_length > 0) tp.mass_per_length = sc.mass_per_length;
+  if (sc.axial_stiffness > 0) tp.axial_stiffness = sc.axial_stiffness;
+  if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
+  if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
+  if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
   params.asv_attachment = sc.asv_attachment;
   params.auv_attachment = sc.auv_attachment;
   ke::SeaStateOptions sea_options;
@@ -110,6 +117,15 @@ int run(const Options& o) {
   kc::AuvControllerSettings auv_settings;
   auv_settings.compensate = sc.compensation;
   auv_settings.period = 1.0 / sc.auv_rate;
+  const auto gain = [](kc::PidGains& g, const tethered_pair::Gains& x) {
+    g.kp = x.kp;
+    g.ki = x.ki;
+    g.kd = x.kd;
+  };
+  gain(auv_settings.surge, sc.auv_surge);
+  gain(auv_settings.sway, sc.auv_sway);
+  gain(auv_settings.heave, sc.auv_heave);
+  gain(auv_settings.yaw, sc.auv_yaw);
   kc::AsvControllerSettings asv_settings;
   asv_settings.compensate = sc.compensation;
   asv_settings.period = 1.0 / sc.asv_rate;
@@ -143,6 +159,8 @@ int run(const Options& o) {
         "auv_target_x,auv_target_y,auv_target_z,auv_error,asv_error,"
         "asv_thrust_port,asv_thrust_starboard";
   for (int i = 1; i <= 8; ++i) ts << ",auv_thrust_" << i;
+  ts << ",asv_command_port,asv_command_starboard";
+  for (int i = 1; i <= 8; ++i) ts << ",auv_command_" << i;
   ts << ",tension_asv,tension_auv\n";
   nodes << "t,node,x,y,z\n";
   char buf[64];
@@ -204,6 +222,8 @@ int run(const Options& o) {
             auv.target().z(), e_auv,          e_asv,          bc.left,          bc.right})
         ts << ',' << num(v);
       for (Eigen::Index i = 0; i < ac.thrust.size(); ++i) ts << ',' << num(ac.thrust(i));
+      ts << ',' << num(bc.command(0)) << ',' << num(bc.command(1));
+      for (Eigen::Index i = 0; i < ac.command.size(); ++i) ts << ',' << num(ac.command(i));
       ts << ',' << num(ta) << ',' << num(tb) << '\n';
     }
     if (k % node_every == 0)

@@ -38,6 +38,9 @@ struct Scenario {
   double tether_length = 10.0;
   std::string tether_kind = "rov_tether";  // or "bead_chain"
   double segment_length = 0.5;
+  // Cable properties overriding the kind's (unset: keep the preset's).
+  double diameter = 0, mass_per_length = 0, axial_stiffness = 0, internal_damping = -1;
+  double normal_drag = -1, tangential_drag = -1;
   // Vehicles: attachment points (body axes) and the AUV's start (NED; empty: the paper's start).
   kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
   std::vector<double> auv_start;
@@ -46,6 +49,8 @@ struct Scenario {
   Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
   double asv_thrust_clip = 15.0, asv_rate = 10.0;
   double auv_rate = 50.0;
+  Gains auv_surge{40.0, 4.0, 56.0}, auv_sway{40.0, 4.0, 56.0}, auv_heave{60.0, 8.0, 88.0},
+      auv_yaw{5.0, 0.2, 3.4};
   // Mission: NED waypoints; empty: a square of side `square_side` at `depth` from the start.
   std::vector<kelp::Vector3<double>> waypoints;
   double depth = 5.0, square_side = 10.0;
@@ -185,7 +190,15 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   if (j.contains("tether")) {
     const auto& t = j.at("tether");
-    r.object(t, "/tether", {"length", "kind", "segment_length"});
+    r.object(t, "/tether",
+             {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
+              "internal_damping", "normal_drag", "tangential_drag"});
+    r.number(t, "/tether", "diameter", s.diameter, 1e-4, 0.5);
+    r.number(t, "/tether", "mass_per_length", s.mass_per_length, 1e-4, 100);
+    r.number(t, "/tether", "axial_stiffness", s.axial_stiffness, 1, 1e10);
+    r.number(t, "/tether", "internal_damping", s.internal_damping, 0, 1e6);
+    r.number(t, "/tether", "normal_drag", s.normal_drag, 0, 10);
+    r.number(t, "/tether", "tangential_drag", s.tangential_drag, 0, 10);
     r.number(t, "/tether", "length", s.tether_length, 0.5, 1000);
     r.choice(t, "/tether", "kind", s.tether_kind, {"rov_tether", "bead_chain"});
     r.number(t, "/tether", "segment_length", s.segment_length, 0.05, 10);
@@ -216,8 +229,13 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
       r.number(a, "/control/asv", "rate", s.asv_rate, 0.1, 1000);
     }
     if (c.contains("auv")) {
-      r.object(c.at("auv"), "/control/auv", {"rate"});
-      r.number(c.at("auv"), "/control/auv", "rate", s.auv_rate, 0.1, 1000);
+      const auto& a = c.at("auv");
+      r.object(a, "/control/auv", {"surge", "sway", "heave", "yaw", "rate"});
+      r.gains(a, "/control/auv", "surge", s.auv_surge);
+      r.gains(a, "/control/auv", "sway", s.auv_sway);
+      r.gains(a, "/control/auv", "heave", s.auv_heave);
+      r.gains(a, "/control/auv", "yaw", s.auv_yaw);
+      r.number(a, "/control/auv", "rate", s.auv_rate, 0.1, 1000);
     }
   }
   if (j.contains("mission")) {
@@ -269,6 +287,15 @@ inline nlohmann::json to_json(const Scenario& s) {
     j["sea"] = s.sea;
   j["tether"] = {
       {"length", s.tether_length}, {"kind", s.tether_kind}, {"segment_length", s.segment_length}};
+  const auto opt = [&](const char* key, double v, double unset) {
+    if (v > unset) j["tether"][key] = v;
+  };
+  opt("diameter", s.diameter, 0);
+  opt("mass_per_length", s.mass_per_length, 0);
+  opt("axial_stiffness", s.axial_stiffness, 0);
+  opt("internal_damping", s.internal_damping, -1);
+  opt("normal_drag", s.normal_drag, -1);
+  opt("tangential_drag", s.tangential_drag, -1);
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;
@@ -279,7 +306,12 @@ inline nlohmann::json to_json(const Scenario& s) {
                     {"yaw", g(s.asv_yaw)},
                     {"thrust_clip", s.asv_thrust_clip},
                     {"rate", s.asv_rate}}},
-                  {"auv", {{"rate", s.auv_rate}}}};
+                  {"auv",
+                   {{"surge", g(s.auv_surge)},
+                    {"sway", g(s.auv_sway)},
+                    {"heave", g(s.auv_heave)},
+                    {"yaw", g(s.auv_yaw)},
+                    {"rate", s.auv_rate}}}};
   nlohmann::json wp = nlohmann::json::array();
   for (const auto& w : s.waypoints) wp.push_back(v3(w));
   j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
