@@ -48,6 +48,16 @@ foreach(kind unknown_key wrong_type out_of_range non_finite empty_waypoints shor
   message(STATUS "${kind}: ${err}")
 endforeach()
 
+# An explicit sea with only a current (no waves) is a valid scenario.
+file(WRITE "${OUT}/current_only.json" [=[{"sea": {"current_speed": 0.3}, "duration": 5}]=])
+file(REMOVE_RECURSE "${OUT}/current_only")
+execute_process(COMMAND "${PROGRAM}" --scenario "${OUT}/current_only.json"
+                        --out "${OUT}/current_only" --quiet --no-plots RESULT_VARIABLE rc
+                        OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "current_only failed: ${out} ${err}")
+endif()
+
 file(REMOVE_RECURSE "${OUT}/calm")
 execute_process(COMMAND "${PROGRAM}" --scenario "${SCENARIOS}/calm_hold.json" --out "${OUT}/calm"
                         --quiet --no-plots RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

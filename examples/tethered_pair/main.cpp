@@ -86,8 +86,13 @@ int run(const Options& o) {
   if (sc.sea == "moderate") sea = ke::presets::moderate();
   if (sc.sea == "rough") sea = ke::presets::rough();
   if (sc.sea == "custom") {
-    sea = ke::presets::paper_sea_state(sc.significant_height, sc.wind_speed, sc.current_speed);
+    sea = ke::SeaState{};  // no waves unless a height is given
+    sea.significant_height = sc.significant_height;
     sea.peak_period = sc.peak_period;
+    if (sc.significant_height > 0)
+      sea.peak_enhancement = ke::dnv_peak_enhancement(sc.significant_height, sc.peak_period);
+    sea.wind_speed = sc.wind_speed;
+    sea.current_speed = sc.current_speed;
     sea.wave_direction = sc.wave_direction;
     sea.wind_direction = sc.wind_direction;
     sea.current_direction = sc.current_direction;
