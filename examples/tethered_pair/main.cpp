@@ -136,9 +136,7 @@ int run(const Options& o) {
   asv_settings.period = 1.0 / sc.asv_rate;
   asv_settings.thrust_clip = sc.asv_thrust_clip;
   const auto set = [&](kc::PidGains& g, const tethered_pair::Gains& x) {
-    g.kp = x.kp;
-    g.ki = x.ki;
-    g.kd = x.kd;
+    gain(g, x);
     g.output_limit = sc.asv_thrust_clip;
   };
   set(asv_settings.linear, sc.asv_linear);

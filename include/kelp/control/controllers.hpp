@@ -48,10 +48,7 @@ inline Navigation navigation_of(const vehicle::VehicleState<double>& x) {
 }
 
 /// \brief Heading ψ [rad] of an attitude (yaw of the ZYX Euler angles).
-inline double heading_of(const Quaternion<double>& q) {
-  const Matrix3<double> R = q.toRotationMatrix();
-  return std::atan2(R(1, 0), R(0, 0));
-}
+inline double heading_of(const Quaternion<double>& q) { return euler_from_quaternion(q).z(); }
 
 /// \brief Angle wrapped to (−π, π].
 inline double wrap_angle(double a) {
