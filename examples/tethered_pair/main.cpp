@@ -22,6 +22,7 @@
 #include "kelp/system/presets.hpp"
 #include "kelp/tether/presets.hpp"
 #include "scenario.hpp"
+#include "world.hpp"
 
 namespace fs = std::filesystem;
 namespace kc = kelp::control;
@@ -61,60 +62,15 @@ std::string plot_script() {
 }
 
 int run(const Options& o) {
-  namespace sp = ks::presets;
-  namespace ke = kelp::environment;
   const tethered_pair::Scenario& sc = o.scenario;
-  // The system from the scenario.
-  const sp::TetherKind kind =
-      sc.tether_kind == "bead_chain" ? sp::TetherKind::bead_chain : sp::TetherKind::rov_tether;
-  ks::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
-  if (kind == sp::TetherKind::rov_tether)
-    params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
-  auto& tp = params.tether;
-  if (sc.diameter > 0) tp.diameter = sc.diameter;
-  if (sc.mass_per_length > 0) tp.mass_per_length = sc.mass_per_length;
-  if (sc.axial_stiffness > 0) tp.axial_stiffness = sc.axial_stiffness;
-  if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
-  if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
-  if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
-  params.asv_attachment = sc.asv_attachment;
-  params.auv_attachment = sc.auv_attachment;
-  ke::SeaStateOptions sea_options;
-  sea_options.seed = sc.seed;
-  sea_options.wave_components = sc.wave_components;
-  ke::SeaState sea = ke::presets::calm();
-  if (sc.sea == "moderate") sea = ke::presets::moderate();
-  if (sc.sea == "rough") sea = ke::presets::rough();
-  if (sc.sea == "custom") {
-    sea = ke::SeaState{};  // no waves unless a height is given
-    sea.significant_height = sc.significant_height;
-    sea.peak_period = sc.peak_period;
-    if (sc.significant_height > 0)
-      sea.peak_enhancement = ke::dnv_peak_enhancement(sc.significant_height, sc.peak_period);
-    sea.wind_speed = sc.wind_speed;
-    sea.current_speed = sc.current_speed;
-    sea.wave_direction = sc.wave_direction;
-    sea.wind_direction = sc.wind_direction;
-    sea.current_direction = sc.current_direction;
-  }
-  const ks::SystemModeld model(params, ke::make_environment<double>(sea, sea_options));
+  const tethered_pair::WorldSetup setup = tethered_pair::world_setup(sc, o.scenario_file);
+  const ks::SystemModeld model(setup.parameters, setup.environment);
   ks::SystemWorkspaced ws(model);
-  sp::StartPoses<double> start_poses = sp::paper_start(sc.tether_length);
-  if (!sc.auv_start.empty())
-    start_poses.auv.position = Vector3<double>(sc.auv_start[0], sc.auv_start[1], sc.auv_start[2]);
-  const double span = (start_poses.auv.point_position(params.auv_attachment) -
-                       start_poses.asv.point_position(params.asv_attachment))
-                          .norm();
-  if (span > sc.tether_length)
-    throw tethered_pair::scenario_error(
-        o.scenario_file + ": /tether/length: " + std::to_string(sc.tether_length) +
-        " m is shorter than the initial distance between its ends (" + std::to_string(span) +
-        " m)");
   struct World {
     const ks::SystemModeld& model;
     ks::SystemWorkspaced& workspace;
     ks::SystemStated state;
-  } w{model, ws, ks::initial_state(model, ws, start_poses.asv, start_poses.auv)};
+  } w{model, ws, ks::initial_state(model, ws, setup.start.asv, setup.start.auv)};
   const auto rov = kv::bluerov2_heavy<double>();
   const auto boat = kv::blueboat<double>();
   const kv::ThrusterAllocationd rov_thrusters(rov.thruster_positions, rov.thruster_directions);
@@ -155,22 +111,7 @@ int run(const Options& o) {
   auv.follow(square);
   asv.follow_auv();
 
-  fs::create_directories(o.out);
-  std::ofstream ts(fs::path(o.out) / "timeseries.csv"), nodes(fs::path(o.out) / "nodes.csv");
-  ts << "t,asv_x,asv_y,asv_z,asv_roll,asv_pitch,asv_yaw,asv_u,asv_v,asv_r,"
-        "auv_x,auv_y,auv_z,auv_roll,auv_pitch,auv_yaw,auv_u,auv_v,auv_w,"
-        "auv_target_x,auv_target_y,auv_target_z,auv_error,asv_error,"
-        "asv_thrust_port,asv_thrust_starboard";
-  for (int i = 1; i <= 8; ++i) ts << ",auv_thrust_" << i;
-  ts << ",asv_command_port,asv_command_starboard";
-  for (int i = 1; i <= 8; ++i) ts << ",auv_command_" << i;
-  ts << ",tension_asv,tension_auv\n";
-  nodes << "t,node,x,y,z\n";
-  char buf[64];
-  const auto num = [&](double v) {
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return std::string(buf);
-  };
+  tethered_pair::RunLog log(o.out);
 
   const double dt = 0.01;
   const double duration = sc.duration;
@@ -212,28 +153,22 @@ int run(const Options& o) {
           late_asv = std::max(late_asv, e_asv);
         }
       }
-      const Vector3<double> ea = kelp::euler_from_quaternion(w.state.asv.attitude);
-      const Vector3<double> eb = kelp::euler_from_quaternion(w.state.auv.attitude);
-      const auto& a = w.state.asv;
-      const auto& b = w.state.auv;
-      ts << num(t);
-      for (double v :
-           {a.position.x(),   a.position.y(), a.position.z(), ea.x(),           ea.y(),
-            ea.z(),           a.nu(0),        a.nu(1),        a.nu(5),          b.position.x(),
-            b.position.y(),   b.position.z(), eb.x(),         eb.y(),           eb.z(),
-            b.nu(0),          b.nu(1),        b.nu(2),        auv.target().x(), auv.target().y(),
-            auv.target().z(), e_auv,          e_asv,          bc.left,          bc.right})
-        ts << ',' << num(v);
-      for (Eigen::Index i = 0; i < ac.thrust.size(); ++i) ts << ',' << num(ac.thrust(i));
-      ts << ',' << num(bc.command(0)) << ',' << num(bc.command(1));
-      for (Eigen::Index i = 0; i < ac.command.size(); ++i) ts << ',' << num(ac.command(i));
-      ts << ',' << num(ta) << ',' << num(tb) << '\n';
+      tethered_pair::LogRow row;
+      row.t = t;
+      row.asv = &w.state.asv;
+      row.auv = &w.state.auv;
+      row.auv_target = auv.target();
+      row.auv_error = e_auv;
+      row.asv_error = e_asv;
+      row.asv_thrust << bc.left, bc.right;
+      row.auv_thrust = ac.thrust;
+      row.asv_command = bc.command;
+      row.auv_command = ac.command;
+      row.tension_asv = ta;
+      row.tension_auv = tb;
+      log.row(row);
     }
-    if (k % node_every == 0)
-      for (int i = 0; i < w.model.tether().nodes(); ++i)
-        nodes << num(t) << ',' << i << ',' << num(w.state.tether.position(0, i)) << ','
-              << num(w.state.tether.position(1, i)) << ',' << num(w.state.tether.position(2, i))
-              << '\n';
+    if (k % node_every == 0) log.nodes(t, w.state.tether);
     if (k == steps) break;
     in.auv.control = ac.wrench;
     in.asv.control = bc.wrench;
@@ -246,8 +181,7 @@ int run(const Options& o) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   if (bar) std::fprintf(stderr, "\n");
-  ts.close();
-  nodes.close();
+  log.close();
 
   nlohmann::json summary;
   const double n = std::max<double>(1, samples);
