@@ -32,8 +32,16 @@ namespace {
 std::atomic<bool> stop_requested{false};
 void on_signal(int) { stop_requested = true; }
 
+// The embedded default: kelp-tethered-pair's (the paper's moderate sea, a 10 m tether), but the
+// ROV starts at the surface 4 m astern of the boat, so that ArduSub has a dive to fly.
+tethered_pair::Scenario default_scenario() {
+  tethered_pair::Scenario s;
+  s.auv_start = {-4.0, 0.0, 0.3};
+  return s;
+}
+
 struct Options {
-  tethered_pair::Scenario scenario;
+  tethered_pair::Scenario scenario = default_scenario();
   std::string scenario_file = "(embedded default)";
   std::string bind = "127.0.0.1";
   int sub_port = 9002, rover_port = 9012;

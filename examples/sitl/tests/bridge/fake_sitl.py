@@ -53,17 +53,18 @@ def packet(magic, frame, pwm, rate=int(RATE)):
 
 
 def sitl_read(record, section, key, count):
-    """Reads a value as SIM_JSON does: strstr for the key (inside its section), '":' after it,
-    then a float or a vector of `count` floats in sscanf's '[%f, %f, ...]' format."""
-    start = 0
-    if section:
-        start = record.find('"' + section)
-        if start < 0:
-            return None
-    i = record.find('"' + key, start)
+    """Reads a value as SIM_JSON::parse_sensors does: strstr for the section (the top level is
+    the empty section: the record from its second character), then strstr for the bare key
+    after it, skip the key and 2 characters (which must be '":' here), then atof or
+    sscanf('[%f, %f, ...]')."""
+    start = record.find(section)
+    if start < 0:
+        return None
+    start += len(section) + 1
+    i = record.find(key, start)
     if i < 0:
         return None
-    j = i + 1 + len(key)
+    j = i + len(key)
     if record[j:j + 2] != '":':
         return None
     rest = record[j + 2:]
@@ -88,12 +89,12 @@ def validate(raw):
         check(False, "reply is not JSON (%s): %s" % (e, record[:80]))
         return None
     st = {
-        "timestamp": sitl_read(record, None, "timestamp", 1),
+        "timestamp": sitl_read(record, "", "timestamp", 1),
         "gyro": sitl_read(record, "imu", "gyro", 3),
         "accel": sitl_read(record, "imu", "accel_body", 3),
-        "position": sitl_read(record, None, "position", 3),
-        "velocity": sitl_read(record, None, "velocity", 3),
-        "quaternion": sitl_read(record, None, "quaternion", 4),
+        "position": sitl_read(record, "", "position", 3),
+        "velocity": sitl_read(record, "", "velocity", 3),
+        "quaternion": sitl_read(record, "", "quaternion", 4),
     }
     for k, v in st.items():
         if not check(v is not None, "SITL's parser would not find '%s' in %s" % (k, record[:120])):
