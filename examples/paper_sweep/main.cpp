@@ -1,0 +1,249 @@
+// kelp-sweep: the paper's evaluation (tether length × sea state × compensation × seeds) or any
+// sweep over kelp-tethered-pair scenarios, in parallel on one machine, sharded over a cluster
+// (--shard I/N, then `kelp-sweep merge`), resumable (results keyed by the run's scenario hash),
+// with a table (CSV and Markdown) of mean ± standard deviation over seeds and a figure.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "simulate.hpp"
+#include "sweep.hpp"
+
+namespace fs = std::filesystem;
+using paper_sweep::json;
+
+namespace {
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) throw paper_sweep::sweep_error(p.string() + ": cannot be read");
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A stored result of run `hash`, or null when there is none (or it is unreadable: rerun it).
+json stored_result(const fs::path& dir, const std::string& hash) {
+  const fs::path p = dir / "runs" / (hash + ".json");
+  std::ifstream in(p);
+  if (!in) return nullptr;
+  try {
+    json j = json::parse(in);
+    if (j.value("hash", "") == hash && j.contains("summary")) return j;
+  } catch (const json::exception&) {
+  }
+  return nullptr;
+}
+
+void write_atomically(const fs::path& p, const std::string& text) {
+  const fs::path tmp = p.string() + ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, p);  // a preempted job leaves no half-written result
+}
+
+std::string plot_script() {
+  if (const char* env = std::getenv("KELP_SWEEP_PLOT_SCRIPT")) return env;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = self.parent_path().parent_path() / "share/kelp/plot_sweep.py";
+    if (fs::exists(installed)) return installed.string();
+  }
+  return KELP_SWEEP_PLOT_SCRIPT_SOURCE;
+}
+
+// Table and figure of a complete set of results in `dir`.
+int finish(const paper_sweep::Sweep& s, const std::map<std::string, json>& results,
+           const fs::path& dir, bool plot) {
+  paper_sweep::write_table(s, results, dir);
+  if (plot) {
+    const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string cmd = python + " '" + plot_script() + "' '" + dir.string() + "'";
+    if (std::system(cmd.c_str()) != 0) {
+      std::fprintf(stderr, "kelp-sweep: the plotting script failed (%s)\n", cmd.c_str());
+      return 2;
+    }
+  }
+  std::printf("kelp-sweep: table in %s (table.csv, table.md%s)\n", dir.string().c_str(),
+              plot ? ", errors.png" : "");
+  return 0;
+}
+
+struct RunOptions {
+  std::string sweep_file, out = "kelp-sweep";
+  std::string shard;
+  unsigned jobs = 0;
+  bool quiet = false, no_plot = false;
+};
+
+int run(const RunOptions& o) {
+  const paper_sweep::Sweep s =
+      o.sweep_file.empty() ? paper_sweep::parse_sweep(paper_sweep::default_sweep_json().dump(),
+                                                      "(embedded paper sweep)")
+                           : paper_sweep::load_sweep(o.sweep_file);
+  std::size_t shard = 0, shards = 1;
+  if (!o.shard.empty()) {
+    unsigned long i = 0, n = 0;
+    char tail = 0;
+    if (std::sscanf(o.shard.c_str(), "%lu/%lu%c", &i, &n, &tail) != 2 || n < 1 || i >= n)
+      throw CLI::ValidationError("--shard", "expected I/N with 0 <= I < N, got " + o.shard);
+    shard = i;
+    shards = n;
+  }
+  const fs::path out(o.out);
+  fs::create_directories(out / "runs");
+  write_atomically(out / "sweep.json", s.source.dump(2) + "\n");
+
+  std::vector<const paper_sweep::Run*> todo;
+  std::map<std::string, json> results;
+  std::size_t mine = 0;
+  for (const paper_sweep::Run& r : s.runs) {
+    if (r.index % shards != shard) continue;
+    ++mine;
+    json stored = stored_result(out, r.hash);
+    if (stored.is_null())
+      todo.push_back(&r);
+    else
+      results[r.hash] = std::move(stored);
+  }
+  const std::size_t reused = results.size();
+  const unsigned jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  const bool bar = !o.quiet && isatty(2);
+  std::atomic<std::size_t> next{0}, done{0};
+  std::mutex mutex;
+  std::vector<std::string> failures;
+  double simulated = 0;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  };
+  const auto worker = [&] {
+    for (std::size_t k; (k = next++) < todo.size();) {
+      const paper_sweep::Run& r = *todo[k];
+      json result = {{"hash", r.hash},
+                     {"index", r.index},
+                     {"point", paper_sweep::point_values(s, r.point)},
+                     {"seed", r.seed}};
+      std::string error;
+      try {
+        result["summary"] = tethered_pair::simulate(r.scenario);
+        write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      if (error.empty()) {
+        simulated += r.scenario.duration;
+        results[r.hash] = std::move(result);
+      } else {
+        failures.push_back("run " + std::to_string(r.index) + " (" + r.hash + "): " + error);
+      }
+      const std::size_t d = ++done;
+      if (bar) {
+        const double t = elapsed();
+        std::fprintf(stderr, "\r[%-40s] %zu/%zu runs, %.0f s, about %.0f s left ",
+                     std::string(40 * d / todo.size(), '#').c_str(), d, todo.size(), t,
+                     t / static_cast<double>(d) * static_cast<double>(todo.size() - d));
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 0; i < std::min<std::size_t>(jobs, std::max<std::size_t>(1, todo.size())); ++i)
+    pool.emplace_back(worker);
+  for (std::thread& t : pool) t.join();
+  if (bar && !todo.empty()) std::fprintf(stderr, "\n");
+  const double wall = elapsed();
+  std::printf(
+      "kelp-sweep: %zu runs%s: %zu ran, %zu reused, %zu failed; %.0f s simulated in %.1f s wall "
+      "on %u threads (%.0fx real time)\n",
+      mine, shards > 1 ? (" in shard " + o.shard).c_str() : "", todo.size() - failures.size(),
+      reused, failures.size(), simulated, wall, jobs, wall > 0 ? simulated / wall : 0.0);
+  for (const std::string& f : failures) std::fprintf(stderr, "kelp-sweep: failed: %s\n", f.c_str());
+  if (!failures.empty()) return 1;
+  if (shards > 1) return 0;  // the table comes from `kelp-sweep merge`
+  return finish(s, results, out, !o.no_plot);
+}
+
+int merge(const std::vector<std::string>& dirs, const std::string& out_dir, bool plot) {
+  const std::string text = read_file(fs::path(dirs.at(0)) / "sweep.json");
+  const paper_sweep::Sweep s = paper_sweep::parse_sweep(text, dirs[0] + "/sweep.json");
+  for (const std::string& d : dirs)
+    if (json::parse(read_file(fs::path(d) / "sweep.json")) != s.source)
+      throw paper_sweep::sweep_error(d + "/sweep.json: not the same sweep as " + dirs[0] +
+                                     "/sweep.json");
+  const fs::path out(out_dir);
+  fs::create_directories(out / "runs");
+  write_atomically(out / "sweep.json", s.source.dump(2) + "\n");
+  std::map<std::string, json> results;
+  std::size_t missing = 0;
+  for (const paper_sweep::Run& r : s.runs) {
+    for (const std::string& d : dirs) {
+      json j = stored_result(d, r.hash);
+      if (j.is_null()) continue;
+      if (fs::path(d) != out) write_atomically(out / "runs" / (r.hash + ".json"), j.dump(1) + "\n");
+      results[r.hash] = std::move(j);
+      break;
+    }
+    if (!results.count(r.hash)) ++missing;
+  }
+  if (missing > 0) {
+    std::fprintf(stderr,
+                 "kelp-sweep merge: %zu of %zu runs have no result in the given directories "
+                 "(a shard did not finish: run it again, it resumes)\n",
+                 missing, s.runs.size());
+    return 1;
+  }
+  std::printf("kelp-sweep merge: %zu runs from %zu directories\n", s.runs.size(), dirs.size());
+  return finish(s, results, out, plot);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "kelp-sweep: kelp-tethered-pair over a grid of scenarios (default: the paper's tether "
+      "length x sea state x compensation x 5 seeds, 300 s each), in parallel, shardable, "
+      "resumable"};
+  RunOptions o;
+  app.add_option("--sweep", o.sweep_file, "sweep file (JSON; see examples/paper_sweep/README.md)");
+  app.add_option("--out", o.out, "output directory (runs/, table.csv, table.md, errors.png)")
+      ->capture_default_str();
+  app.add_option("--jobs", o.jobs, "parallel runs (default: the number of cores)");
+  app.add_option("--shard", o.shard, "run only shard I of N (0-based, I/N); no table");
+  app.add_flag("--quiet", o.quiet, "no progress bar");
+  app.add_flag("--no-plot", o.no_plot, "no figure");
+  CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
+  std::vector<std::string> dirs;
+  std::string merged = "kelp-sweep-merged";
+  bool merge_no_plot = false;
+  m->add_option("dirs", dirs, "shard output directories")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  m->add_option("--out", merged, "merged output directory")->capture_default_str();
+  m->add_flag("--no-plot", merge_no_plot, "no figure");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*m) return merge(dirs, merged, !merge_no_plot);
+    return run(o);
+  } catch (const paper_sweep::sweep_error& e) {
+    std::fprintf(stderr, "kelp-sweep: invalid sweep: %s\n", e.what());
+    return 3;
+  } catch (const CLI::ValidationError& e) {
+    std::fprintf(stderr, "kelp-sweep: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "kelp-sweep: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,326 @@
+// Sweep files of kelp-sweep, their runs and their table.
+//
+// A sweep is a base scenario (kelp-tethered-pair's schema) and axes, each a JSON path into the
+// scenario and a list of values; the runs are the Cartesian product of the axes (the first axis
+// varies slowest) times the seeds. Each run is keyed by a hash of its scenario as used (every
+// field, canonical JSON), so a result found on disk is the result of exactly that scenario.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scenario.hpp"
+
+namespace paper_sweep {
+
+using nlohmann::json;
+
+/// A sweep file that cannot be used: the message names the file and the JSON path.
+struct sweep_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Axis {
+  std::string path;          ///< JSON pointer into the scenario, e.g. /tether/length
+  std::vector<json> values;  ///< what it takes
+};
+
+struct Run {
+  std::size_t index = 0;  ///< position in the sweep (grid point major, seed minor)
+  std::size_t point = 0;  ///< grid point (the axes' values)
+  std::uint64_t seed = 0;
+  tethered_pair::Scenario scenario;  ///< as used
+  std::string hash;                  ///< 16 hex digits of the canonical scenario JSON
+};
+
+struct Sweep {
+  json base;  ///< the base scenario (JSON)
+  std::vector<Axis> axes;
+  std::vector<std::uint64_t> seeds;
+  std::vector<Run> runs;
+  std::size_t points = 1;  ///< product of the axes' sizes
+  json source;             ///< the sweep file as read (written as sweep.json)
+};
+
+namespace detail {
+
+// Tracks the JSON path while parsing, to name where a syntax error or an out-of-range number
+// (1e999: JSON has no infinity) is.
+class PathTracker : public nlohmann::json_sax<json> {
+ public:
+  std::string error_path;
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override {
+    stack_.push_back({false, 0, ""});
+    return true;
+  }
+  bool key(string_t& k) override {
+    stack_.back().key = k;
+    return true;
+  }
+  bool end_object() override { return end(); }
+  bool start_array(std::size_t) override {
+    stack_.push_back({true, 0, ""});
+    return true;
+  }
+  bool end_array() override { return end(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    error_path.clear();
+    for (const Level& l : stack_) error_path += "/" + (l.array ? std::to_string(l.index) : l.key);
+    if (error_path.empty()) error_path = "/";
+    return false;
+  }
+
+ private:
+  struct Level {
+    bool array;
+    std::size_t index;
+    std::string key;
+  };
+  bool value() {
+    if (!stack_.empty() && stack_.back().array) ++stack_.back().index;
+    return true;
+  }
+  bool end() {
+    stack_.pop_back();
+    return value();
+  }
+  std::vector<Level> stack_;
+};
+
+inline std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+inline std::string value_text(const json& v) {
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+}  // namespace detail
+
+/// The paper's grid: tether length {5, 10, 15} m × sea {moderate, rough} × compensation
+/// {off, on} × seeds 1–5, 300 s each.
+inline json default_sweep_json() {
+  return json::parse(R"({
+    "base": {"duration": 300},
+    "axes": [
+      {"path": "/tether/length", "values": [5, 10, 15]},
+      {"path": "/sea", "values": ["moderate", "rough"]},
+      {"path": "/control/compensation", "values": [false, true]}
+    ],
+    "seeds": [1, 2, 3, 4, 5]
+  })");
+}
+
+/// Reads and checks a sweep from JSON text; expands its runs. `file` names it in errors.
+/// \throws sweep_error naming the file and the JSON path (of the sweep file, or of a run's
+/// scenario for a value the scenario refuses).
+inline Sweep parse_sweep(const std::string& text, const std::string& file) {
+  const auto fail = [&](const std::string& path, const std::string& what) -> void {
+    throw sweep_error(file + ": " + path + ": " + what);
+  };
+  Sweep s;
+  try {
+    s.source = json::parse(text);
+  } catch (const json::exception& e) {
+    detail::PathTracker tracker;
+    json::sax_parse(text, &tracker);
+    fail(tracker.error_path, std::string("not valid JSON (") + e.what() + ")");
+  }
+  const json& j = s.source;
+  if (!j.is_object()) fail("/", "expected an object with base, axes and seeds");
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.key() != "base" && it.key() != "axes" && it.key() != "seeds")
+      fail("/" + it.key(), "unknown key (allowed: axes, base, seeds)");
+  s.base = j.value("base", json::object());
+  if (!s.base.is_object()) fail("/base", "expected a scenario object");
+  if (j.contains("axes")) {
+    const json& a = j.at("axes");
+    if (!a.is_array()) fail("/axes", "expected an array of {\"path\", \"values\"}");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string p = "/axes/" + std::to_string(i);
+      const json& ax = a[i];
+      if (!ax.is_object()) fail(p, "expected {\"path\": \"/json/pointer\", \"values\": [...]}");
+      for (auto it = ax.begin(); it != ax.end(); ++it)
+        if (it.key() != "path" && it.key() != "values")
+          fail(p + "/" + it.key(), "unknown key (allowed: path, values)");
+      if (!ax.contains("path") || !ax.at("path").is_string())
+        fail(p + "/path", "expected a JSON pointer into the scenario, e.g. \"/tether/length\"");
+      Axis axis;
+      axis.path = ax.at("path").get<std::string>();
+      if (axis.path.empty() || axis.path[0] != '/')
+        fail(p + "/path", "\"" + axis.path + "\" is not a JSON pointer (it starts with /)");
+      if (axis.path == "/seed") fail(p + "/path", "seeds are given by /seeds, not an axis");
+      if (!ax.contains("values") || !ax.at("values").is_array() || ax.at("values").empty())
+        fail(p + "/values", "expected a non-empty array of values");
+      for (std::size_t k = 0; k < ax.at("values").size(); ++k) {
+        const json& v = ax.at("values")[k];
+        if (v.is_number() && !std::isfinite(v.get<double>()))
+          fail(p + "/values/" + std::to_string(k), "not a finite number");
+        axis.values.push_back(v);
+      }
+      s.axes.push_back(axis);
+      s.points *= axis.values.size();
+    }
+  }
+  const json seeds = j.value("seeds", json::array({1}));
+  const auto natural = [](const json& v) {
+    return v.is_number_integer() && v.get<std::int64_t>() >= 0;
+  };
+  if (natural(seeds)) {
+    const auto n = seeds.get<std::uint64_t>();
+    if (n < 1 || n > 100000) fail("/seeds", "expected a count in [1, 100000] or a list of seeds");
+    for (std::uint64_t k = 1; k <= n; ++k) s.seeds.push_back(k);
+  } else if (seeds.is_array() && !seeds.empty()) {
+    for (std::size_t k = 0; k < seeds.size(); ++k) {
+      if (!natural(seeds[k]))
+        fail("/seeds/" + std::to_string(k),
+             "expected a non-negative integer, got " + seeds[k].dump());
+      s.seeds.push_back(seeds[k].get<std::uint64_t>());
+    }
+  } else {
+    fail("/seeds", "expected a count or a non-empty list of non-negative integers");
+  }
+
+  // Expand: each grid point's scenario, validated by the scenario reader (which names the path).
+  for (std::size_t point = 0; point < s.points; ++point) {
+    json scenario = s.base;
+    std::string where;
+    std::size_t rest = point;
+    for (std::size_t i = s.axes.size(); i-- > 0;) {
+      const Axis& ax = s.axes[i];
+      const json& v = ax.values[rest % ax.values.size()];
+      rest /= ax.values.size();
+      try {
+        scenario[json::json_pointer(ax.path)] = v;
+      } catch (const json::exception& e) {
+        fail("/axes/" + std::to_string(i) + "/path",
+             "\"" + ax.path + "\" cannot be set in the base scenario (" + e.what() + ")");
+      }
+      where = ax.path + " = " + v.dump() + (where.empty() ? "" : ", ") + where;
+    }
+    for (const std::uint64_t seed : s.seeds) {
+      scenario["seed"] = seed;
+      Run r;
+      try {
+        r.scenario =
+            tethered_pair::parse_scenario(scenario.dump(), file + " (run with " + where + ")");
+      } catch (const tethered_pair::scenario_error& e) {
+        throw sweep_error(e.what());
+      }
+      r.index = s.runs.size();
+      r.point = point;
+      r.seed = seed;
+      char h[17];
+      std::snprintf(h, sizeof h, "%016llx",
+                    static_cast<unsigned long long>(
+                        detail::fnv1a(tethered_pair::to_json(r.scenario).dump())));
+      r.hash = h;
+      s.runs.push_back(std::move(r));
+    }
+  }
+  return s;
+}
+
+inline Sweep load_sweep(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw sweep_error(file + ": cannot be read");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_sweep(text, file);
+}
+
+/// The values of grid point `point`, one per axis.
+inline std::vector<json> point_values(const Sweep& s, std::size_t point) {
+  std::vector<json> v(s.axes.size());
+  for (std::size_t i = s.axes.size(); i-- > 0;) {
+    v[i] = s.axes[i].values[point % s.axes[i].values.size()];
+    point /= s.axes[i].values.size();
+  }
+  return v;
+}
+
+/// The numbers the table summarises, from a run's summary.
+struct Metrics {
+  double auv = 0, asv = 0, combined = 0, max_tension = 0, slack = 0;
+};
+inline Metrics metrics_of(const json& summary) {
+  Metrics m;
+  m.auv = summary.at("auv").at("rms_path_error_m").get<double>();
+  m.asv = summary.at("asv").at("rms_distance_to_auv_m").get<double>();
+  m.combined = std::sqrt(0.5 * (m.auv * m.auv + m.asv * m.asv));
+  m.max_tension = summary.at("tether").at("max_tension_n").get<double>();
+  m.slack = summary.at("tether").at("slack_fraction").get<double>();
+  return m;
+}
+
+/// Writes table.csv and table.md: per grid point, mean and sample standard deviation over the
+/// seeds. `results` maps run hashes to their stored result ({"summary": ...}).
+inline void write_table(const Sweep& s, const std::map<std::string, json>& results,
+                        const std::filesystem::path& dir) {
+  std::ofstream csv(dir / "table.csv"), md(dir / "table.md");
+  const char* names[] = {"auv_rms_error_m", "asv_rms_error_m", "combined_rms_error_m",
+                         "max_tension_n", "slack_fraction"};
+  for (const Axis& a : s.axes) csv << a.path << ',';
+  csv << "seeds";
+  for (const char* n : names) csv << ',' << n << "_mean," << n << "_sd";
+  csv << '\n';
+  md << '|';
+  for (const Axis& a : s.axes) md << ' ' << a.path << " |";
+  md << " seeds | AUV RMS error [m] | ASV RMS error [m] | combined [m] | max tension [N] | slack "
+        "fraction |\n|";
+  for (std::size_t i = 0; i < s.axes.size() + 6; ++i) md << "---|";
+  md << '\n';
+  char b[64];
+  for (std::size_t point = 0; point < s.points; ++point) {
+    std::vector<Metrics> ms;
+    for (const Run& r : s.runs)
+      if (r.point == point) ms.push_back(metrics_of(results.at(r.hash).at("summary")));
+    const auto stat = [&](double Metrics::*f, double& mean, double& sd) {
+      mean = 0;
+      for (const Metrics& m : ms) mean += m.*f;
+      mean /= static_cast<double>(ms.size());
+      double ss = 0;
+      for (const Metrics& m : ms) ss += (m.*f - mean) * (m.*f - mean);
+      sd = ms.size() > 1 ? std::sqrt(ss / static_cast<double>(ms.size() - 1)) : 0.0;
+    };
+    const std::vector<json> values = point_values(s, point);
+    md << '|';
+    for (const json& v : values) {
+      csv << detail::value_text(v) << ',';
+      md << ' ' << detail::value_text(v) << " |";
+    }
+    csv << ms.size();
+    md << ' ' << ms.size() << " |";
+    for (double Metrics::*f : {&Metrics::auv, &Metrics::asv, &Metrics::combined,
+                               &Metrics::max_tension, &Metrics::slack}) {
+      double mean, sd;
+      stat(f, mean, sd);
+      std::snprintf(b, sizeof b, ",%.9g,%.9g", mean, sd);
+      csv << b;
+      std::snprintf(b, sizeof b, " %.3g ± %.2g |", mean, sd);
+      md << b;
+    }
+    csv << '\n';
+    md << '\n';
+  }
+}
+
+}  // namespace paper_sweep
