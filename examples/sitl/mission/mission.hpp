@@ -1,0 +1,546 @@
+// kelp-mission's logic: a MAVLink ground station for two ArduPilot vehicles on TCP links, the
+// AUV (ArduSub, BlueROV2 Heavy) and the ASV (ArduRover boat, BlueBoat) joined by the tether.
+//
+// Mission: connect, wait for both HEARTBEATs and for the AUV's position estimate
+// (LOCAL_POSITION_NED), arm both, AUV to ALT_HOLD and boat to GUIDED; the AUV dives to --depth
+// with the throttle stick below neutral and holds it for --hold s;
+// then it flies a square of --survey-side m at that depth in GUIDED; all along the boat is
+// sent the AUV's latitude/longitude at 1 Hz, so it stays above it. Finally both are put in a
+// safe state (AUV MANUAL and disarmed, boat HOLD and disarmed).
+//
+// One thread, poll() on both sockets. Every wait is bounded; a time-out, a refusal, a lost link
+// or an unexpected disarm ends the mission with a message naming the vehicle, the command and
+// the MAV_RESULT, an attempt to leave both vehicles safe, and exit code 1.
+#pragma once
+
+#include <poll.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <iomanip>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "csv_log.hpp"
+#include "mavlink/mavlink.hpp"
+#include "tcp_link.hpp"
+
+namespace kelp_sitl::mission {
+
+struct Options {
+  std::string sub = "tcp:127.0.0.1:5760";    // ArduSub SERIAL0; "none": no AUV
+  std::string rover = "tcp:127.0.0.1:5770";  // ArduRover SERIAL0 (-I1); "none": no boat
+  double depth = 5.0;            // m, target depth (LOCAL_POSITION_NED z, down from the EKF origin)
+  double depth_tolerance = 0.3;  // m: the dive ends at depth - tolerance
+  double hold = 60.0;            // s in ALT_HOLD at depth
+  double survey_side = 10.0;     // m, side of the square (0: no survey)
+  double survey_radius = 1.0;    // m: a corner counts as reached within this horizontal distance
+  std::string log_dir = "kelp-mission-log";
+  double connect_timeout = 60.0;    // s, per vehicle, retrying the TCP connect
+  double heartbeat_timeout = 30.0;  // s for the first HEARTBEAT after connecting
+  double arm_timeout = 60.0;        // s of arming retries (the EKF needs 10-30 s after boot)
+  double position_timeout = 120.0;  // s for the sub's first LOCAL_POSITION_NED (before arming)
+  double mode_timeout = 30.0;       // s of mode-change retries (GUIDED needs a position)
+  double dive_timeout = 120.0;      // s to reach the depth
+  double leg_timeout = 120.0;       // s per side of the square
+  double retry_interval = 3.0;      // s between repeats of a refused or unanswered command
+  double link_timeout = 5.0;        // s without HEARTBEAT during the mission: link lost
+  int dive_throttle = 300;          // MANUAL_CONTROL z while diving (0..1000, 500 neutral)
+};
+
+struct MissionError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// One vehicle: its link and the latest state it reported.
+struct Vehicle {
+  std::string name;  // "sub" or "boat": log and message prefix
+  Endpoint endpoint;
+  TcpLink link;
+  mavlink::Sender gcs{255, mavlink::kCompMissionPlanner};  // the GCS identity on this link
+  std::uint8_t sysid = 1;                                  // learnt from the first HEARTBEAT
+  bool have_heartbeat = false;
+  Clock::time_point last_heartbeat{};
+  mavlink::Heartbeat heartbeat;
+  std::optional<mavlink::LocalPositionNed> local;
+  std::optional<mavlink::GlobalPositionInt> global;
+  std::optional<mavlink::Attitude> attitude;
+  std::optional<mavlink::CommandAck> ack;  // last COMMAND_ACK not yet consumed
+  std::string last_text;                   // last STATUSTEXT
+  bool expect_armed = false;
+  Clock::time_point armed_since{};
+
+  bool armed() const { return (heartbeat.base_mode & mavlink::kModeFlagSafetyArmed) != 0; }
+};
+
+class Mission {
+ public:
+  Mission(Options options, std::ostream& out, std::ostream& err)
+      : opt_(std::move(options)), out_(out), err_(err), start_(Clock::now()) {
+    if (opt_.sub != "none") {
+      sub_ = std::make_unique<Vehicle>();
+      sub_->name = "sub";
+      sub_->endpoint = parse_endpoint(opt_.sub);
+    }
+    if (opt_.rover != "none") {
+      boat_ = std::make_unique<Vehicle>();
+      boat_->name = "boat";
+      boat_->endpoint = parse_endpoint(opt_.rover);
+    }
+    if (!sub_ && !boat_) throw std::invalid_argument("--sub and --rover are both 'none'");
+  }
+
+  // Flies the mission; returns the exit code (0 done, 1 failed).
+  int run() {
+    try {
+      log_ = std::make_unique<CsvLog>(opt_.log_dir);
+      fly();
+      finish(true);
+      phase("mission complete");
+      print_link_stats();
+      return 0;
+    } catch (const std::exception& e) {
+      err_ << "kelp-mission: FAILED: " << e.what() << std::endl;
+      try {
+        finish(false);
+      } catch (const std::exception& e2) {
+        err_ << "kelp-mission: could not leave the vehicles safe: " << e2.what() << std::endl;
+      }
+      print_link_stats();
+      return 1;
+    }
+  }
+
+ private:
+  std::vector<Vehicle*> vehicles() {
+    std::vector<Vehicle*> v;
+    if (sub_) v.push_back(sub_.get());
+    if (boat_) v.push_back(boat_.get());
+    return v;
+  }
+
+  double now_s() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+  void phase(const std::string& what) {
+    out_ << "[" << std::fixed << std::setprecision(1) << std::setw(7) << now_s() << " s] " << what
+         << std::endl;
+    out_.unsetf(std::ios::floatfield);
+  }
+
+  static Clock::duration seconds(double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  }
+
+  // ---- the mission ---------------------------------------------------------------------------
+  void fly() {
+    for (Vehicle* v : vehicles()) {
+      phase(v->name + ": connecting to " + v->endpoint.host + ":" +
+            std::to_string(v->endpoint.port));
+      std::string error;
+      if (!v->link.connect(v->endpoint, Clock::now() + seconds(opt_.connect_timeout), error))
+        throw MissionError(v->name + ": cannot connect to " + v->endpoint.host + ":" +
+                           std::to_string(v->endpoint.port) + " within " +
+                           fmt(opt_.connect_timeout) + " s (" + error + ")");
+    }
+    for (Vehicle* v : vehicles()) {
+      phase(v->name + ": waiting for HEARTBEAT");
+      wait_for([&] { return v->have_heartbeat; }, opt_.heartbeat_timeout,
+               v->name + ": no HEARTBEAT within " + fmt(opt_.heartbeat_timeout) +
+                   " s of connecting (is it an ArduPilot SITL, and running?)");
+      phase(v->name + ": HEARTBEAT from sysid " + std::to_string(v->sysid) + ", MAV_TYPE " +
+            std::to_string(v->heartbeat.type) + ", mode " +
+            std::to_string(v->heartbeat.custom_mode) + (v->armed() ? ", armed" : ", disarmed"));
+    }
+    if (sub_) {
+      // ArduSub sends LOCAL_POSITION_NED only once its EKF has a position (after GPS lock, tens
+      // of seconds after boot; seen with ArduSub SITL). Without it the dive could not be stopped
+      // at the depth. Waiting before arming keeps the sub disarmed (floating at the surface)
+      // meanwhile, and the EKF origin (z = 0) is set at the surface.
+      phase("sub: waiting for a position estimate (LOCAL_POSITION_NED)");
+      wait_for([&] { return sub_->local.has_value(); }, opt_.position_timeout,
+               "sub: no LOCAL_POSITION_NED within " + fmt(opt_.position_timeout) +
+                   " s (no position estimate: GPS? EKF?)");
+      phase("sub: position (" + fmt(sub_->local->x) + ", " + fmt(sub_->local->y) + ", " +
+            fmt(sub_->local->z) + ") m NED");
+    }
+    for (Vehicle* v : vehicles()) {
+      phase(v->name + ": arming");
+      arm(*v, true);
+    }
+    if (sub_) set_mode(*sub_, mavlink::sub_mode::kAltHold, "ALT_HOLD");
+    if (boat_) {
+      set_mode(*boat_, mavlink::rover_mode::kGuided, "GUIDED");
+      following_ = sub_ != nullptr;
+      if (following_) phase("boat: following the sub (SET_POSITION_TARGET_GLOBAL_INT at 1 Hz)");
+    }
+    if (!sub_) return;
+
+    phase("sub: diving to " + fmt(opt_.depth) + " m (ALT_HOLD, throttle " +
+          std::to_string(opt_.dive_throttle) + ")");
+    manual_z_ = static_cast<std::int16_t>(opt_.dive_throttle);
+    const double target = opt_.depth - opt_.depth_tolerance;
+    wait_for([&] { return sub_->local && sub_->local->z >= target; }, opt_.dive_timeout,
+             [&] {
+               return "sub: did not reach " + fmt(opt_.depth) + " m within " +
+                      fmt(opt_.dive_timeout) + " s (depth " +
+                      (sub_->local ? fmt(sub_->local->z) + " m" : std::string("unknown")) + ")";
+             },
+             [&] { return "depth " + (sub_->local ? fmt(sub_->local->z) : "?") + " m"; });
+    manual_z_ = kNeutralZ;
+    phase("sub: at " + fmt(sub_->local->z) + " m; holding depth for " + fmt(opt_.hold) + " s");
+    hold(opt_.hold, [&] { return "depth " + fmt(sub_->local->z) + " m"; });
+
+    if (opt_.survey_side > 0.0) survey();
+  }
+
+  // A square at the dive depth: north, east, south, west, from where the sub is.
+  void survey() {
+    set_mode(*sub_, mavlink::sub_mode::kGuided, "GUIDED");
+    const double x0 = sub_->local->x, y0 = sub_->local->y, s = opt_.survey_side;
+    const std::array<std::array<double, 2>, 4> corners{
+        {{x0 + s, y0}, {x0 + s, y0 + s}, {x0, y0 + s}, {x0, y0}}};
+    double from_x = x0, from_y = y0;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+      const double tx = corners[i][0], ty = corners[i][1];
+      // Yaw along the leg (NED: 0 north, pi/2 east). type_mask 2552 (0x09F8) ignores velocity,
+      // acceleration and yaw rate but not yaw, so the target yaw must be meaningful.
+      const float yaw = static_cast<float>(std::atan2(ty - from_y, tx - from_x));
+      phase("sub: survey leg " + std::to_string(i + 1) + "/4 to (" + fmt(tx) + ", " + fmt(ty) +
+            ") m NED, yaw " + fmt(yaw * 180.0 / kPi) + " deg");
+      mavlink::SetPositionTargetLocalNed t;
+      t.x = static_cast<float>(tx);
+      t.y = static_cast<float>(ty);
+      t.z = static_cast<float>(opt_.depth);
+      t.yaw = yaw;
+      t.type_mask = mavlink::kTypeMaskPositionYaw;
+      t.coordinate_frame = mavlink::kFrameLocalNed;
+      t.target_system = sub_->sysid;
+      t.target_component = mavlink::kCompAutopilot1;
+      local_target_ = t;
+      next_local_target_ = Clock::now();
+      auto distance = [&] { return std::hypot(sub_->local->x - tx, sub_->local->y - ty); };
+      wait_for([&] { return distance() <= opt_.survey_radius; }, opt_.leg_timeout,
+               [&] {
+                 return "sub: corner " + std::to_string(i + 1) + " not reached within " +
+                        fmt(opt_.leg_timeout) + " s (" + fmt(distance()) + " m away)";
+               },
+               [&] { return "distance " + fmt(distance()) + " m"; });
+      from_x = tx;
+      from_y = ty;
+    }
+    local_target_.reset();
+    phase("sub: survey done");
+  }
+
+  // Safe state. After a failure: best effort, short waits, no exception for a refusal.
+  void finish(bool strict) {
+    following_ = false;
+    local_target_.reset();
+    manual_z_ = kNeutralZ;
+    // From here on a lost link or a disarm is no longer an error: it must not stop the other
+    // vehicle from being made safe. Each command still has its time-out.
+    checks_ = false;
+    for (Vehicle* v : vehicles()) v->expect_armed = false;
+    const double timeout = strict ? opt_.mode_timeout : std::min(opt_.mode_timeout, 5.0);
+    auto attempt = [&](Vehicle& v, auto&& action) {
+      if (!v.link.is_open() || !v.have_heartbeat) return;
+      if (Clock::now() - v.last_heartbeat > seconds(opt_.link_timeout)) {
+        err_ << "kelp-mission: " << v.name << ": no link, cannot make it safe" << std::endl;
+        return;
+      }
+      try {
+        action();
+      } catch (const MissionError& e) {
+        if (strict) throw;
+        err_ << "kelp-mission: " << e.what() << std::endl;
+      }
+    };
+    bool any = false;
+    for (Vehicle* v : vehicles()) any = any || (v->link.is_open() && v->have_heartbeat);
+    if (!any) return;
+    std::string what = sub_ ? "sub MANUAL + disarm" : "";
+    if (boat_) what += std::string(sub_ ? ", " : "") + "boat HOLD + disarm";
+    phase((strict ? "finishing: " : "leaving the vehicles safe: ") + what);
+    if (sub_) {
+      attempt(*sub_, [&] { set_mode(*sub_, mavlink::sub_mode::kManual, "MANUAL", timeout); });
+      attempt(*sub_, [&] { arm(*sub_, false, timeout); });
+    }
+    if (boat_) {
+      attempt(*boat_, [&] { set_mode(*boat_, mavlink::rover_mode::kHold, "HOLD", timeout); });
+      attempt(*boat_, [&] { arm(*boat_, false, timeout); });
+    }
+  }
+
+  // ---- commands ------------------------------------------------------------------------------
+  void arm(Vehicle& v, bool on, double timeout = -1) {
+    if (timeout < 0) timeout = opt_.arm_timeout;
+    v.expect_armed = false;  // no "disarmed unexpectedly" while this changes
+    command(v, mavlink::kCmdComponentArmDisarm, {on ? 1.0f : 0.0f}, on ? "arm" : "disarm", timeout);
+    wait_for([&] { return v.armed() == on; }, std::max(timeout, 3.0),
+             v.name + ": " + (on ? "arm" : "disarm") +
+                 " was accepted but the HEARTBEAT does not show it");
+    v.expect_armed = on;
+    v.armed_since = Clock::now();
+  }
+
+  void set_mode(Vehicle& v, std::uint32_t mode, const std::string& name, double timeout = -1) {
+    if (timeout < 0) timeout = opt_.mode_timeout;
+    // param1: base_mode with MAV_MODE_FLAG_CUSTOM_MODE_ENABLED; param2: ArduPilot's mode number.
+    command(v, mavlink::kCmdDoSetMode,
+            {static_cast<float>(mavlink::kModeFlagCustomModeEnabled), static_cast<float>(mode)},
+            "mode " + name + " (" + std::to_string(mode) + ")", timeout);
+    wait_for([&] { return v.heartbeat.custom_mode == mode; }, std::max(timeout, 3.0),
+             v.name + ": mode " + name + " was accepted but the HEARTBEAT does not show it");
+  }
+
+  // COMMAND_LONG repeated every retry_interval until COMMAND_ACK ACCEPTED or `timeout`.
+  void command(Vehicle& v, std::uint16_t cmd, std::array<float, 7> params, const std::string& what,
+               double timeout) {
+    const auto deadline = Clock::now() + seconds(timeout);
+    auto next_send = Clock::now();
+    std::optional<std::uint8_t> last_result;
+    int attempts = 0;
+    v.last_text.clear();
+    for (;;) {
+      const auto now = Clock::now();
+      if (now >= next_send) {
+        mavlink::CommandLong c;
+        c.param1 = params[0];
+        c.param2 = params[1];
+        c.param3 = params[2];
+        c.param4 = params[3];
+        c.param5 = params[4];
+        c.param6 = params[5];
+        c.param7 = params[6];
+        c.command = cmd;
+        c.target_system = v.sysid;
+        c.target_component = mavlink::kCompAutopilot1;
+        c.confirmation = static_cast<std::uint8_t>(std::min(attempts, 255));
+        v.ack.reset();
+        send(v, c);
+        ++attempts;
+        next_send = now + seconds(opt_.retry_interval);
+      }
+      if (v.ack && v.ack->command == cmd) {
+        const std::uint8_t r = v.ack->result;
+        v.ack.reset();
+        if (r == static_cast<std::uint8_t>(mavlink::Result::Accepted)) {
+          phase(v.name + ": " + what + ": ACCEPTED");
+          return;
+        }
+        if (r != static_cast<std::uint8_t>(mavlink::Result::InProgress)) {
+          last_result = r;
+          phase(v.name + ": " + what + ": " + mavlink::command_name(cmd) +
+                " refused: " + mavlink::result_name(r) +
+                (v.last_text.empty() ? "" : " (" + v.last_text + ")") + "; retrying");
+        }
+      }
+      if (now >= deadline)
+        throw MissionError(
+            v.name + ": " + what + ": " + mavlink::command_name(cmd) + " not accepted within " +
+            fmt(timeout) + " s after " + std::to_string(attempts) + " attempts; last result: " +
+            (last_result ? mavlink::result_name(*last_result) : std::string("no COMMAND_ACK")) +
+            (v.last_text.empty() ? "" : "; last STATUSTEXT: \"" + v.last_text + "\""));
+      spin(std::min(next_send, deadline));
+    }
+  }
+
+  template <class M>
+  void send(Vehicle& v, const M& msg) {
+    if (!v.link.send(v.gcs.pack(msg)))
+      throw MissionError(v.name + ": cannot send (" + std::string(M::name) + "): link broken");
+  }
+
+  // ---- the loop ------------------------------------------------------------------------------
+  // Runs the loop until pred() or `timeout` s, then throws MissionError(message) (a string, or a
+  // callable that makes it then). status() is printed every 5 s while waiting.
+  template <class Pred, class Message>
+  void wait_for(Pred pred, double timeout, const Message& message) {
+    wait_for(pred, timeout, message, [] { return std::string(); });
+  }
+  template <class Pred, class Message, class Status>
+  void wait_for(Pred pred, double timeout, const Message& message, Status status) {
+    const auto deadline = Clock::now() + seconds(timeout);
+    auto next_status = Clock::now() + std::chrono::seconds(5);
+    while (!pred()) {
+      const auto now = Clock::now();
+      if (now >= deadline) {
+        if constexpr (std::is_invocable_v<Message>)
+          throw MissionError(message());
+        else
+          throw MissionError(message);
+      }
+      if (now >= next_status) {
+        const std::string s = status();
+        if (!s.empty()) phase("  " + s);
+        next_status = now + std::chrono::seconds(5);
+      }
+      spin(std::min(deadline, next_status));
+    }
+  }
+
+  // Runs the loop for `duration` s.
+  template <class Status>
+  void hold(double duration, Status status) {
+    const auto end = Clock::now() + seconds(duration);
+    auto next_status = Clock::now() + std::chrono::seconds(5);
+    while (Clock::now() < end) {
+      if (Clock::now() >= next_status) {
+        phase("  " + status());
+        next_status += std::chrono::seconds(5);
+      }
+      spin(std::min(end, next_status));
+    }
+  }
+
+  // One round: periodic sends, poll() until input or `until` (at most 20 ms), read, dispatch,
+  // then the link and arming checks.
+  void spin(Clock::time_point until) {
+    periodic();
+    std::vector<pollfd> fds;
+    std::vector<Vehicle*> owners;
+    for (Vehicle* v : vehicles())
+      if (v->link.is_open()) {
+        fds.push_back(pollfd{v->link.fd(), POLLIN, 0});
+        owners.push_back(v);
+      }
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count();
+    const int timeout_ms = static_cast<int>(std::max<long long>(0, std::min<long long>(left, 20)));
+    const int n = ::poll(fds.data(), fds.size(), timeout_ms);
+    if (n < 0 && errno != EINTR) throw MissionError(std::string("poll: ") + std::strerror(errno));
+    for (std::size_t i = 0; n > 0 && i < fds.size(); ++i) {
+      if (fds[i].revents == 0) continue;
+      Vehicle& v = *owners[i];
+      if (!v.link.receive([&](const mavlink::Frame& f) { handle(v, f); })) {
+        v.link.close();
+        if (checks_) throw MissionError(v.name + ": the autopilot closed the connection");
+        err_ << "kelp-mission: " << v.name << ": the autopilot closed the connection" << std::endl;
+      }
+    }
+    if (!checks_) return;
+    const auto now = Clock::now();
+    for (Vehicle* v : vehicles()) {
+      if (v->have_heartbeat && now - v->last_heartbeat > seconds(opt_.link_timeout))
+        throw MissionError(v->name + ": no HEARTBEAT for " + fmt(opt_.link_timeout) +
+                           " s: link lost");
+      if (v->expect_armed && !v->armed() && now - v->armed_since > std::chrono::seconds(2))
+        throw MissionError(
+            v->name + " disarmed unexpectedly" +
+            (v->last_text.empty() ? "" : " (last STATUSTEXT: \"" + v->last_text + "\")"));
+    }
+  }
+
+  // HEARTBEAT 1 Hz to both; MANUAL_CONTROL 20 Hz to the sub (ArduSub's pilot-input failsafe);
+  // the boat's follow target 1 Hz; the sub's survey target 2 Hz.
+  void periodic() {
+    const auto now = Clock::now();
+    if (now >= next_heartbeat_) {
+      mavlink::Heartbeat hb;
+      hb.type = mavlink::kTypeGcs;
+      hb.autopilot = mavlink::kAutopilotInvalid;
+      for (Vehicle* v : vehicles())
+        if (v->link.is_open()) send(*v, hb);
+      next_heartbeat_ = now + std::chrono::seconds(1);
+    }
+    if (sub_ && sub_->link.is_open() && now >= next_manual_) {
+      mavlink::ManualControl mc;
+      mc.z = manual_z_;
+      mc.target = sub_->sysid;
+      send(*sub_, mc);
+      next_manual_ = now + std::chrono::milliseconds(50);
+    }
+    if (following_ && boat_ && sub_ && sub_->global && now >= next_follow_) {
+      mavlink::SetPositionTargetGlobalInt t;
+      t.lat_int = sub_->global->lat;
+      t.lon_int = sub_->global->lon;
+      t.type_mask = mavlink::kTypeMaskPosition;
+      t.coordinate_frame = mavlink::kFrameGlobalRelativeAltInt;
+      t.target_system = boat_->sysid;
+      t.target_component = mavlink::kCompAutopilot1;
+      send(*boat_, t);
+      next_follow_ = now + std::chrono::seconds(1);
+    }
+    if (local_target_ && sub_ && now >= next_local_target_) {
+      send(*sub_, *local_target_);
+      next_local_target_ = now + std::chrono::milliseconds(500);
+    }
+  }
+
+  void handle(Vehicle& v, const mavlink::Frame& f) {
+    const double t = now_s();
+    if (auto hb = mavlink::decode<mavlink::Heartbeat>(f)) {
+      // Only the autopilot's own HEARTBEAT (a GCS or a camera may share the link).
+      if (hb->autopilot == mavlink::kAutopilotInvalid) return;
+      if (v.have_heartbeat && f.sysid != v.sysid) return;
+      v.sysid = f.sysid;
+      v.have_heartbeat = true;
+      v.last_heartbeat = Clock::now();
+      v.heartbeat = *hb;
+      return;
+    }
+    if (!v.have_heartbeat || f.sysid != v.sysid) return;
+    if (auto m = mavlink::decode<mavlink::LocalPositionNed>(f)) {
+      v.local = *m;
+      log_->write(t, v.name, *m);
+    } else if (auto g = mavlink::decode<mavlink::GlobalPositionInt>(f)) {
+      v.global = *g;
+      log_->write(t, v.name, *g);
+    } else if (auto a = mavlink::decode<mavlink::Attitude>(f)) {
+      v.attitude = *a;
+      log_->write(t, v.name, *a);
+    } else if (auto s = mavlink::decode<mavlink::Statustext>(f)) {
+      v.last_text = mavlink::to_string(s->text);
+      phase(v.name + " says (" + mavlink::severity_name(s->severity) + "): " + v.last_text);
+      log_->write(t, v.name, *s);
+    } else if (auto ack = mavlink::decode<mavlink::CommandAck>(f)) {
+      v.ack = *ack;
+      log_->write(t, v.name, *ack);
+    }
+  }
+
+  void print_link_stats() {
+    if (log_) log_->flush();
+    for (Vehicle* v : vehicles()) {
+      const auto& s = v->link.stats();
+      out_ << v->name << " link: " << s.frames << " frames; dropped: " << s.bad_crc << " bad CRC, "
+           << s.bad_length << " bad length, " << s.bad_flags << " bad flags, " << s.unknown_msgid
+           << " of unknown messages; " << s.junk_bytes << " bytes outside frames; "
+           << v->link.dropped_frames() << " frames not sent" << std::endl;
+    }
+  }
+
+  static std::string fmt(double x) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(x == std::floor(x) && std::fabs(x) < 1e6 ? 0 : 2) << x;
+    return s.str();
+  }
+
+  static constexpr std::int16_t kNeutralZ = 500;
+  static constexpr double kPi = 3.14159265358979323846;
+
+  Options opt_;
+  std::ostream& out_;
+  std::ostream& err_;
+  Clock::time_point start_;
+  std::unique_ptr<Vehicle> sub_, boat_;
+  std::unique_ptr<CsvLog> log_;
+  bool following_ = false;
+  bool checks_ = true;  // link and arming checks in spin()
+  std::int16_t manual_z_ = kNeutralZ;
+  std::optional<mavlink::SetPositionTargetLocalNed> local_target_;
+  Clock::time_point next_heartbeat_{}, next_manual_{}, next_follow_{}, next_local_target_{};
+};
+
+}  // namespace kelp_sitl::mission

@@ -1,0 +1,267 @@
+// kelp-mission against scripted fake autopilots on loopback TCP: the whole mission with short
+// timings, a refused then accepted arm, an arm always refused, a silent peer, nobody listening.
+#include <catch2/catch.hpp>
+
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "fake_autopilot.hpp"
+#include "mission/mission.hpp"
+
+using kelp_sitl::mission::Mission;
+using kelp_sitl::mission::Options;
+using kelp_sitl::test::FakeAutopilot;
+using kelp_sitl::test::FakeConfig;
+namespace mv = kelp_sitl::mavlink;
+constexpr double kPi = 3.14159265358979323846;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("kelp-mission-test-" + std::to_string(::getpid()) + "-" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+Options short_options(const std::string& log_name) {
+  Options o;
+  o.depth = 2.0;
+  o.depth_tolerance = 0.2;
+  o.hold = 1.0;
+  o.survey_side = 4.0;
+  o.survey_radius = 0.5;
+  o.log_dir = fresh_dir(log_name).string();
+  o.connect_timeout = 3.0;
+  o.heartbeat_timeout = 3.0;
+  o.arm_timeout = 4.0;
+  o.position_timeout = 4.0;
+  o.mode_timeout = 3.0;
+  o.dive_timeout = 10.0;
+  o.leg_timeout = 5.0;
+  o.retry_interval = 0.5;
+  o.link_timeout = 3.0;
+  return o;
+}
+
+FakeConfig boat_config() {
+  FakeConfig c;
+  c.mav_type = mv::kTypeSurfaceBoat;
+  c.initial_mode = 0;
+  return c;
+}
+
+int count_lines(const std::filesystem::path& p) {
+  std::ifstream f(p);
+  int n = 0;
+  for (std::string line; std::getline(f, line);) ++n;
+  return n;
+}
+
+struct Run {
+  int code;
+  double seconds;
+  std::string out, err;
+};
+
+Run run_mission(const Options& o) {
+  std::ostringstream out, err;
+  const auto t0 = Clock::now();
+  Mission m(o, out, err);
+  const int code = m.run();
+  return {code, std::chrono::duration<double>(Clock::now() - t0).count(), out.str(), err.str()};
+}
+
+}  // namespace
+
+TEST_CASE("kelp-mission flies the whole mission against fake autopilots", "[mission]") {
+  FakeConfig sub_cfg;
+  sub_cfg.banner = true;
+  sub_cfg.arm_refusals = 1;      // refused once ("PreArm: ..."), accepted on the retry
+  sub_cfg.position_after = 1.5;  // no position estimate at first: the dive must wait for it
+  FakeAutopilot sub(sub_cfg);
+  FakeAutopilot boat(boat_config());
+  Options o = short_options("full");
+  o.sub = sub.endpoint();
+  o.rover = boat.endpoint();
+
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.seconds < 20.0);
+  CHECK(r.out.find("PreArm: Gyros inconsistent") != std::string::npos);
+  CHECK(r.out.find("refused: FAILED") != std::string::npos);
+  CHECK(r.out.find("mission complete") != std::string::npos);
+
+  const auto s = sub.record();
+  const auto b = boat.record();
+  // GCS identity and heartbeats.
+  CHECK(s.gcs_heartbeats >= 2);
+  CHECK(s.gcs_heartbeat_ok);
+  CHECK(b.gcs_heartbeat_ok);
+  for (std::uint8_t id : s.senders) CHECK(id == 255);
+  // Pilot input to the sub at >= 10 Hz while armed, gaps bounded; throttle below neutral to dive.
+  REQUIRE(s.manual_control_times.size() > 20);
+  double max_gap = 0;
+  for (std::size_t i = 1; i < s.manual_control_times.size(); ++i)
+    max_gap = std::max(max_gap, s.manual_control_times[i] - s.manual_control_times[i - 1]);
+  const double span = s.manual_control_times.back() - s.manual_control_times.front();
+  CHECK(static_cast<double>(s.manual_control_times.size() - 1) / span >= 10.0);
+  CHECK(max_gap < 1.0);  // ArduSub's FS_PILOT_TIMEOUT is 3 s; slack for a loaded machine
+  bool dived = false;
+  for (const auto& mc : s.manual_controls) {
+    CHECK(mc.target == 1);
+    dived = dived || mc.z < 500;
+  }
+  CHECK(dived);
+  CHECK_FALSE(s.dive_before_position);
+  CHECK(b.manual_controls.empty());
+  // Arming: sub refused once then armed; both disarmed at the end.
+  CHECK(s.arm_states == std::vector<int>{1, 0});
+  CHECK(b.arm_states == std::vector<int>{1, 0});
+  CHECK_FALSE(sub.armed());
+  CHECK_FALSE(boat.armed());
+  // Modes: sub ALT_HOLD, GUIDED, MANUAL; boat GUIDED, HOLD.
+  CHECK(s.modes == std::vector<std::uint32_t>{2, 4, 19});
+  CHECK(b.modes == std::vector<std::uint32_t>{15, 4});
+  for (const auto& c : s.commands) {
+    CHECK(c.target_system == 1);
+    CHECK(c.target_component == 1);
+    if (c.command == mv::kCmdDoSetMode) CHECK(c.param1 == 1.0f);
+  }
+  // Survey targets: LOCAL_NED, type_mask 2552, at depth, yaw along each leg.
+  REQUIRE(s.local_targets.size() >= 4);
+  std::vector<float> yaws;
+  for (const auto& t : s.local_targets) {
+    CHECK(t.coordinate_frame == mv::kFrameLocalNed);
+    CHECK(t.type_mask == 2552);
+    CHECK(t.z == Approx(2.0f));
+    CHECK(t.target_system == 1);
+    if (yaws.empty() || yaws.back() != t.yaw) yaws.push_back(t.yaw);
+  }
+  REQUIRE(yaws.size() == 4);
+  CHECK(yaws[0] == Approx(0.0).margin(0.05));             // north
+  CHECK(yaws[1] == Approx(kPi / 2).margin(0.05));         // east
+  CHECK(std::fabs(yaws[2]) == Approx(kPi).margin(0.05));  // south
+  CHECK(yaws[3] == Approx(-kPi / 2).margin(0.05));        // west
+  const auto end = sub.position();
+  CHECK(end[2] >= 1.8);
+  // The boat followed the sub: position-only global targets, frame 6, the sub's lat/lon.
+  REQUIRE(b.global_targets.size() >= 3);
+  for (const auto& t : b.global_targets) {
+    CHECK(t.coordinate_frame == 6);
+    CHECK(t.type_mask == 3576);
+    CHECK(t.target_system == 1);
+    CHECK(std::abs(t.lat_int - 338103130) < 1000);  // within ~10 m of the sub's start
+  }
+  const auto boat_end = boat.position();
+  CHECK(std::hypot(boat_end[0] - end[0], boat_end[1] - end[1]) < 8.0);
+  // Logs.
+  const std::filesystem::path dir = o.log_dir;
+  for (const char* f : {"attitude.csv", "local_position_ned.csv", "global_position_int.csv",
+                        "statustext.csv", "command_ack.csv"})
+    CHECK(std::filesystem::exists(dir / f));
+  CHECK(count_lines(dir / "local_position_ned.csv") > 50);
+  CHECK(count_lines(dir / "statustext.csv") == 2);
+  CHECK(count_lines(dir / "command_ack.csv") >= 10);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("kelp-mission: an arm always refused fails clearly within the time-out", "[mission]") {
+  FakeConfig sub_cfg;
+  sub_cfg.arm_refusals = -1;
+  FakeAutopilot sub(sub_cfg);
+  Options o = short_options("refused");
+  o.sub = sub.endpoint();
+  o.rover = "none";
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 1);
+  CHECK(r.seconds < o.arm_timeout + 3.0);
+  CHECK(r.err.find("sub: arm: MAV_CMD_COMPONENT_ARM_DISARM not accepted within 4 s") !=
+        std::string::npos);
+  CHECK(r.err.find("last result: FAILED") != std::string::npos);
+  CHECK(r.err.find("PreArm: Gyros inconsistent") != std::string::npos);
+  const auto s = sub.record();
+  CHECK(s.commands.size() >= 5);                                        // retried every 0.5 s
+  CHECK(std::count(s.arm_states.begin(), s.arm_states.end(), 1) == 0);  // never armed
+  std::filesystem::remove_all(o.log_dir);
+}
+
+TEST_CASE("kelp-mission: a peer that never sends times out", "[mission]") {
+  FakeConfig silent;
+  silent.silent = true;
+  FakeAutopilot sub(silent);
+  Options o = short_options("silent");
+  o.sub = sub.endpoint();
+  o.rover = "none";
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 1);
+  CHECK(r.seconds < o.heartbeat_timeout + 2.0);
+  CHECK(r.err.find("sub: no HEARTBEAT within 3 s") != std::string::npos);
+  // It still heard from us: GCS heartbeats (and pilot input) go out from the connection on.
+  CHECK(sub.record().gcs_heartbeats >= 2);
+  std::filesystem::remove_all(o.log_dir);
+}
+
+TEST_CASE("kelp-mission: nobody listening times out on connect", "[mission]") {
+  // A port that was free a moment ago.
+  std::uint16_t port = 0;
+  {
+    FakeConfig c;
+    c.silent = true;
+    FakeAutopilot probe(c);
+    port = probe.port();
+  }
+  Options o = short_options("noconnect");
+  o.sub = "none";
+  o.rover = "tcp:127.0.0.1:" + std::to_string(port);
+  o.connect_timeout = 1.5;
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 1);
+  CHECK(r.seconds < 4.0);
+  CHECK(r.err.find("boat: cannot connect to 127.0.0.1:" + std::to_string(port)) !=
+        std::string::npos);
+  std::filesystem::remove_all(o.log_dir);
+}
+
+TEST_CASE("kelp-mission: a vehicle that stops talking mid-mission fails it; the other is made safe",
+          "[mission]") {
+  FakeConfig sub_cfg;
+  sub_cfg.silent_after = 2.0;  // during the dive / hold
+  FakeAutopilot sub(sub_cfg);
+  FakeAutopilot boat(boat_config());
+  Options o = short_options("lost");
+  o.sub = sub.endpoint();
+  o.rover = boat.endpoint();
+  o.hold = 10.0;
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 1);
+  CHECK(r.seconds < 12.0);
+  CHECK(r.err.find("sub: no HEARTBEAT for 3 s: link lost") != std::string::npos);
+  CHECK(r.err.find("sub: no link, cannot make it safe") != std::string::npos);
+  const auto b = boat.record();
+  CHECK(b.arm_states == std::vector<int>{1, 0});
+  REQUIRE_FALSE(b.modes.empty());
+  CHECK(b.modes.back() == 4);  // HOLD
+  CHECK_FALSE(boat.armed());
+  std::filesystem::remove_all(o.log_dir);
+}
