@@ -162,10 +162,15 @@ class Bridge {
       p.active = true;
       event(std::string(slot_name(slot)) + " is back after a silence, at physics time " +
             time_string());
-      if (pkt.frame_count < p.frame)
+      if (pkt.frame_count < p.frame) {
         restart(slot, pkt);
-      else
+      } else if (pkt.frame_count == p.frame && p.reply_size > 0) {
+        ++p.counters.repeats;  // the frame it last got an answer for: the same answer
+        out.push({slot, from, p.reply.data(), p.reply_size});
+        return;
+      } else {
         accept_frame(p, slot, pkt);
+      }
     } else if (pkt.frame_count == p.frame) {
       if (p.pending) {
         ++p.counters.waiting_resends;

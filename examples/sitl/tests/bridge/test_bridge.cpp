@@ -201,5 +201,11 @@ TEST_CASE("lockstep: one clock for both, start with the first when asked, missed
     CHECK(f.bridge.active(sub));
     CHECK(!f.bridge.active(rover));
     CHECK(f.bridge.counters(rover).timeouts == 1);
+    // Back with the frame it was last answered for: the same answer again, no step.
+    const std::uint64_t steps = f.bridge.steps();
+    REQUIRE(f.send(rover, 0, {}, 2.0, out) == 1);
+    CHECK(f.bridge.steps() == steps);
+    CHECK(f.bridge.active(rover));
+    CHECK(f.bridge.counters(rover).repeats == 1);
   }
 }
