@@ -175,17 +175,22 @@ def main(program, outdir):
                              "--log", log, "--peer-timeout", "1.5", "--log-rate", "50",
                              "--status-interval", "1", "--scenario", scenario])
     try:
-        time.sleep(0.5)
+        # Wait (at most 20 s, the machine may be loaded) until both ports are bound; they must be
+        # bound to loopback only, since no --bind was given.
+        deadline = time.time() + 20
+        while True:
+            bound = {}
+            with open("/proc/net/udp") as f:
+                for line in f.readlines()[1:]:
+                    addr, port = line.split()[1].split(":")
+                    if int(port, 16) in (sub_port, rover_port):
+                        bound.setdefault(int(port, 16), set()).add(addr)
+            if len(bound) == 2 or time.time() > deadline or proc.poll() is not None:
+                break
+            time.sleep(0.05)
         check(proc.poll() is None, "kelp-sitl exited at start")
-        # Bound to loopback by default (no --bind given).
-        bound = set()
-        with open("/proc/net/udp") as f:
-            for line in f.readlines()[1:]:
-                local = line.split()[1]
-                addr, port = local.split(":")
-                if int(port, 16) in (sub_port, rover_port):
-                    bound.add(addr)
-        check(bound == {"0100007F"}, "kelp-sitl is not bound to 127.0.0.1 only: %r" % bound)
+        check(len(bound) == 2 and all(a == {"0100007F"} for a in bound.values()),
+              "kelp-sitl is not bound to 127.0.0.1 only on both ports: %r" % bound)
 
         sub = Sitl("ArduSub", sub_port, MAGIC16)
         rover = Sitl("ArduRover", rover_port, MAGIC32)
