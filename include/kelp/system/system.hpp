@@ -88,6 +88,13 @@ struct SystemParameters {
   /// fastest; each pass costs about one more step and makes the exchange of work between the
   /// vehicles and the tether more exact (see the file's comment).
   int coupling_corrections = 0;
+  /// When an implicit tether step fails (Newton's method does not converge even in the
+  /// sub-steps `tether_options.max_step_halvings` allows), redo that step with RK4 in sub-steps
+  /// of the line's stable explicit step (tether::estimate_stable_dt) instead of throwing; counted
+  /// in SystemReport::tether_fallbacks. Such steps are rare (a vehicle tumbling at the surface in
+  /// a rough sea can fold the line so that Newton stalls) and cost about dt / h_stable × 4 force
+  /// evaluations. false: throw kelp::numerical_error as the tether step does.
+  bool explicit_fallback = true;
 };
 
 /// \brief Checks system parameters (the parts' own checks, kinematic tether ends, attachment
@@ -210,6 +217,9 @@ struct SystemReport {
   Vector3<Scalar> force_on_auv = Vector3<Scalar>::Zero();  ///< see force_on_asv
   /// The energy terms after the step, when the step was asked for them (else all zero).
   SystemEnergy<Scalar> energy;
+  /// Tether steps redone explicitly after the implicit scheme failed
+  /// (SystemParameters::explicit_fallback).
+  int tether_fallbacks = 0;
 };
 
 /// \brief Preallocated buffers of a system step.
@@ -344,8 +354,19 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     ends.start = detail::predicted_end(state.asv, state.asv_nu_dot, p.asv_attachment);
     ends.end = detail::predicted_end(state.auv, state.auv_nu_dot, p.auv_attachment);
     for (int pass = 0;; ++pass) {
-      report.tether = tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt,
-                                      p.max_tether_dt, p.tether_integrator, p.tether_options);
+      try {
+        report.tether = tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt,
+                                        p.max_tether_dt, p.tether_integrator, p.tether_options);
+      } catch (const kelp::numerical_error&) {
+        if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
+        // The failed step left the tether as it was: redo it explicitly.
+        const Scalar h = tether::estimate_stable_dt(model.tether(), tether::Integrator::rk4,
+                                                    env.water_density());
+        report.tether = tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt,
+                                        std::min(p.max_tether_dt, double(value_of(h))),
+                                        tether::Integrator::rk4, p.tether_options);
+        ++report.tether_fallbacks;
+      }
       // The impulse the tether's integrator delivered to its ends, as a mean force.
       report.force_on_asv = ws.tether.end_impulse.on_start / Scalar(dt);
       report.force_on_auv = ws.tether.end_impulse.on_end / Scalar(dt);
