@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "../tether/benchmark_line.hpp"
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
@@ -43,13 +44,9 @@ using kelp::Vector3;
 
 namespace {
 
-constexpr double kAmp = 0.1, kFreq = 0.2;
-const double kW = 2 * M_PI * kFreq;
-
-// heave of the far end in NED (z down): z = 5 + amp (1 - cos w t)
-double heave_z(double t) { return 5.0 + kAmp * (1 - std::cos(kW * t)); }
-double heave_vz(double t) { return kAmp * kW * std::sin(kW * t); }
-double heave_az(double t) { return kAmp * kW * kW * std::cos(kW * t); }
+// The far end's heave in NED (z down), shared with bench_tether.
+double heave_z(double t) { return kelp_bench::Heave::z(t); }
+double heave_vz(double t) { return kelp_bench::Heave::vz(t); }
 
 double thread_cpu() {
   timespec ts;
@@ -81,28 +78,9 @@ Timing run_for(double min_time, long batch, F&& body) {
 }
 
 // ---------------------------------------------------------------------------------------------
-struct Kelp {
-  kelp::environment::Environmentd env;
-  kt::TetherModeld model;
-  kt::TetherWorkspaced ws;
-  kt::TetherStated state;
-  Vector3<double> a{0, 0, 0}, b{10, 0, 5};
-  explicit Kelp(int n) : model(params(n)), ws(model) {
-    if (!kt::static_initial_state(model, ws, env, a, b, state).converged)
-      throw std::runtime_error("kelp static equilibrium did not converge");
-  }
-  static kt::TetherParametersd params(int n) {
-    kt::TetherParametersd p;
-    p.segments = n;
-    return p;
-  }
-  kt::TetherBoundaryd boundary(double t) const {
-    kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(a, b);
-    bnd.end.position.z() = heave_z(t);
-    bnd.end.velocity.z() = heave_vz(t);
-    bnd.end.acceleration.z() = heave_az(t);
-    return bnd;
-  }
+// The benchmark line in kelp, with a step at the current time.
+struct Kelp : kelp_bench::BenchmarkLine {
+  using BenchmarkLine::BenchmarkLine;
   void step(double dt, kt::Integrator integ) {
     kt::step(model, ws, env, state, boundary(state.time), dt, integ);
   }

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "benchmark_line.hpp"
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
@@ -26,31 +27,7 @@ using kelp::Vector3;
 
 namespace {
 
-struct Setup {
-  kelp::environment::Environmentd env;
-  kt::TetherModeld model;
-  kt::TetherWorkspaced ws;
-  kt::TetherStated state;
-  Vector3<double> a{0, 0, 0}, b{10, 0, 5};
-
-  explicit Setup(int n) : model(params(n)), ws(model) {
-    if (!kt::static_initial_state(model, ws, env, a, b, state).converged)
-      throw std::runtime_error("bench_tether: static equilibrium did not converge");
-  }
-  static kt::TetherParametersd params(int n) {
-    kt::TetherParametersd p;
-    p.segments = n;
-    return p;
-  }
-  kt::TetherBoundaryd boundary(double t) const {
-    const double amp = 0.1, w = 2 * kelp::pi * 0.2;
-    kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(a, b);
-    bnd.end.position.z() += amp * (1 - std::cos(w * t));
-    bnd.end.velocity.z() = amp * w * std::sin(w * t);
-    bnd.end.acceleration.z() = amp * w * w * std::cos(w * t);
-    return bnd;
-  }
-};
+using Setup = kelp_bench::BenchmarkLine;
 
 void BM_TetherForces(benchmark::State& st) {
   const int n = static_cast<int>(st.range(0));

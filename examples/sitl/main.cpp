@@ -185,6 +185,13 @@ int run(const Options& o) {
   std::array<UdpSocket*, 2> sockets{&sub, &rover};
   std::array<std::uint8_t, 2048> buf{};
   kelp_sitl::Outbox out;
+  // Each reply leaves from the port of the autopilot it answers.
+  const auto send_all = [&] {
+    for (int i = 0; i < out.count; ++i) {
+      const kelp_sitl::Outgoing& g = out.items[static_cast<std::size_t>(i)];
+      sockets[static_cast<std::size_t>(g.slot)]->send(g.to, g.data, g.size);
+    }
+  };
   pollfd fds[2] = {{sub.fd(), POLLIN, 0}, {rover.fd(), POLLIN, 0}};
   std::uint64_t logged_steps = 0;
   bool done = false;
@@ -201,10 +208,7 @@ int run(const Options& o) {
         if (n < 0) break;
         out.clear();
         bridge.receive(s, buf.data(), static_cast<std::size_t>(n), from, now, out);
-        for (int i = 0; i < out.count; ++i) {
-          const kelp_sitl::Outgoing& g = out.items[static_cast<std::size_t>(i)];
-          sockets[static_cast<std::size_t>(g.slot)]->send(g.to, g.data, g.size);
-        }
+        send_all();
         if (bridge.steps() != logged_steps) {
           logged_steps = bridge.steps();
           log_state();
@@ -214,10 +218,7 @@ int run(const Options& o) {
     }
     out.clear();
     bridge.check_timeouts(now, out);
-    for (int i = 0; i < out.count; ++i) {
-      const kelp_sitl::Outgoing& g = out.items[static_cast<std::size_t>(i)];
-      sockets[static_cast<std::size_t>(g.slot)]->send(g.to, g.data, g.size);
-    }
+    send_all();
     if (now >= next_status) {
       next_status = now + o.status_interval;
       log.flush();

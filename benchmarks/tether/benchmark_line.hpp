@@ -1,0 +1,53 @@
+// kelp's tether benchmark line, shared by bench_tether and the MoorDyn side-by-side
+// (benchmarks/moordyn/): TetherParameters defaults (20 m, d 8 mm, 0.07 kg/m, EA 1e5 N, Cdn 1.2,
+// Cdt 0.008, Can 1, no internal damping) with N segments, ends 10 m apart horizontally and 5 m
+// vertically in still seawater, started from static equilibrium, the far end heaving
+// 0.1 m (1 − cos ωt) with ω = 2π · 0.2 Hz.
+#pragma once
+
+#include <cmath>
+#include <stdexcept>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/environment/environment.hpp"
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+
+namespace kelp_bench {
+
+/// The far end's heave, NED: depth z(t) [m], its velocity and acceleration.
+struct Heave {
+  static constexpr double amplitude = 0.1, base_depth = 5.0;
+  static constexpr double omega = 2 * kelp::pi * 0.2;
+  static double z(double t) { return base_depth + amplitude * (1 - std::cos(omega * t)); }
+  static double vz(double t) { return amplitude * omega * std::sin(omega * t); }
+  static double az(double t) { return amplitude * omega * omega * std::cos(omega * t); }
+};
+
+struct BenchmarkLine {
+  kelp::environment::Environmentd env;
+  kelp::tether::TetherModeld model;
+  kelp::tether::TetherWorkspaced ws;
+  kelp::tether::TetherStated state;
+  kelp::Vector3<double> a{0, 0, 0}, b{10, 0, Heave::base_depth};
+
+  explicit BenchmarkLine(int n) : model(params(n)), ws(model) {
+    if (!kelp::tether::static_initial_state(model, ws, env, a, b, state).converged)
+      throw std::runtime_error("benchmark line: static equilibrium did not converge");
+  }
+  static kelp::tether::TetherParametersd params(int n) {
+    kelp::tether::TetherParametersd p;
+    p.segments = n;
+    return p;
+  }
+  /// Fixed start at a, the far end heaving about b.
+  kelp::tether::TetherBoundaryd boundary(double t) const {
+    kelp::tether::TetherBoundaryd bnd = kelp::tether::TetherBoundaryd::fixed(a, b);
+    bnd.end.position.z() = Heave::z(t);
+    bnd.end.velocity.z() = Heave::vz(t);
+    bnd.end.acceleration.z() = Heave::az(t);
+    return bnd;
+  }
+};
+
+}  // namespace kelp_bench
