@@ -28,6 +28,7 @@
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
+#include "kelp/core/simd.hpp"
 #include "kelp/core/types.hpp"
 
 namespace kelp::tether {
@@ -385,6 +386,13 @@ struct TetherWorkspace {
   /// zero), 1 dashpot only (slack), 2 elastic plus dashpot (taut)
   VectorX<Scalar> seg_branch;
   Matrix3X<Scalar> x0, v0, x1, v1, xs, vs;  ///< integrator stages and Newton/line-search iterates
+  /// compute_forces' scratch, one contiguous column per component: T_s u_s of each segment
+  /// (columns 0–2), each node's force before the added-mass coupling to its neighbours (3–5),
+  /// and that coupling term (6–8)
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 9> pass_buffer;
+  /// Copies of positions and velocities given to compute_forces as expressions rather than as
+  /// column-major storage
+  Matrix3X<Scalar> x_eval, v_eval;
   /// State at entry of a driver (`advance`, `solve_static_equilibrium`), restored if it fails
   StateBackup<Scalar> entry_backup;
   /// State at entry of an implicit step that is retried in sub-steps, restored if they fail
@@ -414,8 +422,9 @@ struct TetherWorkspace {
   /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
   void resize(int nodes) {
     const int n = nodes, s = nodes - 1;
-    for (Matrix3X<Scalar>* m : {&force, &bending, &acceleration, &tangent, &water_velocity,
-                                &water_acceleration, &rhs, &delta, &x0, &v0, &x1, &v1, &xs, &vs})
+    for (Matrix3X<Scalar>* m :
+         {&force, &bending, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs,
+          &delta, &x0, &v0, &x1, &v1, &xs, &vs, &x_eval, &v_eval})
       m->setZero(3, n);
     for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &friction_normal, &submerged,
                                &node_kz, &surface_elevation})
@@ -426,6 +435,7 @@ struct TetherWorkspace {
                                &seg_true_k_uu, &seg_true_c_uu, &seg_rate, &seg_branch})
       v->setZero(s);
     node_dv.setZero(6, n);
+    pass_buffer.setZero(n, 9);
     block_inv.setZero(6, n);
     entry_backup.resize(n);
     retry_backup.resize(n);
@@ -546,6 +556,435 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 
 }  // namespace detail
 
+namespace detail {
+
+/// Constants of one kind of node (start, interior, end) for compute_forces: fully wet, or
+/// scaled to a submerged fraction φ.
+template <typename Scalar>
+struct NodeConstants {
+  Scalar li, dry_weight, wet_weight, rho_vol, kn, kt, mass_dry, mass_iso_wet, mass_tan_wet;
+  /// The constants of a node with submerged fraction φ (fluid terms scaled by φ).
+  NodeConstants submerged(Scalar phi) const {
+    NodeConstants c = *this;
+    c.wet_weight = dry_weight + phi * (wet_weight - dry_weight);
+    c.rho_vol = phi * rho_vol;
+    c.kn = phi * kn;
+    c.kt = phi * kt;
+    c.mass_iso_wet = mass_dry + phi * (mass_iso_wet - mass_dry);
+    c.mass_tan_wet = phi * mass_tan_wet;
+    return c;
+  }
+};
+
+/// Everything compute_forces' passes share: the environment's and the model's constants of one
+/// evaluation, the node kinds (0 start, 1 interior, 2 end), and where the positions and
+/// velocities are (column-major 3 × (N+1) with the given column strides).
+template <typename Scalar>
+struct ForcePass {
+  const TetherParameters<Scalar>* p;
+  int n;
+  Scalar rho, g, bed, l, l2, inv_l, ea_l, ba_l, ea, ba, can, cat, inv_d, bed_k, bed_c;
+  bool clamp, damping, still, bending, mass_turns;
+  NodeConstants<Scalar> kinds[3];
+  const Scalar* x;
+  Eigen::Index xs;
+  const Scalar* v;
+  Eigen::Index vs;
+  Scalar X(int k, int i) const { return x[i * xs + k]; }
+  Scalar V(int k, int i) const { return v[i * vs + k]; }
+};
+
+/// Columns of TetherWorkspace::pass_buffer.
+enum PassColumn : int { kSegmentForce = 0, kNodeForce = 3, kMassRate = 6 };
+
+/// Segments s … s + lanes − 1 (see compute_forces): length, direction, axial force T_s (elastic
+/// EA·ε when stretched plus the dashpot BA·ε̇ at any length, clamped at zero unless
+/// compressive_damping), T_s u_s into the pass buffer, and the Jacobian terms.
+template <bool WithJacobian, bool Wide, typename Scalar>
+void segment_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int s) {
+  using P = simd::Pack<Scalar, Wide>;
+  const P zero = P::all(Scalar(0));
+  const Scalar* a = c.x + s * c.xs;
+  const P d0 = P::gather(a + c.xs, c.xs) - P::gather(a, c.xs);
+  const P d1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a + 1, c.xs);
+  const P d2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a + 2, c.xs);
+  const P ls2 = (d0 * d0 + d1 * d1) + d2 * d2;
+  const P ls = sqrt(ls2);
+  const auto positive = simd::greater(ls, zero);
+  const P inv_ls = simd::select(positive, P::all(Scalar(1)) / ls, zero);
+  const P u0 = d0 * inv_ls, u1 = d1 * inv_ls, u2 = d2 * inv_ls;
+  const auto stretched = simd::greater(ls2, P::all(c.l2));
+  P tension = simd::select(stretched, (P::all(c.ea) * (ls - P::all(c.l))) * P::all(c.inv_l), zero);
+  P k_axial = simd::select(stretched, P::all(c.ea_l), zero);
+  P c_axial = P::all(c.ba_l);
+  P rate = zero;
+  if (c.damping) {
+    const Scalar* b = c.v + s * c.vs;
+    const P e0 = P::gather(b + c.vs, c.vs) - P::gather(b, c.vs);
+    const P e1 = P::gather(b + c.vs + 1, c.vs) - P::gather(b + 1, c.vs);
+    const P e2 = P::gather(b + c.vs + 2, c.vs) - P::gather(b + 2, c.vs);
+    rate = (u0 * e0 + u1 * e1) + u2 * e2;
+    tension += (P::all(c.ba) * rate) * P::all(c.inv_l);
+    if (c.clamp) {
+      // A zero-length segment keeps its dashpot slope (its force is zero either way).
+      const auto keep = simd::greater(tension, zero);
+      tension = simd::select(keep, tension, zero);
+      k_axial = simd::select(keep, k_axial, zero);
+      c_axial = simd::select(keep || simd::greater_equal(zero, ls), c_axial, zero);
+    }
+  }
+  ls.store(&ws.stretched_length(s));
+  tension.store(&ws.tension(s));
+  Scalar* dir = ws.direction.data() + 3 * s;
+  u0.scatter(dir, 3);
+  u1.scatter(dir + 1, 3);
+  u2.scatter(dir + 2, 3);
+  (tension * u0).store(&ws.pass_buffer(s, kSegmentForce));
+  (tension * u1).store(&ws.pass_buffer(s, kSegmentForce + 1));
+  (tension * u2).store(&ws.pass_buffer(s, kSegmentForce + 2));
+  if constexpr (WithJacobian) {
+    // ∂(T u)/∂x_{s+1} = k_axial u uᵀ + (T/l_s)(I − u uᵀ); the geometric term is kept only for
+    // T > 0 so that the Jacobian stays positive semi-definite.
+    const P k_perp = simd::select(simd::greater(tension, zero), tension * inv_ls, zero);
+    (k_axial - k_perp).store(&ws.seg_k_uu(s));
+    k_perp.store(&ws.seg_k_perp(s));
+    c_axial.store(&ws.seg_c_uu(s));
+    rate.store(&ws.seg_rate(s));
+  }
+}
+
+/// Interior nodes i … i + lanes − 1 (1 ≤ i, i + lanes ≤ N) when all of them are below the
+/// surface band and off the seabed (returns false, writing nothing, otherwise): tangent, node
+/// force without the added-mass coupling to the neighbours, that coupling term w_i, masses and
+/// the Jacobian terms. The same arithmetic as node_general for such nodes.
+template <bool WithJacobian, bool Wide, typename Scalar>
+bool interior_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i) {
+  using P = simd::Pack<Scalar, Wide>;
+  const P zero = P::all(Scalar(0));
+  const Scalar* a = c.x + i * c.xs;
+  const P z = P::gather(a + 2, c.xs);
+  if (c.still) {
+    if (simd::any(simd::less(z, zero) || simd::greater(z - P::all(c.bed), zero))) return false;
+  } else {
+    const P zeta = P::load(&ws.surface_elevation(i));
+    if (simd::any(simd::less(z + zeta, zero) || simd::greater(z - P::all(c.bed), zero)))
+      return false;
+  }
+  const NodeConstants<Scalar>& nc = c.kinds[1];
+  const P c0 = P::gather(a + c.xs, c.xs) - P::gather(a - c.xs, c.xs);
+  const P c1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a - c.xs + 1, c.xs);
+  const P c2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a - c.xs + 2, c.xs);
+  const P cc = (c0 * c0 + c1 * c1) + c2 * c2;
+  const P inv_c2 = simd::select(simd::greater(cc, zero), P::all(Scalar(1)) / cc, zero);
+  const P inv_c = sqrt(inv_c2);
+  const P q0 = c0 * inv_c, q1 = c1 * inv_c, q2 = c2 * inv_c;
+  Scalar* tan = ws.tangent.data() + 3 * i;
+  q0.scatter(tan, 3);
+  q1.scatter(tan + 1, 3);
+  q2.scatter(tan + 2, 3);
+  const Scalar* tu = &ws.pass_buffer(i, kSegmentForce);
+  const Eigen::Index col = ws.pass_buffer.rows();
+  P f0 = P::load(tu) - P::load(tu - 1);
+  P f1 = P::load(tu + col) - P::load(tu + col - 1);
+  P f2 = P::load(tu + 2 * col) - P::load(tu + 2 * col - 1);
+  f2 += P::all(nc.wet_weight);
+  // Morison drag on the relative velocity, split along the chord.
+  const Scalar* vi = c.v + i * c.vs;
+  const Scalar* wi = ws.water_velocity.data() + 3 * i;
+  const P vr0 = P::gather(wi, 3) - P::gather(vi, c.vs);
+  const P vr1 = P::gather(wi + 1, 3) - P::gather(vi + 1, c.vs);
+  const P vr2 = P::gather(wi + 2, 3) - P::gather(vi + 2, c.vs);
+  const P vc = (vr0 * c0 + vr1 * c1) + vr2 * c2;
+  const P sc = vc * inv_c2;
+  const P vn0 = vr0 - sc * c0, vn1 = vr1 - sc * c1, vn2 = vr2 - sc * c2;
+  const P vn_abs = sqrt((vn0 * vn0 + vn1 * vn1) + vn2 * vn2);
+  const P vq = vc * inv_c;
+  const P kn = P::all(nc.kn), kt = P::all(nc.kt);
+  const P dn = kn * vn_abs, dt = (kt * abs(vq)) * vq;
+  f0 += dn * vn0 + dt * q0;
+  f1 += dn * vn1 + dt * q1;
+  f2 += dn * vn2 + dt * q2;
+  if (!c.still) {
+    // Froude–Krylov plus added-mass forcing (zero where the water does not accelerate).
+    const Scalar* ai = ws.water_acceleration.data() + 3 * i;
+    const P aw0 = P::gather(ai, 3), aw1 = P::gather(ai + 1, 3), aw2 = P::gather(ai + 2, 3);
+    const P qa = P::all(c.cat - c.can) * ((q0 * aw0 + q1 * aw1) + q2 * aw2);
+    const P rv = P::all(nc.rho_vol), ca = P::all(Scalar(1) + c.can);
+    f0 += rv * (ca * aw0 + qa * q0);
+    f1 += rv * (ca * aw1 + qa * q1);
+    f2 += rv * (ca * aw2 + qa * q2);
+  }
+  P::all(nc.mass_iso_wet).store(&ws.mass_iso(i));
+  P::all(nc.mass_tan_wet).store(&ws.mass_tan(i));
+  if (c.mass_turns) {
+    // Added-mass rate terms (see compute_forces; zero for a zero chord, where 1/|c| = 0).
+    const P k = P::all(nc.mass_tan_wet) * inv_c, ks = k * vq;
+    const P dc0 = P::gather(vi + c.vs, c.vs) - P::gather(vi - c.vs, c.vs);
+    const P dc1 = P::gather(vi + c.vs + 1, c.vs) - P::gather(vi - c.vs + 1, c.vs);
+    const P dc2 = P::gather(vi + c.vs + 2, c.vs) - P::gather(vi - c.vs + 2, c.vs);
+    const P m = k * ((dc0 * vn0 + dc1 * vn1) + dc2 * vn2) - ks * ((q0 * dc0 + q1 * dc1) + q2 * dc2);
+    f0 += ks * dc0 + m * q0;
+    f1 += ks * dc1 + m * q1;
+    f2 += ks * dc2 + m * q2;
+    (ks * vn0).store(&ws.pass_buffer(i, kMassRate));
+    (ks * vn1).store(&ws.pass_buffer(i, kMassRate + 1));
+    (ks * vn2).store(&ws.pass_buffer(i, kMassRate + 2));
+  }
+  f0.store(&ws.pass_buffer(i, kNodeForce));
+  f1.store(&ws.pass_buffer(i, kNodeForce + 1));
+  f2.store(&ws.pass_buffer(i, kNodeForce + 2));
+  P::all(Scalar(1)).store(&ws.submerged(i));
+  zero.store(&ws.seabed_force(i));
+  if constexpr (WithJacobian) {
+    // −∂F/∂v of the drag (q held fixed) = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
+    const P cn = simd::select(simd::greater(vn_abs, zero), kn / vn_abs, zero);
+    const P c31 = (P::all(Scalar(2)) * kt) * abs(vq) - dn;
+    Scalar* dv = ws.node_dv.data() + 6 * i;
+    (dn + c31 * q0 * q0 + cn * vn0 * vn0).scatter(dv, 6);
+    (c31 * q1 * q0 + cn * vn1 * vn0).scatter(dv + 1, 6);
+    (c31 * q2 * q0 + cn * vn2 * vn0).scatter(dv + 2, 6);
+    (dn + c31 * q1 * q1 + cn * vn1 * vn1).scatter(dv + 3, 6);
+    (c31 * q2 * q1 + cn * vn2 * vn1).scatter(dv + 4, 6);
+    (dn + c31 * q2 * q2 + cn * vn2 * vn2).scatter(dv + 5, 6);
+    zero.store(&ws.node_kz(i));
+  }
+  return true;
+}
+
+/// Node i, any kind and state (end node, surface band, in air, on the seabed): tangent, node
+/// force without the added-mass coupling to the neighbours, that coupling term w_i, masses,
+/// submerged fraction, seabed force and the Jacobian terms.
+template <bool WithJacobian, typename Scalar>
+void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i) {
+  using std::abs;
+  using std::sqrt;
+  using V3 = Vector3<Scalar>;
+  const TetherParameters<Scalar>& p = *c.p;
+  const int n = c.n;
+  // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends. The drag below
+  // is written with the unnormalised chord and 1/|c|² so that its square root and the
+  // tangent's run in parallel instead of one after the other.
+  const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
+  const V3 chord(c.X(0, hi) - c.X(0, lo), c.X(1, hi) - c.X(1, lo), c.X(2, hi) - c.X(2, lo));
+  const Scalar c2 = (chord(0) * chord(0) + chord(1) * chord(1)) + chord(2) * chord(2);
+  const Scalar inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
+  const Scalar inv_c = sqrt(inv_c2);
+  const V3 q = chord * inv_c;
+  ws.tangent.col(i) = q;
+  V3 f;
+  for (int k = 0; k < 3; ++k) {
+    const Scalar in = i < n ? ws.pass_buffer(i, kSegmentForce + k) : Scalar(0);
+    const Scalar out = i > 0 ? ws.pass_buffer(i - 1, kSegmentForce + k) : Scalar(0);
+    f(k) = in - out;
+  }
+  const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
+  const Scalar li = c.kinds[kind].li;
+  const Scalar z = c.X(2, i);
+  const Scalar zeta = c.still ? Scalar(0) : ws.surface_elevation(i);
+  // (Below the surface φ = 1 without the ramp's arithmetic.)
+  const Scalar phi =
+      z + zeta >= Scalar(0) ? Scalar(1) : submerged_fraction(z, zeta, p.diameter, c.inv_d);
+  ws.submerged(i) = phi;
+  const bool wet = phi > Scalar(0);
+  // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
+  NodeConstants<Scalar> band;
+  const bool in_band = wet && phi < Scalar(1);
+  const NodeConstants<Scalar>& nc = in_band ? (band = c.kinds[kind].submerged(phi)) : c.kinds[kind];
+  // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
+  Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
+  V3 w = V3::Zero();
+  if (wet) {
+    f(2) += nc.wet_weight;
+    // Morison drag on the relative velocity, split along q.
+    const V3 vi(c.V(0, i), c.V(1, i), c.V(2, i));
+    const V3 vr = ws.water_velocity.col(i) - vi;
+    const Scalar vc = (vr(0) * chord(0) + vr(1) * chord(1)) + vr(2) * chord(2);  // = |c| v_q
+    const Scalar sc = vc * inv_c2;
+    const V3 vn = vr - sc * chord;
+    const Scalar vn_abs = sqrt((vn(0) * vn(0) + vn(1) * vn(1)) + vn(2) * vn(2));
+    const Scalar vq = vc * inv_c;
+    const Scalar kn = nc.kn, kt = nc.kt;
+    const Scalar dn = kn * vn_abs, dt = (kt * abs(vq)) * vq;
+    for (int k = 0; k < 3; ++k) f(k) += dn * vn(k) + dt * q(k);
+    if (!c.still) {
+      // Froude–Krylov plus added-mass forcing from the water acceleration.
+      const V3 aw = ws.water_acceleration.col(i);
+      const Scalar qa = (c.cat - c.can) * ((q(0) * aw(0) + q(1) * aw(1)) + q(2) * aw(2));
+      for (int k = 0; k < 3; ++k) f(k) += nc.rho_vol * ((Scalar(1) + c.can) * aw(k) + qa * q(k));
+    }
+    ws.mass_iso(i) = nc.mass_iso_wet;
+    ws.mass_tan(i) = nc.mass_tan_wet;
+    if (c.mass_turns) {
+      // Added-mass rate terms, written with w_r = u_water − v = −v_r (vr above; both factors
+      // of each term flip sign): G_i = b[(q̇·w_r) q + s q̇] and ∂T/∂x = ±b s P w_r/|c| with
+      // s = q·w_r = vq, P w_r = vn, q̇ = P (v_hi − v_lo)/|c|.
+      // With k = b/|c| and dc = v_hi − v_lo: G_i = k[s dc + (dc·vn − s q·dc) q], w = k s vn,
+      // which goes to node hi with a plus sign and to node lo with a minus sign.
+      const Scalar k = nc.mass_tan_wet * inv_c, ks = k * vq;
+      const V3 dc(c.V(0, hi) - c.V(0, lo), c.V(1, hi) - c.V(1, lo), c.V(2, hi) - c.V(2, lo));
+      const Scalar m = k * ((dc(0) * vn(0) + dc(1) * vn(1)) + dc(2) * vn(2)) -
+                       ks * ((q(0) * dc(0) + q(1) * dc(1)) + q(2) * dc(2));
+      for (int j = 0; j < 3; ++j) f(j) += ks * dc(j) + m * q(j);
+      w = ks * vn;
+    }
+    if constexpr (WithJacobian) {
+      // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ
+      // = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
+      const Scalar cn = vn_abs > Scalar(0) ? kn / vn_abs : Scalar(0);
+      const Scalar c31 = (Scalar(2) * kt) * abs(vq) - dn;
+      dv[0] = dn + c31 * q(0) * q(0) + cn * vn(0) * vn(0);
+      dv[1] = c31 * q(1) * q(0) + cn * vn(1) * vn(0);
+      dv[2] = c31 * q(2) * q(0) + cn * vn(2) * vn(0);
+      dv[3] = dn + c31 * q(1) * q(1) + cn * vn(1) * vn(1);
+      dv[4] = c31 * q(2) * q(1) + cn * vn(2) * vn(1);
+      dv[5] = dn + c31 * q(2) * q(2) + cn * vn(2) * vn(2);
+    }
+  } else {
+    f(2) += nc.dry_weight;
+    ws.mass_iso(i) = nc.mass_dry;
+    ws.mass_tan(i) = Scalar(0);
+  }
+  // Seabed: spring–damper normal force (never pulling) and saturated-viscous friction.
+  Scalar normal(0), kz(0);
+  const Scalar pen = z - c.bed;
+  if (pen > Scalar(0)) {
+    const Scalar vz = c.V(2, i);
+    const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
+    normal = (pen * c.bed_k + vz * c.bed_c * ramp) * li;
+    if (normal > Scalar(0)) {
+      f(2) -= normal;
+      kz = c.bed_k * li;
+      // The ramp's ∂/∂z while landing (ż > 0); left out when rising, where it is negative.
+      if (ramp < Scalar(1) && vz > Scalar(0)) kz += vz * c.bed_c * li / p.seabed_damping_depth;
+      if constexpr (WithJacobian) dv[5] += c.bed_c * ramp * li;
+      if (p.seabed_friction > Scalar(0)) {
+        const Scalar vx = c.V(0, i), vy = c.V(1, i);
+        const Scalar vh2 = vx * vx + vy * vy;
+        const Scalar vf = p.friction_velocity;
+        // The implicit steps hold the normal force of the start of the step (see
+        // TetherWorkspace::frozen_friction).
+        const Scalar fmax =
+            p.seabed_friction * (ws.frozen_friction ? ws.friction_normal(i) : normal);
+        const Scalar coef = vh2 > vf * vf ? fmax / sqrt(vh2) : fmax / vf;
+        f(0) -= coef * vx;
+        f(1) -= coef * vy;
+        if constexpr (WithJacobian) {
+          dv[0] += coef;
+          dv[3] += coef;
+        }
+      }
+    } else {
+      normal = Scalar(0);
+    }
+  }
+  ws.seabed_force(i) = normal;
+  // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
+  if (in_band) kz += c.kinds[kind].rho_vol * c.g / p.diameter;
+  if constexpr (WithJacobian) {
+    for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
+    ws.node_kz(i) = kz;
+  }
+  for (int k = 0; k < 3; ++k) {
+    ws.pass_buffer(i, kNodeForce + k) = f(k);
+    ws.pass_buffer(i, kMassRate + k) = w(k);
+  }
+}
+
+/// Node forces i … i + lanes − 1 into ws.force: the node pass's force plus the added-mass
+/// coupling of the neighbours (+w_{i−1} − w_{i+1}; at node 0 the node's own −w_0, at node N its
+/// own +w_N, as its chord is its own segment) and bending.
+template <bool Wide, typename Scalar>
+void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i) {
+  using P = simd::Pack<Scalar, Wide>;
+  Scalar* out = ws.force.data() + 3 * i;
+  for (int k = 0; k < 3; ++k) {
+    P f = P::load(&ws.pass_buffer(i, kNodeForce + k));
+    if (c.mass_turns) {
+      const Scalar* w = &ws.pass_buffer(0, kMassRate + k);
+      if constexpr (P::lanes == 1) {
+        const Scalar prev = i > 0 ? w[i - 1] : -w[0], next = i < c.n ? w[i + 1] : -w[c.n];
+        f = f + (P::all(prev) - P::all(next));
+      } else {
+        f = f + (P::load(w + i - 1) - P::load(w + i + 1));
+      }
+    }
+    if (c.bending) f += P::gather(ws.bending.data() + 3 * i + k, 3);
+    f.scatter(out + k, 3);
+  }
+}
+
+/// Bending forces into ws.bending from the segment pass (see compute_forces).
+template <typename Scalar>
+void bending_forces(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  using V3 = Vector3<Scalar>;
+  // E_i = k (1 − c), c = u_a·u_b, k = EI/l at interior node i between segment a (i−1) and b (i);
+  // F_{i−1} = −k (u_b − c u_a)/l_a, F_{i+1} = k (u_a − c u_b)/l_b, F_i = −F_{i−1} − F_{i+1}.
+  ws.bending.setZero();
+  const Scalar k = c.p->bending_stiffness * c.inv_l;
+  for (int i = 1; i < c.n; ++i) {
+    const Scalar la = ws.stretched_length(i - 1), lb = ws.stretched_length(i);
+    if (!(la > Scalar(0) && lb > Scalar(0))) continue;
+    const V3 ua = ws.direction.col(i - 1), ub = ws.direction.col(i);
+    const Scalar cs = ua.dot(ub);
+    const V3 fa = (-k / la) * (ub - cs * ua);
+    const V3 fb = (k / lb) * (ua - cs * ub);
+    ws.bending.col(i - 1) += fa;
+    ws.bending.col(i + 1) += fb;
+    ws.bending.col(i) -= fa + fb;
+  }
+}
+
+/// Points `data`/`stride` at the columns of `m` when it is column-major storage with unit inner
+/// stride; otherwise evaluates `m` into `copy` (sized by the workspace) and points at that.
+template <typename Scalar, typename D>
+void bind_columns(const Eigen::MatrixBase<D>& m, Matrix3X<Scalar>& copy, const Scalar*& data,
+                  Eigen::Index& stride) {
+  using M = typename D::PlainObject;
+  constexpr int flags = Eigen::internal::traits<D>::Flags;
+  if constexpr (bool(flags & Eigen::DirectAccessBit) && !bool(flags & Eigen::RowMajorBit) &&
+                std::is_same_v<typename M::Scalar, Scalar>) {
+    if (m.derived().innerStride() == 1) {
+      data = m.derived().data();
+      stride = m.derived().outerStride();
+      return;
+    }
+  }
+  copy = m;
+  data = copy.data();
+  stride = 3;
+}
+
+/// The passes of compute_forces on positions and velocities stored column-major with the given
+/// column strides.
+template <bool WithJacobian, typename Scalar>
+void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  constexpr bool wide = simd::vectorized<Scalar>;
+  constexpr int lanes = simd::Pack<Scalar, wide>::lanes;
+  const int n = c.n;
+  int s = 0;
+  if constexpr (wide)
+    for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, ws, s);
+  for (; s < n; ++s) segment_block<WithJacobian, false>(c, ws, s);
+  if (c.bending) bending_forces(c, ws);
+  node_general<WithJacobian>(c, ws, 0);
+  int i = 1;
+  if constexpr (wide)
+    for (; i + lanes <= n; i += lanes)
+      if (!interior_block<WithJacobian, true>(c, ws, i))
+        for (int j = i; j < i + lanes; ++j)
+          if (!interior_block<WithJacobian, false>(c, ws, j)) node_general<WithJacobian>(c, ws, j);
+  for (; i < n; ++i)
+    if (!interior_block<WithJacobian, false>(c, ws, i)) node_general<WithJacobian>(c, ws, i);
+  if (n > 0) node_general<WithJacobian>(c, ws, n);
+  finish_block<false>(c, ws, 0);
+  i = 1;
+  if constexpr (wide)
+    for (; i + lanes <= n; i += lanes) finish_block<true>(c, ws, i);
+  for (; i <= n; ++i) finish_block<false>(c, ws, i);
+}
+
+}  // namespace detail
+
 /// \brief Net force on every node of the tether at positions `x`, velocities `v`, time `t`.
 ///
 /// Fills `ws.force` (NED [N]) and the per-node mass matrices M_i = a_i I + b_i q_i q_iᵀ
@@ -578,22 +1017,36 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
 void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
-  using std::abs;
-  using std::sqrt;
-  using V3 = Vector3<Scalar>;
   const TetherParameters<Scalar>& p = model.parameters();
   const int n = model.segments();
-  const Scalar rho = Scalar(env.water_density());
-  const Scalar g = Scalar(env.gravity());
-  const Scalar bed = Scalar(env.seabed_depth());
-  const Scalar l = model.segment_length(), l2 = l * l, inv_l = model.inverse_segment_length();
-  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
-  const Scalar ea = p.axial_stiffness, ba = p.internal_damping;
+  detail::ForcePass<Scalar> c;
+  c.p = &p;
+  c.n = n;
+  c.rho = Scalar(env.water_density());
+  c.g = Scalar(env.gravity());
+  c.bed = Scalar(env.seabed_depth());
+  c.l = model.segment_length();
+  c.l2 = c.l * c.l;
+  c.inv_l = model.inverse_segment_length();
+  c.ea_l = model.axial_spring();
+  c.ba_l = model.axial_damper();
+  c.ea = p.axial_stiffness;
+  c.ba = p.internal_damping;
+  c.can = p.normal_added_mass;
+  c.cat = p.tangential_added_mass;
+  c.inv_d = Scalar(1) / p.diameter;
+  c.bed_k = p.seabed_stiffness * p.diameter;
+  c.bed_c = p.seabed_damping * p.diameter;
+  c.clamp = !p.compressive_damping;
+  c.damping = c.ba != Scalar(0);
+  c.bending = p.bending_stiffness > Scalar(0);
+  // Added-mass rate terms (see above); none when Cat = Can (b = 0).
+  c.mass_turns = c.cat != c.can;
 
   // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
   // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
-  const bool still = detail::is_still_water(env);
-  if (!still) {
+  c.still = detail::is_still_water(env);
+  if (!c.still) {
     if (!ws.water_frozen) {
       ws.water_is_zero = false;
       detail::sample_water_at_nodes(env, x, t, ws);
@@ -605,248 +1058,31 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
     ws.water_is_zero = true;
   }
 
-  // Segments: elastic tension EA·ε when stretched plus the internal dashpot BA·ε̇, which acts
-  // whether or not the segment is stretched, so that the axial force is continuous in the node
-  // positions (a dashpot switched on at l_s = l would make it jump, which Newton's method cannot
-  // handle); the sum is clamped at zero (a cable cannot push) unless compressive_damping. The
-  // clamp is a kink like the one of the elastic force at l_s = l; the implicit schemes' active
-  // set handles both (detail::active_set_direction). Returns T_s u_s.
-  const bool clamp = !p.compressive_damping;
-  const auto segment = [&](int s) -> V3 {
-    const V3 d = x.col(s + 1) - x.col(s);
-    const Scalar ls2 = d.squaredNorm();
-    const Scalar ls = sqrt(ls2);
-    ws.stretched_length(s) = ls;
-    Scalar tension(0), k_axial(0), c_axial(ba_l);
-    V3 u = V3::Zero();
-    if (ls > Scalar(0)) {
-      const Scalar inv_ls = Scalar(1) / ls;
-      u = d * inv_ls;
-      if (ls2 > l2) {
-        tension = ea * (ls - l) * inv_l;
-        k_axial = ea_l;
-      }
-      if (ba != Scalar(0)) {
-        const Scalar rate = u.dot(v.col(s + 1) - v.col(s));
-        if constexpr (WithJacobian) ws.seg_rate(s) = rate;
-        tension += ba * rate * inv_l;
-        if (clamp && !(tension > Scalar(0))) {
-          tension = Scalar(0);
-          k_axial = c_axial = Scalar(0);
-        }
-      } else if constexpr (WithJacobian) {
-        ws.seg_rate(s) = Scalar(0);
-      }
-      if constexpr (WithJacobian) {
-        // ∂(T u)/∂x_{s+1} = k_axial u uᵀ + (T/l_s)(I − u uᵀ); the geometric term is kept only for
-        // T > 0 so that the Jacobian stays positive semi-definite.
-        const Scalar k_perp = tension > Scalar(0) ? tension * inv_ls : Scalar(0);
-        ws.seg_k_uu(s) = k_axial - k_perp;
-        ws.seg_k_perp(s) = k_perp;
-      }
-    } else if constexpr (WithJacobian) {
-      ws.seg_k_uu(s) = ws.seg_k_perp(s) = ws.seg_rate(s) = Scalar(0);
-    }
-    ws.direction.col(s) = u;
-    ws.tension(s) = tension;
-    if constexpr (WithJacobian) ws.seg_c_uu(s) = c_axial;
-    return tension * u;
-  };
-
-  // Bending: E_i = k (1 − c), c = u_a·u_b, k = EI/l at interior node i between segment a (i−1)
-  // and b (i); F_{i−1} = −k (u_b − c u_a)/l_a, F_{i+1} = k (u_a − c u_b)/l_b, F_i = −F_{i−1} −
-  // F_{i+1}. It needs every segment first; without it the segments are computed inside the node
-  // loop (one pass over the line).
-  const bool bending = p.bending_stiffness > Scalar(0);
-  if (bending) {
-    for (int s = 0; s < n; ++s) segment(s);
-    ws.bending.setZero();
-    const Scalar k = p.bending_stiffness * inv_l;
-    for (int i = 1; i < n; ++i) {
-      const Scalar la = ws.stretched_length(i - 1), lb = ws.stretched_length(i);
-      if (!(la > Scalar(0) && lb > Scalar(0))) continue;
-      const V3 ua = ws.direction.col(i - 1), ub = ws.direction.col(i);
-      const Scalar c = ua.dot(ub);
-      const V3 fa = (-k / la) * (ub - c * ua);
-      const V3 fb = (k / lb) * (ua - c * ub);
-      ws.bending.col(i - 1) += fa;
-      ws.bending.col(i + 1) += fb;
-      ws.bending.col(i) -= fa + fb;
-    }
-  }
-
-  // Nodes. The interior nodes share their mass, volume and length; the constants of the three
-  // kinds of node (start, interior, end) are computed once per evaluation.
-  const Scalar half_rho_d = Scalar(0.5) * rho * p.diameter;
+  // The constants of the three kinds of node (start, interior, end), once per evaluation.
+  const Scalar half_rho_d = Scalar(0.5) * c.rho * p.diameter;
   const Scalar kn_per_l = half_rho_d * p.normal_drag;
   const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
-  const Scalar can = p.normal_added_mass, cat = p.tangential_added_mass;
-  const Scalar bed_k = p.seabed_stiffness * p.diameter, bed_c = p.seabed_damping * p.diameter;
-  struct NodeConstants {
-    Scalar li, dry_weight, wet_weight, rho_vol, kn, kt, mass_dry, mass_iso_wet, mass_tan_wet;
-    // The constants of a node with submerged fraction φ (fluid terms scaled by φ).
-    NodeConstants submerged(Scalar phi) const {
-      NodeConstants c = *this;
-      c.wet_weight = dry_weight + phi * (wet_weight - dry_weight);
-      c.rho_vol = phi * rho_vol;
-      c.kn = phi * kn;
-      c.kt = phi * kt;
-      c.mass_iso_wet = mass_dry + phi * (mass_iso_wet - mass_dry);
-      c.mass_tan_wet = phi * mass_tan_wet;
-      return c;
-    }
-  };
   const auto node_constants = [&](int i) {
     const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
-    return NodeConstants{li,
-                         m * g,
-                         (m - rho * vol) * g,
-                         rho * vol,
-                         kn_per_l * li,
-                         kt_per_l * li,
-                         m,
-                         m + rho * vol * can,
-                         rho * vol * (cat - can)};
+    return detail::NodeConstants<Scalar>{li,
+                                         m * c.g,
+                                         (m - c.rho * vol) * c.g,
+                                         c.rho * vol,
+                                         kn_per_l * li,
+                                         kt_per_l * li,
+                                         m,
+                                         m + c.rho * vol * c.can,
+                                         c.rho * vol * (c.cat - c.can)};
   };
-  const NodeConstants kinds[3] = {node_constants(0), node_constants(n > 1 ? 1 : 0),
-                                  node_constants(n)};
-  // Added-mass rate terms (see the function's documentation); none when Cat = Can (b = 0).
-  const bool mass_turns = cat != can;
-  const Scalar inv_d = Scalar(1) / p.diameter;
-  V3 tu_prev = V3::Zero();  // T_{i−1} u_{i−1}
-  V3 carry = V3::Zero();    // ∂T/∂x_{i} from node i − 1's tangent, added when node i is built
-  for (int i = 0; i <= n; ++i) {
-    // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends.
-    // The drag below is written with the unnormalised chord and 1/|c|² so that its square root
-    // and the tangent's run in parallel instead of one after the other.
-    const detail::NodeTangent<Scalar> nt = detail::node_tangent<Scalar>(x, i, n);
-    const V3& chord = nt.chord;
-    const Scalar inv_c2 = nt.inv_c2, inv_c = nt.inv_c;
-    const V3& q = nt.q;
-    ws.tangent.col(i) = q;
+  c.kinds[0] = node_constants(0);
+  c.kinds[1] = node_constants(n > 1 ? 1 : 0);
+  c.kinds[2] = node_constants(n);
 
-    V3 f;
-    if (i < n) {
-      const V3 tu = bending ? V3(ws.tension(i) * ws.direction.col(i)) : segment(i);
-      f = tu - tu_prev;
-      tu_prev = tu;
-    } else {
-      f = -tu_prev;
-    }
-    if (bending) f += ws.bending.col(i);
-    if (mass_turns) {
-      f += carry;
-      carry.setZero();
-    }
-
-    const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
-    const Scalar li = kinds[kind].li;
-    const Scalar zeta = still ? Scalar(0) : ws.surface_elevation(i);
-    // (Below the surface φ = 1 without the ramp's arithmetic.)
-    const Scalar phi = x(2, i) + zeta >= Scalar(0)
-                           ? Scalar(1)
-                           : detail::submerged_fraction(Scalar(x(2, i)), zeta, p.diameter, inv_d);
-    ws.submerged(i) = phi;
-    const bool wet = phi > Scalar(0);
-    // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
-    NodeConstants band;
-    const bool in_band = wet && phi < Scalar(1);
-    const NodeConstants& nc = in_band ? (band = kinds[kind].submerged(phi)) : kinds[kind];
-    // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
-    Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
-    if (wet) {
-      f(2) += nc.wet_weight;
-      // Morison drag on the relative velocity, split along q.
-      const V3 vr = ws.water_velocity.col(i) - v.col(i);
-      const Scalar vc = vr.dot(chord);  // = |c| v_q
-      const V3 vn = vr - (vc * inv_c2) * chord;
-      const Scalar vn_abs = sqrt(vn.squaredNorm());
-      const Scalar vq = vc * inv_c;
-      const Scalar kn = nc.kn, kt = nc.kt;
-      f += (kn * vn_abs) * vn + (kt * abs(vq) * vq) * q;
-      // Froude–Krylov plus added-mass forcing from the water acceleration.
-      const V3 aw = ws.water_acceleration.col(i);
-      if (!still && aw.squaredNorm() > Scalar(0))  // skipped in still water and steady current
-        f += nc.rho_vol * ((Scalar(1) + can) * aw + ((cat - can) * q.dot(aw)) * q);
-      ws.mass_iso(i) = nc.mass_iso_wet;
-      ws.mass_tan(i) = nc.mass_tan_wet;
-      if (mass_turns && inv_c > Scalar(0)) {
-        // Added-mass rate terms, written with w_r = u_water − v = −v_r (vr above; both factors
-        // of each term flip sign): G_i = b[(q̇·w_r) q + s q̇] and ∂T/∂x = ±b s P w_r/|c| with
-        // s = q·w_r = vq, P w_r = vn, q̇ = P (v_hi − v_lo)/|c|.
-        // With k = b/|c| and dc = v_hi − v_lo: G_i = k[s dc + (dc·vn − s q·dc) q], w = k s vn.
-        const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
-        const Scalar k = nc.mass_tan_wet * inv_c, ks = k * vq;
-        const V3 dc = v.col(hi) - v.col(lo);
-        f += ks * dc + (k * dc.dot(vn) - ks * q.dot(dc)) * q;
-        const V3 w = ks * vn;
-        if (hi == i)
-          f += w;
-        else
-          carry = w;
-        if (lo == i)
-          f -= w;
-        else
-          ws.force.col(lo) -= w;
-      }
-      if constexpr (WithJacobian) {
-        // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ
-        // = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
-        const Scalar c1 = kn * vn_abs, cn = vn_abs > Scalar(0) ? kn / vn_abs : Scalar(0);
-        const Scalar c31 = Scalar(2) * kt * abs(vq) - c1;
-        dv[0] = c1 + c31 * q(0) * q(0) + cn * vn(0) * vn(0);
-        dv[1] = c31 * q(1) * q(0) + cn * vn(1) * vn(0);
-        dv[2] = c31 * q(2) * q(0) + cn * vn(2) * vn(0);
-        dv[3] = c1 + c31 * q(1) * q(1) + cn * vn(1) * vn(1);
-        dv[4] = c31 * q(2) * q(1) + cn * vn(2) * vn(1);
-        dv[5] = c1 + c31 * q(2) * q(2) + cn * vn(2) * vn(2);
-      }
-    } else {
-      f(2) += nc.dry_weight;
-      ws.mass_iso(i) = nc.mass_dry;
-      ws.mass_tan(i) = Scalar(0);
-    }
-    // Seabed: spring–damper normal force (never pulling) and saturated-viscous friction.
-    Scalar normal(0), kz(0);
-    const Scalar pen = x(2, i) - bed;
-    if (pen > Scalar(0)) {
-      const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
-      normal = (pen * bed_k + v(2, i) * bed_c * ramp) * li;
-      if (normal > Scalar(0)) {
-        f(2) -= normal;
-        kz = bed_k * li;
-        // The ramp's ∂/∂z while landing (ż > 0); left out when rising, where it is negative.
-        if (ramp < Scalar(1) && v(2, i) > Scalar(0))
-          kz += v(2, i) * bed_c * li / p.seabed_damping_depth;
-        if constexpr (WithJacobian) dv[5] += bed_c * ramp * li;
-        if (p.seabed_friction > Scalar(0)) {
-          const Scalar vh2 = v(0, i) * v(0, i) + v(1, i) * v(1, i);
-          const Scalar vf = p.friction_velocity;
-          // The implicit steps hold the normal force of the start of the step (see
-          // TetherWorkspace::frozen_friction).
-          const Scalar fmax =
-              p.seabed_friction * (ws.frozen_friction ? ws.friction_normal(i) : normal);
-          const Scalar coef = vh2 > vf * vf ? fmax / sqrt(vh2) : fmax / vf;
-          f(0) -= coef * v(0, i);
-          f(1) -= coef * v(1, i);
-          if constexpr (WithJacobian) {
-            dv[0] += coef;
-            dv[3] += coef;
-          }
-        }
-      } else {
-        normal = Scalar(0);
-      }
-    }
-    ws.seabed_force(i) = normal;
-    // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
-    if (in_band) kz += kinds[kind].rho_vol * g / p.diameter;
-    if constexpr (WithJacobian) {
-      for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
-      ws.node_kz(i) = kz;
-    }
-    ws.force.col(i) = f;
-  }
+  // The passes read the coordinates through a pointer and a column stride: straight from
+  // column-major storage, or from a copy of any other expression.
+  detail::bind_columns(x, ws.x_eval, c.x, c.xs);
+  detail::bind_columns(v, ws.v_eval, c.v, c.vs);
+  detail::force_passes<WithJacobian>(c, ws);
 }
 
 /// \brief Node accelerations a_i = M_i⁻¹ F_i from the last `compute_forces` (free nodes only;
