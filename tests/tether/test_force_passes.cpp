@@ -152,6 +152,9 @@ void compare(const Case<Scalar>& c, double tol, bool frozen_friction, bool as_ex
   CHECK(field_error(a.tangent, b.tangent) <= tol);
   CHECK(field_error(a.mass_iso, b.mass_iso) <= tol);
   CHECK(field_error(a.mass_tan, b.mass_tan) <= tol);
+  // The inverse mass terms the integrators use (the reference did not store them).
+  CHECK(field_error(a.mass_iso_inv, b.mass_iso.cwiseInverse()) <= tol);
+  CHECK(field_error(a.mass_tan_ratio, b.mass_tan.cwiseQuotient(b.mass_iso + b.mass_tan)) <= tol);
   CHECK(field_error(a.submerged, b.submerged) <= tol);
   CHECK(field_error(a.seabed_force, b.seabed_force) <= tol);
   CHECK(field_error(a.direction, b.direction) <= tol);

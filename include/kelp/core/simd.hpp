@@ -23,15 +23,37 @@ namespace kelp::simd {
 
 /// \brief True when Eigen vectorises `Scalar` with the current compiler flags.
 template <typename Scalar>
-constexpr bool vectorized = Eigen::internal::packet_traits<Scalar>::Vectorizable&&
-                                Eigen::internal::packet_traits<Scalar>::size > 1;
+constexpr bool vectorized = bool(Eigen::internal::packet_traits<Scalar>::Vectorizable) &&
+                            (Eigen::internal::packet_traits<Scalar>::size > 1);
 
-/// \brief `Lanes` values of `Scalar` processed together: the widest Eigen packet when
-/// `Wide`, a plain scalar otherwise (the same code then handles remainders and odd cases).
+namespace detail {
+/// Packets of at most 32 bytes: the kernels gather their operands from 3-component columns, and
+/// 64-byte (AVX-512) gathers cost more than the wider arithmetic saves (measured: a tether force
+/// evaluation about 2× slower with 8 doubles per packet than with 4).
+template <typename P, bool = (sizeof(P) > 32)>
+struct AtMost32Bytes {
+  using type = P;
+};
+template <typename P>
+struct AtMost32Bytes<P, true> {
+  using type = typename AtMost32Bytes<typename Eigen::internal::unpacket_traits<P>::half>::type;
+};
+template <typename Scalar, bool Wide>
+struct RawPack {
+  using type = Scalar;
+};
+template <typename Scalar>
+struct RawPack<Scalar, true> {
+  using type = typename AtMost32Bytes<typename Eigen::internal::packet_traits<Scalar>::type>::type;
+};
+}  // namespace detail
+
+/// \brief `Lanes` values of `Scalar` processed together: the widest Eigen packet of at most 32
+/// bytes when `Wide`, a plain scalar otherwise (the same code then handles remainders and odd
+/// cases).
 template <typename Scalar, bool Wide>
 struct Pack {
-  using Raw = std::conditional_t<Wide && vectorized<Scalar>,
-                                 typename Eigen::internal::packet_traits<Scalar>::type, Scalar>;
+  using Raw = typename detail::RawPack<Scalar, Wide && vectorized<Scalar>>::type;
   static constexpr int lanes = Eigen::internal::unpacket_traits<Raw>::size;
   Raw r;
 

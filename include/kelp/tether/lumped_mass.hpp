@@ -355,7 +355,9 @@ struct TetherWorkspace {
   Matrix3X<Scalar> bending;             ///< bending force on each node (when EI > 0) [N]
   VectorX<Scalar> mass_iso;             ///< a_i: M_i = a_i I + b_i q qᵀ [kg]
   VectorX<Scalar> mass_tan;             ///< b_i [kg]
-  VectorX<Scalar> seabed_force;         ///< upward normal seabed contact force on node i [N]
+  VectorX<Scalar> mass_iso_inv;         ///< 1/a_i [1/kg]
+  VectorX<Scalar> mass_tan_ratio;  ///< b_i/(a_i + b_i): M_i⁻¹ = (I − (b/(a+b)) q qᵀ)/a [-]
+  VectorX<Scalar> seabed_force;    ///< upward normal seabed contact force on node i [N]
   /// Seabed normal force that sets the friction limit μ_f N when `frozen_friction` [N]
   VectorX<Scalar> friction_normal;
   /// Set by the implicit steps for the duration of their Newton iteration: the friction limit
@@ -426,8 +428,8 @@ struct TetherWorkspace {
          {&force, &bending, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs,
           &delta, &x0, &v0, &x1, &v1, &xs, &vs, &x_eval, &v_eval})
       m->setZero(3, n);
-    for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &seabed_force, &friction_normal, &submerged,
-                               &node_kz, &surface_elevation})
+    for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &mass_iso_inv, &mass_tan_ratio, &seabed_force,
+                               &friction_normal, &submerged, &node_kz, &surface_elevation})
       v->setZero(n);
     direction.setZero(3, s);
     rhs_true.setZero(3, n);
@@ -597,13 +599,48 @@ struct ForcePass {
 /// Columns of TetherWorkspace::pass_buffer.
 enum PassColumn : int { kSegmentForce = 0, kNodeForce = 3, kMassRate = 6 };
 
+/// ForcePass constants broadcast to every lane once per evaluation (the kernels run in loops
+/// that would otherwise broadcast them block after block).
+template <typename Scalar, bool Wide>
+struct PackedConstants {
+  using P = simd::Pack<Scalar, Wide>;
+  P zero, one, two, l, l2, inv_l, ea, ea_l, ba, ba_l, bed, wet_weight, kn, kt, rho_vol,
+      one_plus_can, cat_minus_can, mass_iso_wet, mass_tan_wet, mass_iso_inv, mass_tan_ratio;
+  explicit PackedConstants(const ForcePass<Scalar>& c) {
+    const NodeConstants<Scalar>& nc = c.kinds[1];
+    zero = P::all(Scalar(0));
+    one = P::all(Scalar(1));
+    two = P::all(Scalar(2));
+    l = P::all(c.l);
+    l2 = P::all(c.l2);
+    inv_l = P::all(c.inv_l);
+    ea = P::all(c.ea);
+    ea_l = P::all(c.ea_l);
+    ba = P::all(c.ba);
+    ba_l = P::all(c.ba_l);
+    bed = P::all(c.bed);
+    wet_weight = P::all(nc.wet_weight);
+    kn = P::all(nc.kn);
+    kt = P::all(nc.kt);
+    rho_vol = P::all(nc.rho_vol);
+    one_plus_can = P::all(Scalar(1) + c.can);
+    cat_minus_can = P::all(c.cat - c.can);
+    mass_iso_wet = P::all(nc.mass_iso_wet);
+    mass_tan_wet = P::all(nc.mass_tan_wet);
+    mass_iso_inv = P::all(Scalar(1) / nc.mass_iso_wet);
+    mass_tan_ratio = P::all(nc.mass_tan_wet / (nc.mass_iso_wet + nc.mass_tan_wet));
+  }
+};
+
 /// Segments s … s + lanes − 1 (see compute_forces): length, direction, axial force T_s (elastic
 /// EA·ε when stretched plus the dashpot BA·ε̇ at any length, clamped at zero unless
 /// compressive_damping), T_s u_s into the pass buffer, and the Jacobian terms.
 template <bool WithJacobian, bool Wide, typename Scalar>
-void segment_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int s) {
+EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
+                                       const PackedConstants<Scalar, Wide>& pc,
+                                       TetherWorkspace<Scalar>& ws, int s) {
   using P = simd::Pack<Scalar, Wide>;
-  const P zero = P::all(Scalar(0));
+  const P zero = pc.zero;
   const Scalar* a = c.x + s * c.xs;
   const P d0 = P::gather(a + c.xs, c.xs) - P::gather(a, c.xs);
   const P d1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a + 1, c.xs);
@@ -611,12 +648,12 @@ void segment_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int 
   const P ls2 = (d0 * d0 + d1 * d1) + d2 * d2;
   const P ls = sqrt(ls2);
   const auto positive = simd::greater(ls, zero);
-  const P inv_ls = simd::select(positive, P::all(Scalar(1)) / ls, zero);
+  const P inv_ls = simd::select(positive, pc.one / ls, zero);
   const P u0 = d0 * inv_ls, u1 = d1 * inv_ls, u2 = d2 * inv_ls;
-  const auto stretched = simd::greater(ls2, P::all(c.l2));
-  P tension = simd::select(stretched, (P::all(c.ea) * (ls - P::all(c.l))) * P::all(c.inv_l), zero);
-  P k_axial = simd::select(stretched, P::all(c.ea_l), zero);
-  P c_axial = P::all(c.ba_l);
+  const auto stretched = simd::greater(ls2, pc.l2);
+  P tension = simd::select(stretched, (pc.ea * (ls - pc.l)) * pc.inv_l, zero);
+  P k_axial = simd::select(stretched, pc.ea_l, zero);
+  P c_axial = pc.ba_l;
   P rate = zero;
   if (c.damping) {
     const Scalar* b = c.v + s * c.vs;
@@ -624,7 +661,7 @@ void segment_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int 
     const P e1 = P::gather(b + c.vs + 1, c.vs) - P::gather(b + 1, c.vs);
     const P e2 = P::gather(b + c.vs + 2, c.vs) - P::gather(b + 2, c.vs);
     rate = (u0 * e0 + u1 * e1) + u2 * e2;
-    tension += (P::all(c.ba) * rate) * P::all(c.inv_l);
+    tension += (pc.ba * rate) * pc.inv_l;
     if (c.clamp) {
       // A zero-length segment keeps its dashpot slope (its force is zero either way).
       const auto keep = simd::greater(tension, zero);
@@ -658,24 +695,24 @@ void segment_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int 
 /// force without the added-mass coupling to the neighbours, that coupling term w_i, masses and
 /// the Jacobian terms. The same arithmetic as node_general for such nodes.
 template <bool WithJacobian, bool Wide, typename Scalar>
-bool interior_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i) {
+EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
+                                        const PackedConstants<Scalar, Wide>& pc,
+                                        TetherWorkspace<Scalar>& ws, int i) {
   using P = simd::Pack<Scalar, Wide>;
-  const P zero = P::all(Scalar(0));
+  const P zero = pc.zero;
   const Scalar* a = c.x + i * c.xs;
   const P z = P::gather(a + 2, c.xs);
   if (c.still) {
-    if (simd::any(simd::less(z, zero) || simd::greater(z - P::all(c.bed), zero))) return false;
+    if (simd::any(simd::less(z, zero) || simd::greater(z - pc.bed, zero))) return false;
   } else {
     const P zeta = P::load(&ws.surface_elevation(i));
-    if (simd::any(simd::less(z + zeta, zero) || simd::greater(z - P::all(c.bed), zero)))
-      return false;
+    if (simd::any(simd::less(z + zeta, zero) || simd::greater(z - pc.bed, zero))) return false;
   }
-  const NodeConstants<Scalar>& nc = c.kinds[1];
   const P c0 = P::gather(a + c.xs, c.xs) - P::gather(a - c.xs, c.xs);
   const P c1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a - c.xs + 1, c.xs);
   const P c2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a - c.xs + 2, c.xs);
   const P cc = (c0 * c0 + c1 * c1) + c2 * c2;
-  const P inv_c2 = simd::select(simd::greater(cc, zero), P::all(Scalar(1)) / cc, zero);
+  const P inv_c2 = simd::select(simd::greater(cc, zero), pc.one / cc, zero);
   const P inv_c = sqrt(inv_c2);
   const P q0 = c0 * inv_c, q1 = c1 * inv_c, q2 = c2 * inv_c;
   Scalar* tan = ws.tangent.data() + 3 * i;
@@ -687,7 +724,7 @@ bool interior_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int
   P f0 = P::load(tu) - P::load(tu - 1);
   P f1 = P::load(tu + col) - P::load(tu + col - 1);
   P f2 = P::load(tu + 2 * col) - P::load(tu + 2 * col - 1);
-  f2 += P::all(nc.wet_weight);
+  f2 += pc.wet_weight;
   // Morison drag on the relative velocity, split along the chord.
   const Scalar* vi = c.v + i * c.vs;
   const Scalar* wi = ws.water_velocity.data() + 3 * i;
@@ -699,7 +736,7 @@ bool interior_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int
   const P vn0 = vr0 - sc * c0, vn1 = vr1 - sc * c1, vn2 = vr2 - sc * c2;
   const P vn_abs = sqrt((vn0 * vn0 + vn1 * vn1) + vn2 * vn2);
   const P vq = vc * inv_c;
-  const P kn = P::all(nc.kn), kt = P::all(nc.kt);
+  const P kn = pc.kn, kt = pc.kt;
   const P dn = kn * vn_abs, dt = (kt * abs(vq)) * vq;
   f0 += dn * vn0 + dt * q0;
   f1 += dn * vn1 + dt * q1;
@@ -708,17 +745,19 @@ bool interior_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int
     // Froude–Krylov plus added-mass forcing (zero where the water does not accelerate).
     const Scalar* ai = ws.water_acceleration.data() + 3 * i;
     const P aw0 = P::gather(ai, 3), aw1 = P::gather(ai + 1, 3), aw2 = P::gather(ai + 2, 3);
-    const P qa = P::all(c.cat - c.can) * ((q0 * aw0 + q1 * aw1) + q2 * aw2);
-    const P rv = P::all(nc.rho_vol), ca = P::all(Scalar(1) + c.can);
+    const P qa = pc.cat_minus_can * ((q0 * aw0 + q1 * aw1) + q2 * aw2);
+    const P rv = pc.rho_vol, ca = pc.one_plus_can;
     f0 += rv * (ca * aw0 + qa * q0);
     f1 += rv * (ca * aw1 + qa * q1);
     f2 += rv * (ca * aw2 + qa * q2);
   }
-  P::all(nc.mass_iso_wet).store(&ws.mass_iso(i));
-  P::all(nc.mass_tan_wet).store(&ws.mass_tan(i));
+  pc.mass_iso_wet.store(&ws.mass_iso(i));
+  pc.mass_tan_wet.store(&ws.mass_tan(i));
+  pc.mass_iso_inv.store(&ws.mass_iso_inv(i));
+  pc.mass_tan_ratio.store(&ws.mass_tan_ratio(i));
   if (c.mass_turns) {
     // Added-mass rate terms (see compute_forces; zero for a zero chord, where 1/|c| = 0).
-    const P k = P::all(nc.mass_tan_wet) * inv_c, ks = k * vq;
+    const P k = pc.mass_tan_wet * inv_c, ks = k * vq;
     const P dc0 = P::gather(vi + c.vs, c.vs) - P::gather(vi - c.vs, c.vs);
     const P dc1 = P::gather(vi + c.vs + 1, c.vs) - P::gather(vi - c.vs + 1, c.vs);
     const P dc2 = P::gather(vi + c.vs + 2, c.vs) - P::gather(vi - c.vs + 2, c.vs);
@@ -733,12 +772,12 @@ bool interior_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int
   f0.store(&ws.pass_buffer(i, kNodeForce));
   f1.store(&ws.pass_buffer(i, kNodeForce + 1));
   f2.store(&ws.pass_buffer(i, kNodeForce + 2));
-  P::all(Scalar(1)).store(&ws.submerged(i));
+  pc.one.store(&ws.submerged(i));
   zero.store(&ws.seabed_force(i));
   if constexpr (WithJacobian) {
     // −∂F/∂v of the drag (q held fixed) = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
     const P cn = simd::select(simd::greater(vn_abs, zero), kn / vn_abs, zero);
-    const P c31 = (P::all(Scalar(2)) * kt) * abs(vq) - dn;
+    const P c31 = (pc.two * kt) * abs(vq) - dn;
     Scalar* dv = ws.node_dv.data() + 6 * i;
     (dn + c31 * q0 * q0 + cn * vn0 * vn0).scatter(dv, 6);
     (c31 * q1 * q0 + cn * vn1 * vn0).scatter(dv + 1, 6);
@@ -878,6 +917,8 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
     }
   }
   ws.seabed_force(i) = normal;
+  ws.mass_iso_inv(i) = Scalar(1) / ws.mass_iso(i);
+  ws.mass_tan_ratio(i) = ws.mass_tan(i) / (ws.mass_iso(i) + ws.mass_tan(i));
   // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
   if (in_band) kz += c.kinds[kind].rho_vol * c.g / p.diameter;
   if constexpr (WithJacobian) {
@@ -894,7 +935,8 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
 /// coupling of the neighbours (+w_{i−1} − w_{i+1}; at node 0 the node's own −w_0, at node N its
 /// own +w_N, as its chord is its own segment) and bending.
 template <bool Wide, typename Scalar>
-void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i) {
+EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws,
+                                      int i) {
   using P = simd::Pack<Scalar, Wide>;
   Scalar* out = ws.force.data() + 3 * i;
   for (int k = 0; k < 3; ++k) {
@@ -961,20 +1003,24 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   constexpr bool wide = simd::vectorized<Scalar>;
   constexpr int lanes = simd::Pack<Scalar, wide>::lanes;
   const int n = c.n;
+  const PackedConstants<Scalar, wide> packed(c);
+  const PackedConstants<Scalar, false> single(c);
   int s = 0;
   if constexpr (wide)
-    for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, ws, s);
-  for (; s < n; ++s) segment_block<WithJacobian, false>(c, ws, s);
+    for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, packed, ws, s);
+  for (; s < n; ++s) segment_block<WithJacobian, false>(c, single, ws, s);
   if (c.bending) bending_forces(c, ws);
   node_general<WithJacobian>(c, ws, 0);
   int i = 1;
   if constexpr (wide)
     for (; i + lanes <= n; i += lanes)
-      if (!interior_block<WithJacobian, true>(c, ws, i))
+      if (!interior_block<WithJacobian, true>(c, packed, ws, i))
         for (int j = i; j < i + lanes; ++j)
-          if (!interior_block<WithJacobian, false>(c, ws, j)) node_general<WithJacobian>(c, ws, j);
+          if (!interior_block<WithJacobian, false>(c, single, ws, j))
+            node_general<WithJacobian>(c, ws, j);
   for (; i < n; ++i)
-    if (!interior_block<WithJacobian, false>(c, ws, i)) node_general<WithJacobian>(c, ws, i);
+    if (!interior_block<WithJacobian, false>(c, single, ws, i))
+      node_general<WithJacobian>(c, ws, i);
   if (n > 0) node_general<WithJacobian>(c, ws, n);
   finish_block<false>(c, ws, 0);
   i = 1;
@@ -1088,17 +1134,17 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
 /// \brief Node accelerations a_i = M_i⁻¹ F_i from the last `compute_forces` (free nodes only;
 /// kinematic ends get the prescribed acceleration `a_start`, `a_end`).
 ///
-/// M_i = a I + b q qᵀ is inverted in closed form: M⁻¹ F = (F − b/(a+b) q (q·F)) / a.
+/// M_i = a I + b q qᵀ is inverted in closed form: M⁻¹ F = (F − b/(a+b) q (q·F)) / a, with
+/// 1/a and b/(a+b) from compute_forces (constants along the wet part of the line).
 template <typename Scalar, typename DA>
 void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                                const Vector3<Scalar>& a_start, const Vector3<Scalar>& a_end,
                                Eigen::MatrixBase<DA>& acc) {
   const int n = model.segments();
   for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
-    const Scalar a = ws.mass_iso(i), b = ws.mass_tan(i);
     const auto q = ws.tangent.col(i);
     const auto f = ws.force.col(i);
-    acc.col(i) = (f - (b / (a + b) * q.dot(f)) * q) / a;
+    acc.col(i) = (f - (ws.mass_tan_ratio(i) * q.dot(f)) * q) * ws.mass_iso_inv(i);
   }
   if (model.first_free_node() == 1) acc.col(0) = a_start;
   if (model.last_free_node() == n - 1) acc.col(n) = a_end;
