@@ -15,7 +15,8 @@
 //
 // Per N and round r (r = 0..R-1), in this order: MoorDyn RK4 (one MoorDyn_Step per dtM),
 // MoorDyn RK4 (one MoorDyn_Step per ~10 ms coupling interval, K internal dtM steps), kelp RK4
-// at dt, kelp bare compute_forces, kelp BDF2 at 10 ms. Each measurement runs >= min_time of wall
+// at dt, kelp bare compute_forces (without and with the Jacobian terms), kelp BDF2 at 10 ms (Newton
+// to tolerance, then one unchecked correction per step). Each measurement runs >= min_time of wall
 // clock (steady_clock); thread CPU time is recorded as well.
 #include <fcntl.h>
 #include <moordyn/MoorDyn2.h>
@@ -81,10 +82,19 @@ Timing run_for(double min_time, long batch, F&& body) {
 // The benchmark line in kelp, with a step at the current time.
 struct Kelp : kelp_bench::BenchmarkLine {
   using BenchmarkLine::BenchmarkLine;
-  void step(double dt, kt::Integrator integ) {
-    kt::step(model, ws, env, state, boundary(state.time), dt, integ);
+  void step(double dt, kt::Integrator integ, const kt::ImplicitOptionsd& o = {}) {
+    kt::step(model, ws, env, state, boundary(state.time), dt, integ, o);
   }
 };
+
+// BDF2 with one unchecked Newton correction per step (linearly implicit; see
+// kt::ImplicitOptions::check_convergence).
+kt::ImplicitOptionsd one_newton() {
+  kt::ImplicitOptionsd o;
+  o.max_iterations = 1;
+  o.check_convergence = false;
+  return o;
+}
 
 // ---------------------------------------------------------------------------------------------
 struct Md {
@@ -237,10 +247,12 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     k.state.velocity.col(i) = m.node_vel_ned(i);
   }
   k.state.clear_history();
-  Kelp kb(n);
-  kb.state.position = k.state.position;
-  kb.state.velocity = k.state.velocity;
+  Kelp kb(n), k1(n);
+  kb.state.position = k1.state.position = k.state.position;
+  kb.state.velocity = k1.state.velocity = k.state.velocity;
   kb.state.clear_history();
+  k1.state.clear_history();
+  double se1 = 0;
   const long K = std::lround(0.01 / dt);
   const long steps = std::lround(T / (K * dt)) * K;
   const int seg = n - 2;
@@ -255,8 +267,10 @@ void agreement(int n, double dt, const std::string& dir, double T) {
       dmax_run = std::max(dmax_run, (m.node_ned(i) - k.state.position.col(i)).norm());
     if (s % K == 0) {
       kb.step(K * dt, kt::Integrator::bdf2);
-      const double tb = ten(kp(kb), seg);
+      k1.step(K * dt, kt::Integrator::bdf2, one_newton());
+      const double tb = ten(kp(kb), seg), t1 = ten(kp(k1), seg);
       se2 += (tm - tb) * (tm - tb);
+      se1 += (tm - t1) * (tm - t1);
       sref2 += tm * tm;
     }
   }
@@ -273,6 +287,10 @@ void agreement(int n, double dt, const std::string& dir, double T) {
       "  N=%3d kelp BDF2 at %.3f ms vs MoorDyn RK4 at dt, sampled every %ld steps: RMS "
       "segment-%d force difference %.2e of RMS force\n",
       n, K * dt * 1e3, K, seg, std::sqrt(se2 / sref2));
+  std::printf(
+      "  N=%3d kelp BDF2 one Newton correction at %.3f ms vs MoorDyn RK4 at dt: RMS segment-%d "
+      "force difference %.2e of RMS force\n",
+      n, K * dt * 1e3, seg, std::sqrt(se1 / sref2));
   // MoorDyn RK4 and kelp RK4 at kelp's own RK4 dt (estimate_stable_dt, 0.8 of the Gershgorin
   // bound), from the same start: is MoorDyn stable there, and do the two still agree?
   {
@@ -370,7 +388,7 @@ int main(int argc, char** argv) {
   struct Sum {
     int n;
     double dt, dt_kelp;
-    Row md, mdc, krk4, kforce, kbdf2, krk4own;
+    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf21, krk4own;
   };
   std::vector<Sum> sums;
   for (int n : sizes) {
@@ -382,7 +400,8 @@ int main(int argc, char** argv) {
     S.dt = dt;
     Md md(n, dt, dir);
     Md mdc(n, dt, dir);
-    Kelp krk(n), kf(n), kbd(n), kown(n);
+    Kelp krk(n), kf(n), kbd(n), kbd1(n), kown(n);
+    const kt::ImplicitOptionsd once = one_newton();
     S.dt_kelp = kt::estimate_stable_dt(kown.model, kt::Integrator::rk4, kown.env.water_density());
     const double nodes = n + 1;
     auto record = [&](const char* name, Row& row, int r, const Timing& t, double evals_per_iter,
@@ -412,6 +431,12 @@ int main(int argc, char** argv) {
         asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
       });
       record("kelp_forces", S.kforce, r, t, 1, 0, 0);
+      t = run_for(min_time, 256, [&] {
+        kt::compute_forces<true>(kf.model, kf.ws, kf.env, 0.0, kf.state.position,
+                                 kf.state.velocity);
+        asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
+      });
+      record("kelp_forces_jacobian", S.kforcej, r, t, 1, 0, 0);
       long evb = 0;
       t = run_for(min_time, 16, [&] {
         evb += kt::step(kbd.model, kbd.ws, kbd.env, kbd.state, kbd.boundary(kbd.state.time), 0.01,
@@ -419,6 +444,8 @@ int main(int argc, char** argv) {
                    .force_evaluations;
       });
       record("kelp_bdf2_10ms", S.kbdf2, r, t, double(evb) / t.iters, 0.01, 0.01);
+      t = run_for(min_time, 16, [&] { kbd1.step(0.01, kt::Integrator::bdf2, once); });
+      record("kelp_bdf2_one_newton_10ms", S.kbdf21, r, t, 1, 0.01, 0.01);
       t = run_for(min_time, 64, [&] { kown.step(S.dt_kelp, kt::Integrator::rk4); });
       record("kelp_rk4_own_dt", S.krk4own, r, t, 4, S.dt_kelp, S.dt_kelp);
     }
@@ -451,10 +478,19 @@ int main(int argc, char** argv) {
     std::printf("  kelp RK4 (same dt)          ns/node/eval %s  RTF %s\n", ns(S.krk4).c_str(),
                 rtf(S.krk4).c_str());
     std::printf("  kelp compute_forces         ns/node      %s\n", ns(S.kforce).c_str());
+    std::printf("  kelp compute_forces<true>   ns/node      %s\n", ns(S.kforcej).c_str());
     std::printf("  kelp BDF2 10 ms             ns/node/eval %s  RTF %s\n", ns(S.kbdf2).c_str(),
                 rtf(S.kbdf2).c_str());
+    std::printf("  kelp BDF2 one Newton 10 ms  ns/node/eval %s  RTF %s\n", ns(S.kbdf21).c_str(),
+                rtf(S.kbdf21).c_str());
     std::printf("  kelp RK4 (own dt)           ns/node/eval %s  RTF %s\n", ns(S.krk4own).c_str(),
                 rtf(S.krk4own).c_str());
+    // Ratios of the minima (wall clock) and of the medians, measured in this run.
+    std::printf(
+        "  ratios MoorDyn/kelp: force evaluation %.2f (min) %.2f (median); RK4 real-time factor "
+        "%.2f (max) %.2f (median)\n",
+        minv(S.md.ns_w) / minv(S.kforce.ns_w), median(S.md.ns_w) / median(S.kforce.ns_w),
+        maxv(S.krk4.rtf_w) / maxv(S.md.rtf_w), median(S.krk4.rtf_w) / median(S.md.rtf_w));
   }
   return 0;
 }

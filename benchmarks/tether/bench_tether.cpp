@@ -86,3 +86,32 @@ BENCHMARK_CAPTURE(BM_TetherStep, implicit_euler, kt::Integrator::implicit_euler)
 BENCHMARK_CAPTURE(BM_TetherStep, bdf2, kt::Integrator::bdf2)->Apply(sizes);
 // One unchecked Newton correction per step (ImplicitOptions::check_convergence = false).
 BENCHMARK_CAPTURE(BM_TetherStep, bdf2_one_newton, kt::Integrator::bdf2, true)->Apply(sizes);
+
+namespace {
+
+// BM_BlockSolve/<N>: one block-tridiagonal Newton solve (kt::detail::solve_block_tridiagonal) on
+// the benchmark line's Jacobian after 20 BDF2 steps at 10 ms (c_m = 1, c_v = γh, c_x = (γh)²,
+// γ = 2/3). ns_per_node = time / free nodes.
+void BM_BlockSolve(benchmark::State& st) {
+  const int n = static_cast<int>(st.range(0));
+  Setup s(n);
+  const double dt = 0.01, gh = 2.0 / 3.0 * dt;
+  for (int k = 0; k < 20; ++k)
+    kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, kt::Integrator::bdf2);
+  kt::compute_forces<true>(s.model, s.ws, s.env, s.state.time, s.state.position, s.state.velocity);
+  for (int i = 0; i < s.model.nodes(); ++i)
+    s.ws.rhs.col(i) = Vector3<double>(std::cos(i), 1.0, std::sin(0.5 * i));
+  for (auto _ : st) {
+    kt::detail::solve_block_tridiagonal(s.model, s.ws, 1.0, gh, gh * gh);
+    benchmark::DoNotOptimize(s.ws.delta.data());
+    benchmark::ClobberMemory();
+  }
+  const int free_nodes = s.model.last_free_node() - s.model.first_free_node() + 1;
+  st.counters["ns_per_node"] =
+      benchmark::Counter(1e-9 * static_cast<double>(st.iterations()) * free_nodes,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+}  // namespace
+
+BENCHMARK(BM_BlockSolve)->Arg(20)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kNanosecond);

@@ -105,6 +105,27 @@ struct Pack {
       return Pack(Eigen::internal::psqrt(a.r));
     }
   }
+  /// Lane-wise maximum (the second operand where either is NaN, as SSE's maxpd).
+  friend Pack max(Pack a, Pack b) {
+    if constexpr (lanes == 1)
+      return Pack(a.r > b.r ? a.r : b.r);
+    else
+      return Pack(Eigen::internal::pmax(a.r, b.r));
+  }
+  /// Sum of the lanes.
+  Scalar sum() const {
+    if constexpr (lanes == 1)
+      return r;
+    else
+      return Eigen::internal::predux(r);
+  }
+  /// Largest lane.
+  Scalar max_lane() const {
+    if constexpr (lanes == 1)
+      return r;
+    else
+      return Eigen::internal::predux_max(r);
+  }
   friend Pack abs(Pack a) {
     if constexpr (lanes == 1) {
       using std::abs;

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -146,127 +147,331 @@ Matrix3<Scalar> segment_block(const TetherWorkspace<Scalar>& ws, int s, Scalar c
   return a;
 }
 
-/// Solves J δ = rhs over the free nodes, J = c_m M + c_v (−∂F/∂v) + c_x (−∂F/∂x), block
-/// tridiagonal and symmetric positive definite, by block-Thomas elimination (block LDLᵀ). The
-/// off-diagonal block of segment s is −A_s with A_s = α_s u uᵀ + β_s I (α = c_v BA/l + c_x k_uu,
-/// β = c_x k_perp), so the Schur complements D'_i = D_i − A_{i−1} D'⁻¹_{i−1} A_{i−1} and the
-/// back substitution δ_i = z_i + D'⁻¹_i A_i δ_{i+1} are written with symmetric 3×3 algebra
-/// (6 stored entries). Each D'_i is factored as L D Lᵀ (3×3, no pivoting). In exact arithmetic
-/// every pivot is at least λ_min(J) ≥ c_m · min_node_mass (J − c_m M is positive semi-definite);
-/// a computed pivot below half that bound is round-off (e.g. (γh)² EA/l ≫ M at a very large
-/// step, or a very short segment) and is raised to it, which keeps the factor positive definite
-/// and the direction a descent direction for the line search. Reads the Jacobian ingredients of
-/// the last compute_forces<true>; writes ws.delta (and ws.block_inv). O(N), no heap allocation.
-template <typename Scalar>
+/// Symmetric 3×3 block (xx, yx, zx, yy, zy, zz) of a scalar or of a pair of lanes.
+template <typename T>
+struct Sym3 {
+  T xx, yx, zx, yy, zy, zz;
+};
+
+#if defined(__GNUC__) || defined(__clang__)
+/// Two lanes of S, one per chain of solve_block_tridiagonal: a GCC/Clang vector (for double, one
+/// SSE2 register, so that both chains advance with the same instructions), else an Eigen array.
+/// Either takes T{a, b}, t[i], + − * / and a scalar on either side.
+template <typename S>
+struct LanePair {
+  typedef S type __attribute__((vector_size(2 * sizeof(S))));
+};
+#else
+template <typename S>
+struct LanePair {
+  using type = Eigen::Array<S, 2, 1>;
+};
+#endif
+
+/// P = D⁻¹ of a symmetric 3×3 block as L⁻ᵀ diag(1/e) L⁻¹ from D = L diag(e) Lᵀ (no pivoting),
+/// each pivot raised to `floor` (see solve_block_tridiagonal). \throws kelp::numerical_error if
+/// a factor is not finite.
+template <typename S>
+Sym3<S> floored_ldlt_inverse(const Sym3<S>& d, S floor) {
+  const S e0 = std::max(d.xx, floor), i0 = S(1) / e0;
+  const S l10 = d.yx * i0, l20 = d.zx * i0;
+  const S e1 = std::max(d.yy - l10 * d.yx, floor), i1 = S(1) / e1;
+  const S l21 = (d.zy - l20 * d.yx) * i1;
+  const S e2 = std::max(d.zz - l20 * d.zx - l21 * l21 * e1, floor), i2 = S(1) / e2;
+  if (!is_finite(i0 + i1 + i2 + l10 + l20 + l21))
+    ::kelp::detail::throw_numerical_error(
+        "tether Newton step: non-finite Jacobian block; the state is unchanged");
+  // L⁻¹ = [1 0 0; m10 1 0; m20 m21 1].
+  const S m10 = -l10, m21 = -l21, m20 = l10 * l21 - l20;
+  return {i0 + m10 * m10 * i1 + m20 * m20 * i2,
+          m10 * i1 + m20 * m21 * i2,
+          m20 * i2,
+          i1 + m21 * m21 * i2,
+          m21 * i2,
+          i2};
+}
+
+/// D⁻¹ = g N of a symmetric positive definite 3×3 block D (a scalar block or a pair of lanes),
+/// the LDLᵀ inverse L⁻ᵀ diag(1/e) L⁻¹ (D = L diag(e) Lᵀ, no pivoting) written fraction-free
+/// over one division, so that everything built from D⁻¹ can be formed from N while g is being
+/// computed. With e0 = d_xx, det₂ = d_xx d_yy − d_yx² = e0 e1, t21 = d_xx d_zy − d_yx d_zx
+/// = det₂ l21, t20 = d_yx t21 − d_zx det₂ = e0 det₂ m20 ((m20, m21, 1) the last row of L⁻¹) and
+/// det₃ = d_zz e0 det₂ − (d_zx² det₂ + t21²) = e0² e1 e2 (each the product form of an
+/// elimination step, with its cancellation, so as accurate), g = 1 / (e0 det₂ det₃) and
+///   N = [det₂ det₃ + d_yx² det₃ + t20²,  −e0 (d_yx det₃ + t20 t21),  e0 det₂ t20;
+///        ·,  e0² (det₃ + t21²),  −e0² det₂ t21;   ·,  ·,  e0² det₂²],
+/// the diagonal a sum of positive terms as in L⁻ᵀ diag(1/e) L⁻¹. When a pivot is below `floor`
+/// (tested before dividing: e0 ≥ floor, det₂ ≥ floor e0, det₃ ≥ floor e0 det₂) or e0 det₂ det₃
+/// is not a finite normal number, N = floored_ldlt_inverse(D) and g = 1, lane by lane.
+template <typename T, typename S>
+void invert_block(const Sym3<T>& d, S floor, Sym3<T>& nm, T& g) {
+  const T det2 = d.xx * d.yy - d.yx * d.yx, t21 = d.xx * d.zy - d.yx * d.zx;
+  const T t20 = d.yx * t21 - d.zx * det2, e001 = d.xx * det2;
+  const T det3 = d.zz * e001 - (d.zx * d.zx * det2 + t21 * t21);
+  const T den = e001 * det3;
+  const S big = std::numeric_limits<S>::max(), tiny = std::numeric_limits<S>::min();
+  bool ok;
+  if constexpr (std::is_arithmetic_v<T>) {
+    ok = d.xx >= floor && det2 >= floor * d.xx && det3 >= floor * e001 && den <= big && den >= tiny;
+  } else if constexpr (std::is_base_of_v<Eigen::ArrayBase<T>, T>) {
+    ok = ((d.xx >= floor) && (det2 >= floor * d.xx) && (det3 >= floor * e001) && (den <= big) &&
+          (den >= tiny))
+             .all();
+  } else {  // GCC/Clang vector: comparisons give lane masks
+    const auto m = (d.xx >= floor) & (det2 >= floor * d.xx) & (det3 >= floor * e001) &
+                   (den <= big) & (den >= tiny);
+    ok = m[0] && m[1];
+  }
+  if (ok) {
+    g = S(1) / den;
+    const T e00 = d.xx * d.xx;
+    nm.xx = (det2 + d.yx * d.yx) * det3 + t20 * t20;
+    nm.yx = d.xx * (S(0) - (d.yx * det3 + t20 * t21));
+    nm.zx = e001 * t20;
+    nm.yy = e00 * (det3 + t21 * t21);
+    nm.zy = (S(0) - e00 * det2) * t21;
+    nm.zz = e00 * (det2 * det2);
+  } else if constexpr (std::is_arithmetic_v<T>) {
+    nm = floored_ldlt_inverse(d, floor);
+    g = S(1);
+  } else {
+    const Sym3<S> q0 =
+        floored_ldlt_inverse(Sym3<S>{d.xx[0], d.yx[0], d.zx[0], d.yy[0], d.zy[0], d.zz[0]}, floor);
+    const Sym3<S> q1 =
+        floored_ldlt_inverse(Sym3<S>{d.xx[1], d.yx[1], d.zx[1], d.yy[1], d.zy[1], d.zz[1]}, floor);
+    nm = {T{q0.xx, q1.xx}, T{q0.yx, q1.yx}, T{q0.zx, q1.zx},
+          T{q0.yy, q1.yy}, T{q0.zy, q1.zy}, T{q0.zz, q1.zz}};
+    g = T{S(1), S(1)};
+  }
+}
+
+/// Solves J δ = rhs over the free nodes f0…f1, J = c_m M + c_v (−∂F/∂v) + c_x (−∂F/∂x), block
+/// tridiagonal and symmetric positive definite. The off-diagonal block of segment s is −A_s with
+/// A_s = α_s u uᵀ + β_s I (α = c_v BA/l + c_x k_uu, β = c_x k_perp); the diagonal block of node
+/// i is D_i = c_m M_i + c_v D_v,i + c_x kz_i e_z e_zᵀ + A_{i−1} + A_i (A_{−1} = A_N = 0).
+///
+/// Twisted block elimination ("burn at both ends"): a top chain eliminates nodes f0, f0+1, …,
+/// m−1 and a bottom chain nodes f1, f1−1, …, m+1 in the same loop (block LDLᵀ from both ends),
+/// in the two lanes of LanePair: two independent dependency chains, advanced by the same
+/// instructions (SIMD for double). Eliminating node i, whose block after the earlier
+/// eliminations is D'_i, with P_i = D'⁻¹_i and z_i = P_i rhs'_i, adds A − A P_i A to the block
+/// of its neighbour towards m and A z_i to its rhs (A the segment between them). The chains meet
+/// at the middle node m, whose block (both neighbours eliminated) gives δ_m; the back
+/// substitution δ_i = z_i + P_i A δ_k (k the neighbour towards m) then runs outward both ways.
+/// Each D' is inverted by invert_block as P = g N with a single division g = 1/(…), so that
+/// A P A = g L, L = u eᵀ + e uᵀ + β² N, e = ½ α² (u·N u) u + α β N u, and N rhs' are formed
+/// while the division runs: the dependency chain per step is D' → g → A − g L → next D'.
+///
+/// Pivot floor: in exact arithmetic every LDLᵀ pivot of every D' is at least λ_min(J) ≥ c_m ·
+/// min_node_mass (J − c_m M is positive semi-definite); a computed pivot below half that bound
+/// is round-off (e.g. (γh)² EA/l ≫ M at a very large step, or a very short segment) and is
+/// raised to it (floored_ldlt_inverse), which keeps the factor positive definite and the
+/// direction a descent direction for the line search; a non-finite factor throws
+/// kelp::numerical_error. The twisted elimination's blocks D' are not those of a one-sided
+/// sweep, so where the floor acts the result differs from that of a one-sided elimination (both
+/// are regularised solutions; elsewhere they agree to round-off). A non-finite right-hand side
+/// is not checked: it gives a non-finite δ.
+///
+/// Reads the Jacobian ingredients of the last compute_forces<true> and ws.rhs; writes the free
+/// columns of ws.delta (the kinematic end columns are left as they are) and uses ws.block_inv
+/// as scratch for the back substitution (per step, both lanes: N rhs', N, g, g β, α g N u, u).
+/// O(N), no heap allocation. `V` is the lane pair (a template parameter for the tests).
+template <typename Scalar, typename V = typename LanePair<Scalar>::type>
 void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                              Scalar c_m, Scalar c_v, Scalar c_x) {
   using S = Scalar;
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  if (f1 < f0) return;
   const S floor = S(0.5) * c_m * model.min_node_mass();
-  // Segment coupling A_s = al u uᵀ + be I.
-  const auto seg = [&](int s, S& al, S& be, S& ux, S& uy, S& uz) {
-    al = c_v * ws.seg_c_uu(s) + c_x * ws.seg_k_uu(s);
-    be = c_x * ws.seg_k_perp(s);
-    ux = ws.direction(0, s);
-    uy = ws.direction(1, s);
-    uz = ws.direction(2, s);
+  // Meeting node m; the chains (lane 0: top, lane 1: bottom) eliminate `pairs` nodes each side
+  // by side. With an even number of free nodes the top chain has one more, f0, eliminated
+  // first in both lanes.
+  const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
+  const bool extra = m - f0 > pairs;
+  // Each elimination step keeps kStepVectors lane pairs for the back substitution in
+  // ws.block_inv, two columns per step (there are at most (N + 1) / 2 steps), both lanes of a
+  // pair side by side.
+  constexpr int kStepVectors = 17, kStepSize = 2 * kStepVectors;
+  static_assert(kStepSize <= 2 * std::decay_t<decltype(ws.block_inv)>::RowsAtCompileTime);
+  KELP_ASSERT(ws.block_inv.cols() == model.nodes());
+  const auto keep = [](S* out, const V& x) {
+    if constexpr (std::is_trivially_copyable_v<V>) {
+      std::memcpy(out, &x, sizeof(V));
+    } else {
+      out[0] = x[0];
+      out[1] = x[1];
+    }
   };
-  // Previous node's inverse (symmetric: 00 10 20 11 21 22) and segment i−1.
-  S p00(0), p10(0), p20(0), p11(0), p21(0), p22(0);
-  S al_p(0), be_p(0), ux_p(0), uy_p(0), uz_p(0);
-  if (f0 > 0) seg(f0 - 1, al_p, be_p, ux_p, uy_p, uz_p);
-  for (int i = f0; i <= f1; ++i) {
+  const auto kept = [](const S* in) {
+    if constexpr (std::is_trivially_copyable_v<V>) {
+      V x;
+      std::memcpy(&x, in, sizeof(V));
+      return x;
+    } else {
+      return V{in[0], in[1]};
+    }
+  };
+
+  const auto lanes = [](const auto& v, int i0, int i1) { return V{v(i0), v(i1)}; };
+  const auto lanes_row = [](const auto& a, int row, int i0, int i1) {
+    return V{a(row, i0), a(row, i1)};
+  };
+  const auto put = [](auto& a, int row, int i0, int i1, const V& x) {
+    a(row, i0) = x[0];
+    a(row, i1) = x[1];
+  };
+  // Each chain carries the coupling of the node it eliminated last to the next one:
+  // A − A P A (cpl) and A z (cr). Before the first node P = 0 and z = 0 (cpl = A, cr = 0), A
+  // being the segment to the kinematic end, or zero when the end is free.
+  const auto end_coupling = [&](int s) {
+    if (s < 0 || s >= n) return Sym3<S>{S(0), S(0), S(0), S(0), S(0), S(0)};
+    const S al = c_v * ws.seg_c_uu(s) + c_x * ws.seg_k_uu(s), be = c_x * ws.seg_k_perp(s);
+    const S ux = ws.direction(0, s), uy = ws.direction(1, s), uz = ws.direction(2, s);
+    return Sym3<S>{al * ux * ux + be, al * uy * ux, al * uz * ux,
+                   al * uy * uy + be, al * uz * uy, al * uz * uz + be};
+  };
+  const Sym3<S> top = end_coupling(f0 - 1), bottom = end_coupling(f1);
+  const Sym3<S> first = extra ? top : bottom;
+  Sym3<V> cpl{V{top.xx, first.xx}, V{top.yx, first.yx}, V{top.zx, first.zx},
+              V{top.yy, first.yy}, V{top.zy, first.zy}, V{top.zz, first.zz}};
+  V cr0{S(0), S(0)}, cr1{S(0), S(0)}, cr2{S(0), S(0)};
+  // Step k eliminates nodes (i0, i1) = (m − pairs + k, f1 − k), both f0 at k = −1; step
+  // k = pairs stops at the meeting node, after its D in `base`. (One loop, so that its body is
+  // compiled once.)
+  Sym3<V> base;
+  V r0, r1, r2;
+  for (int k = extra ? -1 : 0;; ++k) {
+    const int i0 = m - pairs + k, i1 = k < 0 ? f0 : f1 - k;
     // D = c_m (a I + b q qᵀ) + c_v D_v + c_x kz e_z e_zᵀ.
-    const S a = c_m * ws.mass_iso(i), bq = c_m * ws.mass_tan(i);
-    const S qx = ws.tangent(0, i), qy = ws.tangent(1, i), qz = ws.tangent(2, i);
-    const auto dv = ws.node_dv.col(i);
-    S d00 = a + bq * qx * qx + c_v * dv(0);
-    S d10 = bq * qy * qx + c_v * dv(1);
-    S d20 = bq * qz * qx + c_v * dv(2);
-    S d11 = a + bq * qy * qy + c_v * dv(3);
-    S d21 = bq * qz * qy + c_v * dv(4);
-    S d22 = a + bq * qz * qz + c_v * dv(5) + c_x * ws.node_kz(i);
-    S r0 = ws.rhs(0, i), r1 = ws.rhs(1, i), r2 = ws.rhs(2, i);
-    // + A_{i−1} − A_{i−1} P A_{i−1} with P = D'⁻¹_{i−1} (zero, as are α, β and u before the
-    // first segment, when node i − 1 is not eliminated): with w = P u, σ = u·w,
-    // A − A P A = u yᵀ + y uᵀ + β I − β² P, y = ½(α − α² σ) u − αβ w.
     {
-      const S wx = p00 * ux_p + p10 * uy_p + p20 * uz_p;
-      const S wy = p10 * ux_p + p11 * uy_p + p21 * uz_p;
-      const S wz = p20 * ux_p + p21 * uy_p + p22 * uz_p;
-      const S sig = ux_p * wx + uy_p * wy + uz_p * wz;
-      const S cu = S(0.5) * al_p * (S(1) - al_p * sig), ab = al_p * be_p, bb = be_p * be_p;
-      const S yx = cu * ux_p - ab * wx, yy = cu * uy_p - ab * wy, yz = cu * uz_p - ab * wz;
-      d00 += S(2) * ux_p * yx + (be_p - bb * p00);
-      d10 += uy_p * yx + yy * ux_p - bb * p10;
-      d20 += uz_p * yx + yz * ux_p - bb * p20;
-      d11 += S(2) * uy_p * yy + (be_p - bb * p11);
-      d21 += uz_p * yy + yz * uy_p - bb * p21;
-      d22 += S(2) * uz_p * yz + (be_p - bb * p22);
+      const V a = c_m * lanes(ws.mass_iso, i0, i1), bq = c_m * lanes(ws.mass_tan, i0, i1);
+      const V qx = lanes_row(ws.tangent, 0, i0, i1), qy = lanes_row(ws.tangent, 1, i0, i1),
+              qz = lanes_row(ws.tangent, 2, i0, i1);
+      const V bx = bq * qx, by = bq * qy, bz = bq * qz;
+      base.xx = a + bx * qx + c_v * lanes_row(ws.node_dv, 0, i0, i1);
+      base.yx = by * qx + c_v * lanes_row(ws.node_dv, 1, i0, i1);
+      base.zx = bz * qx + c_v * lanes_row(ws.node_dv, 2, i0, i1);
+      base.yy = a + by * qy + c_v * lanes_row(ws.node_dv, 3, i0, i1);
+      base.zy = bz * qy + c_v * lanes_row(ws.node_dv, 4, i0, i1);
+      base.zz =
+          a + bz * qz + c_v * lanes_row(ws.node_dv, 5, i0, i1) + c_x * lanes(ws.node_kz, i0, i1);
+      r0 = lanes_row(ws.rhs, 0, i0, i1) + cr0;
+      r1 = lanes_row(ws.rhs, 1, i0, i1) + cr1;
+      r2 = lanes_row(ws.rhs, 2, i0, i1) + cr2;
     }
-    if (i > f0) {
-      // r += A z_{i−1}
-      const S z0 = ws.delta(0, i - 1), z1 = ws.delta(1, i - 1), z2 = ws.delta(2, i - 1);
-      const S uz_dot = al_p * (ux_p * z0 + uy_p * z1 + uz_p * z2);
-      r0 += uz_dot * ux_p + be_p * z0;
-      r1 += uz_dot * uy_p + be_p * z1;
-      r2 += uz_dot * uz_p + be_p * z2;
+    if (k == pairs) break;
+    // D' = D + A of the segment on the other side (top: i0, bottom: i1 − 1), which couples to
+    // the chain's next node, + the coupling to the eliminated neighbour.
+    const int s0 = i0, s1 = k < 0 ? f0 : i1 - 1;
+    const V al = c_v * lanes(ws.seg_c_uu, s0, s1) + c_x * lanes(ws.seg_k_uu, s0, s1);
+    const V be = c_x * lanes(ws.seg_k_perp, s0, s1);
+    const V ux = lanes_row(ws.direction, 0, s0, s1), uy = lanes_row(ws.direction, 1, s0, s1),
+            uz = lanes_row(ws.direction, 2, s0, s1);
+    Sym3<V> a_s;
+    {
+      const V ax = al * ux, ay = al * uy, az = al * uz;
+      a_s = {ax * ux + be, ay * ux, az * ux, ay * uy + be, az * uy, az * uz + be};
     }
-    S al(0), be(0), ux(0), uy(0), uz(0);
-    if (i < n) {
-      seg(i, al, be, ux, uy, uz);
-      d00 += al * ux * ux + be;
-      d10 += al * uy * ux;
-      d20 += al * uz * ux;
-      d11 += al * uy * uy + be;
-      d21 += al * uz * uy;
-      d22 += al * uz * uz + be;
+    const Sym3<V> d{base.xx + a_s.xx + cpl.xx, base.yx + a_s.yx + cpl.yx,
+                    base.zx + a_s.zx + cpl.zx, base.yy + a_s.yy + cpl.yy,
+                    base.zy + a_s.zy + cpl.zy, base.zz + a_s.zz + cpl.zz};
+    // P = D'⁻¹ = g N. Alongside the division: N u, L = u eᵀ + e uᵀ + β² N with
+    // e = ½ α² (u·N u) u + α β N u (A P A = g L), v = N r', A v; then only products with g.
+    Sym3<V> nm;
+    V g;
+    invert_block(d, floor, nm, g);
+    const V nx = nm.xx * ux + nm.yx * uy + nm.zx * uz;
+    const V ny = nm.yx * ux + nm.yy * uy + nm.zy * uz;
+    const V nz = nm.zx * ux + nm.zy * uy + nm.zz * uz;
+    const V h = S(0.5) * al * al * (ux * nx + uy * ny + uz * nz), ab = al * be, bb = be * be;
+    const V ex = h * ux + ab * nx, ey = h * uy + ab * ny, ez = h * uz + ab * nz;
+    const V lxx = ux * ex, lyy = uy * ey, lzz = uz * ez;
+    const Sym3<V> l{lxx + lxx + bb * nm.xx,         uy * ex + ey * ux + bb * nm.yx,
+                    uz * ex + ez * ux + bb * nm.zx, lyy + lyy + bb * nm.yy,
+                    uz * ey + ez * uy + bb * nm.zy, lzz + lzz + bb * nm.zz};
+    const V v0 = nm.xx * r0 + nm.yx * r1 + nm.zx * r2;
+    const V v1 = nm.yx * r0 + nm.yy * r1 + nm.zy * r2;
+    const V v2 = nm.zx * r0 + nm.zy * r1 + nm.zz * r2;
+    const V uv = al * (ux * v0 + uy * v1 + uz * v2);
+    const V av0 = uv * ux + be * v0, av1 = uv * uy + be * v1, av2 = uv * uz + be * v2;
+    // Coupling to the chain's next node: A − A P A = A − g L, A z = g A v.
+    cpl = {a_s.xx - g * l.xx, a_s.yx - g * l.yx, a_s.zx - g * l.zx,
+           a_s.yy - g * l.yy, a_s.zy - g * l.zy, a_s.zz - g * l.zz};
+    cr0 = g * av0;
+    cr1 = g * av1;
+    cr2 = g * av2;
+    // Kept for the back substitution, step by step (both lanes side by side).
+    {
+      const V ag = al * g;
+      S* const out = ws.block_inv.data() + kStepSize * (k + (extra ? 1 : 0));
+      keep(out, v0);
+      keep(out + 2, v1);
+      keep(out + 4, v2);
+      keep(out + 6, nm.xx);
+      keep(out + 8, nm.yx);
+      keep(out + 10, nm.zx);
+      keep(out + 12, nm.yy);
+      keep(out + 14, nm.zy);
+      keep(out + 16, nm.zz);
+      keep(out + 18, g);
+      keep(out + 20, g * be);
+      keep(out + 22, ag * nx);
+      keep(out + 24, ag * ny);
+      keep(out + 26, ag * nz);
+      keep(out + 28, ux);
+      keep(out + 30, uy);
+      keep(out + 32, uz);
     }
-    // D' = L diag(e0, e1, e2) Lᵀ, pivots floored at the exact lower bound (see above); then
-    // P = D'⁻¹ = L⁻ᵀ diag(1/e) L⁻¹ with L⁻¹ = [1 0 0; m10 1 0; m20 m21 1].
-    const S e0 = std::max(d00, floor), i0 = S(1) / e0;
-    const S l10 = d10 * i0, l20 = d20 * i0;
-    const S e1 = std::max(d11 - l10 * d10, floor), i1 = S(1) / e1;
-    const S l21 = (d21 - l20 * d10) * i1;
-    const S e2 = std::max(d22 - l20 * d20 - l21 * l21 * e1, floor), i2 = S(1) / e2;
-    if (!is_finite(i0 + i1 + i2 + l10 + l20 + l21))
-      ::kelp::detail::throw_numerical_error(
-          "tether Newton step: non-finite Jacobian block; the state is unchanged");
-    const S m10 = -l10, m21 = -l21, m20 = l10 * l21 - l20;
-    p00 = i0 + m10 * m10 * i1 + m20 * m20 * i2;
-    p10 = m10 * i1 + m20 * m21 * i2;
-    p20 = m20 * i2;
-    p11 = i1 + m21 * m21 * i2;
-    p21 = m21 * i2;
-    p22 = i2;
-    ws.delta(0, i) = p00 * r0 + p10 * r1 + p20 * r2;
-    ws.delta(1, i) = p10 * r0 + p11 * r1 + p21 * r2;
-    ws.delta(2, i) = p20 * r0 + p21 * r1 + p22 * r2;
-    auto inv = ws.block_inv.col(i);
-    inv(0) = p00;
-    inv(1) = p10;
-    inv(2) = p20;
-    inv(3) = p11;
-    inv(4) = p21;
-    inv(5) = p22;
-    al_p = al;
-    be_p = be;
-    ux_p = ux;
-    uy_p = uy;
-    uz_p = uz;
+    if (k < 0) {
+      // Lane 1 starts the bottom chain.
+      cpl = {V{cpl.xx[0], bottom.xx}, V{cpl.yx[0], bottom.yx}, V{cpl.zx[0], bottom.zx},
+             V{cpl.yy[0], bottom.yy}, V{cpl.zy[0], bottom.zy}, V{cpl.zz[0], bottom.zz}};
+      cr0 = V{cr0[0], S(0)};
+      cr1 = V{cr1[0], S(0)};
+      cr2 = V{cr2[0], S(0)};
+    }
   }
-  // Back substitution: δ_i += P_i A_i δ_{i+1}.
-  for (int i = f1 - 1; i >= f0; --i) {
-    S al, be, ux, uy, uz;
-    seg(i, al, be, ux, uy, uz);
-    const S y0 = ws.delta(0, i + 1), y1 = ws.delta(1, i + 1), y2 = ws.delta(2, i + 1);
-    const S ud = al * (ux * y0 + uy * y1 + uz * y2);
-    const S t0 = ud * ux + be * y0, t1 = ud * uy + be * y1, t2 = ud * uz + be * y2;
-    const auto p = ws.block_inv.col(i);
-    ws.delta(0, i) += p(0) * t0 + p(1) * t1 + p(2) * t2;
-    ws.delta(1, i) += p(1) * t0 + p(3) * t1 + p(4) * t2;
-    ws.delta(2, i) += p(2) * t0 + p(4) * t1 + p(5) * t2;
+  // Meeting node: δ_m = D'⁻¹_m rhs'_m, with the couplings to both eliminated neighbours (r
+  // holds rhs_m plus lane 0's).
+  S y0, y1, y2;
+  {
+    Sym3<S> pm;
+    S g;
+    invert_block(Sym3<S>{base.xx[0] + cpl.xx[0] + cpl.xx[1], base.yx[0] + cpl.yx[0] + cpl.yx[1],
+                         base.zx[0] + cpl.zx[0] + cpl.zx[1], base.yy[0] + cpl.yy[0] + cpl.yy[1],
+                         base.zy[0] + cpl.zy[0] + cpl.zy[1], base.zz[0] + cpl.zz[0] + cpl.zz[1]},
+                 floor, pm, g);
+    const S s0 = r0[0] + cr0[1], s1 = r1[0] + cr1[1], s2 = r2[0] + cr2[1];
+    y0 = g * (pm.xx * s0 + pm.yx * s1 + pm.zx * s2);
+    y1 = g * (pm.yx * s0 + pm.yy * s1 + pm.zy * s2);
+    y2 = g * (pm.zx * s0 + pm.zy * s1 + pm.zz * s2);
+    ws.delta(0, m) = y0;
+    ws.delta(1, m) = y1;
+    ws.delta(2, m) = y2;
+  }
+  // Back substitution outward from m, the elimination steps in reverse:
+  // δ_i = P_i (rhs'_i + A δ_k) = g (v + α N u (u·δ_k) + N (β δ_k)), k the neighbour towards m,
+  // A = α u uᵀ + β I the segment between them. Step −1 (node f0 in both lanes) copies lane 0.
+  V d0{y0, y0}, d1{y1, y1}, d2{y2, y2};
+  for (int k = pairs - 1; k >= (extra ? -1 : 0); --k) {
+    const int i0 = m - pairs + k, i1 = k < 0 ? f0 : f1 - k;
+    if (k < 0) {
+      d0 = V{d0[0], d0[0]};
+      d1 = V{d1[0], d1[0]};
+      d2 = V{d2[0], d2[0]};
+    }
+    const S* const in = ws.block_inv.data() + kStepSize * (k + (extra ? 1 : 0));
+    const auto q = [&](int j) { return kept(in + 2 * j); };
+    const V ud = q(14) * d0 + q(15) * d1 + q(16) * d2;
+    const V gb = q(10), t0 = gb * d0, t1 = gb * d1, t2 = gb * d2;
+    const V n00 = q(3), n10 = q(4), n20 = q(5), n11 = q(6), n21 = q(7), n22 = q(8), g = q(9);
+    d0 = (g * q(0) + q(11) * ud) + (n00 * t0 + n10 * t1 + n20 * t2);
+    d1 = (g * q(1) + q(12) * ud) + (n10 * t0 + n11 * t1 + n21 * t2);
+    d2 = (g * q(2) + q(13) * ud) + (n20 * t0 + n21 * t1 + n22 * t2);
+    put(ws.delta, 0, i0, i1, d0);
+    put(ws.delta, 1, i0, i1, d1);
+    put(ws.delta, 2, i0, i1, d2);
   }
 }
 
@@ -463,8 +668,10 @@ template <typename Scalar, typename Env>
 void derivative(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                 double t, const TetherBoundary<Scalar>& b, const Matrix3X<Scalar>& x,
                 const Matrix3X<Scalar>& v, Matrix3X<Scalar>& acc) {
-  compute_forces<false>(model, ws, env, t, x, v);
-  accelerations_from_forces(model, ws, b.start.acceleration, b.end.acceleration, acc);
+  evaluate_forces<false>(model, ws, env, t, x, v, acc.data());
+  const int n = model.segments();
+  if (model.first_free_node() == 1) acc.col(0) = b.start.acceleration;
+  if (model.last_free_node() == n - 1) acc.col(n) = b.end.acceleration;
 }
 
 /// Shared start of the explicit steps: checks the inputs and copies the state into x0, v0 with
@@ -543,34 +750,67 @@ StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Sc
   return r;
 }
 
+namespace detail {
+
+/// One RK4 stage's state update in one vectorised pass over the flat 3 × (N+1) arrays: with the
+/// stage accelerations ws.acceleration at the stage point (·, vs), accumulates x1 += w vs,
+/// v1 += w a (the first stage starts them from x0, v0) and, unless this is the last stage, moves
+/// the stage point to xs = x0 + ch vs, vs = v0 + ch a. `vs` is ws.v0 (first stage) or ws.vs
+/// (updated in place). The kinematic end columns are overwritten by apply_boundary afterwards.
+template <typename Scalar>
+void rk4_stage_update(TetherWorkspace<Scalar>& ws, const Matrix3X<Scalar>& vs, Scalar w, Scalar ch,
+                      bool first, bool last) {
+  const Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *a = ws.acceleration.data();
+  const Scalar* vin = vs.data();
+  Scalar *x1 = ws.x1.data(), *v1 = ws.v1.data(), *xs = ws.xs.data(), *vo = ws.vs.data();
+  const auto update = [&](auto lanes, Eigen::Index j) {
+    using P = decltype(lanes);
+    const P wp = P::all(w), vj = P::load(vin + j), aj = P::load(a + j);
+    if (first) {
+      (P::load(x0 + j) + wp * vj).store(x1 + j);
+      (P::load(v0 + j) + wp * aj).store(v1 + j);
+    } else {
+      (P::load(x1 + j) + wp * vj).store(x1 + j);
+      (P::load(v1 + j) + wp * aj).store(v1 + j);
+    }
+    if (!last) {
+      const P cp = P::all(ch);
+      (P::load(x0 + j) + cp * vj).store(xs + j);
+      (P::load(v0 + j) + cp * aj).store(vo + j);
+    }
+  };
+  using Wide = simd::Pack<Scalar, true>;
+  const Eigen::Index m = ws.x1.size();
+  Eigen::Index j = 0;
+  for (; j + Wide::lanes <= m; j += Wide::lanes) update(Wide(), j);
+  for (; j < m; ++j) update(simd::Pack<Scalar, false>(), j);
+}
+
+}  // namespace detail
+
 /// \brief One classical RK4 step of length `dt` [s]. End forces are those at the start of the
-/// step. \throws as step_symplectic_euler.
+/// step. Four force evaluations (each also giving the accelerations M⁻¹F in its last pass), each
+/// followed by one vectorised pass for the stage's state update. \throws as
+/// step_symplectic_euler.
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
                             const TetherBoundary<Scalar>& boundary, double dt) {
   detail::begin_explicit_step(model, ws, state, boundary, dt);
   const double t = state.time;
-  ws.xs = ws.x0;
-  ws.vs = ws.v0;
-  ws.x1 = ws.x0;
-  ws.v1 = ws.v0;
   const Scalar h = Scalar(dt);
   const Scalar c[4] = {Scalar(0), Scalar(0.5), Scalar(0.5), Scalar(1)};
   const Scalar w[4] = {h / Scalar(6), h / Scalar(3), h / Scalar(3), h / Scalar(6)};
   const double tc[4] = {t, t + 0.5 * dt, t + 0.5 * dt, t + dt};
   for (int k = 0; k < 4; ++k) {
-    detail::derivative(model, ws, env, tc[k], boundary, ws.xs, ws.vs, ws.acceleration);
+    const Matrix3X<Scalar>& xk = k == 0 ? ws.x0 : ws.xs;
+    const Matrix3X<Scalar>& vk = k == 0 ? ws.v0 : ws.vs;
+    detail::evaluate_forces<false>(model, ws, env, tc[k], xk, vk, ws.acceleration.data());
     if (k == 0) ws.end_forces = end_forces_from_workspace(model, ws, boundary);
     detail::add_end_impulse(model, ws, boundary, w[k]);
-    ws.x1.noalias() += w[k] * ws.vs;
-    ws.v1.noalias() += w[k] * ws.acceleration;
-    if (k < 3) {
-      const Scalar ch = c[k + 1] * h;
-      ws.xs.noalias() = ws.x0 + ch * ws.vs;
-      ws.vs.noalias() = ws.v0 + ch * ws.acceleration;
-      detail::apply_boundary(model, boundary, ch, ws.xs, ws.vs);
-    }
+    const bool last = k == 3;
+    detail::rk4_stage_update(ws, vk, w[k], last ? Scalar(0) : c[k + 1] * h, k == 0, last);
+    if (!last) detail::apply_boundary(model, boundary, c[k + 1] * h, ws.xs, ws.vs);
   }
   detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
   detail::commit(state, ws.x1, ws.v1, dt, "step_rk4");
@@ -614,33 +854,39 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   const Scalar gh = gamma * Scalar(dt);
   const Scalar tolerance = options.acceleration_tolerance * Scalar(dt);
   // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
-  // One pass over the nodes for the history, the predictor and its positions.
+  // One vectorised pass over the flat 3 × (N+1) arrays for the history, the predictor and its
+  // positions. Predictor: linear extrapolation of the velocity when the last step had the same
+  // dt.
   const int cols = model.nodes();
-  if (use_bdf2) {
+  {
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
-    for (int i = 0; i < cols; ++i) {
-      const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
-      const Vector3<Scalar> xp = state.previous_position.col(i);
-      const Vector3<Scalar> vp = state.previous_velocity.col(i);
-      const Vector3<Scalar> xh = four_thirds * xn - third * xp;
-      const Vector3<Scalar> v1 = Scalar(2) * vn - vp;
-      ws.x0.col(i) = xh;
-      ws.v0.col(i) = four_thirds * vn - third * vp;
-      ws.v1.col(i) = v1;
-      ws.x1.col(i) = xh + gh * v1;
-    }
-  } else {
-    // Predictor: linear extrapolation of the velocity when the last step had the same dt.
-    const bool extrapolate = history;
-    for (int i = 0; i < cols; ++i) {
-      const Vector3<Scalar> xn = state.position.col(i), vn = state.velocity.col(i);
-      const Vector3<Scalar> v1 =
-          extrapolate ? Vector3<Scalar>(Scalar(2) * vn - state.previous_velocity.col(i)) : vn;
-      ws.x0.col(i) = xn;
-      ws.v0.col(i) = vn;
-      ws.v1.col(i) = v1;
-      ws.x1.col(i) = xn + gh * v1;
-    }
+    const Scalar *xn = state.position.data(), *vn = state.velocity.data();
+    const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
+    Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
+    const auto predict = [&](auto lanes, Eigen::Index j) {
+      using P = decltype(lanes);
+      const P xnj = P::load(xn + j), vnj = P::load(vn + j);
+      if (use_bdf2) {
+        const P vpj = P::load(vp + j);
+        const P xh = P::all(four_thirds) * xnj - P::all(third) * P::load(xp + j);
+        const P vg = P::all(Scalar(2)) * vnj - vpj;
+        xh.store(x0 + j);
+        (P::all(four_thirds) * vnj - P::all(third) * vpj).store(v0 + j);
+        vg.store(v1 + j);
+        (xh + P::all(gh) * vg).store(x1 + j);
+      } else {
+        const P vg = history ? P::all(Scalar(2)) * vnj - P::load(vp + j) : vnj;
+        xnj.store(x0 + j);
+        vnj.store(v0 + j);
+        vg.store(v1 + j);
+        (xnj + P::all(gh) * vg).store(x1 + j);
+      }
+    };
+    using Wide = simd::Pack<Scalar, true>;
+    const Eigen::Index m = 3 * Eigen::Index(cols);
+    Eigen::Index j = 0;
+    for (; j + Wide::lanes <= m; j += Wide::lanes) predict(Wide(), j);
+    for (; j < m; ++j) predict(simd::Pack<Scalar, false>(), j);
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton
@@ -664,23 +910,38 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     else
       compute_forces<false>(model, ws, env, t1, x, v);
     ++report.force_evaluations;
-    r_max = Scalar(0);
-    Scalar sum(0);
-    using std::abs;
-    for (int i = f0; i <= f1; ++i) {
-      const Scalar d0 = v(0, i) - ws.v0(0, i), d1 = v(1, i) - ws.v0(1, i),
-                   d2 = v(2, i) - ws.v0(2, i);
-      const Scalar q0 = ws.tangent(0, i), q1 = ws.tangent(1, i), q2 = ws.tangent(2, i);
-      const Scalar a = ws.mass_iso(i), bqd = ws.mass_tan(i) * (q0 * d0 + q1 * d1 + q2 * d2);
-      const Scalar r0 = gh * ws.force(0, i) - (a * d0 + bqd * q0);
-      const Scalar r1 = gh * ws.force(1, i) - (a * d1 + bqd * q1);
-      const Scalar r2 = gh * ws.force(2, i) - (a * d2 + bqd * q2);
-      ws.rhs(0, i) = r0;
-      ws.rhs(1, i) = r1;
-      ws.rhs(2, i) = r2;
-      r_max = std::max(r_max, Scalar(std::max(std::max(abs(r0), abs(r1)), abs(r2)) / a));
-      sum += (r0 + r1) + r2;
-    }
+    // One vectorised pass over the free nodes: rhs = −R, its scaled max-norm and (for the
+    // finiteness test below) its sum.
+    const auto residual = [&](auto lanes, int i, auto& r_lanes, auto& sum_lanes) {
+      using P = decltype(lanes);
+      const Scalar *vi = v.data() + 3 * i, *v0 = ws.v0.data() + 3 * i;
+      const Scalar *qi = ws.tangent.data() + 3 * i, *fi = ws.force.data() + 3 * i;
+      const P d0 = P::gather(vi, 3) - P::gather(v0, 3);
+      const P d1 = P::gather(vi + 1, 3) - P::gather(v0 + 1, 3);
+      const P d2 = P::gather(vi + 2, 3) - P::gather(v0 + 2, 3);
+      const P q0 = P::gather(qi, 3), q1 = P::gather(qi + 1, 3), q2 = P::gather(qi + 2, 3);
+      const P a = P::load(&ws.mass_iso(i));
+      const P bqd = P::load(&ws.mass_tan(i)) * ((q0 * d0 + q1 * d1) + q2 * d2);
+      const P g = P::all(gh);
+      const P r0 = g * P::gather(fi, 3) - (a * d0 + bqd * q0);
+      const P r1 = g * P::gather(fi + 1, 3) - (a * d1 + bqd * q1);
+      const P r2 = g * P::gather(fi + 2, 3) - (a * d2 + bqd * q2);
+      Scalar* out = ws.rhs.data() + 3 * i;
+      r0.scatter(out, 3);
+      r1.scatter(out + 1, 3);
+      r2.scatter(out + 2, 3);
+      r_lanes = max(r_lanes, max(max(abs(r0), abs(r1)), abs(r2)) * P::load(&ws.mass_iso_inv(i)));
+      sum_lanes += (r0 + r1) + r2;
+    };
+    using Wide = simd::Pack<Scalar, true>;
+    using One = simd::Pack<Scalar, false>;
+    Wide r_wide = Wide::all(Scalar(0)), sum_wide = Wide::all(Scalar(0));
+    One r_one = One::all(Scalar(0)), sum_one = One::all(Scalar(0));
+    int i = f0;
+    for (; i + Wide::lanes <= f1 + 1; i += Wide::lanes) residual(Wide(), i, r_wide, sum_wide);
+    for (; i <= f1; ++i) residual(One(), i, r_one, sum_one);
+    r_max = std::max(r_wide.max_lane(), r_one.max_lane());
+    const Scalar sum = sum_wide.sum() + sum_one.sum();
     // NaN fails every comparison and std::max keeps its first argument: test the sum instead.
     if (!is_finite(sum))
       ::kelp::detail::throw_numerical_error(
@@ -740,19 +1001,17 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     // overshoots the minimum along δ (φ'(1) > ½|φ'(0)|, e.g. across the kink of the tension at
     // l_s = l, where plain Newton can cycle between the slack and the taut branch); then secant
     // steps on φ' home in on the minimum. Each trial costs one force evaluation.
+    const Eigen::Index nf = f1 - f0 + 1;
     const auto slope = [&]() {
-      Scalar g(0);
-      for (int i = f0; i <= f1; ++i) g -= ws.rhs.col(i).dot(ws.delta.col(i));
-      return g;
+      return Scalar(-ws.rhs.middleCols(f0, nf).cwiseProduct(ws.delta.middleCols(f0, nf)).sum());
     };
     const Scalar g0 = slope();
     const Scalar a_lo(0), g_lo = g0;
     Scalar alpha(1), trial_res(0);
     for (int ls = 0;; ++ls) {
-      for (int i = f0; i <= f1; ++i) {
-        ws.vs.col(i) = ws.v1.col(i) + alpha * ws.delta.col(i);
-        ws.xs.col(i) = ws.x0.col(i) + gh * ws.vs.col(i);
-      }
+      ws.vs.middleCols(f0, nf).noalias() =
+          ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
+      ws.xs.middleCols(f0, nf).noalias() = ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
       // The trial carries its Jacobian terms: when another Newton iteration follows (half the
       // steps of a line near the surface) they are needed at this point, and filling them costs
       // less than a second evaluation there (−6 % instructions per system step).

@@ -347,7 +347,7 @@ template <typename Scalar>
 struct TetherWorkspace {
   // --- per evaluation, per node -------------------------------------------------------------
   Matrix3X<Scalar> force;               ///< net force on each node (no constraint force), NED [N]
-  Matrix3X<Scalar> acceleration;        ///< node accelerations, NED [m/s²]
+  Matrix3X<Scalar> acceleration;        ///< node accelerations of the explicit steps, NED [m/s²]
   Matrix3X<Scalar> tangent;             ///< unit node tangent q_i (zero if degenerate)
   Matrix3X<Scalar> water_velocity;      ///< current + wave orbital velocity at each node [m/s]
   Matrix3X<Scalar> water_acceleration;  ///< water acceleration at each node [m/s²]
@@ -378,8 +378,10 @@ struct TetherWorkspace {
   Eigen::Matrix<Scalar, 6, Eigen::Dynamic> node_dv;
   VectorX<Scalar> node_kz;  ///< −∂F_z/∂z from the seabed [N/m]
   // --- linear solver and integrator buffers ----------------------------------------------------
-  Eigen::Matrix<Scalar, 6, Eigen::Dynamic> block_inv;  ///< block-Thomas D'⁻¹ (symmetric, 6 entries)
-  Matrix3X<Scalar> rhs, delta;                         ///< Newton right-hand side and correction
+  /// What the block elimination of the Newton solve keeps for its back substitution, two
+  /// columns per elimination step (detail::solve_block_tridiagonal)
+  Eigen::Matrix<Scalar, 17, Eigen::Dynamic> block_inv;
+  Matrix3X<Scalar> rhs, delta;    ///< Newton right-hand side and correction
   Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
   VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
   VectorX<Scalar> seg_true_c_uu;  ///< seg_c_uu saved while the active-set passes modify it
@@ -438,7 +440,7 @@ struct TetherWorkspace {
       v->setZero(s);
     node_dv.setZero(6, n);
     pass_buffer.setZero(n, 9);
-    block_inv.setZero(6, n);
+    block_inv.setZero(17, n);
     entry_backup.resize(n);
     retry_backup.resize(n);
     water_is_zero = true;
@@ -592,6 +594,8 @@ struct ForcePass {
   Eigen::Index xs;
   const Scalar* v;
   Eigen::Index vs;
+  /// When set: M⁻¹F of every node is written here as well (3 × (N+1), column-major).
+  Scalar* acc = nullptr;
   Scalar X(int k, int i) const { return x[i * xs + k]; }
   Scalar V(int k, int i) const { return v[i * vs + k]; }
 };
@@ -938,20 +942,31 @@ template <bool Wide, typename Scalar>
 EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws,
                                       int i) {
   using P = simd::Pack<Scalar, Wide>;
-  Scalar* out = ws.force.data() + 3 * i;
+  P f[3];
   for (int k = 0; k < 3; ++k) {
-    P f = P::load(&ws.pass_buffer(i, kNodeForce + k));
+    f[k] = P::load(&ws.pass_buffer(i, kNodeForce + k));
     if (c.mass_turns) {
       const Scalar* w = &ws.pass_buffer(0, kMassRate + k);
       if constexpr (P::lanes == 1) {
         const Scalar prev = i > 0 ? w[i - 1] : -w[0], next = i < c.n ? w[i + 1] : -w[c.n];
-        f = f + (P::all(prev) - P::all(next));
+        f[k] = f[k] + (P::all(prev) - P::all(next));
       } else {
-        f = f + (P::load(w + i - 1) - P::load(w + i + 1));
+        f[k] = f[k] + (P::load(w + i - 1) - P::load(w + i + 1));
       }
     }
-    if (c.bending) f += P::gather(ws.bending.data() + 3 * i + k, 3);
-    f.scatter(out + k, 3);
+    if (c.bending) f[k] += P::gather(ws.bending.data() + 3 * i + k, 3);
+    f[k].scatter(ws.force.data() + 3 * i + k, 3);
+  }
+  if (c.acc) {
+    // a = M⁻¹F = (F − (b/(a+b)) q (q·F)) / a (see accelerations_from_forces).
+    const Scalar* tq = ws.tangent.data() + 3 * i;
+    const P q0 = P::gather(tq, 3), q1 = P::gather(tq + 1, 3), q2 = P::gather(tq + 2, 3);
+    const P rq = P::load(&ws.mass_tan_ratio(i)) * ((q0 * f[0] + q1 * f[1]) + q2 * f[2]);
+    const P ia = P::load(&ws.mass_iso_inv(i));
+    Scalar* a = c.acc + 3 * i;
+    ((f[0] - rq * q0) * ia).scatter(a, 3);
+    ((f[1] - rq * q1) * ia).scatter(a + 1, 3);
+    ((f[2] - rq * q2) * ia).scatter(a + 2, 3);
   }
 }
 
@@ -1031,6 +1046,86 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
 
 }  // namespace detail
 
+namespace detail {
+
+/// compute_forces, and when `acc` is not null the node accelerations M⁻¹F of every node into
+/// `acc` (3 × (N+1), column-major; the kinematic ends' entries are M⁻¹F too, not their
+/// prescribed accelerations).
+template <bool WithJacobian, typename Scalar, typename Env, typename DX, typename DV>
+void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v,
+                     Scalar* acc) {
+  const TetherParameters<Scalar>& p = model.parameters();
+  const int n = model.segments();
+  ForcePass<Scalar> c;
+  c.p = &p;
+  c.n = n;
+  c.rho = Scalar(env.water_density());
+  c.g = Scalar(env.gravity());
+  c.bed = Scalar(env.seabed_depth());
+  c.l = model.segment_length();
+  c.l2 = c.l * c.l;
+  c.inv_l = model.inverse_segment_length();
+  c.ea_l = model.axial_spring();
+  c.ba_l = model.axial_damper();
+  c.ea = p.axial_stiffness;
+  c.ba = p.internal_damping;
+  c.can = p.normal_added_mass;
+  c.cat = p.tangential_added_mass;
+  c.inv_d = Scalar(1) / p.diameter;
+  c.bed_k = p.seabed_stiffness * p.diameter;
+  c.bed_c = p.seabed_damping * p.diameter;
+  c.clamp = !p.compressive_damping;
+  c.damping = c.ba != Scalar(0);
+  c.bending = p.bending_stiffness > Scalar(0);
+  // Added-mass rate terms (see above); none when Cat = Can (b = 0).
+  c.mass_turns = c.cat != c.can;
+
+  // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
+  // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
+  c.still = is_still_water(env);
+  if (!c.still) {
+    if (!ws.water_frozen) {
+      ws.water_is_zero = false;
+      sample_water_at_nodes(env, x, t, ws);
+    }
+  } else if (!ws.water_is_zero) {
+    ws.water_velocity.setZero();
+    ws.water_acceleration.setZero();
+    ws.surface_elevation.setZero();
+    ws.water_is_zero = true;
+  }
+
+  // The constants of the three kinds of node (start, interior, end), once per evaluation.
+  const Scalar half_rho_d = Scalar(0.5) * c.rho * p.diameter;
+  const Scalar kn_per_l = half_rho_d * p.normal_drag;
+  const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
+  const auto node_constants = [&](int i) {
+    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
+    return NodeConstants<Scalar>{li,
+                                 m * c.g,
+                                 (m - c.rho * vol) * c.g,
+                                 c.rho * vol,
+                                 kn_per_l * li,
+                                 kt_per_l * li,
+                                 m,
+                                 m + c.rho * vol * c.can,
+                                 c.rho * vol * (c.cat - c.can)};
+  };
+  c.kinds[0] = node_constants(0);
+  c.kinds[1] = node_constants(n > 1 ? 1 : 0);
+  c.kinds[2] = node_constants(n);
+
+  // The passes read the coordinates through a pointer and a column stride: straight from
+  // column-major storage, or from a copy of any other expression.
+  bind_columns(x, ws.x_eval, c.x, c.xs);
+  bind_columns(v, ws.v_eval, c.v, c.vs);
+  c.acc = acc;
+  force_passes<WithJacobian>(c, ws);
+}
+
+}  // namespace detail
+
 /// \brief Net force on every node of the tether at positions `x`, velocities `v`, time `t`.
 ///
 /// Fills `ws.force` (NED [N]) and the per-node mass matrices M_i = a_i I + b_i q_i q_iᵀ
@@ -1063,72 +1158,7 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
 template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
 void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
-  const TetherParameters<Scalar>& p = model.parameters();
-  const int n = model.segments();
-  detail::ForcePass<Scalar> c;
-  c.p = &p;
-  c.n = n;
-  c.rho = Scalar(env.water_density());
-  c.g = Scalar(env.gravity());
-  c.bed = Scalar(env.seabed_depth());
-  c.l = model.segment_length();
-  c.l2 = c.l * c.l;
-  c.inv_l = model.inverse_segment_length();
-  c.ea_l = model.axial_spring();
-  c.ba_l = model.axial_damper();
-  c.ea = p.axial_stiffness;
-  c.ba = p.internal_damping;
-  c.can = p.normal_added_mass;
-  c.cat = p.tangential_added_mass;
-  c.inv_d = Scalar(1) / p.diameter;
-  c.bed_k = p.seabed_stiffness * p.diameter;
-  c.bed_c = p.seabed_damping * p.diameter;
-  c.clamp = !p.compressive_damping;
-  c.damping = c.ba != Scalar(0);
-  c.bending = p.bending_stiffness > Scalar(0);
-  // Added-mass rate terms (see above); none when Cat = Can (b = 0).
-  c.mass_turns = c.cat != c.can;
-
-  // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
-  // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
-  c.still = detail::is_still_water(env);
-  if (!c.still) {
-    if (!ws.water_frozen) {
-      ws.water_is_zero = false;
-      detail::sample_water_at_nodes(env, x, t, ws);
-    }
-  } else if (!ws.water_is_zero) {
-    ws.water_velocity.setZero();
-    ws.water_acceleration.setZero();
-    ws.surface_elevation.setZero();
-    ws.water_is_zero = true;
-  }
-
-  // The constants of the three kinds of node (start, interior, end), once per evaluation.
-  const Scalar half_rho_d = Scalar(0.5) * c.rho * p.diameter;
-  const Scalar kn_per_l = half_rho_d * p.normal_drag;
-  const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
-  const auto node_constants = [&](int i) {
-    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
-    return detail::NodeConstants<Scalar>{li,
-                                         m * c.g,
-                                         (m - c.rho * vol) * c.g,
-                                         c.rho * vol,
-                                         kn_per_l * li,
-                                         kt_per_l * li,
-                                         m,
-                                         m + c.rho * vol * c.can,
-                                         c.rho * vol * (c.cat - c.can)};
-  };
-  c.kinds[0] = node_constants(0);
-  c.kinds[1] = node_constants(n > 1 ? 1 : 0);
-  c.kinds[2] = node_constants(n);
-
-  // The passes read the coordinates through a pointer and a column stride: straight from
-  // column-major storage, or from a copy of any other expression.
-  detail::bind_columns(x, ws.x_eval, c.x, c.xs);
-  detail::bind_columns(v, ws.v_eval, c.v, c.vs);
-  detail::force_passes<WithJacobian>(c, ws);
+  detail::evaluate_forces<WithJacobian>(model, ws, env, t, x, v, static_cast<Scalar*>(nullptr));
 }
 
 /// \brief Node accelerations a_i = M_i⁻¹ F_i from the last `compute_forces` (free nodes only;
