@@ -1149,7 +1149,10 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,
 ///   which goes from 1 to 0 as the node rises through the free surface over one cable diameter
 ///   (detail::submerged_fraction): nodes in air get none.
-/// No heap allocation.
+/// Evaluated in passes over SIMD packets (kelp/core/simd.hpp): the segments, then the interior
+/// nodes of the wet line a packet at a time (the ends and nodes in the surface band, in air or
+/// on the seabed one by one, with every branch), then the added-mass coupling of neighbours and
+/// bending. Also fills `ws.mass_iso_inv` and `ws.mass_tan_ratio`. No heap allocation.
 /// \tparam WithJacobian also fill the Jacobian ingredients (`ws.seg_*`, `ws.node_dv`,
 /// `ws.node_kz`); the Jacobian leaves out the added-mass rate terms G_i (quadratic in the
 /// velocities, small beside the mass term M/h of a step).
