@@ -136,6 +136,17 @@ struct Pack {
   }
 };
 
+/// \brief Calls `f(Pack<Scalar, true>(), j)` for j = begin, begin + lanes, … while a whole packet
+/// fits before `end`, then `f(Pack<Scalar, false>(), j)` for each remaining j: a loop body
+/// written once for both widths.
+template <typename Scalar, typename F>
+void for_each_pack(Eigen::Index begin, Eigen::Index end, F&& f) {
+  using Wide = Pack<Scalar, true>;
+  Eigen::Index j = begin;
+  for (; j + Wide::lanes <= end; j += Wide::lanes) f(Wide(), j);
+  for (; j < end; ++j) f(Pack<Scalar, false>(), j);
+}
+
 /// \brief Lane-wise comparison result.
 template <typename Scalar, bool Wide>
 struct Mask {

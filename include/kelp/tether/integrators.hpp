@@ -326,10 +326,8 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
   // being the segment to the kinematic end, or zero when the end is free.
   const auto end_coupling = [&](int s) {
     if (s < 0 || s >= n) return Sym3<S>{S(0), S(0), S(0), S(0), S(0), S(0)};
-    const S al = c_v * ws.seg_c_uu(s) + c_x * ws.seg_k_uu(s), be = c_x * ws.seg_k_perp(s);
-    const S ux = ws.direction(0, s), uy = ws.direction(1, s), uz = ws.direction(2, s);
-    return Sym3<S>{al * ux * ux + be, al * uy * ux, al * uz * ux,
-                   al * uy * uy + be, al * uz * uy, al * uz * uz + be};
+    const Matrix3<S> a = segment_block(ws, s, c_v, c_x);
+    return Sym3<S>{a(0, 0), a(1, 0), a(2, 0), a(1, 1), a(2, 1), a(2, 2)};
   };
   const Sym3<S> top = end_coupling(f0 - 1), bottom = end_coupling(f1);
   const Sym3<S> first = extra ? top : bottom;
@@ -779,11 +777,7 @@ void rk4_stage_update(TetherWorkspace<Scalar>& ws, const Matrix3X<Scalar>& vs, S
       (P::load(v0 + j) + cp * aj).store(vo + j);
     }
   };
-  using Wide = simd::Pack<Scalar, true>;
-  const Eigen::Index m = ws.x1.size();
-  Eigen::Index j = 0;
-  for (; j + Wide::lanes <= m; j += Wide::lanes) update(Wide(), j);
-  for (; j < m; ++j) update(simd::Pack<Scalar, false>(), j);
+  simd::for_each_pack<Scalar>(0, ws.x1.size(), update);
 }
 
 }  // namespace detail
@@ -882,11 +876,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
         (xnj + P::all(gh) * vg).store(x1 + j);
       }
     };
-    using Wide = simd::Pack<Scalar, true>;
-    const Eigen::Index m = 3 * Eigen::Index(cols);
-    Eigen::Index j = 0;
-    for (; j + Wide::lanes <= m; j += Wide::lanes) predict(Wide(), j);
-    for (; j < m; ++j) predict(simd::Pack<Scalar, false>(), j);
+    simd::for_each_pack<Scalar>(0, 3 * Eigen::Index(cols), predict);
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton

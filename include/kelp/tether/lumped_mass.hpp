@@ -598,6 +598,10 @@ struct ForcePass {
   Scalar* acc = nullptr;
   Scalar X(int k, int i) const { return x[i * xs + k]; }
   Scalar V(int k, int i) const { return v[i * vs + k]; }
+  /// The positions as a 3 × (N+1) matrix.
+  Eigen::Map<const Matrix3X<Scalar>, 0, Eigen::OuterStride<>> positions() const {
+    return {x, 3, n + 1, Eigen::OuterStride<>(xs)};
+  }
 };
 
 /// Columns of TetherWorkspace::pass_buffer.
@@ -808,11 +812,10 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
   // is written with the unnormalised chord and 1/|c|² so that its square root and the
   // tangent's run in parallel instead of one after the other.
   const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
-  const V3 chord(c.X(0, hi) - c.X(0, lo), c.X(1, hi) - c.X(1, lo), c.X(2, hi) - c.X(2, lo));
-  const Scalar c2 = (chord(0) * chord(0) + chord(1) * chord(1)) + chord(2) * chord(2);
-  const Scalar inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
-  const Scalar inv_c = sqrt(inv_c2);
-  const V3 q = chord * inv_c;
+  const NodeTangent<Scalar> nt = node_tangent<Scalar>(c.positions(), i, n);
+  const V3& chord = nt.chord;
+  const Scalar inv_c2 = nt.inv_c2, inv_c = nt.inv_c;
+  const V3& q = nt.q;
   ws.tangent.col(i) = q;
   V3 f;
   for (int k = 0; k < 3; ++k) {
