@@ -147,6 +147,59 @@ TEST_CASE("a failed system step throws and leaves every part of the state bit-id
   CHECK(bitwise_equal(s, before2));
 }
 
+TEST_CASE("bad vehicle states, attachment points and workspaces are refused, state unchanged",
+          "[system][errors][bad_input]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  World w;
+  const ks::SystemModeld model(w.params, w.env);
+  ks::SystemWorkspaced ws(model);
+  auto s = initial_state(model, ws);
+  ks::SystemInputsd in;
+  ks::step(model, ws, s, in, 0.01);
+  // attachment_motion / attachment_wrench: NaN velocity, NaN point, non-unit attitude, NaN force.
+  kv::VehicleStated v = s.auv;
+  const Vector3<double> r(0, 0, -0.15);
+  CHECK_NOTHROW(ks::attachment_motion(v, r));
+  v.nu(1) = nan;
+  CHECK_THROWS_AS(ks::attachment_motion(v, r), kelp::invalid_argument);
+  CHECK_THROWS_AS(ks::attachment_wrench(v, r, Vector3<double>(1, 2, 3)), kelp::invalid_argument);
+  v = s.auv;
+  v.attitude.coeffs() *= 1.1;
+  CHECK_THROWS_WITH(ks::attachment_motion(v, r), Catch::Contains("unit quaternion"));
+  CHECK_THROWS_AS(ks::attachment_motion(s.auv, Vector3<double>(0, nan, 0)), kelp::invalid_argument);
+  CHECK_THROWS_AS(ks::attachment_wrench(s.auv, r, Vector3<double>(nan, 0, 0)),
+                  kelp::invalid_argument);
+  // The system step: each bad part of the state is refused and nothing changes.
+  for (int k = 0; k < 5; ++k) {
+    ks::SystemStated bad = s;
+    if (k == 0) bad.asv.nu(0) = nan;
+    if (k == 1) bad.auv.position(2) = nan;
+    if (k == 2) bad.auv.attitude.coeffs() << 0, 0, 0, 0;
+    if (k == 3) bad.asv_nu_dot(5) = nan;
+    if (k == 4) bad.tether.velocity(1, 3) = nan;
+    const ks::SystemStated before = bad;
+    INFO("case " << k);
+    CHECK_THROWS_AS(ks::step(model, ws, bad, in, 0.01), kelp::invalid_argument);
+    CHECK(bitwise_equal(bad, before));
+  }
+  // A workspace of another system, or one default-constructed.
+  auto p = w.params;
+  p.tether = kt::presets::rov_tether(12.0, 0.5);
+  const ks::SystemModeld other(p, w.env);
+  ks::SystemWorkspaced foreign(other);
+  const ks::SystemStated before = s;
+  CHECK_THROWS_AS(ks::step(model, foreign, s, in, 0.01), kelp::invalid_argument);
+  CHECK(bitwise_equal(s, before));
+  // advance_attached_tether with a NaN attachment point.
+  CHECK_THROWS_AS(ks::advance_attached_tether(model.tether(), ws.tether, model.environment(),
+                                              s.tether, s.asv, Vector3<double>(nan, 0, 0), s.auv, r,
+                                              0.01, 0.01, kt::Integrator::bdf2),
+                  kelp::invalid_argument);
+  CHECK(bitwise_equal(s, before));
+  // The system still steps.
+  CHECK_NOTHROW(ks::step(model, ws, s, in, 0.01));
+}
+
 TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a converged one",
           "[system][errors]") {
   // One Newton iteration and no halving: most dynamic tether steps fail, and each is redone

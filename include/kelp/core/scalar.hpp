@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <type_traits>
 
@@ -78,6 +79,29 @@ template <typename Scalar>
 void check_non_negative(const Scalar& x, const char* field) {
   if (!(is_finite(x) && value_of(x) >= 0.0))
     detail::throw_invalid_argument(std::string(field) + " must be finite and >= 0");
+}
+
+/// \brief Throws `kelp::invalid_argument` naming `field` and the bound unless `x` ≤ `bound`
+/// (NaN fails). For parameters whose finite but absurd values would overflow what is computed
+/// from them; the bound is part of the documented contract of the parameter.
+template <typename Scalar>
+void check_at_most(const Scalar& x, double bound, const char* field) {
+  if (!(value_of(x) <= bound)) {
+    char text[96];
+    std::snprintf(text, sizeof text, " must be <= %g (got %g)", bound, value_of(x));
+    detail::throw_invalid_argument(std::string(field) + text);
+  }
+}
+
+/// \brief Throws `kelp::invalid_argument` naming `field` and the bound unless `x` ≥ `bound`
+/// (NaN fails).
+template <typename Scalar>
+void check_at_least(const Scalar& x, double bound, const char* field) {
+  if (!(value_of(x) >= bound)) {
+    char text[96];
+    std::snprintf(text, sizeof text, " must be >= %g (got %g)", bound, value_of(x));
+    detail::throw_invalid_argument(std::string(field) + text);
+  }
 }
 
 }  // namespace kelp

@@ -253,7 +253,7 @@ Vector3<Scalar> point_acceleration(const vehicle::VehicleState<Scalar>& x,
 template <typename Scalar>
 tether::EndMotion<Scalar> predicted_end(const vehicle::VehicleState<Scalar>& x,
                                         const Vector6<Scalar>& nu_dot, const Vector3<Scalar>& r) {
-  tether::EndMotion<Scalar> m = attachment_motion(x, r);
+  tether::EndMotion<Scalar> m = motion_of_point(x, r);
   m.acceleration = point_acceleration(x, nu_dot, r);
   return m;
 }
@@ -297,7 +297,7 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
              [&](const vehicle::VehicleState<Scalar>& s, double c) {
                vehicle::StateDerivative<Scalar> d;
                d.pose = vehicle::pose_rate(s.attitude, s.nu);
-               const Vector6<Scalar> tau_ext = in.external + attachment_wrench(s, r, f_ned);
+               const Vector6<Scalar> tau_ext = in.external + wrench_of_force(s, r, f_ned);
                d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.control, tau_ext,
                                                     lerp(s0, s1, Scalar(c)));
                return d;
@@ -328,8 +328,9 @@ struct CouplingSnapshot {
 /// allocation.
 /// \param[in] with_energy also fill `SystemReport::energy` (energy(model, state) after the step).
 /// \returns the tether's integration report and the forces applied to the vehicles.
-/// \throws kelp::invalid_argument for bad input (dt, non-finite inputs); kelp::numerical_error
-/// when a part cannot be advanced. After any throw every part of `state` is bit-identical to
+/// \throws kelp::invalid_argument for bad input (dt, non-finite inputs or vehicle states, a
+/// non-unit attitude, a workspace not built for the model); kelp::numerical_error when a part
+/// cannot be advanced. After any throw every part of `state` is bit-identical to
 /// what it was.
 template <typename Scalar>
 SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
@@ -340,8 +341,11 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   check_all_finite(inputs.asv.external, "inputs.asv.external");
   check_all_finite(inputs.auv.control, "inputs.auv.control");
   check_all_finite(inputs.auv.external, "inputs.auv.external");
-  KELP_CHECK(ws.tether.force.cols() == model.tether().nodes(),
-             "workspace was built for a different system");
+  KELP_CHECK(ws.tether.fits(model.tether().nodes()), "workspace was built for a different system");
+  detail::check_vehicle_pose(state.asv);
+  detail::check_vehicle_pose(state.auv);
+  check_all_finite(state.asv_nu_dot, "state.asv_nu_dot");
+  check_all_finite(state.auv_nu_dot, "state.auv_nu_dot");
   const SystemParameters<Scalar>& p = model.parameters();
   const auto& env = model.environment();
   const double t = state.time();
@@ -408,10 +412,8 @@ SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorksp
                                   const vehicle::VehicleState<Scalar>& asv,
                                   const vehicle::VehicleState<Scalar>& auv, double t = 0.0,
                                   tether::StaticOptions<Scalar> options = {}) {
-  check_all_finite(asv.position, "asv.position");
-  check_all_finite(auv.position, "auv.position");
-  check_all_finite(asv.nu, "asv.nu");
-  check_all_finite(auv.nu, "auv.nu");
+  detail::check_vehicle_pose(asv);
+  detail::check_vehicle_pose(auv);
   SystemState<Scalar> s;
   s.asv = asv;
   s.auv = auv;

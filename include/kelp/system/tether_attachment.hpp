@@ -17,31 +17,68 @@
 
 namespace kelp::system {
 
-/// \brief NED motion of the body-fixed point `r_body` [m] of a vehicle, as a tether end motion:
-/// position p_CO + R r_b, velocity R (v + ω × r_b). The acceleration is left zero: a VehicleState
-/// carries no ν̇ (pass one through `EndMotion::acceleration` if the caller has it).
-/// \tparam Scalar double or float. \param[in] vehicle state \param[in] r_body point, body frame [m]
+namespace detail {
+/// Refuses a vehicle state that cannot place a tether end: non-finite position, velocity or
+/// attitude, or an attitude that is not a unit quaternion (Eigen would read it as some rotation).
+template <typename Scalar>
+void check_vehicle_pose(const vehicle::VehicleState<Scalar>& s) {
+  if (!(all_finite(s.position) && all_finite(s.nu) && all_finite(s.attitude.coeffs())))
+    ::kelp::detail::throw_invalid_argument(
+        "attached vehicle: state.position, state.nu and state.attitude must be finite");
+  using std::abs;
+  KELP_CHECK(abs(value_of(s.attitude.squaredNorm()) - 1.0) < 1e-3,
+             "attached vehicle: state.attitude must be a unit quaternion");
+}
+
+/// attachment_motion without the checks (the system's own, already checked, states).
 template <typename Scalar, typename Derived>
-tether::EndMotion<Scalar> attachment_motion(const vehicle::VehicleState<Scalar>& vehicle,
-                                            const Eigen::MatrixBase<Derived>& r_body) {
+tether::EndMotion<Scalar> motion_of_point(const vehicle::VehicleState<Scalar>& vehicle,
+                                          const Eigen::MatrixBase<Derived>& r_body) {
   tether::EndMotion<Scalar> m;
   m.position = vehicle.point_position(r_body);
   m.velocity = vehicle.point_velocity(r_body);
   return m;
 }
 
-/// \brief Body-frame generalized force τ = (Rᵀ f, r_b × Rᵀ f) on a vehicle from an NED force
-/// `force_ned` [N] applied at the body-fixed point `r_body` [m] (Fossen 2021, eq. 2.122 form:
-/// moment about the CO). Add it to the vehicle's τ.
+/// attachment_wrench without the checks (RK4 stages, whose attitude is not exactly unit).
 template <typename Scalar, typename D1, typename D2>
-Vector6<Scalar> attachment_wrench(const vehicle::VehicleState<Scalar>& vehicle,
-                                  const Eigen::MatrixBase<D1>& r_body,
-                                  const Eigen::MatrixBase<D2>& force_ned) {
+Vector6<Scalar> wrench_of_force(const vehicle::VehicleState<Scalar>& vehicle,
+                                const Eigen::MatrixBase<D1>& r_body,
+                                const Eigen::MatrixBase<D2>& force_ned) {
   const Vector3<Scalar> f_body = vehicle.attitude.conjugate() * Vector3<Scalar>(force_ned);
   Vector6<Scalar> tau;
   tau.template head<3>() = f_body;
   tau.template tail<3>() = Vector3<Scalar>(r_body).cross(f_body);
   return tau;
+}
+}  // namespace detail
+
+/// \brief NED motion of the body-fixed point `r_body` [m] of a vehicle, as a tether end motion:
+/// position p_CO + R r_b, velocity R (v + ω × r_b). The acceleration is left zero: a VehicleState
+/// carries no ν̇ (pass one through `EndMotion::acceleration` if the caller has it).
+/// \tparam Scalar double or float. \param[in] vehicle state \param[in] r_body point, body frame [m]
+/// \throws kelp::invalid_argument for a non-finite r_body or vehicle state, or a non-unit attitude.
+template <typename Scalar, typename Derived>
+tether::EndMotion<Scalar> attachment_motion(const vehicle::VehicleState<Scalar>& vehicle,
+                                            const Eigen::MatrixBase<Derived>& r_body) {
+  detail::check_vehicle_pose(vehicle);
+  check_all_finite(r_body, "r_body");
+  return detail::motion_of_point(vehicle, r_body);
+}
+
+/// \brief Body-frame generalized force τ = (Rᵀ f, r_b × Rᵀ f) on a vehicle from an NED force
+/// `force_ned` [N] applied at the body-fixed point `r_body` [m] (Fossen 2021, eq. 2.122 form:
+/// moment about the CO). Add it to the vehicle's τ.
+/// \throws kelp::invalid_argument for a non-finite r_body, force or vehicle state, or a non-unit
+/// attitude.
+template <typename Scalar, typename D1, typename D2>
+Vector6<Scalar> attachment_wrench(const vehicle::VehicleState<Scalar>& vehicle,
+                                  const Eigen::MatrixBase<D1>& r_body,
+                                  const Eigen::MatrixBase<D2>& force_ned) {
+  detail::check_vehicle_pose(vehicle);
+  check_all_finite(r_body, "r_body");
+  check_all_finite(force_ned, "force_ned");
+  return detail::wrench_of_force(vehicle, r_body, force_ned);
 }
 
 /// \brief Boundary of a tether whose start end is at `r_start_body` on `start` (e.g. the ASV) and
@@ -90,8 +127,6 @@ TetherLoads<Scalar> advance_attached_tether(
   KELP_CHECK(model.parameters().start_mode == tether::EndMode::kinematic &&
                  model.parameters().end_mode == tether::EndMode::kinematic,
              "advance_attached_tether: both tether ends (start_mode, end_mode) must be kinematic");
-  check_all_finite(r_start_body, "r_start_body");
-  check_all_finite(r_end_body, "r_end_body");
   const tether::TetherBoundary<Scalar> b = tether_boundary(start, r_start_body, end, r_end_body);
   TetherLoads<Scalar> loads;
   loads.report = tether::advance(model, ws, env, state, b, dt, max_dt, integrator, options);

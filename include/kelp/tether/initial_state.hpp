@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
@@ -66,7 +67,8 @@ TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, con
 
 /// \brief Catenary initial state refined by `solve_static_equilibrium` with both ends fixed at
 /// `start_ned`, `end_ned` (free ends of the model stay free). Returns the solve's result (check
-/// `converged`); the state is written to `state`.
+/// `converged`); the state is written to `state` when the solve returns.
+/// \throws as catenary_initial_state and solve_static_equilibrium, with `state` unchanged.
 template <typename Scalar, typename Env>
 [[nodiscard]] StaticResult<Scalar> static_initial_state(const TetherModel<Scalar>& model,
                                                         TetherWorkspace<Scalar>& ws, const Env& env,
@@ -74,9 +76,12 @@ template <typename Scalar, typename Env>
                                                         const Vector3<Scalar>& end_ned,
                                                         TetherState<Scalar>& state,
                                                         const StaticOptions<Scalar>& options = {}) {
-  state = catenary_initial_state(model, env, start_ned, end_ned);
-  return solve_static_equilibrium(model, ws, env, state,
-                                  TetherBoundary<Scalar>::fixed(start_ned, end_ned), options);
+  // Solved on a copy: `state` changes only when the solve returns.
+  TetherState<Scalar> s = catenary_initial_state(model, env, start_ned, end_ned);
+  const StaticResult<Scalar> result = solve_static_equilibrium(
+      model, ws, env, s, TetherBoundary<Scalar>::fixed(start_ned, end_ned), options);
+  state = std::move(s);
+  return result;
 }
 
 }  // namespace kelp::tether

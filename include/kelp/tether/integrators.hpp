@@ -601,28 +601,39 @@ void check_implicit_options(const ImplicitOptions<Scalar>& o) {
              "ImplicitOptions::max_step_halvings must be in [0, 30]");
 }
 
-/// Checks a step's inputs; gives a state whose history buffers do not fit the model (a state
-/// assembled by hand) fitting ones and no history.
+/// Checks a step's inputs, then gives a state whose history buffers do not fit the model (a
+/// state assembled by hand) fitting ones and no history: nothing is changed unless all checks
+/// pass.
 template <typename Scalar>
 void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                        TetherState<Scalar>& state, const TetherBoundary<Scalar>& b, double dt) {
   check_positive(dt, "dt");
-  KELP_CHECK(ws.force.cols() == model.nodes(), "workspace was built for a different tether");
+  check_workspace(model, ws);
   KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
              "state.position and state.velocity must have segments + 1 columns");
-  if (state.previous_position.cols() != model.nodes() ||
-      state.previous_velocity.cols() != model.nodes()) {
+  check_boundary(b);
+  const bool history_fits = state.previous_position.cols() == model.nodes() &&
+                            state.previous_velocity.cols() == model.nodes();
+  // One pass over the state; the named checks run only to build the message.
+  if (!(all_finite_fast(state.position, state.velocity) && std::isfinite(state.time) &&
+        state.previous_dt >= 0.0 &&
+        (!history_fits || !state.has_history() ||
+         all_finite_fast(state.previous_position, state.previous_velocity)))) {
+    check_all_finite(state.position, "state.position");
+    check_all_finite(state.velocity, "state.velocity");
+    check_finite(state.time, "state.time");
+    check_non_negative(state.previous_dt, "state.previous_dt");
+    if (history_fits) {
+      check_all_finite(state.previous_position, "state.previous_position");
+      check_all_finite(state.previous_velocity, "state.previous_velocity");
+    }
+    ::kelp::detail::throw_invalid_argument("state: the sum of its coordinates overflows");
+  }
+  if (!history_fits) {
     state.previous_position.setZero(3, model.nodes());
     state.previous_velocity.setZero(3, model.nodes());
     state.previous_dt = 0.0;
   }
-  // One pass over the state; the named check runs only to build the message.
-  if (!(all_finite_fast(state.position, state.velocity) && std::isfinite(state.time) &&
-        state.previous_dt >= 0.0 &&
-        (!state.has_history() ||
-         all_finite_fast(state.previous_position, state.previous_velocity))))
-    check_state(model, state);
-  check_boundary(b);
 }
 
 /// `x` in %g format, for error messages.
@@ -1152,6 +1163,13 @@ namespace detail {
 /// Number of segment springs on node i of a line of n segments (1 at an end, else 2).
 inline int node_springs(int i, int n) { return (i > 0 ? 1 : 0) + (i < n ? 1 : 0); }
 
+/// Water densities from 0 (air, vacuum) to 1e5 kg/m³ (seven times mercury's); NaN and Inf refused.
+template <typename Scalar>
+void check_water_density(const Scalar& rho) {
+  check_non_negative(rho, "water_density");
+  check_at_most(rho, 1e5, "water_density");
+}
+
 /// Axial mass of node i [kg]: structural plus tangential added mass, the node taken as
 /// submerged in water of density ρ [kg/m³].
 template <typename Scalar>
@@ -1168,9 +1186,11 @@ Scalar axial_node_mass(const TetherModel<Scalar>& model, int i, Scalar water_den
 /// mass, nodes taken as submerged). Bending (EI > 0): the discrete bending stiffness is
 /// (EI/l³)·DᵀD with D the second difference (‖DᵀD‖ ≤ 16), so ω²_b ≤ 16 EI/(l³ m_n) with m_n the
 /// normal (added-mass) node mass. Returns √(ω²_a + ω²_b).
+/// \throws kelp::invalid_argument for a water density ρ outside [0, 1e5] kg/m³ or NaN.
 template <typename Scalar>
 Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_density) {
   using std::sqrt;
+  detail::check_water_density(water_density);
   const int n = model.segments();
   const TetherParameters<Scalar>& p = model.parameters();
   const Scalar l = model.segment_length();
@@ -1196,13 +1216,20 @@ Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_de
 /// a heavily damped segment inside the negative-real-axis limit. Drag and seabed damping are
 /// not included. Implicit schemes: +infinity (unconditionally stable for the linearised line;
 /// choose dt for accuracy, e.g. 10 ms).
-/// \param[in] water_density ρ [kg/m³] for the added mass.
+/// \param[in] water_density ρ [kg/m³] for the added mass (0: in air).
+/// \param[in] safety factor in (0, 1] on the stability limit.
+/// \throws kelp::invalid_argument for ρ outside [0, 1e5] kg/m³ or NaN, a safety factor outside
+/// (0, 1], or an Integrator value outside the enumeration.
 template <typename Scalar>
 Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrator,
                           Scalar water_density = Scalar(kelp::seawater_density),
                           Scalar safety = Scalar(0.8)) {
   using std::sqrt;
   check_positive(safety, "safety");
+  check_at_most(safety, 1.0, "safety");
+  detail::check_water_density(water_density);
+  KELP_CHECK(std::string(integrator_name(integrator)) != "unknown",
+             "integrator is not a kelp::tether::Integrator value");
   if (is_implicit(integrator)) return std::numeric_limits<Scalar>::infinity();
   const Scalar w = highest_axial_frequency(model, water_density);
   if (!(w > Scalar(0))) return std::numeric_limits<Scalar>::infinity();
@@ -1224,10 +1251,10 @@ Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrato
 /// steps of the chosen integrator; the kinematic ends follow `boundary` (given at the current
 /// time) through the interval. `ws.end_forces` holds the forces of the last sub-step,
 /// `ws.end_impulse` the impulse on the ends summed over all of them. If any
-/// sub-step fails (after its own retries, for the implicit schemes) the state is restored to its
-/// value at entry, history included, and the error rethrown. No heap allocation.
-/// \returns the sum of the sub-steps' reports (committed steps, Newton iterations, worst
-/// residual, retries).
+/// sub-step fails (after its own retries, for the implicit schemes) or throws for any other reason
+/// the state is restored to its value at entry, history included, and the error rethrown. No heap
+/// allocation. \returns the sum of the sub-steps' reports (committed steps, Newton iterations,
+/// worst residual, retries).
 template <typename Scalar, typename Env>
 StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                            const Env& env, TetherState<Scalar>& state,
@@ -1249,7 +1276,7 @@ StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Sca
       impulse.on_start += ws.end_impulse.on_start;
       impulse.on_end += ws.end_impulse.on_end;
     }
-  } catch (const kelp::numerical_error&) {
+  } catch (...) {
     ws.entry_backup.restore(state);
     throw;
   }
@@ -1287,22 +1314,38 @@ struct StaticResult {
 /// retried after a step whose Newton solve did not converge). Drag from a current enters F.
 /// Starts from `state` (e.g. the catenary); `state` ends at the last iterate with zero velocity
 /// and unchanged time; `ws.end_forces` holds the static end forces.
-/// \throws kelp::invalid_argument for bad input; kelp::numerical_error if the iteration produces
-/// non-finite values (state unchanged).
+/// \throws kelp::invalid_argument for bad input (a workspace not built for the model, a state or
+/// boundary that does not fit or is not finite, StaticOptions with a NaN or infinite
+/// force_tolerance, an initial_pseudo_dt not finite and > 0, max_iterations < 1), before the
+/// state is touched; kelp::numerical_error if the iteration produces non-finite values (state
+/// unchanged).
 template <typename Scalar, typename Env>
 [[nodiscard]] StaticResult<Scalar> solve_static_equilibrium(
     const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
     TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
     const StaticOptions<Scalar>& options = {}) {
+  // Every check before the state is touched.
+  detail::check_workspace(model, ws);
   check_state(model, state);
   check_boundary(boundary);
-  check_positive(options.initial_pseudo_dt, "initial_pseudo_dt");
-  KELP_CHECK(options.max_iterations >= 1, "max_iterations must be >= 1");
+  check_finite(options.force_tolerance, "StaticOptions::force_tolerance");
+  check_positive(options.initial_pseudo_dt, "StaticOptions::initial_pseudo_dt");
+  KELP_CHECK(options.max_iterations >= 1, "StaticOptions::max_iterations must be >= 1");
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   Scalar tol = options.force_tolerance;
   if (!(tol > Scalar(0)))
     tol = Scalar(1e-7) * model.parameters().mass_per_length * model.parameters().length *
           Scalar(env.gravity());
+  ImplicitOptions<Scalar> inner;
+  inner.max_iterations = 6;
+  const Scalar m_ref = model.node_mass(model.segments() / 2);
+  // The inner residual is max_i h·|F_i|/a_i [m/s], a_i the node's isotropic mass (structural
+  // plus added mass), not m_ref: this tolerance asks for |F_i| ≤ ½·tol·a_i/m_ref, half the
+  // force tolerance for an interior node in air, looser where added mass or a point mass
+  // makes a_i > m_ref (the outer loop checks |F_i| ≤ tol itself).
+  // (acceleration_tolerance · h is the inner velocity tolerance.)
+  inner.acceleration_tolerance = Scalar(0.5) * tol / m_ref;
+  detail::check_implicit_options(inner);
   TetherBoundary<Scalar> b = boundary;
   b.start.velocity.setZero();
   b.end.velocity.setZero();
@@ -1315,9 +1358,6 @@ template <typename Scalar, typename Env>
   state.velocity.setZero();
   state.clear_history();
   detail::apply_boundary(model, b, Scalar(0), state.position, state.velocity);
-  ImplicitOptions<Scalar> inner;
-  inner.max_iterations = 6;
-  const Scalar m_ref = model.node_mass(model.segments() / 2);
   StaticResult<Scalar> result;
   Scalar h = options.initial_pseudo_dt;
   const Scalar h_max(1e6);
@@ -1335,12 +1375,6 @@ template <typename Scalar, typename Env>
         break;
       }
       if (it >= options.max_iterations) break;
-      // The inner residual is max_i h·|F_i|/a_i [m/s], a_i the node's isotropic mass (structural
-      // plus added mass), not m_ref: this tolerance asks for |F_i| ≤ ½·tol·a_i/m_ref, half the
-      // force tolerance for an interior node in air, looser where added mass or a point mass
-      // makes a_i > m_ref (the outer loop checks |F_i| ≤ tol itself).
-      // (acceleration_tolerance · h is the inner velocity tolerance.)
-      inner.acceleration_tolerance = Scalar(0.5) * tol / m_ref;
       StepReport<Scalar> r;
       // A pseudo step that does not converge is not committed: retry it shorter.
       const bool taken =
@@ -1357,7 +1391,7 @@ template <typename Scalar, typename Env>
         h = std::min(h_max, h * Scalar(2));
       }
     }
-  } catch (const kelp::numerical_error&) {
+  } catch (...) {
     ws.entry_backup.restore(state);
     throw;
   }

@@ -42,6 +42,23 @@ enum class EndMode {
   free
 };
 
+/// \brief Upper bounds of TetherParameters (validate() refuses values above them). Far above any
+/// real tether (a 1 km, 150 mm steel mooring chain has 450 kg/m and EA 2e9 N), they keep every
+/// force computed from the parameters finite.
+namespace limits {
+inline constexpr int max_segments = 100000;            ///< segments
+inline constexpr double max_length = 1e5;              ///< length, seabed_damping_depth [m]
+inline constexpr double min_segment_length = 1e-6;     ///< length / segments [m]
+inline constexpr double max_diameter = 10.0;           ///< diameter [m]
+inline constexpr double max_mass_per_length = 1e5;     ///< mass_per_length [kg/m]
+inline constexpr double max_axial_stiffness = 1e13;    ///< EA [N], internal damping BA [N s]
+inline constexpr double max_bending_stiffness = 1e12;  ///< EI [N m²]
+inline constexpr double max_coefficient = 100.0;       ///< drag, added-mass, friction coefficients
+inline constexpr double max_seabed_constant = 1e13;  ///< seabed stiffness [Pa/m], damping [Pa s/m]
+inline constexpr double max_speed = 1e3;             ///< friction_velocity [m/s]
+inline constexpr double max_point_mass = 1e9;        ///< end point masses [kg]
+}  // namespace limits
+
 /// \brief User-facing physical description of a lumped-mass tether (all magnitudes positive).
 ///
 /// Defaults are a small ROV tether used as kelp's benchmark line (20 m, d 8 mm, 0.07 kg/m,
@@ -110,28 +127,43 @@ struct TetherParameters {
 };
 
 /// \brief Checks tether parameters.
-/// \throws kelp::invalid_argument naming the offending field (segments ≥ 1; length, diameter,
-/// mass_per_length, axial_stiffness, friction_velocity > 0; the rest finite and ≥ 0).
+/// \throws kelp::invalid_argument naming the offending field: segments in [1, 100000]; length,
+/// diameter, mass_per_length, axial_stiffness, friction_velocity finite and > 0; the rest finite
+/// and ≥ 0; every magnitude at most its bound in kelp::tether::limits; segments at least 1 µm
+/// long; end modes EndMode values.
 template <typename Scalar>
 void validate(const TetherParameters<Scalar>& p) {
-  KELP_CHECK(p.segments >= 1, "segments must be >= 1");
-  check_positive(p.length, "length");
-  check_positive(p.diameter, "diameter");
-  check_positive(p.mass_per_length, "mass_per_length");
-  check_positive(p.axial_stiffness, "axial_stiffness");
-  check_non_negative(p.internal_damping, "internal_damping");
-  check_non_negative(p.bending_stiffness, "bending_stiffness");
-  check_non_negative(p.normal_drag, "normal_drag");
-  check_non_negative(p.tangential_drag, "tangential_drag");
-  check_non_negative(p.normal_added_mass, "normal_added_mass");
-  check_non_negative(p.tangential_added_mass, "tangential_added_mass");
-  check_non_negative(p.seabed_stiffness, "seabed_stiffness");
-  check_non_negative(p.seabed_damping, "seabed_damping");
-  check_non_negative(p.seabed_damping_depth, "seabed_damping_depth");
-  check_non_negative(p.seabed_friction, "seabed_friction");
-  check_positive(p.friction_velocity, "friction_velocity");
-  check_non_negative(p.start_point_mass, "start_point_mass");
-  check_non_negative(p.end_point_mass, "end_point_mass");
+  // Each magnitude finite and of the right sign, then below a generous physical bound (far above
+  // any cable, chain or umbilical, so that the forces computed from them cannot overflow).
+  const auto bounded = [](const Scalar& x, double bound, const char* name, bool zero_ok) {
+    if (zero_ok)
+      check_non_negative(x, name);
+    else
+      check_positive(x, name);
+    check_at_most(x, bound, name);
+  };
+  KELP_CHECK(p.segments >= 1 && p.segments <= limits::max_segments,
+             "segments must be in [1, " + std::to_string(limits::max_segments) + "]");
+  bounded(p.length, limits::max_length, "length", false);
+  bounded(p.diameter, limits::max_diameter, "diameter", false);
+  bounded(p.mass_per_length, limits::max_mass_per_length, "mass_per_length", false);
+  bounded(p.axial_stiffness, limits::max_axial_stiffness, "axial_stiffness", false);
+  bounded(p.internal_damping, limits::max_axial_stiffness, "internal_damping", true);
+  bounded(p.bending_stiffness, limits::max_bending_stiffness, "bending_stiffness", true);
+  bounded(p.normal_drag, limits::max_coefficient, "normal_drag", true);
+  bounded(p.tangential_drag, limits::max_coefficient, "tangential_drag", true);
+  bounded(p.normal_added_mass, limits::max_coefficient, "normal_added_mass", true);
+  bounded(p.tangential_added_mass, limits::max_coefficient, "tangential_added_mass", true);
+  bounded(p.seabed_stiffness, limits::max_seabed_constant, "seabed_stiffness", true);
+  bounded(p.seabed_damping, limits::max_seabed_constant, "seabed_damping", true);
+  bounded(p.seabed_damping_depth, limits::max_length, "seabed_damping_depth", true);
+  bounded(p.seabed_friction, limits::max_coefficient, "seabed_friction", true);
+  bounded(p.friction_velocity, limits::max_speed, "friction_velocity", false);
+  bounded(p.start_point_mass, limits::max_point_mass, "start_point_mass", true);
+  bounded(p.end_point_mass, limits::max_point_mass, "end_point_mass", true);
+  // Segments shorter than this make EA/l and the stable explicit step absurd.
+  check_at_least(p.length / Scalar(p.segments), limits::min_segment_length,
+                 "length / segments (the segment length)");
   KELP_CHECK(p.start_mode == EndMode::kinematic || p.start_mode == EndMode::free,
              "start_mode must be EndMode::kinematic or EndMode::free");
   KELP_CHECK(p.end_mode == EndMode::kinematic || p.end_mode == EndMode::free,
@@ -425,29 +457,54 @@ struct TetherWorkspace {
 
   /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
   void resize(int nodes) {
-    const int n = nodes, s = nodes - 1;
-    for (Matrix3X<Scalar>* m :
-         {&force, &bending, &acceleration, &tangent, &water_velocity, &water_acceleration, &rhs,
-          &delta, &x0, &v0, &x1, &v1, &xs, &vs, &x_eval, &v_eval})
-      m->setZero(3, n);
-    for (VectorX<Scalar>* v : {&mass_iso, &mass_tan, &mass_iso_inv, &mass_tan_ratio, &seabed_force,
-                               &friction_normal, &submerged, &node_kz, &surface_elevation})
-      v->setZero(n);
-    direction.setZero(3, s);
-    rhs_true.setZero(3, n);
-    for (VectorX<Scalar>* v : {&tension, &stretched_length, &seg_k_uu, &seg_k_perp, &seg_c_uu,
-                               &seg_true_k_uu, &seg_true_c_uu, &seg_rate, &seg_branch})
-      v->setZero(s);
-    node_dv.setZero(6, n);
-    pass_buffer.setZero(n, 9);
-    block_inv.setZero(17, n);
-    entry_backup.resize(n);
-    retry_backup.resize(n);
+    for_each_buffer(*this, nodes,
+                    [](auto& m, Eigen::Index rows, Eigen::Index cols) { m.setZero(rows, cols); });
+    entry_backup.resize(nodes);
+    retry_backup.resize(nodes);
     water_is_zero = true;
+  }
+
+  /// \brief True when every buffer has the size resize(nodes) gives it (false for a
+  /// default-constructed workspace, one built for another tether, or one edited by hand). O(1).
+  bool fits(int nodes) const {
+    bool ok = nodes >= 2;
+    for_each_buffer(*this, nodes, [&ok](const auto& m, Eigen::Index rows, Eigen::Index cols) {
+      ok = ok && m.rows() == rows && m.cols() == cols;
+    });
+    return ok;
+  }
+
+ private:
+  // Calls f(buffer, rows, cols) for every per-node and per-segment buffer of a workspace sized
+  // for `nodes` nodes (Self: TetherWorkspace, const or not).
+  template <typename Self, typename F>
+  static void for_each_buffer(Self& w, int nodes, F&& f) {
+    const Eigen::Index n = nodes, s = nodes - 1;
+    for (auto* m : {&w.force, &w.bending, &w.acceleration, &w.tangent, &w.water_velocity,
+                    &w.water_acceleration, &w.rhs, &w.rhs_true, &w.delta, &w.x0, &w.v0, &w.x1,
+                    &w.v1, &w.xs, &w.vs, &w.x_eval, &w.v_eval})
+      f(*m, 3, n);
+    for (auto* v : {&w.mass_iso, &w.mass_tan, &w.mass_iso_inv, &w.mass_tan_ratio, &w.seabed_force,
+                    &w.friction_normal, &w.submerged, &w.node_kz, &w.surface_elevation})
+      f(*v, n, 1);
+    f(w.direction, 3, s);
+    for (auto* v : {&w.tension, &w.stretched_length, &w.seg_k_uu, &w.seg_k_perp, &w.seg_c_uu,
+                    &w.seg_true_k_uu, &w.seg_true_c_uu, &w.seg_rate, &w.seg_branch})
+      f(*v, s, 1);
+    f(w.node_dv, 6, n);
+    f(w.pass_buffer, n, 9);
+    f(w.block_inv, 17, n);
   }
 };
 
 namespace detail {
+
+/// \throws kelp::invalid_argument unless `ws` was built for `model` (TetherWorkspace::fits).
+template <typename Scalar>
+void check_workspace(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws) {
+  KELP_CHECK(ws.fits(model.nodes()),
+             "the workspace was not built for this tether: use TetherWorkspace(model)");
+}
 
 /// True for environments that can say they are still water at all times through
 /// `bool is_still_water() const`, as kelp::environment::Environment can. Other environments are
@@ -1161,9 +1218,24 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// velocities, small beside the mass term M/h of a step).
 /// \param[in] model the tether \param[in,out] ws workspace \param[in] env environment
 /// \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v velocities [m/s]
+/// \throws kelp::invalid_argument when `ws` was not built for `model` (TetherWorkspace::fits),
+/// x or v is not 3×(N+1), or t, x or v is not finite (O(N) check; the integrators call the
+/// evaluation behind it directly, after checking the state once per step).
 template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
 void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
+  detail::check_workspace(model, ws);
+  KELP_CHECK(
+      x.rows() == 3 && x.cols() == model.nodes() && v.rows() == 3 && v.cols() == model.nodes(),
+      "compute_forces: x and v must be 3 x (segments + 1)");
+  check_finite(t, "compute_forces: t");
+  // One pass over the inputs: NaN and ±Inf survive the sum (a sum that overflows is refused
+  // too, rightly: coordinates of 1e307 m are not a tether).
+  if (!is_finite(x.sum() + v.sum())) {
+    check_all_finite(x, "compute_forces: x");
+    check_all_finite(v, "compute_forces: v");
+    ::kelp::detail::throw_invalid_argument("compute_forces: x and v overflow");
+  }
   detail::evaluate_forces<WithJacobian>(model, ws, env, t, x, v, static_cast<Scalar*>(nullptr));
 }
 
@@ -1172,10 +1244,17 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
 ///
 /// M_i = a I + b q qᵀ is inverted in closed form: M⁻¹ F = (F − b/(a+b) q (q·F)) / a, with
 /// 1/a and b/(a+b) from compute_forces (constants along the wet part of the line).
+/// \throws kelp::invalid_argument when `ws` was not built for `model`, `acc` is not 3×(N+1) or
+/// an end acceleration is not finite.
 template <typename Scalar, typename DA>
 void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                                const Vector3<Scalar>& a_start, const Vector3<Scalar>& a_end,
                                Eigen::MatrixBase<DA>& acc) {
+  detail::check_workspace(model, ws);
+  KELP_CHECK(acc.rows() == 3 && acc.cols() == model.nodes(),
+             "accelerations_from_forces: acc must be 3 x (segments + 1)");
+  check_all_finite(a_start, "accelerations_from_forces: a_start");
+  check_all_finite(a_end, "accelerations_from_forces: a_end");
   const int n = model.segments();
   for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
     const auto q = ws.tangent.col(i);
@@ -1189,10 +1268,13 @@ void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace
 /// \brief Forces the tether exerts on its kinematic attachment points from the last
 /// `compute_forces`: F_end = F_node − M_node a_end (the negative of the constraint force that
 /// holds the end node on its prescribed path), NED [N]. Zero for a free end.
+/// \throws kelp::invalid_argument when `ws` was not built for `model` or `boundary` is not finite.
 template <typename Scalar>
 EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
                                             const TetherWorkspace<Scalar>& ws,
                                             const TetherBoundary<Scalar>& boundary) {
+  detail::check_workspace(model, ws);
+  check_boundary(boundary);
   EndForces<Scalar> out;
   const int n = model.segments();
   const auto inertia = [&](int i, const Vector3<Scalar>& a) -> Vector3<Scalar> {
@@ -1211,10 +1293,12 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
 /// wet node plus D/2, see detail::submerged_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
 /// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
 /// tangents and wetness itself.
+/// \throws kelp::invalid_argument when the state does not fit the model or is not finite.
 template <typename Scalar, typename Env>
 Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
                      const TetherState<Scalar>& state) {
   using std::sqrt;
+  check_state(model, state);
   const TetherParameters<Scalar>& p = model.parameters();
   const int n = model.segments();
   const Scalar rho = Scalar(env.water_density()), g = Scalar(env.gravity());

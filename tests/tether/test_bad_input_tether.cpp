@@ -1,0 +1,373 @@
+// Bad input at every public entry point of kelp/tether (lumped-mass model, integrators, statics,
+// initial states): NaN, Inf, negative, zero, absurdly large, mismatched sizes, an empty or foreign
+// workspace, out-of-range enums. Each must answer kelp::invalid_argument, and a state passed in
+// must be unchanged bit for bit after the throw.
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/integrators.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+#include "tether_test_support.hpp"
+
+namespace kt = kelp::tether;
+using kelp::Matrix3X;
+using kelp::Vector3;
+
+namespace {
+
+const double nan_ = std::numeric_limits<double>::quiet_NaN();
+const double inf_ = std::numeric_limits<double>::infinity();
+
+bool same_bits(const Matrix3X<double>& a, const Matrix3X<double>& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
+}
+
+bool same_state(const kt::TetherStated& a, const kt::TetherStated& b) {
+  return same_bits(a.position, b.position) && same_bits(a.velocity, b.velocity) &&
+         same_bits(a.previous_position, b.previous_position) &&
+         same_bits(a.previous_velocity, b.previous_velocity) &&
+         std::memcmp(&a.time, &b.time, sizeof a.time) == 0 &&
+         std::memcmp(&a.previous_dt, &b.previous_dt, sizeof a.previous_dt) == 0;
+}
+
+// A 10-segment line hanging between two fixed points, one step taken (so it has a history).
+struct Line {
+  kt::TetherParametersd params = kelp_test::benchmark_line<double>(10);
+  kt::TetherModeld model{params};
+  kt::TetherWorkspaced ws{model};
+  kelp_test::TestWater<double> water;
+  kt::TetherBoundaryd boundary =
+      kt::TetherBoundaryd::fixed(Vector3<double>(0, 0, 1), Vector3<double>(15, 0, 6));
+  kt::TetherStated state;
+  Line() {
+    state =
+        kt::catenary_initial_state(model, water, boundary.start.position, boundary.end.position);
+    (void)kt::step(model, ws, water, state, boundary, 0.01, kt::Integrator::bdf2);
+  }
+};
+
+// Requires `f` to throw kelp::invalid_argument and to leave `state` as it found it.
+void require_refused(const std::string& what, kt::TetherStated& state,
+                     const std::function<void()>& f) {
+  INFO(what);
+  const kt::TetherStated before = state;
+  REQUIRE_THROWS_AS(f(), kelp::invalid_argument);
+  REQUIRE(same_state(before, state));
+}
+
+}  // namespace
+
+TEST_CASE("Tether parameters: NaN, Inf, negative, zero and absurd values are refused",
+          "[tether][bad_input]") {
+  using P = kt::TetherParametersd;
+  struct Field {
+    const char* name;
+    double P::*member;
+    bool zero_ok;
+  };
+  const std::vector<Field> fields = {
+      {"length", &P::length, false},
+      {"diameter", &P::diameter, false},
+      {"mass_per_length", &P::mass_per_length, false},
+      {"axial_stiffness", &P::axial_stiffness, false},
+      {"internal_damping", &P::internal_damping, true},
+      {"bending_stiffness", &P::bending_stiffness, true},
+      {"normal_drag", &P::normal_drag, true},
+      {"tangential_drag", &P::tangential_drag, true},
+      {"normal_added_mass", &P::normal_added_mass, true},
+      {"tangential_added_mass", &P::tangential_added_mass, true},
+      {"seabed_stiffness", &P::seabed_stiffness, true},
+      {"seabed_damping", &P::seabed_damping, true},
+      {"seabed_damping_depth", &P::seabed_damping_depth, true},
+      {"seabed_friction", &P::seabed_friction, true},
+      {"friction_velocity", &P::friction_velocity, false},
+      {"start_point_mass", &P::start_point_mass, true},
+      {"end_point_mass", &P::end_point_mass, true},
+  };
+  for (const Field& f : fields) {
+    std::vector<double> bad = {nan_, inf_, -inf_, -1.0, 1e300};
+    if (!f.zero_ok) bad.push_back(0.0);
+    for (const double value : bad) {
+      P p;
+      p.*(f.member) = value;
+      INFO(f.name << " = " << value);
+      REQUIRE_THROWS_AS(kt::TetherModeld(p), kelp::invalid_argument);
+      // The message names the field.
+      try {
+        kt::TetherModeld m(p);
+      } catch (const kelp::invalid_argument& e) {
+        CHECK(std::string(e.what()).find(f.name) != std::string::npos);
+      }
+    }
+    // A value inside the documented range is accepted (the bounds are not too tight).
+    P p;
+    p.*(f.member) = f.zero_ok ? 0.0 : 0.5 * (p.*(f.member));
+    CHECK_NOTHROW(kt::TetherModeld(p));
+  }
+  // Tiny lengths whose derived constants overflow: EA/l = 1e5 N / 1e-310 m.
+  for (const double length : {1e-300, 1e-310}) {
+    P p;
+    p.length = length;
+    INFO("length = " << length);
+    REQUIRE_THROWS_AS(kt::TetherModeld(p), kelp::invalid_argument);
+  }
+  for (const int segments : {0, -1, 2000000}) {
+    P p;
+    p.segments = segments;
+    INFO("segments = " << segments);
+    REQUIRE_THROWS_AS(kt::TetherModeld(p), kelp::invalid_argument);
+  }
+  P p;
+  p.start_mode = static_cast<kt::EndMode>(7);
+  REQUIRE_THROWS_AS(kt::TetherModeld(p), kelp::invalid_argument);
+  p = P{};
+  p.end_mode = static_cast<kt::EndMode>(-1);
+  REQUIRE_THROWS_AS(kt::TetherModeld(p), kelp::invalid_argument);
+  // Real tethers sit well inside the bounds: a 1 km steel mooring chain and a 2 m micro-tether.
+  P chain;
+  chain.segments = 200;
+  chain.length = 1000;
+  chain.diameter = 0.15;
+  chain.mass_per_length = 450;
+  chain.axial_stiffness = 2e9;
+  CHECK_NOTHROW(kt::TetherModeld(chain));
+  P micro;
+  micro.segments = 40;
+  micro.length = 2;
+  micro.diameter = 0.001;
+  micro.mass_per_length = 0.001;
+  micro.axial_stiffness = 500;
+  CHECK_NOTHROW(kt::TetherModeld(micro));
+}
+
+TEST_CASE("Tether low-level functions refuse an empty or foreign workspace and mismatched sizes",
+          "[tether][bad_input]") {
+  Line line;
+  const kt::TetherModeld& model = line.model;
+  kt::TetherWorkspaced empty;
+  kt::TetherWorkspaced foreign{kt::TetherModeld(kelp_test::benchmark_line<double>(7))};
+  const Matrix3X<double>& x = line.state.position;
+  const Matrix3X<double>& v = line.state.velocity;
+  const Vector3<double> zero = Vector3<double>::Zero();
+  Matrix3X<double> short_x = x.leftCols(5), short_v = v.leftCols(5);
+  for (kt::TetherWorkspaced* ws : {&empty, &foreign}) {
+    REQUIRE_THROWS_AS(kt::compute_forces(model, *ws, line.water, 0.0, x, v),
+                      kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kt::compute_forces<true>(model, *ws, line.water, 0.0, x, v),
+                      kelp::invalid_argument);
+    Matrix3X<double> acc(3, model.nodes());
+    REQUIRE_THROWS_AS(kt::accelerations_from_forces(model, *ws, zero, zero, acc),
+                      kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kt::end_forces_from_workspace(model, *ws, line.boundary),
+                      kelp::invalid_argument);
+    require_refused("step with a foreign workspace", line.state, [&] {
+      (void)kt::step(model, *ws, line.water, line.state, line.boundary, 0.01, kt::Integrator::rk4);
+    });
+    require_refused("static solve with a foreign workspace", line.state, [&] {
+      (void)kt::solve_static_equilibrium(model, *ws, line.water, line.state, line.boundary);
+    });
+  }
+  // A workspace with one buffer resized by hand is foreign too.
+  kt::TetherWorkspaced edited{model};
+  edited.tension.resize(3);
+  REQUIRE_THROWS_AS(kt::compute_forces(model, edited, line.water, 0.0, x, v),
+                    kelp::invalid_argument);
+  // Positions and velocities of the wrong size.
+  kt::TetherWorkspaced& ws = line.ws;
+  REQUIRE_THROWS_AS(kt::compute_forces(model, ws, line.water, 0.0, short_x, v),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kt::compute_forces(model, ws, line.water, 0.0, x, short_v),
+                    kelp::invalid_argument);
+  // Non-finite positions, velocities or time: refused, not NaN forces.
+  Matrix3X<double> bad_x = x, bad_v = v;
+  bad_x(1, 4) = nan_;
+  bad_v(2, 3) = inf_;
+  REQUIRE_THROWS_AS(kt::compute_forces(model, ws, line.water, 0.0, bad_x, v),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kt::compute_forces(model, ws, line.water, 0.0, x, bad_v),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kt::compute_forces(model, ws, line.water, nan_, x, v), kelp::invalid_argument);
+  // After all that the workspace still works and gives the forces of the state.
+  kt::compute_forces(model, ws, line.water, 0.0, x, v);
+  REQUIRE(kelp::all_finite(ws.force));
+  Matrix3X<double> acc(3, model.nodes()), wrong(3, 4);
+  REQUIRE_THROWS_AS(kt::accelerations_from_forces(model, ws, zero, zero, wrong),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(
+      kt::accelerations_from_forces(model, ws, Vector3<double>(nan_, 0, 0), zero, acc),
+      kelp::invalid_argument);
+  kt::TetherBoundaryd nan_boundary = line.boundary;
+  nan_boundary.end.acceleration.x() = nan_;
+  REQUIRE_THROWS_AS(kt::end_forces_from_workspace(model, ws, nan_boundary), kelp::invalid_argument);
+  // Energy of a state that does not fit, or is not finite.
+  kt::TetherStated empty_state;
+  REQUIRE_THROWS_AS(kt::tether_energy(model, line.water, empty_state), kelp::invalid_argument);
+  kt::TetherStated nan_state = line.state;
+  nan_state.velocity(0, 2) = nan_;
+  REQUIRE_THROWS_AS(kt::tether_energy(model, line.water, nan_state), kelp::invalid_argument);
+  CHECK(std::isfinite(kt::tether_energy(model, line.water, line.state)));
+}
+
+TEST_CASE("Tether steps refuse bad input and leave the state unchanged", "[tether][bad_input]") {
+  Line line;
+  kt::TetherStated& state = line.state;
+  REQUIRE(state.has_history());
+  const auto step = [&](double dt, kt::Integrator integrator,
+                        const kt::ImplicitOptionsd& options = {},
+                        const kt::TetherBoundaryd* b = nullptr) {
+    (void)kt::step(line.model, line.ws, line.water, state, b ? *b : line.boundary, dt, integrator,
+                   options);
+  };
+  const kt::Integrator all[] = {kt::Integrator::symplectic_euler, kt::Integrator::rk2,
+                                kt::Integrator::rk4, kt::Integrator::implicit_euler,
+                                kt::Integrator::bdf2};
+  for (const kt::Integrator integrator : all) {
+    INFO(kt::integrator_name(integrator));
+    for (const double dt : {0.0, -0.01, nan_, inf_, -inf_})
+      require_refused("dt", state, [&] { step(dt, integrator); });
+    for (int k = 0; k < 6; ++k) {
+      kt::TetherBoundaryd b = line.boundary;
+      kt::EndMotion<double>& e = k < 3 ? b.start : b.end;
+      Vector3<double>& field = k % 3 == 0 ? e.position : (k % 3 == 1 ? e.velocity : e.acceleration);
+      field.y() = nan_;
+      require_refused("boundary", state, [&] { step(0.01, integrator, {}, &b); });
+    }
+  }
+  require_refused("integrator out of range", state,
+                  [&] { step(0.01, static_cast<kt::Integrator>(42)); });
+  // Invalid implicit options.
+  const std::vector<std::function<void(kt::ImplicitOptionsd&)>> bad_options = {
+      [](kt::ImplicitOptionsd& o) { o.max_iterations = 0; },
+      [](kt::ImplicitOptionsd& o) { o.acceleration_tolerance = 0; },
+      [](kt::ImplicitOptionsd& o) { o.acceleration_tolerance = nan_; },
+      [](kt::ImplicitOptionsd& o) { o.acceleration_tolerance = inf_; },
+      [](kt::ImplicitOptionsd& o) { o.slack_band = -0.1; },
+      [](kt::ImplicitOptionsd& o) { o.slack_band = nan_; },
+      [](kt::ImplicitOptionsd& o) { o.max_active_set_passes = 0; },
+      [](kt::ImplicitOptionsd& o) { o.max_backtracks = -1; },
+      [](kt::ImplicitOptionsd& o) { o.max_step_halvings = 31; },
+  };
+  for (std::size_t k = 0; k < bad_options.size(); ++k) {
+    kt::ImplicitOptionsd o;
+    bad_options[k](o);
+    INFO("option case " << k);
+    require_refused("implicit options", state, [&] { step(0.01, kt::Integrator::bdf2, o); });
+    require_refused("advance with implicit options", state, [&] {
+      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, 0.05, 0.01,
+                        kt::Integrator::implicit_euler, o);
+    });
+  }
+  // States that do not fit or are not finite are refused as they are.
+  kt::TetherStated wrong = state;
+  wrong.position.conservativeResize(3, 4);
+  require_refused("state of the wrong size", wrong, [&] {
+    (void)kt::step(line.model, line.ws, line.water, wrong, line.boundary, 0.01,
+                   kt::Integrator::rk4);
+  });
+  for (int k = 0; k < 5; ++k) {
+    kt::TetherStated s = state;
+    if (k == 0) s.position(0, 3) = nan_;
+    if (k == 1) s.velocity(2, 5) = -inf_;
+    if (k == 2) s.time = nan_;
+    if (k == 3) s.previous_position(1, 1) = nan_;
+    if (k == 4) s.previous_dt = -1;
+    for (const kt::Integrator integrator : all)
+      require_refused("non-finite state", s, [&] {
+        (void)kt::step(line.model, line.ws, line.water, s, line.boundary, 0.01, integrator);
+      });
+  }
+  // Driver arguments.
+  for (const double d : {0.0, -1.0, nan_, inf_})
+    require_refused("advance duration", state, [&] {
+      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, d, 0.01,
+                        kt::Integrator::rk4);
+    });
+  for (const double h : {0.0, -1.0, nan_, 1e-300})
+    require_refused("advance max_dt", state, [&] {
+      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, 1.0, h,
+                        kt::Integrator::rk4);
+    });
+  // The line still steps after all of this.
+  const double t0 = state.time;
+  step(0.01, kt::Integrator::bdf2);
+  CHECK(state.time == Approx(t0 + 0.01));
+}
+
+TEST_CASE("Static solve and initial states refuse bad options before touching the state",
+          "[tether][bad_input]") {
+  Line line;
+  kt::TetherStated& state = line.state;
+  const std::vector<std::function<void(kt::StaticOptionsd&)>> bad = {
+      [](kt::StaticOptionsd& o) { o.force_tolerance = nan_; },
+      [](kt::StaticOptionsd& o) { o.force_tolerance = inf_; },
+      [](kt::StaticOptionsd& o) { o.max_iterations = 0; },
+      [](kt::StaticOptionsd& o) { o.initial_pseudo_dt = 0; },
+      [](kt::StaticOptionsd& o) { o.initial_pseudo_dt = -0.05; },
+      [](kt::StaticOptionsd& o) { o.initial_pseudo_dt = nan_; },
+      [](kt::StaticOptionsd& o) { o.initial_pseudo_dt = inf_; },
+  };
+  for (std::size_t k = 0; k < bad.size(); ++k) {
+    kt::StaticOptionsd o;
+    bad[k](o);
+    INFO("static option case " << k);
+    require_refused("static options", state, [&] {
+      (void)kt::solve_static_equilibrium(line.model, line.ws, line.water, state, line.boundary, o);
+    });
+    require_refused("static initial state options", state, [&] {
+      (void)kt::static_initial_state(line.model, line.ws, line.water, line.boundary.start.position,
+                                     line.boundary.end.position, state, o);
+    });
+  }
+  require_refused("static initial state with a NaN end", state, [&] {
+    (void)kt::static_initial_state(line.model, line.ws, line.water, Vector3<double>(0, nan_, 0),
+                                   line.boundary.end.position, state);
+  });
+  kt::TetherBoundaryd b = line.boundary;
+  b.start.position.z() = inf_;
+  require_refused("static solve with an infinite end", state, [&] {
+    (void)kt::solve_static_equilibrium(line.model, line.ws, line.water, state, b);
+  });
+  REQUIRE_THROWS_AS(kt::catenary_initial_state(line.model, line.water, Vector3<double>(nan_, 0, 0),
+                                               line.boundary.end.position),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(
+      kt::straight_line_state(line.model, Vector3<double>(0, 0, 0), Vector3<double>(0, inf_, 0)),
+      kelp::invalid_argument);
+  // A good static solve still converges from the state.
+  const kt::StaticResultd r =
+      kt::solve_static_equilibrium(line.model, line.ws, line.water, state, line.boundary);
+  CHECK(r.converged);
+}
+
+TEST_CASE("Stable time step estimate refuses non-physical water and safety factors",
+          "[tether][bad_input]") {
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(20));
+  for (const double rho : {nan_, inf_, -1.0, 1e300})
+    for (const kt::Integrator integrator : {kt::Integrator::rk4, kt::Integrator::bdf2}) {
+      INFO("rho = " << rho);
+      REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, integrator, rho), kelp::invalid_argument);
+    }
+  for (const double safety : {nan_, inf_, 0.0, -0.5})
+    REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, kt::Integrator::rk4, 1025.0, safety),
+                      kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, static_cast<kt::Integrator>(9)),
+                    kelp::invalid_argument);
+  for (const double rho : {nan_, -1.0})
+    REQUIRE_THROWS_AS(kt::highest_axial_frequency(model, rho), kelp::invalid_argument);
+  // Vacuum (ρ = 0) is allowed and gives a finite step, shorter than in water when the line has
+  // tangential added mass (lighter axially).
+  kt::TetherParametersd p = kelp_test::benchmark_line<double>(20);
+  p.tangential_added_mass = 0.5;
+  const kt::TetherModeld with_cat(p);
+  const double in_water = kt::estimate_stable_dt(with_cat, kt::Integrator::rk4, 1025.0);
+  const double in_vacuum = kt::estimate_stable_dt(with_cat, kt::Integrator::rk4, 0.0);
+  CHECK(std::isfinite(in_water));
+  CHECK(in_vacuum < in_water);
+  CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2, 1025.0)));
+}
