@@ -3,6 +3,7 @@
 // workspace, out-of-range enums. Each must answer kelp::invalid_argument, and a state passed in
 // must be unchanged bit for bit after the throw.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -370,4 +371,60 @@ TEST_CASE("Stable time step estimate refuses non-physical water and safety facto
   CHECK(std::isfinite(in_water));
   CHECK(in_vacuum < in_water);
   CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2, 1025.0)));
+}
+
+TEST_CASE("Catenary solvers answer bad input with invalid_input and valid input with finite values",
+          "[tether][catenary][bad_input]") {
+  const double values[] = {0, -1, 1e-300, 1e300, nan_, inf_, -inf_,
+                           1, 10, 5e-324, 1e-10, 1e15, 1e-7, 2e9};
+  int checked = 0;
+  for (const double D : values)
+    for (const double dz : values)
+      for (const double L : values) {
+        const kt::CatenaryResultd r = kt::solve_catenary(D, dz, L);
+        INFO("D = " << D << ", dz = " << dz << ", L = " << L);
+        const bool in_range = D >= 0 && D <= 1e9 && std::abs(dz) <= 1e9 && L >= 1e-6 && L <= 1e9;
+        REQUIRE((r.status == kt::CatenaryStatus::invalid_input) == !in_range);
+        if (r.status == kt::CatenaryStatus::taut)
+          REQUIRE(std::isfinite(r.taut_tension));
+        else if (r.status != kt::CatenaryStatus::invalid_input)
+          REQUIRE((std::isfinite(r.a) && std::isfinite(r.c)));
+        ++checked;
+      }
+  for (const double x : values)
+    for (const double L : values)
+      for (const double w : values)
+        for (const double ea : {0.0, 1e5, nan_, -1.0, 1e300}) {
+          kt::CatenaryOptionsd o;
+          o.EA = ea;
+          const kt::CatenaryShaped s =
+              kt::catenary_between(Vector3<double>(0, 0, 0), Vector3<double>(x, 0, 5), L, w, o);
+          INFO("x = " << x << ", L = " << L << ", w = " << w << ", EA = " << ea);
+          if (!(ea >= 0 && ea <= 1e15 && std::abs(w) <= 1e9))
+            REQUIRE(s.status() == kt::CatenaryStatus::invalid_input);
+          if (s.status() == kt::CatenaryStatus::invalid_input) continue;
+          REQUIRE(kelp::all_finite(s.force_on_start()));
+          REQUIRE(kelp::all_finite(s.force_on_end()));
+          REQUIRE(kelp::all_finite(s.point_at(L / 2)));
+          ++checked;
+        }
+  CHECK(checked > 1000);
+  // Unusable options.
+  const std::vector<std::function<void(kt::CatenaryOptionsd&)>> bad = {
+      [](kt::CatenaryOptionsd& o) { o.tolerance = -1e-14; },
+      [](kt::CatenaryOptionsd& o) { o.tolerance = nan_; },
+      [](kt::CatenaryOptionsd& o) { o.max_iterations = 0; },
+      [](kt::CatenaryOptionsd& o) { o.vertical_tolerance = -1e-12; },
+      [](kt::CatenaryOptionsd& o) { o.vertical_tolerance = inf_; },
+      [](kt::CatenaryOptionsd& o) { o.seabed_depth = nan_; },
+      [](kt::CatenaryOptionsd& o) { o.residual_tolerance = nan_; },
+      [](kt::CatenaryOptionsd& o) { o.target_residual = -1; },
+  };
+  for (std::size_t k = 0; k < bad.size(); ++k) {
+    kt::CatenaryOptionsd o;
+    bad[k](o);
+    INFO("option case " << k);
+    CHECK(kt::solve_catenary(8.0, 3.0, 10.0, o).status == kt::CatenaryStatus::invalid_input);
+  }
+  CHECK(kt::solve_catenary(8.0, 3.0, 10.0).status == kt::CatenaryStatus::converged);
 }

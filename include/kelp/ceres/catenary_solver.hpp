@@ -155,8 +155,8 @@ class CatenarySolver {
   bool classify(const Scalar& D, const Scalar& dz, const Scalar& L,
                 const CatenaryOptions<Scalar>& options, CatenaryResult<Scalar>& result) {
     double excess = 0.0;
-    const CatenaryStatus kind = tether::detail::classify_catenary(
-        value_of(D), value_of(dz), value_of(L), options.vertical_tolerance, excess);
+    const CatenaryStatus kind =
+        tether::detail::classify_catenary(value_of(D), value_of(dz), value_of(L), options, excess);
     if (kind == CatenaryStatus::converged) return true;
     tether::detail::fill_unsolved(kind, D, dz, L, options, result);
     has_previous_ = false;

@@ -44,8 +44,12 @@ enum class CatenaryStatus {
   converged,  ///< Slack line: a, c solve the paper's two equations.
   taut,       ///< L ≤ chord: the line is straight (stretched when L < chord); a = +∞, c = NaN.
   vertical,   ///< D ≤ vertical_tolerance·L: the ends are vertically aligned; a = 0, c = 0.
-  invalid_input,   ///< NaN or ±Inf input, L ≤ 0, D < 0 or a negative vertical_tolerance (3-D
-                   ///< helper: also a non-finite w, or an end below options.seabed_depth).
+  invalid_input,   ///< NaN or ±Inf input, D < 0, L or a length outside the range of
+                   ///< tether::limits (L in [1e-6, 1e9] m, D and |Δz| ≤ 1e9 m), unusable options
+                   ///< (a tolerance not finite and ≥ 0, max_iterations < 1, a negative
+                   ///< vertical_tolerance, EA not finite in [0, 1e15] N, a NaN seabed_depth);
+                   ///< 3-D helper: also |w| not finite and ≤ 1e9 N/m, or an end below
+                   ///< options.seabed_depth.
   max_iterations,  ///< The iteration limit was hit; a, c hold the last iterate (3-D helper: the
                    ///< shape, H = a·|w|, end forces and tensions all describe that iterate).
 };
@@ -66,6 +70,16 @@ inline const char* to_string(CatenaryStatus status) {
   }
   return "unknown";
 }
+
+/// \brief Ranges of the catenary solvers' inputs (outside them: CatenaryStatus::invalid_input).
+/// Far beyond any tether (kilometres, kilonewtons per metre), they keep every product of the
+/// solve (L², a·w, EA·strain) finite.
+namespace limits {
+inline constexpr double min_catenary_length = 1e-6;  ///< L [m]
+inline constexpr double max_catenary_length = 1e9;   ///< L, D, |Δz| [m]
+inline constexpr double max_catenary_weight = 1e9;   ///< |w| [N/m]
+inline constexpr double max_catenary_EA = 1e15;      ///< EA [N]
+}  // namespace limits
 
 /// \brief Controls of the catenary solvers (the fast path here and
 /// `kelp::ceres_solver::solve_catenary`). \tparam Scalar double, float or `ceres::Jet` (EA may
@@ -304,15 +318,33 @@ T asinh_via_log(const T& y) {
   return log1p(y + y * y / (T(1.0) + sqrt(T(1.0) + y * y)));
 }
 
+/// True when the options can be used (see CatenaryOptions): finite tolerances ≥ 0, at least one
+/// iteration, EA finite in [0, limits::max_catenary_EA], a seabed depth that is not NaN.
+template <typename Scalar>
+bool catenary_options_valid(const CatenaryOptions<Scalar>& o) {
+  const double ea = value_of(o.EA);
+  return std::isfinite(o.tolerance) && o.tolerance >= 0.0 && o.max_iterations >= 1 &&
+         std::isfinite(o.vertical_tolerance) && o.vertical_tolerance >= 0.0 && ea >= 0.0 &&
+         ea <= limits::max_catenary_EA && !std::isnan(o.seabed_depth) &&
+         std::isfinite(o.residual_tolerance) && o.residual_tolerance >= 0.0 &&
+         std::isfinite(o.target_residual) && o.target_residual >= 0.0;
+}
+
 /// Classification shared by the fast and the Ceres paths, on the value parts.
-/// Returns `converged` when the geometry needs a solve.
+/// Returns `converged` when the geometry needs a solve; `invalid_input` for non-finite or
+/// out-of-range lengths (see limits) or unusable options.
 /// `excess` receives L² − Δz² − D² (see slack_excess) for valid input.
-inline CatenaryStatus classify_catenary(double D, double dz, double L, double vertical_tolerance,
-                                        double& excess) {
+template <typename Scalar>
+CatenaryStatus classify_catenary(double D, double dz, double L,
+                                 const CatenaryOptions<Scalar>& options, double& excess) {
   excess = 0.0;
-  if (!(std::isfinite(D) && std::isfinite(dz) && std::isfinite(L)) || !(L > 0.0) || D < 0.0 ||
-      !(vertical_tolerance >= 0.0))
+  // NaN fails every comparison below.
+  if (!(D >= 0.0 && D <= limits::max_catenary_length &&
+        std::abs(dz) <= limits::max_catenary_length && L >= limits::min_catenary_length &&
+        L <= limits::max_catenary_length) ||
+      !catenary_options_valid(options))
     return CatenaryStatus::invalid_input;
+  const double vertical_tolerance = options.vertical_tolerance;
   excess = slack_excess(D, dz, L);
   if (!(excess > 0.0)) return CatenaryStatus::taut;
   if (D <= vertical_tolerance * L) return CatenaryStatus::vertical;
@@ -486,8 +518,7 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
   CatenaryResult<Scalar> result;
   const double Dd = value_of(D), dzd = value_of(dz), Ld = value_of(L);
   double excess = 0.0;
-  const CatenaryStatus kind =
-      detail::classify_catenary(Dd, dzd, Ld, options.vertical_tolerance, excess);
+  const CatenaryStatus kind = detail::classify_catenary(Dd, dzd, Ld, options, excess);
   if (kind != CatenaryStatus::converged) {
     detail::fill_unsolved(kind, D, dz, L, options, result);
     return result;
@@ -547,7 +578,8 @@ class CatenaryShape {
     horizontal_dir_ = Vector3S(Scalar(1.0), Scalar(0.0), Scalar(0.0));
     const double seabed = options.seabed_depth;
     const bool has_seabed = std::isfinite(seabed);
-    if (!(all_finite(start_ned) && all_finite(end_ned) && is_finite(w)) || std::isnan(seabed) ||
+    if (!(all_finite(start_ned) && all_finite(end_ned) && is_finite(w)) ||
+        !(abs(value_of(w)) <= limits::max_catenary_weight) || std::isnan(seabed) ||
         (has_seabed && (value_of(start_ned.z()) > seabed || value_of(end_ned.z()) > seabed))) {
       detail::fill_unsolved(CatenaryStatus::invalid_input, Scalar(0.0), Scalar(0.0), L, options,
                             result_);
