@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -30,12 +31,22 @@ inline double distance_to_segment(const kelp::Vector3<double>& p, const kelp::Ve
 }
 }  // namespace detail
 
+/// What an observer of the run sees after every step (SimulateOptions::on_step).
+struct StepView {
+  long step;                                  ///< steps taken so far (1 after the first)
+  const kelp::system::SystemModeld& model;    ///< the system being run
+  const kelp::system::SystemStated& state;    ///< its state after the step
+  const kelp::system::SystemReportd& report;  ///< what the step did
+};
+
 struct SimulateOptions {
   /// Where to write timeseries.csv and nodes.csv (at the scenario's rates), created once the
   /// scenario is known to be valid; empty: no CSV.
   std::string log_dir;
   bool progress = false;                             ///< a progress bar on stderr
   std::string scenario_file = "(embedded default)";  ///< named in errors and in the summary
+  /// Called after every step (e.g. the soak test's checks); empty: nothing is called.
+  std::function<void(const StepView&)> on_step;
 };
 
 /// Runs `sc` and returns its summary (the JSON kelp-tethered-pair writes as summary.json, without
@@ -156,6 +167,7 @@ inline nlohmann::json simulate(const Scenario& sc, const SimulateOptions& o = {}
     in.auv.control = ac.wrench;
     in.asv.control = bc.wrench;
     rep = ks::step(w.model, w.workspace, w.state, in, dt);
+    if (o.on_step) o.on_step(StepView{k + 1, w.model, w.state, rep});
     if (bar && k % 500 == 0)
       std::fprintf(stderr, "\r[%-40s] %5.1f / %.0f s",
                    std::string(static_cast<std::size_t>(40.0 * k / steps), '#').c_str(), t,

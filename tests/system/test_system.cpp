@@ -61,7 +61,8 @@ bool bitwise_equal(const ks::SystemStated& a, const ks::SystemStated& b) {
          same_bits(a.auv_nu_dot.data(), b.auv_nu_dot.data(), 6 * sizeof(double)) &&
          m(a.tether.position, b.tether.position) && m(a.tether.velocity, b.tether.velocity) &&
          m(a.tether.previous_position, b.tether.previous_position) &&
-         a.tether.time == b.tether.time && a.tether.previous_dt == b.tether.previous_dt;
+         a.tether.time == b.tether.time && a.tether.time_carry == b.tether.time_carry &&
+         a.tether.previous_dt == b.tether.previous_dt;
 }
 
 // Horizontal (x, y) generalized momentum of everything: each vehicle's R (M ν)_linear (its

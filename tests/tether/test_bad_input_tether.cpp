@@ -13,6 +13,7 @@
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/presets.hpp"
 #include "tether_test_support.hpp"
 
 namespace kt = kelp::tether;
@@ -34,6 +35,7 @@ bool same_state(const kt::TetherStated& a, const kt::TetherStated& b) {
          same_bits(a.previous_position, b.previous_position) &&
          same_bits(a.previous_velocity, b.previous_velocity) &&
          std::memcmp(&a.time, &b.time, sizeof a.time) == 0 &&
+         std::memcmp(&a.time_carry, &b.time_carry, sizeof a.time_carry) == 0 &&
          std::memcmp(&a.previous_dt, &b.previous_dt, sizeof a.previous_dt) == 0;
 }
 
@@ -427,4 +429,17 @@ TEST_CASE("Catenary solvers answer bad input with invalid_input and valid input 
     CHECK(kt::solve_catenary(8.0, 3.0, 10.0, o).status == kt::CatenaryStatus::invalid_input);
   }
   CHECK(kt::solve_catenary(8.0, 3.0, 10.0).status == kt::CatenaryStatus::converged);
+}
+
+TEST_CASE("Tether presets refuse lengths they cannot cut into segments", "[tether][bad_input]") {
+  for (const double length : {0.0, -1.0, nan_, inf_, 1e300, 2e5})
+    REQUIRE_THROWS_AS(kt::presets::rov_tether(length), kelp::invalid_argument);
+  for (const double length : {0.0, -1.0, nan_, inf_, 1e300, 2e5})
+    REQUIRE_THROWS_AS(kt::presets::bead_chain(length), kelp::invalid_argument);
+  for (const double seg : {0.0, -0.5, nan_, inf_, 1e-300})
+    REQUIRE_THROWS_AS(kt::presets::rov_tether(10.0, seg), kelp::invalid_argument);
+  // 100 m at 1 mm is 100000 segments: the most a model takes.
+  CHECK(kt::presets::rov_tether(100.0, 1e-3).segments == 100000);
+  CHECK_THROWS_AS(kt::presets::rov_tether(100.0, 0.9e-3), kelp::invalid_argument);
+  CHECK(kt::presets::bead_chain(30.0).segments == 60);
 }

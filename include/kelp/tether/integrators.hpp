@@ -580,7 +580,11 @@ void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v
   state.position.swap(x);
   state.velocity.swap(v);
   state.previous_dt = dt;
-  state.time += dt;
+  // Kahan summation of the clock (TetherState::time_carry).
+  const double step = dt + state.time_carry;
+  const double next = state.time + step;
+  state.time_carry = step - (next - state.time);
+  state.time = next;
 }
 
 /// True when the state's history is the step just before it with the same step `dt`.
@@ -1354,7 +1358,7 @@ template <typename Scalar, typename Env>
   // Keep the entry state (no single step uses that backup) and iterate on `state` itself,
   // restoring it on error.
   ws.entry_backup.save(state);
-  const double t_entry = state.time;
+  const double t_entry = state.time, carry_entry = state.time_carry;
   state.velocity.setZero();
   state.clear_history();
   detail::apply_boundary(model, b, Scalar(0), state.position, state.velocity);
@@ -1380,6 +1384,7 @@ template <typename Scalar, typename Env>
       const bool taken =
           detail::try_implicit(model, ws, env, state, b, double(value_of(h)), false, inner, r);
       state.time = t_entry;
+      state.time_carry = carry_entry;
       state.velocity.setZero();
       state.clear_history();
       if (!taken) {

@@ -29,15 +29,20 @@ namespace kelp::tether::presets {
 /// neutrally-buoyant-in-fresh-water variant, so it is slightly buoyant in seawater
 /// (−0.011 N/m); EA = E π d²/4 = 2.92 kN with von Benzon et al.'s E = 6.437e7 Pa; Cdn 1.2,
 /// Cdt 0.01, internal damping 100 N s (von Benzon et al. 2022, Table A1); Can 1, Cat 0.
-/// \throws kelp::invalid_argument for a non-positive length or segment length.
+/// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m, a segment length not
+/// finite and > 0, or more than 100000 segments.
 template <typename Scalar>
 TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = Scalar(0.25)) {
   check_positive(length, "length");
+  check_at_most(length, limits::max_length, "length");
   check_positive(max_segment_length, "max_segment_length");
+  const double count = std::ceil(double(value_of(length / max_segment_length)) - 1e-9);
+  // Before the conversion to int (undefined beyond its range).
+  check_at_most(count, double(limits::max_segments), "length / max_segment_length (segments)");
   const double d = 7.6e-3, area = kelp::pi * d * d / 4.0;
   TetherParameters<Scalar> p;
   p.length = length;
-  p.segments = static_cast<int>(std::ceil(double(value_of(length / max_segment_length)) - 1e-9));
+  p.segments = static_cast<int>(count);
   if (p.segments < 1) p.segments = 1;
   p.diameter = Scalar(d);
   p.mass_per_length = Scalar(1000.0 * area);
@@ -62,10 +67,11 @@ TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = S
 /// bending moment (EI = 0) and the links do not stretch: EA = 1e5 N keeps the stretch under the
 /// line's own loads below 1e-6 (the joints' ±1.5 rad limits and 0.05 damping have no lumped-mass
 /// counterpart and are left out). `length` is rounded to whole beads (at least one segment).
-/// \throws kelp::invalid_argument for a non-positive length.
+/// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m.
 template <typename Scalar>
 TetherParameters<Scalar> bead_chain(Scalar length) {
   check_positive(length, "length");
+  check_at_most(length, limits::max_length, "length");
   const double spacing = 0.5, radius = 0.01, bead_mass = 0.00429;
   const double volume = 4.0 / 3.0 * kelp::pi * radius * radius * radius;
   const double d = std::sqrt(4.0 * volume / (kelp::pi * spacing));
