@@ -5,6 +5,7 @@
 #include <limits>
 #include <random>
 #include <type_traits>
+#include <vector>
 
 #include "kelp/ceres/catenary_solver.hpp"
 #include "random_geometry.hpp"
@@ -169,4 +170,35 @@ TEST_CASE("Ceres path does not allocate", "[catenary][ceres]") {
   const auto r = solver.solve(10.0, 5.0, 20.0, 15.0, 4.0);
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(r.status == CatenaryStatus::converged);
+}
+
+TEST_CASE(
+    "Ceres path: out-of-range input and unusable options are invalid_input, as on the fast "
+    "path",
+    "[catenary][ceres][bad_input]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    double D, dz, L;
+    CatenaryOptions<double> o;
+  };
+  std::vector<Case> cases = {{nan, 0, 10, {}},  {8, 3, 1e-7, {}},  {8, 3, 2e9, {}},
+                             {2e9, 3, 3e9, {}}, {8, 1e10, 10, {}}, {-1, 3, 10, {}}};
+  CatenaryOptions<double> o;
+  o.EA = -1;
+  cases.push_back({8, 3, 10, o});
+  o = {};
+  o.EA = 1e300;
+  cases.push_back({8, 3, 10, o});
+  o = {};
+  o.max_iterations = 0;
+  cases.push_back({8, 3, 10, o});
+  o = {};
+  o.residual_tolerance = nan;
+  cases.push_back({8, 3, 10, o});
+  for (const Case& c : cases) {
+    INFO("D = " << c.D << ", dz = " << c.dz << ", L = " << c.L);
+    CHECK(kc::solve_catenary(c.D, c.dz, c.L, c.o).status == CatenaryStatus::invalid_input);
+    CHECK(kt::solve_catenary(c.D, c.dz, c.L, c.o).status == CatenaryStatus::invalid_input);
+  }
+  CHECK(kc::solve_catenary(8.0, 3.0, 10.0).status == CatenaryStatus::converged);
 }
