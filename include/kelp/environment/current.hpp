@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <vector>
 
 #include "kelp/core/constants.hpp"
@@ -21,6 +22,7 @@
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/fast_math.hpp"
+#include "kelp/environment/limits.hpp"
 
 namespace kelp {
 namespace environment {
@@ -31,9 +33,13 @@ namespace environment {
 /// current vector (`current_velocity_ned`); with α_c = β_c = 0 it is the whole current, flowing
 /// north. \param[in] speed V_c [m/s] \param[in] alpha α_c vertical angle [rad]
 /// \param[in] beta β_c horizontal direction [rad]
+/// \throws kelp::invalid_argument when V_c, α_c or β_c is not finite.
 template <typename Scalar>
 Scalar paper_current(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
   using std::cos;
+  check_finite(speed, "current speed");
+  check_finite(alpha, "current vertical angle alpha");
+  check_finite(beta, "current direction beta");
   return speed * cos(alpha) * cos(beta);
 }
 
@@ -42,10 +48,14 @@ Scalar paper_current(const Scalar& speed, const Scalar& alpha, const Scalar& bet
 /// (Fossen 2021, §8.3, 3-D irrotational current). With α_c = 0 the current is horizontal and
 /// flows towards the azimuth β_c. \param[in] speed V_c [m/s] \param[in] alpha α_c [rad]
 /// \param[in] beta β_c [rad]
+/// \throws kelp::invalid_argument when V_c, α_c or β_c is not finite.
 template <typename Scalar>
 Vector3<Scalar> current_velocity_ned(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
   using std::cos;
   using std::sin;
+  check_finite(speed, "current speed");
+  check_finite(alpha, "current vertical angle alpha");
+  check_finite(beta, "current direction beta");
   return Vector3<Scalar>(speed * cos(alpha) * cos(beta), speed * sin(beta),
                          speed * sin(alpha) * cos(beta));
 }
@@ -101,7 +111,7 @@ struct GaussMarkov {
 
 /// \brief Everything that defines a current.
 struct CurrentParameters {
-  double speed = 0.0;               ///< nominal surface speed V_c [m/s] (≥ 0)
+  double speed = 0.0;               ///< nominal surface speed V_c [m/s] (0 ≤ V_c ≤ 50)
   double direction = 0.0;           ///< β_c: NED azimuth the current flows towards [rad]
   double vertical_angle = 0.0;      ///< α_c [rad]
   CurrentProfile profile;           ///< depth profile
@@ -116,8 +126,14 @@ struct CurrentParameters {
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the bad field of `p`.
+/// \throws kelp::invalid_argument when the speed is not in [0, 50] m/s
+/// (`limits::max_current_speed`), a direction or angle is not finite, the profile is invalid, a
+/// variation's time constant is not finite and > 0, its σ is negative or not finite, its bounds
+/// are NaN or do not enclose the nominal value, n_harmonics is not in [1, 2^20]
+/// (`limits::max_components`) or max_frequency is not finite and > 0.
 inline void validate(const CurrentParameters& p) {
-  check_non_negative(p.speed, "speed");
+  detail::check_in_range(p.speed, 0.0, limits::max_current_speed, "speed",
+                         "finite and in [0, 50] m/s");
   check_finite(p.direction, "direction");
   check_finite(p.vertical_angle, "vertical_angle");
   validate(p.profile);
@@ -132,7 +148,8 @@ inline void validate(const CurrentParameters& p) {
                is_speed ? "speed_variation bounds must satisfy lower <= speed <= upper"
                         : "direction_variation bounds must satisfy lower <= direction <= upper");
   }
-  KELP_CHECK(p.n_harmonics >= 1, "n_harmonics must be >= 1");
+  KELP_CHECK(p.n_harmonics >= 1 && p.n_harmonics <= limits::max_components,
+             "n_harmonics must be >= 1 and <= 1048576");
   check_positive(p.max_frequency, "max_frequency");
 }
 
@@ -163,20 +180,25 @@ class CurrentModel {
   /// \brief No current.
   CurrentModel() = default;
 
-  /// \brief Builds the current and draws its harmonics. \throws kelp::invalid_argument
+  /// \brief Builds the current and draws its harmonics.
+  /// \throws kelp::invalid_argument naming the bad field (see `validate(const
+  /// CurrentParameters&)`), or naming a variation's σ and time constant with their values when
+  /// its amplitude or a frequency is not finite (e.g. σ = 1e300).
   explicit CurrentModel(const CurrentParameters& p) : params_(p) {
     validate(p);
     varying_ = p.speed_variation.sigma > 0.0 || p.direction_variation.sigma > 0.0;
     if (!varying_) return;
     std::mt19937_64 rng(p.seed);
-    draw(p.speed_variation, rng, speed_);
-    draw(p.direction_variation, rng, direction_);
+    draw(p.speed_variation, rng, speed_, "speed_variation");
+    draw(p.direction_variation, rng, direction_, "direction_variation");
   }
 
   /// \brief A constant current of the given NED velocity [m/s], uniform in depth.
-  /// \throws kelp::invalid_argument naming `current` when not finite.
+  /// \throws kelp::invalid_argument naming `current` when not finite or not 3 entries, or
+  /// naming the speed when |v| > 50 m/s.
   template <typename Derived>
   static CurrentModel constant(const Eigen::MatrixBase<Derived>& v_ned) {
+    KELP_CHECK(v_ned.size() == 3, "current must have 3 entries (NED)");
     check_all_finite(v_ned, "current");
     const double u = value_of(v_ned(0)), v = value_of(v_ned(1)), w = value_of(v_ned(2));
     CurrentParameters p;
@@ -196,21 +218,25 @@ class CurrentModel {
   bool is_zero() const { return params_.speed == 0.0 && !varying_; }
 
   /// \brief Surface speed V_c(t) [m/s] at time t [s].
+  /// \throws kelp::invalid_argument when the current varies and t is not finite.
   double speed_at(double t) const {
     return varying_ ? speed_.value(t, params_.speed, params_.speed_variation) : params_.speed;
   }
   /// \brief Direction β_c(t) [rad] at time t [s].
+  /// \throws kelp::invalid_argument when the current varies and t is not finite.
   double direction_at(double t) const {
     return varying_ ? direction_.value(t, params_.direction, params_.direction_variation)
                     : params_.direction;
   }
   /// \brief Current velocity at the surface, NED [m/s], at time t [s].
+  /// \throws kelp::invalid_argument when the current varies and t is not finite.
   Vector3<Scalar> surface_velocity(double t) const {
     return current_velocity_ned(Scalar(speed_at(t)), Scalar(params_.vertical_angle),
                                 Scalar(direction_at(t)));
   }
   /// \brief Current velocity at NED point p [m] and time t [s], NED [m/s]. Above the surface
   /// (z < 0) the surface value is returned.
+  /// \throws kelp::invalid_argument when the current varies and t is not finite.
   template <typename Derived>
   Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, double t) const {
     return surface_velocity(t) * profile_factor(params_.profile, Scalar(p(2)));
@@ -221,20 +247,35 @@ class CurrentModel {
   struct Harmonics {
     std::vector<double> omega, phase;  ///< ω_k [rad/s], φ_k [rad]
     double amplitude = 0.0;            ///< a = √(2 σ_x² / N)
+    /// |t| up to which ω_k t + φ_k stays in wrap_two_pi's exact range (one check per call).
+    double time_fast_limit = std::numeric_limits<double>::infinity();
     /// x̄ + a Σ cos(ω_k t + φ_k), clamped to the bounds (x̄ when there are no harmonics).
     double value(double t, double nominal, const GaussMarkov& g) const {
       double sum = 0.0;
-      for (std::size_t k = 0; k < omega.size(); ++k) {
-        double s, c;
-        detail::fast_sincos(detail::wrap_two_pi(omega[k] * t + phase[k]), s, c);
-        sum += c;
+      if (std::fabs(t) <= time_fast_limit) {
+        for (std::size_t k = 0; k < omega.size(); ++k) {
+          double s, c;
+          detail::fast_sincos(detail::wrap_two_pi(omega[k] * t + phase[k]), s, c);
+          sum += c;
+        }
+      } else {
+        sum = sum_exact(t);
       }
       const double x = nominal + amplitude * sum;
       return std::min(std::max(x, g.lower), g.upper);
     }
+    /// Σ cos(ω_k t + φ_k) with exactly reduced phases (huge or non-finite t).
+    KELP_COLD double sum_exact(double t) const {
+      if (omega.empty()) return 0.0;
+      if (!std::isfinite(t)) detail::throw_bad_value("current: time t", "finite", t);
+      double sum = 0.0;
+      for (std::size_t k = 0; k < omega.size(); ++k)
+        sum += std::cos(detail::reduce_phase_exact(omega[k] * t + phase[k]));
+      return sum;
+    }
   };
 
-  void draw(const GaussMarkov& g, std::mt19937_64& rng, Harmonics& h) const {
+  void draw(const GaussMarkov& g, std::mt19937_64& rng, Harmonics& h, const char* name) const {
     if (g.sigma == 0.0) return;
     const auto n = static_cast<std::size_t>(params_.n_harmonics);
     auto uniform = [&rng]() { return (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53; };
@@ -249,6 +290,18 @@ class CurrentModel {
       h.omega[k] = mu * std::tan(u * span);
       h.phase[k] = 2.0 * kelp::pi * uniform();
     }
+    bool ok = std::isfinite(h.amplitude);
+    for (double w : h.omega) ok = ok && std::isfinite(w);
+    if (!ok) {
+      std::ostringstream msg;
+      msg.precision(9);
+      msg << name << ": sigma = " << g.sigma << ", time_constant = " << g.time_constant
+          << " s and max_frequency = " << params_.max_frequency
+          << " rad/s give a non-finite amplitude or frequency";
+      ::kelp::detail::throw_invalid_argument(msg.str());
+    }
+    // ω_k ≤ max_frequency; |ω_k t + φ_k| ≤ max_frequency |t| + 2π.
+    h.time_fast_limit = (detail::kWrapTwoPiLimit - 8.0) / params_.max_frequency;
   }
 
   CurrentParameters params_;

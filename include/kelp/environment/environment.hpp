@@ -26,6 +26,7 @@
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/current.hpp"
+#include "kelp/environment/limits.hpp"
 #include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/waves.hpp"
 #include "kelp/environment/wind.hpp"
@@ -84,24 +85,30 @@ class Environment {
   /// \brief NED z of a flat seabed [m] (> 0); +infinity when there is none.
   Scalar seabed_depth() const { return seabed_depth_; }
 
-  /// \brief Sets the water density [kg/m³] (> 0). \throws kelp::invalid_argument naming
-  /// `water_density`.
+  /// \brief Sets the water density [kg/m³] (> 0, ≤ 1e5: `limits::max_fluid_density`, far above
+  /// any liquid). \throws kelp::invalid_argument naming `water_density` and the value when it is
+  /// not finite or not in (0, 1e5].
   Environment& set_water_density(Scalar rho) {
-    check_positive(rho, "water_density");
+    detail::check_positive_at_most(value_of(rho), limits::max_fluid_density, "water_density",
+                                   "finite and in (0, 1e5] kg/m^3");
     water_density_ = rho;
     return *this;
   }
-  /// \brief Sets the air density [kg/m³] (> 0). \throws kelp::invalid_argument naming
-  /// `air_density`.
+  /// \brief Sets the air density [kg/m³] (> 0, ≤ 1e5: `limits::max_fluid_density`).
+  /// \throws kelp::invalid_argument naming `air_density` and the value when it is not finite or
+  /// not in (0, 1e5].
   Environment& set_air_density(Scalar rho) {
-    check_positive(rho, "air_density");
+    detail::check_positive_at_most(value_of(rho), limits::max_fluid_density, "air_density",
+                                   "finite and in (0, 1e5] kg/m^3");
     air_density_ = rho;
     return *this;
   }
-  /// \brief Sets the gravitational acceleration [m/s²] (> 0). \throws kelp::invalid_argument
-  /// naming `gravity`.
+  /// \brief Sets the gravitational acceleration [m/s²] (> 0, ≤ 1000: `limits::max_gravity`).
+  /// \throws kelp::invalid_argument naming `gravity` and the value when it is not finite or not
+  /// in (0, 1000], or when it differs from the wave field's gravity.
   Environment& set_gravity(Scalar g) {
-    check_positive(g, "gravity");
+    detail::check_positive_at_most(value_of(g), limits::max_gravity, "gravity",
+                                   "finite and in (0, 1000] m/s^2");
     check_wave_gravity(waves_, value_of(g));
     gravity_ = g;
     return *this;
@@ -155,6 +162,8 @@ class Environment {
   /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
   /// and acceleration (zero above the free surface), surface elevation at (x, y), wind at 10 m
   /// (left at zero when `with_wind` is false: the gust sum costs as much as the waves at a point).
+  /// \throws kelp::invalid_argument when t is not finite and a wave field, a varying current or
+  /// gusts read it (a NaN position gives NaN values, no exception).
   EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t,
                                    bool with_wind = true) const {
     EnvironmentSample<Scalar> s;
@@ -171,12 +180,14 @@ class Environment {
   }
 
   /// \brief Free-surface elevation ζ(x, y, t) [m], positive up (x north, y east [m], t [s]).
+  /// \throws kelp::invalid_argument when there are waves and t is not finite.
   Scalar surface_elevation(Scalar x, Scalar y, double t) const {
     if (waves_.empty()) return Scalar(0);
     return waves_.elevation(x, y, t);
   }
 
   /// \brief Free-surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t).
+  /// \throws kelp::invalid_argument when there are waves and t is not finite.
   Eigen::Matrix<Scalar, 2, 1> surface_slope(Scalar x, Scalar y, double t) const {
     return waves_.slope(x, y, t);
   }
@@ -188,6 +199,9 @@ class Environment {
   /// `acceleration.col(i)` = wave orbital acceleration there (no wave part above the free
   /// surface; the current there is the surface current). \param[in] points 3×n NED positions [m]
   /// \param[in] t time [s] \param[out] velocity 3×n [m/s] \param[out] acceleration 3×n [m/s²]
+  /// \throws kelp::invalid_argument when the output sizes differ from the points', or t is not
+  /// finite and waves or a varying current read it (NaN positions give NaN values, no exception:
+  /// the tether's integrators report those as a numerical error).
   void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                     Eigen::Ref<Matrix3X<Scalar>> velocity,
                     Eigen::Ref<Matrix3X<Scalar>> acceleration) const {

@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "kelp/core/error.hpp"
+
 #if defined(__GNUC__) || defined(__clang__)
 /// Forces inlining, so that the math inlines into kernels compiled for a wider instruction set.
 #define KELP_ENV_ALWAYS_INLINE __attribute__((always_inline))
@@ -92,7 +94,8 @@ KELP_ENV_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
 }
 
 /// x reduced to [−π, π] by subtracting the nearest multiple of 2π: x − 2πn, n = round(x/2π)
-/// (|x| < 2^51). Cody–Waite reduction with 2π split in three parts (26 + 26 + 53 bits): n·h1 and
+/// (|x| ≤ kWrapTwoPiLimit for an exact result; garbage beyond 2^51 rad, see `reduce_phase`).
+/// Cody–Waite reduction with 2π split in three parts (26 + 26 + 53 bits): n·h1 and
 /// n·h2 are exact for |n| < 2^27 (|x| < 8e8 rad), so the reduced phase carries only the rounding
 /// of x itself and ≲ 1e-16 rad of its own. Used to bring a wave phase φ − ω t (formed in double)
 /// into the range where `fast_sincos` and a single-precision cast are accurate, however large t.
@@ -103,6 +106,32 @@ KELP_ENV_ALWAYS_INLINE inline double wrap_two_pi(double x) {
   constexpr double h3 = 2.4492935982947064e-16;  // the rest, rounded
   const double n = round_nearest(x * inv_two_pi);
   return ((x - n * h1) - n * h2) - n * h3;
+}
+
+/// Largest |x| [rad] for which `wrap_two_pi` is exact to the rounding of x: n = round(x/2π)
+/// stays below 2^27 (so n·h1 and n·h2 are exact) with a margin, about 2.5 years of a 10 rad/s
+/// component. Callers check |φ| + ω_max |t| against it ONCE per query and take
+/// `reduce_phase_exact` beyond it.
+inline constexpr double kWrapTwoPiLimit = 8.0e8;
+
+/// Largest |x| [rad] for which `fast_sincos` is accurate (≲ 1e-10 absolute, most of it the
+/// rounding of x itself): n = round(x/π) stays below 2^20, where n·p1 is exact. Beyond it the
+/// reduction loses accuracy, and past 2^51 rad the result is garbage (not even in [−1, 1]).
+inline constexpr double kFastSinCosLimit = 1.0e6;
+
+/// x reduced to [−π, π] for any finite x, as accurately as the C library's own sin and cos
+/// (which reduce by a many-digit 2π, Payne–Hanek): atan2(sin x, cos x). Slow (three library
+/// calls): the fallback of `wrap_two_pi` beyond `kWrapTwoPiLimit`, e.g. t = 1e17 s. NaN or ±Inf
+/// give NaN (callers reject non-finite times before).
+inline KELP_COLD double reduce_phase_exact(double x) {
+  return std::atan2(std::sin(x), std::cos(x));
+}
+
+/// x reduced to [−π, π] for any finite x: `wrap_two_pi` within its exact range (one compare,
+/// well predicted), `reduce_phase_exact` beyond it. For one-off reductions; loops hoist the
+/// range check out instead.
+inline double reduce_phase(double x) {
+  return std::fabs(x) <= kWrapTwoPiLimit ? wrap_two_pi(x) : reduce_phase_exact(x);
 }
 
 /// e^x for −708 ≤ x ≤ 0 (no range check: the caller guarantees the range).

@@ -16,6 +16,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/limits.hpp"
 
 namespace kelp {
 namespace environment {
@@ -25,9 +26,15 @@ namespace environment {
 /// Although the paper calls it "a constant representing wave characteristics", k is the
 /// maximum slope k_w A of a regular wave of amplitude A and wave number k_w = 2π/Λ (the wave
 /// steepness), hence dimensionless. \param[in] amplitude A [m] \param[in] wavelength Λ [m]
+/// \throws kelp::invalid_argument when A is negative or not finite, Λ is not finite and > 0, or
+/// k overflows (A/Λ beyond 1e307).
 template <typename Scalar>
 Scalar paper_wave_parameter(const Scalar& amplitude, const Scalar& wavelength) {
-  return Scalar(2.0 * kelp::pi) / wavelength * amplitude;
+  check_non_negative(amplitude, "amplitude");
+  check_positive(wavelength, "wavelength");
+  const Scalar k = Scalar(2.0 * kelp::pi) / wavelength * amplitude;
+  check_finite(k, "paper_wave_parameter: k = 2 pi A / wavelength");
+  return k;
 }
 
 /// \brief The paper's wave force (eq:wave): F_wave = ρ g B L T k [N], k = (2π/Λ) A.
@@ -40,11 +47,24 @@ Scalar paper_wave_parameter(const Scalar& amplitude, const Scalar& wavelength) {
 /// \param[in] rho water density [kg/m³] \param[in] g gravity [m/s²] \param[in] beam B [m]
 /// \param[in] length L [m] \param[in] draft T [m] \param[in] amplitude A [m]
 /// \param[in] wavelength Λ [m]
+/// \throws kelp::invalid_argument when ρ is not in (0, 1e5] kg/m³
+/// (`limits::max_fluid_density`), g is not in (0, 1000] m/s² (`limits::max_gravity`), B, L or T
+/// is negative or not finite, A or Λ is invalid (see `paper_wave_parameter`), or the force
+/// overflows.
 template <typename Scalar>
 Scalar paper_wave_force(const Scalar& rho, const Scalar& g, const Scalar& beam,
                         const Scalar& length, const Scalar& draft, const Scalar& amplitude,
                         const Scalar& wavelength) {
-  return rho * g * beam * length * draft * paper_wave_parameter(amplitude, wavelength);
+  detail::check_positive_at_most(value_of(rho), limits::max_fluid_density, "rho",
+                                 "finite and in (0, 1e5] kg/m^3");
+  detail::check_positive_at_most(value_of(g), limits::max_gravity, "gravity",
+                                 "finite and in (0, 1000] m/s^2");
+  check_non_negative(beam, "beam");
+  check_non_negative(length, "length");
+  check_non_negative(draft, "draft");
+  const Scalar f = rho * g * beam * length * draft * paper_wave_parameter(amplitude, wavelength);
+  check_finite(f, "paper_wave_force: the force rho g B L T k");
+  return f;
 }
 
 /// \brief A regular wave and a hull for the time-varying form of the paper's wave force.
@@ -61,9 +81,15 @@ struct PaperWave {
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the bad field of `w`.
+/// \throws kelp::invalid_argument when rho is not in (0, 1e5] kg/m³
+/// (`limits::max_fluid_density`), gravity is not in (0, 1000] m/s² (`limits::max_gravity`), a
+/// length or the amplitude is negative or not finite, the wavelength is not finite and > 0, the
+/// direction or phase is not finite, or the force ρ g B L T k overflows.
 inline void validate(const PaperWave& w) {
-  check_positive(w.rho, "rho");
-  check_positive(w.gravity, "gravity");
+  detail::check_positive_at_most(w.rho, limits::max_fluid_density, "rho",
+                                 "finite and in (0, 1e5] kg/m^3");
+  detail::check_positive_at_most(w.gravity, limits::max_gravity, "gravity",
+                                 "finite and in (0, 1000] m/s^2");
   check_non_negative(w.beam, "beam");
   check_non_negative(w.length, "length");
   check_non_negative(w.draft, "draft");
@@ -71,17 +97,26 @@ inline void validate(const PaperWave& w) {
   check_positive(w.wavelength, "wavelength");
   check_finite(w.direction, "direction");
   check_finite(w.phase, "phase");
+  paper_wave_force(w.rho, w.gravity, w.beam, w.length, w.draft, w.amplitude, w.wavelength);
 }
 
 /// \brief Encounter frequency ω_e = ω − (ω²/g) U cos β [rad/s] of a deep-water wave of
 /// frequency ω seen from a vessel at forward speed U, β being the angle from the vessel's heading
 /// to the wave's direction of travel (β = 0 following sea, π head sea)
 /// (Fossen 2021, §10.2.2, eq. for the encounter frequency).
+/// \throws kelp::invalid_argument when ω, U or β is not finite, g is not finite and > 0, or ω_e
+/// overflows.
 template <typename Scalar>
 Scalar encounter_frequency(const Scalar& omega, const Scalar& g, const Scalar& speed,
                            const Scalar& beta) {
   using std::cos;
-  return omega - omega * omega / g * speed * cos(beta);
+  check_finite(omega, "omega");
+  check_positive(g, "gravity");
+  check_finite(speed, "speed");
+  check_finite(beta, "beta");
+  const Scalar we = omega - omega * omega / g * speed * cos(beta);
+  check_finite(we, "encounter_frequency: omega_e");
+  return we;
 }
 
 /// \brief The paper's wave force as a time-varying load on the ASV, body frame (X, Y, N)
@@ -94,12 +129,17 @@ Scalar encounter_frequency(const Scalar& omega, const Scalar& g, const Scalar& s
 /// \param[in] w wave and hull \param[in] t time [s] (a double for every Scalar)
 /// \param[in] psi heading [rad]
 /// \param[in] speed forward speed U [m/s]
+/// \throws kelp::invalid_argument when `w` is invalid (see `validate(const PaperWave&)`), or t,
+/// ψ or U is not finite.
 template <typename Scalar>
 Vector3<Scalar> paper_wave_load(const PaperWave& w, double t, const Scalar& psi,
                                 const Scalar& speed) {
   using std::cos;
   using std::sin;
   validate(w);
+  check_finite(t, "t");
+  check_finite(psi, "psi");
+  check_finite(speed, "speed");
   const double f =
       paper_wave_force(w.rho, w.gravity, w.beam, w.length, w.draft, w.amplitude, w.wavelength);
   const double omega = std::sqrt(2.0 * kelp::pi * w.gravity / w.wavelength);
@@ -133,11 +173,24 @@ Vector3<Scalar> paper_wave_load(const PaperWave& w, double t, const Scalar& psi,
 /// \param[in] added_mass translational added mass: a 3×3 matrix or a 3-vector of its diagonal
 /// (positive magnitudes −X_u̇, −Y_v̇, −Z_ẇ) [kg]
 /// \param[in] R_nb rotation body → NED \param[in] fluid_acceleration_ned u̇_f NED [m/s²]
+/// \throws kelp::invalid_argument when ρ is not in (0, 1e5] kg/m³ (`limits::max_fluid_density`),
+/// ∇ is negative or not finite, added_mass is not 3×3 or 3×1, R_nb is not 3×3 or the
+/// acceleration has not 3 entries, or an entry of them is not finite.
 template <typename Scalar, typename DerivedA, typename DerivedR, typename DerivedF>
 Vector3<Scalar> small_body_wave_force(const Scalar& rho, const Scalar& displaced_volume,
                                       const Eigen::MatrixBase<DerivedA>& added_mass,
                                       const Eigen::MatrixBase<DerivedR>& R_nb,
                                       const Eigen::MatrixBase<DerivedF>& fluid_acceleration_ned) {
+  detail::check_positive_at_most(value_of(rho), limits::max_fluid_density, "rho",
+                                 "finite and in (0, 1e5] kg/m^3");
+  check_non_negative(displaced_volume, "displaced_volume");
+  KELP_CHECK(added_mass.rows() == 3 && (added_mass.cols() == 3 || added_mass.cols() == 1),
+             "added_mass must be 3 x 3 or 3 x 1");
+  KELP_CHECK(R_nb.rows() == 3 && R_nb.cols() == 3, "R_nb must be 3 x 3");
+  KELP_CHECK(fluid_acceleration_ned.size() == 3, "fluid_acceleration_ned must have 3 entries");
+  check_all_finite(added_mass, "added_mass");
+  check_all_finite(R_nb, "R_nb");
+  check_all_finite(fluid_acceleration_ned, "fluid_acceleration_ned");
   const Vector3<Scalar> a_b = R_nb.transpose() * fluid_acceleration_ned;
   Vector3<Scalar> f = rho * displaced_volume * a_b;
   if constexpr (DerivedA::ColsAtCompileTime == 1) {
@@ -157,6 +210,27 @@ struct SurfaceHydrostatics {
   double gm_transverse = 0.0;               ///< GM_T [m]
   double gm_longitudinal = 0.0;             ///< GM_L [m]
 };
+
+/// \brief Throws `kelp::invalid_argument` naming the bad field of `h`.
+/// \throws kelp::invalid_argument when rho is not in (0, 1e5] kg/m³
+/// (`limits::max_fluid_density`), gravity is not in (0, 1000] m/s² (`limits::max_gravity`), the
+/// waterplane area or displaced volume is negative or not finite, a metacentric height is not
+/// finite, or a stiffness ρ g A_wp, ρ g ∇ GM overflows.
+inline void validate(const SurfaceHydrostatics& h) {
+  detail::check_positive_at_most(h.rho, limits::max_fluid_density, "rho",
+                                 "finite and in (0, 1e5] kg/m^3");
+  detail::check_positive_at_most(h.gravity, limits::max_gravity, "gravity",
+                                 "finite and in (0, 1000] m/s^2");
+  check_non_negative(h.waterplane_area, "waterplane_area");
+  check_non_negative(h.displaced_volume, "displaced_volume");
+  check_finite(h.gm_transverse, "gm_transverse");
+  check_finite(h.gm_longitudinal, "gm_longitudinal");
+  const double rg = h.rho * h.gravity;
+  KELP_CHECK(std::isfinite(rg * h.waterplane_area) &&
+                 std::isfinite(rg * h.displaced_volume * h.gm_transverse) &&
+                 std::isfinite(rg * h.displaced_volume * h.gm_longitudinal),
+             "SurfaceHydrostatics: a stiffness rho g A_wp or rho g V GM overflows");
+}
 
 /// \brief Surface-relative attitude of the free surface under a vessel: the roll φ_s and pitch
 /// θ_s [rad] a hull lying flat on the local surface would have, from the surface slope
@@ -188,11 +262,15 @@ Eigen::Matrix<Scalar, 2, 1> surface_attitude(const Scalar& slope_north, const Sc
 /// \param[in] phi roll [rad] \param[in] theta pitch [rad] \param[in] psi heading [rad]
 /// \param[in] zeta local elevation ζ [m] (up) \param[in] slope_north ∂ζ/∂x [-]
 /// \param[in] slope_east ∂ζ/∂y [-]
+/// \throws kelp::invalid_argument when `h` is invalid (see `validate(const
+/// SurfaceHydrostatics&)`); non-finite motions give non-finite loads (they come from a state the
+/// integrators check).
 template <typename Scalar>
 Vector6<Scalar> surface_following_restoring(const SurfaceHydrostatics& h, const Scalar& heave,
                                             const Scalar& phi, const Scalar& theta,
                                             const Scalar& psi, const Scalar& zeta,
                                             const Scalar& slope_north, const Scalar& slope_east) {
+  validate(h);
   const Eigen::Matrix<Scalar, 2, 1> att = surface_attitude(slope_north, slope_east, psi);
   const double rg = h.rho * h.gravity;
   Vector6<Scalar> tau = Vector6<Scalar>::Zero();
@@ -205,9 +283,12 @@ Vector6<Scalar> surface_following_restoring(const SurfaceHydrostatics& h, const 
 /// \brief The wave part of `surface_following_restoring`: its value minus the calm-water
 /// restoring −Gη, i.e. G η_s = (0, 0, −ρgA_wp ζ, ρg∇GM_T φ_s, ρg∇GM_L θ_s, 0) [N, N·m]. Add it
 /// to a vehicle model that already has its own (calm-water) restoring g(η). Zero in a calm sea.
+/// \throws kelp::invalid_argument when `h` is invalid (see `validate(const
+/// SurfaceHydrostatics&)`).
 template <typename Scalar>
 Vector6<Scalar> wave_restoring(const SurfaceHydrostatics& h, const Scalar& psi, const Scalar& zeta,
                                const Scalar& slope_north, const Scalar& slope_east) {
+  validate(h);
   const Eigen::Matrix<Scalar, 2, 1> att = surface_attitude(slope_north, slope_east, psi);
   const double rg = h.rho * h.gravity;
   Vector6<Scalar> tau = Vector6<Scalar>::Zero();

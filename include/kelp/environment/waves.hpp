@@ -35,6 +35,8 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <sstream>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -43,6 +45,7 @@
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/fast_math.hpp"
+#include "kelp/environment/limits.hpp"
 #include "kelp/environment/spectra.hpp"
 
 namespace kelp {
@@ -318,7 +321,7 @@ struct WaveFieldParameters {
   std::uint64_t seed = 1;
   /// Mean direction the waves travel TOWARDS, NED azimuth from north, clockwise [rad].
   double direction = 0.0;
-  /// Spreading exponent s ≥ 0 of D(θ) ∝ cos^{2s}(θ − β̄), |θ − β̄| < π/2 (s = 1 is the ITTC
+  /// Spreading exponent 0 ≤ s ≤ 1000 of D(θ) ∝ cos^{2s}(θ − β̄), |θ − β̄| < π/2 (s = 1 is the ITTC
   /// cos² spreading; 0 means long-crested). Each component gets one direction drawn from D.
   double spreading = 0.0;
   /// Lower end of the frequency band, as a multiple of ω_p (> 0).
@@ -335,17 +338,36 @@ struct WaveFieldParameters {
   double gravity = kelp::standard_gravity;
 };
 
-/// \brief Throws `kelp::invalid_argument` naming the offending field of `p`.
+/// \brief Throws `kelp::invalid_argument` naming the offending field of `p` (and its value
+/// where a bound applies).
+///
+/// \throws kelp::invalid_argument when the spectrum is out of its bounds (see
+/// `validate(const WaveSpectrum&)`), n_components is not in [1, 2^20]
+/// (`limits::max_components`), direction is not finite, spreading is not in [0, 1000]
+/// (`limits::max_spreading`),
+/// omega_min_factor is not finite and > 0, omega_max_factor is not finite and > omega_min_factor
+/// or makes the highest wave number overflow, depth is NaN or ≤ 0, or gravity is not in (0, 1000]
+/// m/s² (`limits::max_gravity`).
 inline void validate(const WaveFieldParameters& p) {
   validate(p.spectrum);
-  KELP_CHECK(p.n_components >= 1, "n_components must be >= 1");
+  KELP_CHECK(
+      p.n_components >= 1 && p.n_components <= limits::max_components,
+      "n_components must be >= 1 and <= 1048576 (got " + std::to_string(p.n_components) + ")");
   check_finite(p.direction, "direction");
-  check_non_negative(p.spreading, "spreading");
+  detail::check_in_range(p.spreading, 0.0, limits::max_spreading, "spreading",
+                         "finite and in [0, 1000]");
   check_positive(p.omega_min_factor, "omega_min_factor");
   KELP_CHECK(std::isfinite(p.omega_max_factor) && p.omega_max_factor > p.omega_min_factor,
              "omega_max_factor must be finite and > omega_min_factor");
   KELP_CHECK(!std::isnan(p.depth) && p.depth > 0.0, "depth must be > 0 (or +infinity)");
-  check_positive(p.gravity, "gravity");
+  detail::check_positive_at_most(p.gravity, limits::max_gravity, "gravity",
+                                 "finite and in (0, 1000] m/s^2");
+  const double w_hi = p.omega_max_factor * 2.0 * kelp::pi / p.spectrum.peak_period;
+  if (!std::isfinite(w_hi * w_hi / p.gravity))
+    detail::throw_bad_value("omega_max_factor",
+                            "such that the highest wave number (omega_max_factor 2 pi / "
+                            "peak_period)^2 / gravity is finite",
+                            p.omega_max_factor);
 }
 
 /// \brief Elevation and orbital kinematics at one point.
@@ -380,7 +402,10 @@ class WaveField {
   /// frequency does not change the variance and Σ a_j²/2 equals the band's m₀ ≈ Hs²/16;
   /// Fossen 2021 §10.2.3 and DNV-RP-C205 §3.5 describe the S(ω_j)Δω form); phase
   /// φ_j ~ U[0, 2π); direction from the spreading function; k_j from the dispersion relation.
-  /// \throws kelp::invalid_argument naming the bad field.
+  /// \throws kelp::invalid_argument naming the bad field (see `validate(const
+  /// WaveFieldParameters&)`), or naming the spectrum's parameters and their values when a derived
+  /// quantity of the discretised sea (a frequency, wave number or amplitude) is not finite, or a
+  /// wave number is 0.
   explicit WaveField(const WaveFieldParameters& p) : params_(p) {
     validate(p);
     if (p.spectrum.significant_height == 0.0) return;
@@ -442,6 +467,12 @@ class WaveField {
     for (double a : amp_) amp_sum += a;
     trough_bound_ = amp_sum * (1.0 + 1e-9);
     z_exp_limit_ = 700.0 / k_.back();  // k grows with j: k_.back() is the largest
+    check_derived();
+    // The kernel's accurate range, checked once per query: |φ_j − ω_j t| ≤ 2π + ω_max |t| within
+    // wrap_two_pi's exact range, |k_j (x cos β + y sin β) + α| ≤ k_max (|x| + |y|) + π within
+    // fast_sincos's. ω and k grow with j.
+    time_fast_limit_ = (detail::kWrapTwoPiLimit - 8.0) / omega_.back();
+    position_fast_limit_ = (detail::kFastSinCosLimit - 8.0) / k_.back();
   }
 
   /// \brief True for a calm sea (no components).
@@ -472,26 +503,34 @@ class WaveField {
 
   /// \brief The time part φ_j − ω_j t of component j's phase [rad], formed in double and reduced
   /// to [−π, π] (time is a double for every Scalar, so the phase does not lose precision as t
-  /// grows, nor with a single-precision model). \param[in] j component \param[in] t time [s]
+  /// grows, nor with a single-precision model; beyond the fast reduction's range, t ≳ 1e8 s, it
+  /// is reduced as exactly as std::cos would). \param[in] j component \param[in] t time [s]
+  /// \throws kelp::invalid_argument when t is not finite.
   double time_phase(std::size_t j, double t) const {
-    return detail::wrap_two_pi(phase_[j] - omega_[j] * t);
+    const double x = phase_[j] - omega_[j] * t;
+    if (std::fabs(x) <= detail::kWrapTwoPiLimit) return detail::wrap_two_pi(x);
+    check_time(t);
+    return detail::reduce_phase_exact(x);
   }
 
   /// \brief Surface elevation ζ(x, y, t) [m], positive up.
   /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s] (a double for
   /// every Scalar)
+  /// \throws kelp::invalid_argument when t is not finite (a NaN x or y gives NaN).
   Scalar elevation(const Scalar& x, const Scalar& y, double t) const {
     if constexpr (std::is_floating_point_v<Scalar>) {
       const double xd = x, yd = y;
+      if (!fast_range(xd, yd, t)) return static_cast<Scalar>(elevation_exact(xd, yd, t));
       double z = 0.0;
       for (std::size_t j = 0; j < omega_.size(); ++j) {
         double s, c;
-        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + time_phase(j, t), s, c);
+        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + fast_time_phase(j, t), s, c);
         z += amp_[j] * c;
       }
       return static_cast<Scalar>(z);
     } else {
       using std::cos;
+      check_time(t);
       Scalar z(0);
       for (std::size_t j = 0; j < omega_.size(); ++j)
         z += Scalar(amp_[j]) *
@@ -503,19 +542,29 @@ class WaveField {
   /// \brief Surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t): the rise of the surface per metre
   /// north and per metre east.
   /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s]
+  /// \throws kelp::invalid_argument when t is not finite (a NaN x or y gives NaN).
   Eigen::Matrix<Scalar, 2, 1> slope(const Scalar& x, const Scalar& y, double t) const {
     if constexpr (std::is_floating_point_v<Scalar>) {
       const double xd = x, yd = y;
       double sx = 0.0, sy = 0.0;
+      if (!fast_range(xd, yd, t)) {  // huge t or position: the C library's sine
+        for (std::size_t j = 0; j < omega_.size(); ++j) {
+          const double s = std::sin(kx_[j] * xd + ky_[j] * yd + time_phase(j, t));
+          sx -= kx_[j] * amp_[j] * s;
+          sy -= ky_[j] * amp_[j] * s;
+        }
+        return Eigen::Matrix<Scalar, 2, 1>(static_cast<Scalar>(sx), static_cast<Scalar>(sy));
+      }
       for (std::size_t j = 0; j < omega_.size(); ++j) {
         double s, c;
-        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + time_phase(j, t), s, c);
+        detail::fast_sincos(kx_[j] * xd + ky_[j] * yd + fast_time_phase(j, t), s, c);
         sx -= kx_[j] * amp_[j] * s;
         sy -= ky_[j] * amp_[j] * s;
       }
       return Eigen::Matrix<Scalar, 2, 1>(static_cast<Scalar>(sx), static_cast<Scalar>(sy));
     } else {
       using std::sin;
+      check_time(t);
       Scalar sx(0), sy(0);
       for (std::size_t j = 0; j < omega_.size(); ++j) {
         const Scalar s = Scalar(amp_[j]) *
@@ -529,6 +578,7 @@ class WaveField {
 
   /// \brief Elevation, orbital velocity and acceleration at NED point `p` and time `t`.
   /// \param[in] p NED position [m] \param[in] t time [s]
+  /// \throws kelp::invalid_argument when t is not finite (a NaN position gives NaN).
   template <typename Derived>
   WaveKinematics<Scalar> kinematics(const Eigen::MatrixBase<Derived>& p, double t) const {
     WaveKinematics<Scalar> out;
@@ -558,6 +608,8 @@ class WaveField {
   /// no heap allocation. Overwrites `velocity` and `acceleration` (3×n each).
   /// \param[in] points 3×n NED [m] \param[in] t time [s]
   /// \param[out] velocity 3×n NED [m/s] \param[out] acceleration 3×n NED [m/s²]
+  /// \throws kelp::invalid_argument when the output sizes differ from the points' or t is not
+  /// finite (a NaN position gives NaN at that point only).
   void kinematics(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                   Eigen::Ref<Matrix3X<Scalar>> velocity,
                   Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
@@ -567,6 +619,7 @@ class WaveField {
   /// \brief The same, plus the surface elevation ζ(x_i, y_i, t) above each point [m] (the sums
   /// share the phases, so this costs a few per cent more, far less than separate `elevation`
   /// calls). \param[out] elevation n values [m], positive up
+  /// \throws kelp::invalid_argument as the overload above, or when elevation has not n entries.
   void kinematics(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                   Eigen::Ref<Matrix3X<Scalar>> velocity, Eigen::Ref<Matrix3X<Scalar>> acceleration,
                   Eigen::Ref<VectorX<Scalar>> elevation) const {
@@ -637,13 +690,26 @@ class WaveField {
   using Block = detail::WaveBlock;
 
   /// Evaluates m ≤ kBlock points (b.x, b.y, b.z) at time t into b's outputs.
+  ///
+  /// The vectorised kernel is accurate while every phase stays within the fast reductions' range
+  /// (|t| ≤ time_fast_limit_, |x| + |y| ≤ position_fast_limit_: for the paper's moderate sea,
+  /// Tp ≈ 7.8 s, about 6 years and 600 km from the origin; for Tp = 1 s about 10 months and
+  /// 10 km). One compare per call and one per point decide it; beyond, the block is evaluated by
+  /// `exact_block` (C library sin/cos after an exact phase reduction: slower, but as accurate as
+  /// std::cos for any t and position).
   void run_block(Block& b, int m, double t) const {
     const double h = params_.depth;
+    bool fast = std::fabs(t) <= time_fast_limit_;
     for (int i = 0; i < m; ++i) {
       double z = b.z[i] < 0.0 ? 0.0 : b.z[i];  // crest region: kinematics of z = 0
       if (finite_depth_ && z > h) z = h;       // below the seabed: those at the seabed
       if (z > z_exp_limit_) z = z_exp_limit_;  // e^{−k z} < 1e-304 beyond: keeps k z ≤ 700
       b.ze[i] = z;                             // the kernel writes b's sums: no zeroing here
+      fast &= std::fabs(b.x[i]) + std::fabs(b.y[i]) <= position_fast_limit_;  // NaN: false
+    }
+    if (!fast) {
+      exact_block(b, m, t);
+      return;
     }
     if (force_baseline_)
       detail::wave_accumulate_baseline(view(), b, m, t, finite_depth_);
@@ -656,37 +722,105 @@ class WaveField {
     }
   }
 
-  /// The same sums with ADL math for automatic-differentiation scalars. The crest and seabed
-  /// clamps use the value part only (they select a branch, not a derivative).
-  void generic_point(const Vector3<Scalar>& p, double t, WaveKinematics<Scalar>& out) const {
+  /// Throws `kelp::invalid_argument` naming the spectrum's parameters unless every derived
+  /// constant of the discretised sea is finite (and every wave number > 0, so that the kernel's
+  /// depth limit 700/k_max is finite).
+  void check_derived() const {
+    bool ok = std::isfinite(trough_bound_) && std::isfinite(z_exp_limit_);
+    for (std::size_t j = 0; j < omega_.size(); ++j)
+      ok = ok && std::isfinite(omega_[j]) && std::isfinite(k_[j]) && k_[j] > 0.0 &&
+           std::isfinite(amp_[j]) && std::isfinite(aw2_[j]) && std::isfinite(gcc_[j]) &&
+           std::isfinite(gss_[j]) && std::isfinite(q_[j]);
+    if (ok) return;
+    std::ostringstream msg;
+    msg.precision(9);
+    msg << "wave field: significant_height = " << params_.spectrum.significant_height
+        << " m, peak_period = " << params_.spectrum.peak_period
+        << " s, omega_min_factor = " << params_.omega_min_factor
+        << ", omega_max_factor = " << params_.omega_max_factor << ", gravity = " << params_.gravity
+        << " m/s^2 and depth = " << params_.depth
+        << " m give a non-finite component frequency, wave number or amplitude";
+    ::kelp::detail::throw_invalid_argument(msg.str());
+  }
+
+  /// Throws `kelp::invalid_argument` naming the time unless it is finite.
+  static void check_time(double t) {
+    if (!std::isfinite(t)) detail::throw_bad_value("wave field: time t", "finite", t);
+  }
+
+  /// True when the fast kernels are accurate for a query at (x, y) and time t (false for NaN).
+  bool fast_range(double x, double y, double t) const {
+    return std::fabs(t) <= time_fast_limit_ && std::fabs(x) + std::fabs(y) <= position_fast_limit_;
+  }
+
+  /// `time_phase` for |t| ≤ time_fast_limit_ (checked by the caller, once per query).
+  double fast_time_phase(std::size_t j, double t) const {
+    return detail::wrap_two_pi(phase_[j] - omega_[j] * t);
+  }
+
+  /// ζ(x, y, t) with the C library's cosine and exactly reduced time phases (any finite t).
+  KELP_COLD double elevation_exact(double x, double y, double t) const {
+    double z = 0.0;
+    for (std::size_t j = 0; j < omega_.size(); ++j)
+      z += amp_[j] * std::cos(kx_[j] * x + ky_[j] * y + time_phase(j, t));
+    return z;
+  }
+
+  /// The block's sums by `generic_point` in double, point by point (the fallback of run_block).
+  KELP_COLD void exact_block(Block& b, int m, double t) const {
+    check_time(t);
+    for (int i = 0; i < m; ++i) {
+      WaveKinematics<double> k;
+      generic_point<double>(Vector3<double>(b.x[i], b.y[i], b.z[i]), t, k);
+      b.zeta[i] = k.elevation;
+      b.vx[i] = k.velocity(0);
+      b.vy[i] = k.velocity(1);
+      b.vz[i] = k.velocity(2);
+      b.ax[i] = k.acceleration(0);
+      b.ay[i] = k.acceleration(1);
+      b.az[i] = k.acceleration(2);
+      if (i == 0) {
+        b.gxx = k.velocity_gradient(0, 0);
+        b.gxy = k.velocity_gradient(0, 1);
+        b.gyy = k.velocity_gradient(1, 1);
+        b.gxz = k.velocity_gradient(0, 2);
+        b.gyz = k.velocity_gradient(1, 2);
+      }
+    }
+  }
+
+  /// The same sums with ADL math for automatic-differentiation scalars (T = Scalar), and in
+  /// double for the floating-point fallback (T = double). The crest and seabed clamps use the
+  /// value part only (they select a branch, not a derivative).
+  template <typename T>
+  void generic_point(const Vector3<T>& p, double t, WaveKinematics<T>& out) const {
     using std::cos;
     using std::exp;
     using std::sin;
-    Scalar z = p(2);
-    if (value_of(z) < 0.0) z = Scalar(0);
-    if (finite_depth_ && value_of(z) > params_.depth) z = Scalar(params_.depth);
-    out = WaveKinematics<Scalar>();
+    check_time(t);
+    T z = p(2);
+    if (value_of(z) < 0.0) z = T(0);
+    if (finite_depth_ && value_of(z) > params_.depth) z = T(params_.depth);
+    out = WaveKinematics<T>();
     for (std::size_t j = 0; j < omega_.size(); ++j) {
-      const Scalar th = Scalar(kx_[j]) * p(0) + Scalar(ky_[j]) * p(1) + Scalar(time_phase(j, t));
-      const Scalar s = sin(th), c = cos(th);
-      const Scalar e = exp(Scalar(-k_[j]) * z);
-      Scalar fh = e, fv = e;
+      const T th = T(kx_[j]) * p(0) + T(ky_[j]) * p(1) + T(time_phase(j, t));
+      const T s = sin(th), c = cos(th);
+      const T e = exp(T(-k_[j]) * z);
+      T fh = e, fv = e;
       if (finite_depth_) {
-        const Scalar e2 = exp(Scalar(-k_[j]) * (Scalar(2.0 * params_.depth) - z));
-        fh = (e + e2) * Scalar(q_[j]);
-        fv = (e - e2) * Scalar(q_[j]);
+        const T e2 = exp(T(-k_[j]) * (T(2.0 * params_.depth) - z));
+        fh = (e + e2) * T(q_[j]);
+        fv = (e - e2) * T(q_[j]);
       }
-      out.elevation += Scalar(amp_[j]) * c;
-      const Scalar hv = Scalar(aw_[j]) * fh * c, ha = Scalar(aw2_[j]) * fh * s;
-      out.velocity +=
-          Vector3<Scalar>(hv * Scalar(cosb_[j]), hv * Scalar(sinb_[j]), -Scalar(aw_[j]) * fv * s);
-      out.acceleration +=
-          Vector3<Scalar>(ha * Scalar(cosb_[j]), ha * Scalar(sinb_[j]), Scalar(aw2_[j]) * fv * c);
-      const Scalar hs = fh * s, fvc = fv * c;
-      const Scalar gxx = -Scalar(gcc_[j]) * hs, gxy = -Scalar(gcs_[j]) * hs;
-      const Scalar gyy = -Scalar(gss_[j]) * hs, gxz = -Scalar(gc_[j]) * fvc;
-      const Scalar gyz = -Scalar(gs_[j]) * fvc;
-      Eigen::Matrix<Scalar, 3, 3> g;
+      out.elevation += T(amp_[j]) * c;
+      const T hv = T(aw_[j]) * fh * c, ha = T(aw2_[j]) * fh * s;
+      out.velocity += Vector3<T>(hv * T(cosb_[j]), hv * T(sinb_[j]), -T(aw_[j]) * fv * s);
+      out.acceleration += Vector3<T>(ha * T(cosb_[j]), ha * T(sinb_[j]), T(aw2_[j]) * fv * c);
+      const T hs = fh * s, fvc = fv * c;
+      const T gxx = -T(gcc_[j]) * hs, gxy = -T(gcs_[j]) * hs;
+      const T gyy = -T(gss_[j]) * hs, gxz = -T(gc_[j]) * fvc;
+      const T gyz = -T(gs_[j]) * fvc;
+      Eigen::Matrix<T, 3, 3> g;
       g << gxx, gxy, gxz, gxy, gyy, gyz, gxz, gyz, -gxx - gyy;
       out.velocity_gradient += g;
     }
@@ -709,6 +843,8 @@ class WaveField {
   bool finite_depth_ = false;
   bool force_baseline_ = false;
   double z_exp_limit_ = std::numeric_limits<double>::infinity();
+  /// |t| [s] and |x| + |y| [m] up to which the fast kernels are accurate (see run_block).
+  double time_fast_limit_ = 0.0, position_fast_limit_ = 0.0;
   double trough_bound_ = 0.0;  ///< see `detail::WaveComponentsView::trough_bound`
   std::vector<double> omega_, k_, amp_, phase_, dir_, kx_, ky_, cosb_, sinb_, aw_, aw2_, awc_, aws_,
       aw2c_, aw2s_, q_, e2h_, gcc_, gcs_, gss_, gc_, gs_;

@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
+#include <sstream>
 #include <type_traits>
 #include <vector>
 
@@ -20,9 +22,23 @@
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/fast_math.hpp"
+#include "kelp/environment/limits.hpp"
 
 namespace kelp {
 namespace environment {
+
+namespace detail {
+/// The preconditions of the paper's wind forces (see `paper_wind_force`).
+template <typename Scalar>
+void check_paper_wind_arguments(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& c,
+                                const Scalar& area, const char* c_name, const char* area_name) {
+  check_positive_at_most(value_of(rho_air), limits::max_fluid_density, "rho_air",
+                         "finite and in (0, 1e5] kg/m^3");
+  check_finite(wind_speed, "wind_speed");
+  check_finite(c, c_name);
+  check_non_negative(area, area_name);
+}
+}  // namespace detail
 
 /// \brief The paper's wind force (eq:wind): F_wind = ½ ρ_air V_w² C_x A_w [N].
 ///
@@ -31,25 +47,41 @@ namespace environment {
 /// are constant (independent of the wind's angle to the hull).
 /// \param[in] rho_air air density [kg/m³] \param[in] wind_speed V_w [m/s]
 /// \param[in] cx C_x [-] \param[in] frontal_area A_w [m²]
+/// \throws kelp::invalid_argument when ρ_air is not in (0, 1e5] kg/m³
+/// (`limits::max_fluid_density`), V_w or C_x is not finite, the area is negative or not finite,
+/// or the force overflows.
 template <typename Scalar>
 Scalar paper_wind_force(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cx,
                         const Scalar& frontal_area) {
-  return Scalar(0.5) * rho_air * wind_speed * wind_speed * cx * frontal_area;
+  detail::check_paper_wind_arguments(rho_air, wind_speed, cx, frontal_area, "cx", "frontal_area");
+  const Scalar f = Scalar(0.5) * rho_air * wind_speed * wind_speed * cx * frontal_area;
+  check_finite(f, "paper_wind_force: the force");
+  return f;
 }
 
 /// \brief The lateral twin of the paper's wind force: F = ½ ρ_air V_w² C_y A_lw [N], with the
 /// lateral coefficient C_y and the lateral projected area A_lw (paper, text after eq:wind).
+/// \throws kelp::invalid_argument as `paper_wind_force` (naming cy and lateral_area).
 template <typename Scalar>
 Scalar paper_wind_force_lateral(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cy,
                                 const Scalar& lateral_area) {
-  return Scalar(0.5) * rho_air * wind_speed * wind_speed * cy * lateral_area;
+  detail::check_paper_wind_arguments(rho_air, wind_speed, cy, lateral_area, "cy", "lateral_area");
+  const Scalar f = Scalar(0.5) * rho_air * wind_speed * wind_speed * cy * lateral_area;
+  check_finite(f, "paper_wind_force_lateral: the force");
+  return f;
 }
 
 /// \brief Harris wind-gust spectrum S(f) [(m/s)²/Hz] at frequency f [Hz]:
 /// \f$ S(f) = \frac{4\kappa L U_{10}}{(2 + \tilde f^2)^{5/6}},\ \tilde f = L f / U_{10} \f$
 /// with L = 1800 m and the surface drag coefficient κ = 0.0026 (Harris 1971, as given in
 /// Fossen 2021 §10.1.3). Its integral over f ∈ (0, ∞) is ≈ 0.01736 U₁₀² (σ_u ≈ 0.13 U₁₀).
+/// S = 0 for f ≤ 0 or U₁₀ ≤ 0.
+/// \throws kelp::invalid_argument when f or U₁₀ is not finite, or L or κ is not finite and > 0.
 inline double harris_spectrum(double f, double u10, double length = 1800.0, double kappa = 0.0026) {
+  check_finite(f, "harris_spectrum: f");
+  check_finite(u10, "harris_spectrum: u10");
+  check_positive(length, "harris_spectrum: length");
+  check_positive(kappa, "harris_spectrum: kappa");
   if (!(f > 0.0) || !(u10 > 0.0)) return 0.0;
   const double ft = length * f / u10;
   return 4.0 * kappa * length * u10 / std::pow(2.0 + ft * ft, 5.0 / 6.0);
@@ -59,8 +91,12 @@ inline double harris_spectrum(double f, double u10, double length = 1800.0, doub
 /// S(f) [(m/s)²/Hz] at height z [m]:
 /// \f$ S(f) = \frac{320 (U_{10}/10)^2 (z/10)^{0.45}}{(1 + \tilde f^n)^{5/(3n)}},\quad
 /// \tilde f = 172 f (z/10)^{2/3} (U_{10}/10)^{-3/4},\ n = 0.468 \f$
-/// (NORSOK N-003 (2007) §6.3; DNV-RP-C205 (2010) eq. 2.3.2.12).
+/// (NORSOK N-003 (2007) §6.3; DNV-RP-C205 (2010) eq. 2.3.2.12). S = 0 for f ≤ 0 or U₁₀ ≤ 0.
+/// \throws kelp::invalid_argument when f or U₁₀ is not finite, or z is not finite and > 0.
 inline double norsepp_spectrum(double f, double u10, double z = 10.0) {
+  check_finite(f, "norsepp_spectrum: f");
+  check_finite(u10, "norsepp_spectrum: u10");
+  check_positive(z, "norsepp_spectrum: z");
   if (!(f > 0.0) || !(u10 > 0.0)) return 0.0;
   constexpr double n = 0.468;
   const double ft = 172.0 * f * std::pow(z / 10.0, 2.0 / 3.0) * std::pow(u10 / 10.0, -0.75);
@@ -77,8 +113,8 @@ enum class GustSpectrum {
 
 /// \brief A wind field: mean speed and direction plus longitudinal gusts.
 struct WindParameters {
-  double speed = 0.0;                      ///< mean speed U₁₀ at 10 m [m/s] (≥ 0)
-  double direction = 0.0;                  ///< NED azimuth the air moves TOWARDS [rad]
+  double speed = 0.0;      ///< mean speed U₁₀ at 10 m [m/s] (0 ≤ U₁₀ ≤ 200)
+  double direction = 0.0;  ///< NED azimuth the air moves TOWARDS [rad]
   GustSpectrum gust = GustSpectrum::none;  ///< gust spectrum
   int n_components = 64;                   ///< number of gust components (≥ 1)
   double f_min = 1e-4;     ///< lower end of the gust band [Hz] (> 0); frequencies are log-spaced
@@ -87,10 +123,15 @@ struct WindParameters {
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the bad field of `p`.
+/// \throws kelp::invalid_argument when the speed is not in [0, 200] m/s
+/// (`limits::max_wind_speed`), the direction is not finite, n_components is not in [1, 2^20]
+/// (`limits::max_components`), f_min is not finite and > 0, or f_max is not finite and > f_min.
 inline void validate(const WindParameters& p) {
-  check_non_negative(p.speed, "wind speed");
+  detail::check_in_range(p.speed, 0.0, limits::max_wind_speed, "wind speed",
+                         "finite and in [0, 200] m/s");
   check_finite(p.direction, "wind direction");
-  KELP_CHECK(p.n_components >= 1, "wind n_components must be >= 1");
+  KELP_CHECK(p.n_components >= 1 && p.n_components <= limits::max_components,
+             "wind n_components must be >= 1 and <= 1048576");
   check_positive(p.f_min, "f_min");
   KELP_CHECK(std::isfinite(p.f_max) && p.f_max > p.f_min, "f_max must be finite and > f_min");
 }
@@ -104,7 +145,9 @@ class WindField {
  public:
   /// \brief No wind.
   WindField() = default;
-  /// \brief Builds the gust components. \throws kelp::invalid_argument naming the bad field.
+  /// \brief Builds the gust components.
+  /// \throws kelp::invalid_argument naming the bad field, or naming f_min and f_max with their
+  /// values when a gust frequency or amplitude is not finite (e.g. f_max = 1e300).
   explicit WindField(const WindParameters& p) : params_(p) {
     validate(p);
     cos_dir_ = std::cos(p.direction);
@@ -131,7 +174,16 @@ class WindField {
       amp_[j] = std::sqrt(2.0 * sum * h / 3.0);
       omega_[j] = 2.0 * kelp::pi * std::sqrt(f0 * f1);
       phase_[j] = 2.0 * kelp::pi * static_cast<double>(rng() >> 11) * 0x1.0p-53;
+      if (!(std::isfinite(amp_[j]) && std::isfinite(omega_[j]))) {
+        std::ostringstream msg;
+        msg.precision(9);
+        msg << "wind gusts: f_min = " << p.f_min << " Hz and f_max = " << p.f_max
+            << " Hz give a non-finite gust frequency or amplitude";
+        ::kelp::detail::throw_invalid_argument(msg.str());
+      }
     }
+    // |ω_j t + φ_j| ≤ ω_max |t| + 2π stays within wrap_two_pi's exact range up to this |t|.
+    time_fast_limit_ = (detail::kWrapTwoPiLimit - 8.0) / omega_.back();
   }
 
   /// \brief The parameters the field was built from.
@@ -143,9 +195,12 @@ class WindField {
     return v;
   }
   /// \brief Wind speed U(t) = U₁₀ + u_g(t) [m/s] at time t [s].
-  /// Time is a double for every Scalar; the phase is formed in double and reduced to [−π, π].
+  /// Time is a double for every Scalar; the phase is formed in double and reduced to [−π, π]
+  /// (exactly, for any finite t; the fast reduction while |t| is below about 1e8/ω_max s).
+  /// \throws kelp::invalid_argument when the field has gusts and t is not finite.
   Scalar speed(double t) const {
     double u = params_.speed, sn, cs;
+    if (!(std::fabs(t) <= time_fast_limit_)) return Scalar(speed_exact(t));
     for (std::size_t j = 0; j < amp_.size(); ++j) {
       detail::fast_sincos(detail::wrap_two_pi(omega_[j] * t + phase_[j]), sn, cs);
       u += amp_[j] * cs;
@@ -153,6 +208,7 @@ class WindField {
     return Scalar(u);
   }
   /// \brief Wind velocity (air motion) at 10 m, NED [m/s], at time t [s]; horizontal.
+  /// \throws kelp::invalid_argument as `speed`.
   Vector3<Scalar> velocity(double t) const {
     if (params_.speed == 0.0) return Vector3<Scalar>::Zero();
     const Scalar u = speed(t);
@@ -160,7 +216,19 @@ class WindField {
   }
 
  private:
+  /// U(t) with exactly reduced phases and the C library's cosine (huge or non-finite t).
+  KELP_COLD double speed_exact(double t) const {
+    if (amp_.empty()) return params_.speed;
+    if (!std::isfinite(t))
+      ::kelp::environment::detail::throw_bad_value("wind: time t", "finite", t);
+    double u = params_.speed;
+    for (std::size_t j = 0; j < amp_.size(); ++j)
+      u += amp_[j] * std::cos(detail::reduce_phase_exact(omega_[j] * t + phase_[j]));
+    return u;
+  }
+
   WindParameters params_;
+  double time_fast_limit_ = std::numeric_limits<double>::infinity();  ///< see speed()
   double cos_dir_ = 1.0, sin_dir_ = 0.0;
   std::vector<double> omega_, amp_, phase_;
 };
@@ -186,10 +254,18 @@ struct ConstantWindCoefficients {
   double cy = 0.0;  ///< c_y [-] (≥ 0)
   double cn = 0.0;  ///< c_n [-]
   /// \brief (C_X, C_Y, C_N) at the relative wind angle γ_rw [rad].
+  /// \throws kelp::invalid_argument when γ_rw is not finite.
   Eigen::Vector3d operator()(double gamma) const { return at(gamma); }
   /// \brief The same for any scalar (a `ceres::Jet` γ keeps its derivatives).
+  /// \throws kelp::invalid_argument when γ_rw is not finite.
   template <typename Scalar>
   Vector3<Scalar> at(const Scalar& gamma) const {
+    check_finite(gamma, "relative wind angle gamma");
+    return at_unchecked(gamma);
+  }
+  /// \brief `at` without the check (for callers that validated their inputs).
+  template <typename Scalar>
+  Vector3<Scalar> at_unchecked(const Scalar& gamma) const {
     using std::cos;
     using std::sin;
     return Vector3<Scalar>(Scalar(-cx) * cos(gamma), Scalar(cy) * sin(gamma),
@@ -205,11 +281,13 @@ struct TabulatedWindCoefficients {
   std::vector<double> angle;       ///< γ_rw [rad], strictly increasing, from 0 to π
   std::vector<double> cx, cy, cn;  ///< coefficients at those angles [-]
 
-  /// \brief (C_X, C_Y, C_N) at γ_rw [rad] (any value; wrapped to (−π, π]).
-  /// \throws kelp::invalid_argument when the table is too short or its columns differ in length
-  /// (the O(1) part of `validate(const TabulatedWindCoefficients&)`, checked on every call so a
-  /// malformed table never reads out of bounds).
+  /// \brief (C_X, C_Y, C_N) at γ_rw [rad] (any finite value; wrapped to (−π, π]).
+  /// \throws kelp::invalid_argument when γ_rw is not finite, or when the table is too short or
+  /// its columns differ in length (the O(1) part of `validate(const
+  /// TabulatedWindCoefficients&)`, checked on every call so a malformed table never reads out of
+  /// bounds).
   Eigen::Vector3d operator()(double gamma) const {
+    check_finite(gamma, "relative wind angle gamma");
     KELP_CHECK(angle.size() >= 2, "wind table angle needs at least 2 entries");
     KELP_CHECK(cx.size() == angle.size() && cy.size() == angle.size() && cn.size() == angle.size(),
                "wind table cx, cy, cn must have as many entries as angle");
@@ -226,35 +304,34 @@ struct TabulatedWindCoefficients {
 };
 
 /// \brief Throws `kelp::invalid_argument` unless the table `t` is well formed: at least two
-/// angles, running strictly increasing from 0 to π, and as many cx, cy, cn entries as angles.
+/// angles, running strictly increasing from 0 to π, and as many cx, cy, cn entries as angles,
+/// all finite.
 inline void validate(const TabulatedWindCoefficients& t) {
   KELP_CHECK(t.angle.size() >= 2, "wind table angle needs at least 2 entries");
   KELP_CHECK(t.cx.size() == t.angle.size() && t.cy.size() == t.angle.size() &&
                  t.cn.size() == t.angle.size(),
              "wind table cx, cy, cn must have as many entries as angle");
+  for (std::size_t i = 0; i < t.angle.size(); ++i) {
+    check_finite(t.angle[i], "wind table angle");
+    check_finite(t.cx[i], "wind table cx");
+    check_finite(t.cy[i], "wind table cy");
+    check_finite(t.cn[i], "wind table cn");
+  }
   KELP_CHECK(std::abs(t.angle.front()) < 1e-9 && std::abs(t.angle.back() - kelp::pi) < 1e-6,
              "wind table angle must run from 0 to pi");
   for (std::size_t i = 1; i < t.angle.size(); ++i)
     KELP_CHECK(t.angle[i] > t.angle[i - 1], "wind table angle must be strictly increasing");
 }
 
-/// \brief Wind force and yaw moment (X, Y, N) on a surface vessel, body frame [N, N, N·m]
-/// (Fossen 2021 §10.1.1):
-/// \f$ X = \tfrac12\rho_a V_{rw}^2 C_X(\gamma_{rw}) A_{Fw},\quad
-///     Y = \tfrac12\rho_a V_{rw}^2 C_Y(\gamma_{rw}) A_{Lw},\quad
-///     N = \tfrac12\rho_a V_{rw}^2 C_N(\gamma_{rw}) A_{Lw} L_{oa} \f$
-/// with the relative velocity u_rw = u − u_w, v_rw = v − v_w (wind resolved in the body frame by
-/// the heading ψ), V_rw² = u_rw² + v_rw² and γ_rw = −atan2(v_rw, u_rw).
-/// Assumes a level hull (roll and pitch ignored) and wind at 10 m acting on the whole area.
-/// \tparam Coefficients `ConstantWindCoefficients`, `TabulatedWindCoefficients` or any callable
-/// γ ↦ Eigen::Vector3d (C_X, C_Y, C_N).
-/// \param[in] coefficients coefficient model \param[in] areas projected areas and length
-/// \param[in] rho_air [kg/m³] \param[in] wind_ned wind velocity (air motion) NED [m/s]
-/// \param[in] psi heading [rad] \param[in] u surge velocity [m/s] \param[in] v sway velocity [m/s]
+namespace detail {
+/// `wind_load` without its input checks: for the vehicle dynamics, whose parameters are
+/// validated when the model is built and whose state is checked by the integrators (a
+/// non-finite stage state must end as the step's numerical_error, not as an invalid argument).
 template <typename Scalar, typename Coefficients, typename Derived>
-Vector3<Scalar> wind_load(const Coefficients& coefficients, const WindAreas& areas,
-                          const Scalar& rho_air, const Eigen::MatrixBase<Derived>& wind_ned,
-                          const Scalar& psi, const Scalar& u, const Scalar& v) {
+Vector3<Scalar> wind_load_unchecked(const Coefficients& coefficients, const WindAreas& areas,
+                                    const Scalar& rho_air,
+                                    const Eigen::MatrixBase<Derived>& wind_ned, const Scalar& psi,
+                                    const Scalar& u, const Scalar& v) {
   using std::atan2;
   using std::cos;
   using std::sin;
@@ -269,13 +346,47 @@ Vector3<Scalar> wind_load(const Coefficients& coefficients, const WindAreas& are
   // value of γ and carries no derivative with respect to it.
   Vector3<Scalar> c;
   if constexpr (std::is_same<Coefficients, ConstantWindCoefficients>::value)
-    c = coefficients.at(gamma);
+    c = coefficients.at_unchecked(gamma);
   else
     c = coefficients(value_of(gamma)).template cast<Scalar>();
   const Scalar q = Scalar(0.5) * rho_air * v2;
   return Vector3<Scalar>(q * c(0) * Scalar(areas.frontal_area),
                          q * c(1) * Scalar(areas.lateral_area),
                          q * c(2) * Scalar(areas.lateral_area * areas.length_overall));
+}
+}  // namespace detail
+
+/// \brief Wind force and yaw moment (X, Y, N) on a surface vessel, body frame [N, N, N·m]
+/// (Fossen 2021 §10.1.1):
+/// \f$ X = \tfrac12\rho_a V_{rw}^2 C_X(\gamma_{rw}) A_{Fw},\quad
+///     Y = \tfrac12\rho_a V_{rw}^2 C_Y(\gamma_{rw}) A_{Lw},\quad
+///     N = \tfrac12\rho_a V_{rw}^2 C_N(\gamma_{rw}) A_{Lw} L_{oa} \f$
+/// with the relative velocity u_rw = u − u_w, v_rw = v − v_w (wind resolved in the body frame by
+/// the heading ψ), V_rw² = u_rw² + v_rw² and γ_rw = −atan2(v_rw, u_rw).
+/// Assumes a level hull (roll and pitch ignored) and wind at 10 m acting on the whole area.
+/// \tparam Coefficients `ConstantWindCoefficients`, `TabulatedWindCoefficients` or any callable
+/// γ ↦ Eigen::Vector3d (C_X, C_Y, C_N).
+/// \param[in] coefficients coefficient model \param[in] areas projected areas and length
+/// \param[in] rho_air [kg/m³] \param[in] wind_ned wind velocity (air motion) NED [m/s]
+/// \param[in] psi heading [rad] \param[in] u surge velocity [m/s] \param[in] v sway velocity [m/s]
+/// \throws kelp::invalid_argument when ρ_air is not in (0, 1e5] kg/m³
+/// (`limits::max_fluid_density`), an area or L_oa is negative or not finite, wind_ned has not 3
+/// entries or one is not finite, or ψ, u or v is not finite.
+template <typename Scalar, typename Coefficients, typename Derived>
+Vector3<Scalar> wind_load(const Coefficients& coefficients, const WindAreas& areas,
+                          const Scalar& rho_air, const Eigen::MatrixBase<Derived>& wind_ned,
+                          const Scalar& psi, const Scalar& u, const Scalar& v) {
+  detail::check_positive_at_most(value_of(rho_air), limits::max_fluid_density, "rho_air",
+                                 "finite and in (0, 1e5] kg/m^3");
+  check_non_negative(areas.frontal_area, "wind_areas.frontal_area");
+  check_non_negative(areas.lateral_area, "wind_areas.lateral_area");
+  check_non_negative(areas.length_overall, "wind_areas.length_overall");
+  KELP_CHECK(wind_ned.size() == 3, "wind_ned must have 3 entries (NED)");
+  check_all_finite(wind_ned, "wind_ned");
+  check_finite(psi, "psi");
+  check_finite(u, "u");
+  check_finite(v, "v");
+  return detail::wind_load_unchecked(coefficients, areas, rho_air, wind_ned, psi, u, v);
 }
 
 }  // namespace environment

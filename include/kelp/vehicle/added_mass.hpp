@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/vehicle/checks.hpp"
@@ -18,11 +19,13 @@ namespace kelp::vehicle {
 
 /// \brief Diagonal added-mass matrix diag(−X_u̇, −Y_v̇, −Z_ẇ, −K_ṗ, −M_q̇, −N_ṙ).
 /// \param[in] magnitudes the six positive magnitudes [kg, kg, kg, kg m², kg m², kg m²].
-/// \throws kelp::invalid_argument naming `added_mass` if a magnitude is negative or not finite.
+/// \throws kelp::invalid_argument naming `added_mass` if there are not 6 magnitudes or a
+/// magnitude is negative or not finite.
 template <typename Derived>
 Matrix6<typename Derived::Scalar> diagonal_added_mass(
     const Eigen::MatrixBase<Derived>& magnitudes) {
   using S = typename Derived::Scalar;
+  KELP_CHECK(magnitudes.size() == 6, "added_mass needs 6 magnitudes");
   for (Eigen::Index i = 0; i < 6; ++i) check_non_negative(magnitudes(i), "added_mass");
   return Vector6<S>(magnitudes).asDiagonal();
 }

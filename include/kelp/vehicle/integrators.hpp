@@ -113,6 +113,21 @@ void check_step_input(const VehicleState<Scalar>& state, identity_t<Scalar> dt) 
              "state.attitude must be a unit quaternion");
 }
 
+/// Checks the size of a wrench a step holds over its length: 6 entries. Its values are not
+/// checked: a non-finite wrench is reported as the step's numerical_error, state unchanged (the
+/// documented contract the vehicle tests pin down), like any other non-finite result.
+template <typename Derived>
+void check_wrench(const Eigen::MatrixBase<Derived>& w, const char* field) {
+  KELP_CHECK(w.size() == 6, std::string(field) + " must have 6 entries");
+}
+
+/// Checks a current velocity: 3 finite NED entries.
+template <typename Derived>
+void check_current(const Eigen::MatrixBase<Derived>& v) {
+  KELP_CHECK(v.size() == 3, "current_ned must have 3 entries");
+  check_all_finite(v, "current_ned");
+}
+
 }  // namespace detail
 
 /// \brief One classical fourth-order Runge–Kutta step of length `dt` with a wrench evaluated at
@@ -123,13 +138,15 @@ void check_step_input(const VehicleState<Scalar>& state, identity_t<Scalar> dt) 
 /// \param[in,out] state advanced by dt on success, unchanged on failure.
 /// \param[in] dt step [s], > 0. \param[in] wrench callable as above.
 /// \param[in] current_ned v_c^n [m/s], NED, constant over the step.
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
-/// kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude or
+/// a `current_ned` that is not 3 finite entries; kelp::numerical_error on a non-finite result
+/// (including a non-finite wrench returned by the callable).
 template <typename Scalar, typename WrenchFn, typename DC>
 void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                    VehicleState<Scalar>& state, identity_t<Scalar> dt, WrenchFn&& wrench,
                    const Eigen::MatrixBase<DC>& current_ned) {
   detail::check_step_input(state, dt);
+  detail::check_current(current_ned);
   const Vector3<Scalar> vc(current_ned);
   detail::rk4(
       state, dt,
@@ -143,12 +160,15 @@ void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
 /// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
 /// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
-/// kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude, or
+/// `tau`, `tau_env` (not 6 entries) or `current_ned` (not 3 finite entries);
+/// kelp::numerical_error on a non-finite result (a NaN or Inf in tau or tau_env included).
 template <typename Scalar, typename DT, typename DE, typename DC>
 void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
               VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<DT>& tau,
               const Eigen::MatrixBase<DE>& tau_env, const Eigen::MatrixBase<DC>& current_ned) {
+  detail::check_wrench(tau, "tau");
+  detail::check_wrench(tau_env, "tau_env");
   const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_env);
   step_rk4_with(
       model, ws, state, dt,
@@ -215,13 +235,17 @@ Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& 
 /// \param[in] tau_ext external wrench [N, N m], body (e.g. the tether's).
 /// \param[in] env environment (`kelp::environment::Environment` or any type with `sample(p, t)`
 /// and `surface_slope(x, y, t)`). \param[in] t time at the start of the step [s].
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
-/// kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude,
+/// `tau` or `tau_ext` (not 6 entries) or a non-finite `t`; kelp::numerical_error on a
+/// non-finite result (a NaN or Inf in tau or tau_ext included).
 template <typename Scalar, typename Env, typename D1, typename D2>
 void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
               VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<D1>& tau,
               const Eigen::MatrixBase<D2>& tau_ext, const Env& env, double t) {
   detail::check_step_input(state, dt);
+  detail::check_wrench(tau, "tau");
+  detail::check_wrench(tau_ext, "tau_ext");
+  check_finite(t, "t");
   const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext);
   const Vector6<Scalar> zero = Vector6<Scalar>::Zero();
   const double dt_d = value_of(dt);
@@ -244,8 +268,9 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
 /// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
 /// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field or a non-unit attitude;
-/// kelp::numerical_error on a non-finite result.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude, or
+/// `tau`, `tau_env` (not 6 entries) or `current_ned` (not 3 finite entries);
+/// kelp::numerical_error on a non-finite result (a NaN or Inf in tau or tau_env included).
 template <typename Scalar, typename DT, typename DE, typename DC>
 void step_semi_implicit_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                               VehicleState<Scalar>& state, identity_t<Scalar> dt,
@@ -256,6 +281,9 @@ void step_semi_implicit_euler(const VehicleModel<Scalar>& model, VehicleWorkspac
   using std::sin;
   using std::sqrt;
   detail::check_step_input(state, dt);
+  detail::check_wrench(tau, "tau");
+  detail::check_wrench(tau_env, "tau_env");
+  detail::check_current(current_ned);
   VehicleState<Scalar> next;
   next.nu = state.nu + dt * forward_dynamics(model, ws, state, tau, tau_env, current_ned);
   next.position =

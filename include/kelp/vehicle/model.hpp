@@ -22,6 +22,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/limits.hpp"
 #include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/wind.hpp"
 #include "kelp/vehicle/added_mass.hpp"
@@ -66,9 +67,9 @@ struct VehicleParameters {
   Vector3<Scalar> r_b = Vector3<Scalar>::Zero();
   /// ∇ [m³]: displaced volume; B = ρ g ∇ (submerged) or the floating volume (surface).
   Scalar displaced_volume = Scalar(0);
-  /// ρ [kg/m³]: water density.
+  /// ρ [kg/m³]: water density, in (0, 1e5] (`environment::limits::max_fluid_density`).
   Scalar density = Scalar(seawater_density);
-  /// g [m/s²]: gravitational acceleration.
+  /// g [m/s²]: gravitational acceleration, in (0, 1000] (`environment::limits::max_gravity`).
   Scalar gravity = Scalar(standard_gravity);
   /// M_A [kg, kg m, kg m²]: added mass, symmetric positive semi-definite (−X_u̇ … magnitudes).
   Matrix6<Scalar> added_mass = Matrix6<Scalar>::Zero();
@@ -120,11 +121,28 @@ struct VehicleParameters {
   }
 };
 
+namespace detail {
+/// Throws `kelp::invalid_argument` naming `density` or `gravity` and the value unless
+/// 0 < ρ ≤ 1e5 kg/m³ and 0 < g ≤ 1000 m/s² (`environment::limits`: far beyond any water or
+/// planet; beyond them buoyancy and accelerations overflow a step).
+template <typename Scalar>
+void check_water(const Scalar& density, const Scalar& gravity) {
+  environment::detail::check_positive_at_most(value_of(density),
+                                              environment::limits::max_fluid_density, "density",
+                                              "finite and in (0, 1e5] kg/m^3");
+  environment::detail::check_positive_at_most(value_of(gravity), environment::limits::max_gravity,
+                                              "gravity", "finite and in (0, 1000] m/s^2");
+}
+}  // namespace detail
+
 /// \brief Throws kelp::invalid_argument naming the first offending field of `p` (`mass`,
 /// `inertia`, `r_g`, `r_b`, `displaced_volume`, `density`, `gravity`, `added_mass`,
 /// `linear_damping`, `quadratic_damping`, `waterplane_area`, `gm_transverse`, `gm_longitudinal`,
 /// `hull_height`, `wind_areas`, `wind_coefficients`).
 /// `VehicleModel`'s constructor calls it.
+/// \throws kelp::invalid_argument as above; besides finiteness and signs, `density` must be at
+/// most 1e5 kg/m³ and `gravity` at most 1000 m/s² (see `environment::limits`; the message gives
+/// the value), and the weight m g and buoyancy ρ g ∇ must be finite.
 template <typename Scalar>
 void validate(const VehicleParameters<Scalar>& p) {
   check_positive(p.mass, "mass");
@@ -132,8 +150,9 @@ void validate(const VehicleParameters<Scalar>& p) {
   check_all_finite(p.r_g, "r_g");
   check_all_finite(p.r_b, "r_b");
   check_non_negative(p.displaced_volume, "displaced_volume");
-  check_positive(p.density, "density");
-  check_positive(p.gravity, "gravity");
+  detail::check_water(p.density, p.gravity);
+  check_finite(p.weight(), "weight m g");
+  check_finite(p.buoyancy(), "buoyancy rho g displaced_volume");
   check_added_mass(p.added_mass);
   validate(p.damping);
   if (p.hydrostatics == Hydrostatics::surface) {
@@ -164,7 +183,9 @@ template <typename Scalar>
 class VehicleModel {
  public:
   /// \brief Validates `parameters` and factors the mass matrix.
-  /// \throws kelp::invalid_argument naming the offending field.
+  /// \throws kelp::invalid_argument naming the offending field, or when a derived quantity
+  /// (M_RB, M, M⁻¹, the surface vessel's stiffnesses ρ g A_wp and ρ g ∇ GM) is not finite, e.g.
+  /// for a mass or inertia near the largest double.
   explicit VehicleModel(const VehicleParameters<Scalar>& parameters)
       : parameters_((validate(parameters), parameters)) {
     const Scalar h(0.5);
@@ -179,8 +200,18 @@ class VehicleModel {
     // M⁻¹ formed once here from the factorisation (never per step): for a 6×6 system one
     // matrix-vector product per evaluation is several times faster than two triangular solves.
     mass_inverse_ = ldlt_.solve(Matrix6<Scalar>::Identity());
+    check_all_finite(mass_, "mass matrix M = M_RB + M_A (mass, inertia, r_g, added_mass)");
+    check_all_finite(mass_inverse_, "inverse mass matrix (mass, inertia, r_g, added_mass)");
     weight_ = parameters_.weight();
     buoyancy_ = parameters_.buoyancy();
+    if (parameters_.hydrostatics == Hydrostatics::surface) {
+      const Scalar rho_g = parameters_.density * parameters_.gravity;
+      check_finite(rho_g * parameters_.waterplane_area, "heave stiffness rho g waterplane_area");
+      check_finite(rho_g * parameters_.displaced_volume * parameters_.gm_transverse,
+                   "roll stiffness rho g displaced_volume gm_transverse");
+      check_finite(rho_g * parameters_.displaced_volume * parameters_.gm_longitudinal,
+                   "pitch stiffness rho g displaced_volume gm_longitudinal");
+    }
   }
 
   /// \brief The validated parameters.
@@ -345,12 +376,17 @@ struct VehicleWorkspace {
 /// \param[in] tau_ext other external wrench [N, N m], body axes about the CO (e.g. the tether's).
 /// \param[in] s the surroundings at the vehicle's position (see surroundings()).
 /// \return ν̇ [m/s², rad/s²], body axes.
+/// \throws kelp::invalid_argument when tau or tau_ext has not 6 entries (a size, so free for
+/// fixed-size vectors). Values are not checked here: the integrators check what they take from
+/// the caller, and a non-finite stage state must end as their numerical_error.
 template <typename Scalar, typename D1, typename D2>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                                  const VehicleState<Scalar>& state,
                                  const Eigen::MatrixBase<D1>& tau,
                                  const Eigen::MatrixBase<D2>& tau_ext,
                                  const Surroundings<Scalar>& s) {
+  KELP_CHECK(tau.size() == 6 && tau_ext.size() == 6,
+             "forward_dynamics: tau and tau_ext must have 6 entries");
   const VehicleParameters<Scalar>& p = model.parameters();
   ws.rotation = state.attitude.toRotationMatrix();
   const Vector3<Scalar> vw = ws.rotation.transpose() * s.water_velocity;
@@ -374,9 +410,9 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
     if (p.wind_areas.frontal_area > 0.0 || p.wind_areas.lateral_area > 0.0) {
       using std::atan2;
       const Scalar psi = atan2(ws.rotation(1, 0), ws.rotation(0, 0));
-      const Vector3<Scalar> w =
-          environment::wind_load(p.wind_coefficients, p.wind_areas, Scalar(kelp::air_density),
-                                 s.wind_velocity, psi, state.nu(0), state.nu(1));
+      const Vector3<Scalar> w = environment::detail::wind_load_unchecked(
+          p.wind_coefficients, p.wind_areas, Scalar(kelp::air_density), s.wind_velocity, psi,
+          state.nu(0), state.nu(1));
       ws.wind(0) = w(0);
       ws.wind(1) = w(1);
       ws.wind(5) = w(2);
@@ -403,12 +439,14 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
 ///   waves... added by the caller each step).
 /// \param[in] current_ned ocean current velocity v_c^n [m/s] in NED (irrotational, uniform).
 /// \return ν̇ [m/s², rad/s²], body axes.
+/// \throws kelp::invalid_argument when tau or tau_env has not 6 entries or current_ned not 3.
 template <typename Scalar, typename DT, typename DE, typename DC>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                                  const VehicleState<Scalar>& state,
                                  const Eigen::MatrixBase<DT>& tau,
                                  const Eigen::MatrixBase<DE>& tau_env,
                                  const Eigen::MatrixBase<DC>& current_ned) {
+  KELP_CHECK(current_ned.size() == 3, "forward_dynamics: current_ned must have 3 entries");
   Surroundings<Scalar> s;
   s.water_velocity = current_ned;
   return forward_dynamics(model, ws, state, tau, tau_env, s);

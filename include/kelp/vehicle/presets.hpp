@@ -58,9 +58,12 @@ struct VehiclePreset {
 /// linearly with the emerged fraction. With the seawater defaults the unpowered vehicle floats at
 /// φ = W/B ≈ 0.983, its top ≈ 4 mm above the surface.
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
+/// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
+/// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (see `validate(const VehicleParameters&)`).
 template <typename Scalar>
 VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_density),
                                      const Scalar& gravity = Scalar(standard_gravity)) {
+  detail::check_water(density, gravity);
   VehiclePreset<Scalar> p;
   p.name = "BlueROV2 Heavy";
   VehicleParameters<Scalar>& v = p.parameters;
@@ -133,9 +136,12 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 /// thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against the pure surge
 /// balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch 0.68 s.
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
+/// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
+/// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (the displaced volume is m/ρ).
 template <typename Scalar>
 VehiclePreset<Scalar> blueboat(const Scalar& density = Scalar(seawater_density),
                                const Scalar& gravity = Scalar(standard_gravity)) {
+  detail::check_water(density, gravity);
   VehiclePreset<Scalar> p;
   p.name = "BlueBoat";
   VehicleParameters<Scalar>& v = p.parameters;

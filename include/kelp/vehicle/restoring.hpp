@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 
 namespace kelp::vehicle {
@@ -100,8 +101,11 @@ Vector6<Scalar> restoring_force_surface(const Scalar& density, const Scalar& gra
 /// hull's vertical extent is taken as h at every roll and pitch).
 /// \param[in] z_cb NED z of the CB [m] \param[in] zeta surface elevation ζ above the CB [m], up
 /// \param[in] hull_height h [m], > 0
+/// \throws kelp::invalid_argument naming `hull_height` unless it is finite and > 0 (a parameter:
+/// the positions are not checked, a non-finite state is the integrators' to report).
 template <typename Scalar>
 Scalar submerged_fraction(const Scalar& z_cb, const Scalar& zeta, const Scalar& hull_height) {
+  check_positive(hull_height, "hull_height");
   const Scalar s = (z_cb + zeta) / hull_height + Scalar(0.5);
   if (s <= Scalar(0)) return Scalar(0);
   if (s >= Scalar(1)) return Scalar(1);

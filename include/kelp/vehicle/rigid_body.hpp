@@ -31,7 +31,8 @@ Matrix6<typename Derived::Scalar> transformation_h(const Eigen::MatrixBase<Deriv
 ///   definite.
 /// \param[in] r_g CG position [m] relative to the CO, body axes (x fwd, y stbd, z down).
 /// \return symmetric positive definite 6×6 M_RB [kg, kg m, kg m²].
-/// \throws kelp::invalid_argument naming `mass`, `inertia` or `r_g` on bad input.
+/// \throws kelp::invalid_argument naming `mass`, `inertia` or `r_g` on bad input, or when
+/// M_RB overflows (e.g. m |r_g|² beyond the largest double).
 template <typename Scalar, typename DerivedI, typename DerivedR>
 Matrix6<Scalar> rigid_body_mass_matrix(const Scalar& mass,
                                        const Eigen::MatrixBase<DerivedI>& inertia_cg,
@@ -43,7 +44,9 @@ Matrix6<Scalar> rigid_body_mass_matrix(const Scalar& mass,
   M_cg.template topLeftCorner<3, 3>() = mass * Matrix3<Scalar>::Identity();
   M_cg.template bottomRightCorner<3, 3>() = Matrix3<Scalar>(inertia_cg);
   const Matrix6<Scalar> H = transformation_h(Vector3<Scalar>(r_g));
-  return H.transpose() * M_cg * H;
+  const Matrix6<Scalar> M_rb = H.transpose() * M_cg * H;
+  check_all_finite(M_rb, "rigid-body mass matrix M_RB (mass, inertia, r_g)");
+  return M_rb;
 }
 
 /// \brief Rigid-body Coriolis–centripetal matrix C_RB(ν) = m2c(M_RB, ν) (Fossen 2021,

@@ -18,7 +18,8 @@ namespace kelp::vehicle {
 /// CO of a unit thrust along d_i applied at r_i (Fossen 2021, control-allocation chapter: τ = T f).
 /// \param[in] positions r_i [m], 3×n, body axes relative to the CO.
 /// \param[in] directions d_i, 3×n, body axes; normalised here (thrust of a positive command).
-/// \throws kelp::invalid_argument naming `thruster_positions` or `thruster_directions`.
+/// \throws kelp::invalid_argument naming `thruster_positions` or `thruster_directions` (wrong
+/// shape, not finite, a zero direction), or when a moment r_i × d_i overflows.
 template <typename DP, typename DD>
 Eigen::Matrix<typename DP::Scalar, 6, Eigen::Dynamic> allocation_matrix(
     const Eigen::MatrixBase<DP>& positions, const Eigen::MatrixBase<DD>& directions) {
@@ -40,6 +41,7 @@ Eigen::Matrix<typename DP::Scalar, 6, Eigen::Dynamic> allocation_matrix(
     B.col(i).template head<3>() = u;
     B.col(i).template tail<3>() = r.cross(u);
   }
+  check_all_finite(B, "thruster_positions: the allocation matrix (moments r x d)");
   return B;
 }
 
@@ -52,6 +54,7 @@ class ThrusterAllocation {
   /// \brief Builds B from positions and directions (see allocation_matrix()) and B⁺ by a complete
   /// orthogonal decomposition (valid for any rank).
   /// \param[in] positions r_i [m], 3×n, body. \param[in] directions d_i, 3×n, body.
+  /// \throws kelp::invalid_argument as allocation_matrix(), or when B⁺ is not finite.
   template <typename DP, typename DD>
   ThrusterAllocation(const Eigen::MatrixBase<DP>& positions,
                      const Eigen::MatrixBase<DD>& directions)
@@ -62,6 +65,7 @@ class ThrusterAllocation {
     Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<Scalar, 6, Eigen::Dynamic>> cod(matrix_);
     pseudo_inverse_ = cod.pseudoInverse();
     rank_ = cod.rank();
+    check_all_finite(pseudo_inverse_, "thruster_positions: the pseudo-inverse of the allocation");
   }
 
   /// \brief Number of thrusters n.
@@ -78,9 +82,12 @@ class ThrusterAllocation {
   const Eigen::Matrix<Scalar, Eigen::Dynamic, 6>& pseudo_inverse() const { return pseudo_inverse_; }
 
   /// \brief Body wrench τ = B f [N, N m] of the thruster forces f [N] (n-vector).
+  /// \throws kelp::invalid_argument when `forces` has not one entry per thruster or an entry
+  /// is not finite.
   template <typename Derived>
   Vector6<Scalar> wrench(const Eigen::MatrixBase<Derived>& forces) const {
     KELP_CHECK(forces.size() == size(), "forces must have one entry per thruster");
+    check_all_finite(forces, "thruster forces");
     Vector6<Scalar> tau;
     tau.noalias() = matrix_ * forces;
     return tau;
@@ -88,9 +95,13 @@ class ThrusterAllocation {
 
   /// \brief Minimum-norm thruster forces f = B⁺ τ [N] for a desired body wrench τ [N, N m]
   /// (least-squares when τ is not reachable). `forces` must already have n rows.
+  /// \throws kelp::invalid_argument when `tau` has not 6 entries or an entry is not finite, or
+  /// `forces` has not one entry per thruster (`forces` is left unchanged).
   template <typename DW, typename DF>
   void distribute(const Eigen::MatrixBase<DW>& tau, Eigen::MatrixBase<DF>& forces) const {
     KELP_CHECK(forces.size() == size(), "forces must have one entry per thruster");
+    KELP_CHECK(tau.size() == 6, "tau (desired wrench) must have 6 entries");
+    check_all_finite(tau, "tau (desired wrench)");
     forces.noalias() = pseudo_inverse_ * tau;
   }
 
@@ -119,8 +130,10 @@ Scalar t200_thrust(const Scalar& u_in) {
 }
 
 /// \brief dF/du of t200_thrust() [N] (same clamping: 0 outside [−1, 1]).
+/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
 template <typename Scalar>
 Scalar t200_thrust_slope(const Scalar& u) {
+  check_finite(u, "thruster command u");
   if (value_of(u) > 1.0 || value_of(u) < -1.0) return Scalar(0);
   const Scalar u2 = u * u;
   return Scalar(8.9) +
@@ -213,9 +226,12 @@ void validate(const PwmMapping<Scalar>& m) {
 /// \brief Normalised command u ∈ [−1, 1] of a pulse width [µs]: 0 inside the dead band, else
 /// (pwm − neutral)/(max − neutral) above neutral and (pwm − neutral)/(neutral − min) below,
 /// clamped (as ArduPilot's SITL submarine does: no rescaling of the dead band).
+/// \throws kelp::invalid_argument when the pulse width is not finite or `m` is invalid (see
+/// `validate(const PwmMapping&)`).
 template <typename Scalar>
 Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
   check_finite(pwm_us, "pwm");
+  validate(m);
   const Scalar d = pwm_us - m.neutral_us;
   const double dv = value_of(d);
   if (dv <= value_of(m.deadband_us) && dv >= -value_of(m.deadband_us)) return Scalar(0);
@@ -229,9 +245,12 @@ Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmM
 /// neutral + u (max − neutral) for u > 0, neutral + u (neutral − min) otherwise (ArduSub's
 /// `AP_Motors6DOF::calc_thrust_to_pwm`, ArduPilot libraries/AP_Motors/AP_Motors6DOF.cpp). The dead
 /// band is not skipped.
+/// \throws kelp::invalid_argument when u is not finite or `m` is invalid (see
+/// `validate(const PwmMapping&)`).
 template <typename Scalar>
 Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
   check_finite(u_in, "thruster command u");
+  validate(m);
   Scalar u = u_in;
   if (value_of(u) > 1.0) u = Scalar(1);
   if (value_of(u) < -1.0) u = Scalar(-1);

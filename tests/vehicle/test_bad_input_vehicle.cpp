@@ -1,0 +1,221 @@
+// Bad input at the vehicle layer's public boundary: absurd but finite parameters whose derived
+// quantities overflow, NaN / Inf currents and times and mis-sized wrenches given to the steps,
+// thruster allocation
+// with a NaN wrench or mismatched sizes. Each bad input must throw kelp::invalid_argument; the
+// valid inputs next to them must keep working, and a step that blows up from valid input must
+// still end as kelp::numerical_error with the state unchanged.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/environment/sea_state.hpp"
+#include "kelp/vehicle/added_mass.hpp"
+#include "kelp/vehicle/integrators.hpp"
+#include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/restoring.hpp"
+#include "kelp/vehicle/rigid_body.hpp"
+#include "kelp/vehicle/thrusters.hpp"
+
+using kelp::Vector3;
+using kelp::Vector6;
+namespace kv = kelp::vehicle;
+namespace ke = kelp::environment;
+
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool same(const kv::VehicleState<double>& a, const kv::VehicleState<double>& b) {
+  return a.position == b.position && a.attitude.coeffs() == b.attitude.coeffs() && a.nu == b.nu;
+}
+
+}  // namespace
+
+TEST_CASE("bad input: absurd vehicle parameters are refused where the model is built",
+          "[vehicle][bad_input]") {
+  const auto rov = kv::bluerov2_heavy<double>().parameters;
+  auto p = rov;
+  p.density = 1e300;  // buoyancy 1.3e299 N: the first step would overflow
+  REQUIRE_THROWS_AS(kv::VehicleModel<double>(p), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::VehicleModel<double>(p),
+                      Catch::Contains("density") && Catch::Contains("1e+300"));
+  p = rov;
+  p.gravity = 1e300;
+  REQUIRE_THROWS_AS(kv::VehicleModel<double>(p), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::VehicleModel<double>(p), Catch::Contains("gravity"));
+  p = rov;
+  p.mass = 1e308;  // m g overflows
+  p.inertia *= 1e300;
+  REQUIRE_THROWS_AS(kv::VehicleModel<double>(p), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::VehicleModel<double>(p), Catch::Contains("weight"));
+  p = rov;
+  p.r_g = Vector3<double>(1e200, 0.0, 0.0);  // m S(r_g)² overflows in M_RB
+  REQUIRE_THROWS_AS(kv::VehicleModel<double>(p), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::rigid_body_mass_matrix(p.mass, p.inertia, p.r_g), kelp::invalid_argument);
+  p = rov;
+  p.displaced_volume = 1e306;  // ρ g ∇ overflows
+  REQUIRE_THROWS_AS(kv::VehicleModel<double>(p), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::VehicleModel<double>(p), Catch::Contains("buoyancy"));
+  auto boat = kv::blueboat<double>().parameters;
+  boat.gm_transverse = 1e308;  // roll stiffness ρ g ∇ GM_T overflows
+  REQUIRE_THROWS_AS(kv::VehicleModel<double>(boat), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::VehicleModel<double>(boat), Catch::Contains("gm_transverse"));
+
+  // Presets validate the water they are built for (the boat's volume is m/ρ).
+  for (const double rho : {0.0, -1025.0, kNan, 1e300}) {
+    INFO("density " << rho);
+    REQUIRE_THROWS_AS(kv::blueboat<double>(rho), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(kv::blueboat<double>(rho), Catch::Contains("density"));
+    REQUIRE_THROWS_AS(kv::bluerov2_heavy<double>(rho), kelp::invalid_argument);
+  }
+  REQUIRE_THROWS_AS(kv::bluerov2_heavy<double>(1025.0, 0.0), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::blueboat<double>(1025.0, 1e300), kelp::invalid_argument);
+
+  // Nearby valid water: fresh water, the Moon, a dense brine; a step stays finite.
+  for (const auto& water :
+       {std::pair<double, double>{1000.0, 9.82}, {1025.0, 1.62}, {1240.0, 9.81}}) {
+    INFO("rho " << water.first << " g " << water.second);
+    const kv::VehicleModel<double> model(
+        kv::bluerov2_heavy<double>(water.first, water.second).parameters);
+    CHECK(model.buoyancy() == Approx(water.first * water.second * 0.0134));
+    kv::VehicleWorkspace<double> ws;
+    kv::VehicleState<double> x;
+    x.position.z() = 5.0;  // fully submerged
+    kv::step_rk4(model, ws, x, 0.01, Vector6<double>::Zero(), Vector6<double>::Zero());
+    CHECK(x.nu.allFinite());
+    CHECK((x.nu(2) < 0.0) == (model.buoyancy() > model.weight()));  // rises if buoyant
+  }
+  CHECK_NOTHROW(kv::VehicleModel<double>(kv::blueboat<double>(1000.0, 9.81).parameters));
+}
+
+TEST_CASE("bad input: steps refuse NaN currents and times and mis-sized wrenches",
+          "[vehicle][bad_input]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  x.position << 1.0, 2.0, 5.0;
+  x.nu << 0.2, 0.0, 0.1, 0.0, 0.0, 0.05;
+  const kv::VehicleState<double> before = x;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  Vector6<double> bad = zero;
+  bad(3) = kNan;
+  // A non-finite wrench is the documented numerical_error (tests/vehicle/test_dynamics.cpp), state
+  // unchanged; a wrench of the wrong size is an invalid argument.
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, bad, zero), kelp::numerical_error);
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, bad), kelp::numerical_error);
+  CHECK(same(x, before));
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero, Vector3<double>(kInf, 0, 0)),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::step_semi_implicit_euler(model, ws, x, 0.01, bad, zero),
+                    kelp::numerical_error);
+  REQUIRE_THROWS_AS(
+      kv::step_semi_implicit_euler(model, ws, x, 0.01, zero, zero, Vector3<double>(kNan, 0, 0)),
+      kelp::invalid_argument);
+  REQUIRE_THROWS_AS(
+      kv::step_rk4_with(
+          model, ws, x, 0.01, [&](const kv::VehicleState<double>&, double) { return zero; },
+          Vector3<double>(0, kNan, 0)),
+      kelp::invalid_argument);
+  const Eigen::VectorXd short_tau = Eigen::VectorXd::Zero(5);
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, short_tau, zero), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::step_rk4(model, ws, x, 0.01, short_tau, zero), Catch::Contains("tau"));
+  REQUIRE_THROWS_AS(kv::step_semi_implicit_euler(model, ws, x, 0.01, zero, short_tau),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, short_tau, zero), kelp::invalid_argument);
+  const Eigen::VectorXd long_current = Eigen::VectorXd::Zero(4);
+  REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, zero, zero, long_current),
+                    kelp::invalid_argument);
+  const ke::Environment<double> env = ke::make_environment<double>(ke::presets::moderate());
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero, env, kNan),
+                    kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(kv::step_rk4(model, ws, x, 0.01, zero, zero, env, kInf),
+                      Catch::Contains("t must be finite"));
+  CHECK(same(x, before));
+
+  // The valid neighbours step, and give the same result as before any refused call.
+  kv::VehicleState<double> y = before;
+  kv::step_rk4(model, ws, x, 0.01, zero, zero);
+  kv::step_rk4(model, ws, y, 0.01, zero, zero);
+  CHECK(same(x, y));
+  CHECK_FALSE(same(x, before));
+  kv::step_rk4(model, ws, x, 0.01, zero, zero, env, 1e5);
+  CHECK(x.nu.allFinite());
+
+  // A huge but finite wrench is valid input: the step blows up and says so as a numerical error,
+  // state unchanged (also for a surface vessel, whose wind load reads the blown-up stage states).
+  const Vector6<double> huge = Vector6<double>::Constant(1e308);
+  kv::VehicleState<double> z = before;
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, z, 0.01, huge, zero), kelp::numerical_error);
+  CHECK(same(z, before));
+  const kv::VehicleModel<double> boat(kv::blueboat<double>().parameters);
+  kv::VehicleState<double> b;
+  const kv::VehicleState<double> b0 = b;
+  REQUIRE_THROWS_AS(kv::step_rk4(boat, ws, b, 0.01, huge, zero, env, 10.0), kelp::numerical_error);
+  CHECK(same(b, b0));
+}
+
+TEST_CASE("bad input: thruster allocation with NaN wrenches and mismatched sizes",
+          "[vehicle][bad_input]") {
+  const auto rov = kv::bluerov2_heavy<double>();
+  const kv::ThrusterAllocation<double> alloc(rov.thruster_positions, rov.thruster_directions);
+  Eigen::VectorXd f = Eigen::VectorXd::Constant(8, 3.0);
+  const Eigen::VectorXd f_before = f;
+  Vector6<double> tau;
+  tau << 10.0, -5.0, 3.0, 0.5, -0.2, 1.0;
+  Vector6<double> bad = tau;
+  bad(2) = kNan;
+  REQUIRE_THROWS_AS(alloc.distribute(bad, f), kelp::invalid_argument);
+  REQUIRE_THROWS_WITH(alloc.distribute(bad, f), Catch::Contains("tau"));
+  CHECK(f == f_before);  // left unchanged
+  const Eigen::VectorXd tau5 = Eigen::VectorXd::Zero(5);
+  REQUIRE_THROWS_AS(alloc.distribute(tau5, f), kelp::invalid_argument);
+  Eigen::VectorXd f_bad = f;
+  f_bad(7) = kInf;
+  REQUIRE_THROWS_AS(alloc.wrench(f_bad), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(alloc.wrench(Eigen::VectorXd::Zero(7)), kelp::invalid_argument);
+  // Valid: the BlueROV2 Heavy is fully actuated, so B B⁺ τ = τ.
+  alloc.distribute(tau, f);
+  CHECK((alloc.wrench(f) - tau).norm() < 1e-12 * tau.norm());
+
+  // An allocation matrix whose moments overflow.
+  kelp::Matrix3X<double> r(3, 1), d(3, 1);
+  r << 1.7e308, -1.7e308, 0.0;
+  d << 1.0, 1.0, 0.0;
+  REQUIRE_THROWS_AS(kv::allocation_matrix(r, d), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::ThrusterAllocation<double>(r, d), kelp::invalid_argument);
+  r << 0.1, -0.1, 0.0;
+  const auto B = kv::allocation_matrix(r, d);
+  CHECK(B(5, 0) == Approx(0.2 / std::sqrt(2.0)));  // (r × d̂)_z = (r_x d_y − r_y d_x)/√2
+
+  // T200 curve and PWM mapping.
+  REQUIRE_THROWS_AS(kv::t200_thrust_slope(kNan), kelp::invalid_argument);
+  CHECK(kv::t200_thrust_slope(0.0) == Approx(8.9));
+  kv::PwmMapping<double> m;
+  m.min_us = 2000.0;  // above neutral: invalid
+  REQUIRE_THROWS_AS(kv::command_from_pwm(1700.0, m), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::pwm_from_command(0.5, m), kelp::invalid_argument);
+  CHECK(kv::command_from_pwm(1900.0) == 1.0);
+  CHECK(kv::pwm_from_command(-1.0) == 1100.0);
+}
+
+TEST_CASE("bad input: added mass, restoring and hull parameters", "[vehicle][bad_input]") {
+  REQUIRE_THROWS_AS(kv::diagonal_added_mass(Eigen::VectorXd::Ones(5)), kelp::invalid_argument);
+  Eigen::VectorXd a(6);
+  a << 6.36, 7.12, 18.68, 0.189, 0.135, 0.222;
+  CHECK(kv::diagonal_added_mass(a)(2, 2) == 18.68);
+  a(4) = kNan;
+  REQUIRE_THROWS_AS(kv::diagonal_added_mass(a), kelp::invalid_argument);
+
+  REQUIRE_THROWS_AS(kv::submerged_fraction(0.0, 0.0, 0.0), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::submerged_fraction(0.0, 0.0, kNan), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::submerged_fraction(0.0, 0.0, -0.25), kelp::invalid_argument);
+  CHECK(kv::submerged_fraction(0.0, 0.0, 0.25) == 0.5);
+  CHECK(kv::submerged_fraction(1.0, 0.0, 0.25) == 1.0);
+
+  // The surface vessel's hydrostatics handed to the environment layer stay valid.
+  const auto boat = kv::blueboat<double>().parameters;
+  CHECK_NOTHROW(ke::validate(kv::surface_hydrostatics(boat)));
+}
