@@ -6,6 +6,7 @@
 // field, canonical JSON), so a result found on disk is the result of exactly that scenario.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -110,6 +111,53 @@ inline std::uint64_t fnv1a(const std::string& s) {
   return h;
 }
 
+/// The reference tokens of a JSON pointer ("/a/b~1c" → a, b/c).
+inline std::vector<std::string> pointer_tokens(const std::string& pointer) {
+  std::vector<std::string> tokens;
+  for (std::size_t i = 0; i < pointer.size();) {
+    const std::size_t end = std::min(pointer.find('/', i + 1), pointer.size());
+    std::string t;
+    for (std::size_t k = i + 1; k < end; ++k) {
+      if (pointer[k] == '~' && k + 1 < end && (pointer[k + 1] == '0' || pointer[k + 1] == '1')) {
+        t += pointer[k + 1] == '0' ? '~' : '/';
+        ++k;
+      } else {
+        t += pointer[k];
+      }
+    }
+    tokens.push_back(t);
+    i = end;
+  }
+  return tokens;
+}
+
+/// The first array index in `pointer` past the end of the array it indexes in `doc` (as it is,
+/// or as setting the pointer would create it), or an empty string. nlohmann-json fills such a
+/// gap with nulls, and creates a missing array from an index as large as the index: a pointer
+/// ending in /99999999999 would allocate gigabytes. An index equal to the size appends.
+inline std::string index_past_end(const json& doc, const std::string& pointer) {
+  const json* node = &doc;  // nullptr: below here nothing exists yet
+  for (const std::string& t : pointer_tokens(pointer)) {
+    const bool index = !t.empty() && t.find_first_not_of("0123456789") == std::string::npos &&
+                       (t == "0" || t[0] != '0');
+    if (node == nullptr || node->is_null()) {
+      if (index && t != "0") return t;  // would create an array of t + 1 nulls
+      node = nullptr;
+    } else if (node->is_object()) {
+      const auto it = node->find(t);
+      node = it == node->end() ? nullptr : &*it;
+    } else if (node->is_array()) {
+      if (!index) return "";  // "-" appends; anything else is nlohmann-json's error to report
+      if (t.size() > 19 || std::stoull(t) > node->size()) return t;
+      const auto i = static_cast<std::size_t>(std::stoull(t));
+      node = i == node->size() ? nullptr : &(*node)[i];
+    } else {
+      return "";  // a number or a string: nlohmann-json refuses to index it
+    }
+  }
+  return "";
+}
+
 inline std::string value_text(const json& v) {
   return v.is_string() ? v.get<std::string>() : v.dump();
 }
@@ -130,6 +178,11 @@ inline json default_sweep_json() {
   })");
 }
 
+/// The most runs (grid points × seeds) a sweep may expand to: the largest seed count.
+inline constexpr std::size_t max_runs = 100000;
+/// The most reference tokens in an axis' JSON pointer (a scenario is 4 levels deep).
+inline constexpr std::size_t max_pointer_depth = 16;
+
 /// Reads and checks a sweep from JSON text; expands its runs. `file` names it in errors.
 /// \throws sweep_error naming the file and the JSON path (of the sweep file, or of a run's
 /// scenario for a value the scenario refuses).
@@ -138,6 +191,10 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
     throw sweep_error(file + ": " + path + ": " + what);
   };
   Sweep s;
+  if (tethered_pair::detail::json_depth(text, tethered_pair::max_json_depth) >
+      tethered_pair::max_json_depth)
+    fail("/", "arrays and objects nested more than " +
+                  std::to_string(tethered_pair::max_json_depth) + " levels deep");
   try {
     s.source = json::parse(text);
   } catch (const json::exception& e) {
@@ -169,6 +226,11 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
       if (axis.path.empty() || axis.path[0] != '/')
         fail(p + "/path", "\"" + axis.path + "\" is not a JSON pointer (it starts with /)");
       if (axis.path == "/seed") fail(p + "/path", "seeds are given by /seeds, not an axis");
+      const std::size_t levels = detail::pointer_tokens(axis.path).size();
+      if (levels > max_pointer_depth)
+        fail(p + "/path", "a JSON pointer of " + std::to_string(levels) +
+                              " levels is deeper than any scenario field (at most " +
+                              std::to_string(max_pointer_depth) + ")");
       if (!ax.contains("values") || !ax.at("values").is_array() || ax.at("values").empty())
         fail(p + "/values", "expected a non-empty array of values");
       for (std::size_t k = 0; k < ax.at("values").size(); ++k) {
@@ -177,6 +239,9 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
           fail(p + "/values/" + std::to_string(k), "not a finite number");
         axis.values.push_back(v);
       }
+      if (axis.values.size() > max_runs / s.points)
+        fail(p + "/values",
+             "the sweep would have more than " + std::to_string(max_runs) + " grid points");
       s.axes.push_back(axis);
       s.points *= axis.values.size();
     }
@@ -199,6 +264,9 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
   } else {
     fail("/seeds", "expected a count or a non-empty list of non-negative integers");
   }
+  if (s.seeds.size() > max_runs / s.points)
+    fail("/seeds", std::to_string(s.points) + " grid points × " + std::to_string(s.seeds.size()) +
+                       " seeds are more than " + std::to_string(max_runs) + " runs");
 
   // Expand: each grid point's scenario, validated by the scenario reader (which names the path).
   for (std::size_t point = 0; point < s.points; ++point) {
@@ -209,6 +277,10 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
       const Axis& ax = s.axes[i];
       const json& v = ax.values[rest % ax.values.size()];
       rest /= ax.values.size();
+      const std::string past_end = detail::index_past_end(scenario, ax.path);
+      if (!past_end.empty())
+        fail("/axes/" + std::to_string(i) + "/path",
+             "\"" + ax.path + "\": index " + past_end + " is past the end of its array");
       try {
         scenario[json::json_pointer(ax.path)] = v;
       } catch (const json::exception& e) {

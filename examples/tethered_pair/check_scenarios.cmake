@@ -26,9 +26,15 @@ set(bad_gains [=[{"control": {"asv": {"linear": [0.5, -0.1, 0.05]}}}]=])
 set(path_gains "/control/asv/linear")
 set(bad_not_json [=[{"duration": 10,]=])
 set(path_not_json "not valid JSON")
+# Nested 100000 levels deep (found by fuzz/fuzz_scenario): refused before parsing; it used to
+# overflow the stack when the error message dumped the value.
+string(REPEAT "[" 100000 open)
+string(REPEAT "]" 100000 close)
+set(bad_too_deep "{\"vehicles\": {\"asv_attachment\": ${open}${close}}}")
+set(path_too_deep "nested more than 64 levels")
 
 foreach(kind unknown_key wrong_type out_of_range non_finite empty_waypoints short_tether choice
-             vector gains not_json)
+             vector gains not_json too_deep)
   set(file "${OUT}/${kind}.json")
   file(WRITE "${file}" "${bad_${kind}}")
   file(REMOVE_RECURSE "${OUT}/${kind}_out")
@@ -45,7 +51,8 @@ foreach(kind unknown_key wrong_type out_of_range non_finite empty_waypoints shor
   if(EXISTS "${OUT}/${kind}_out")
     message(FATAL_ERROR "${kind}: outputs were written for a bad scenario")
   endif()
-  message(STATUS "${kind}: ${err}")
+  string(SUBSTRING "${err}" 0 300 shown)
+  message(STATUS "${kind}: ${shown}")
 endforeach()
 
 # An explicit sea with only a current (no waves) is a valid scenario.

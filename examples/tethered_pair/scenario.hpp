@@ -4,6 +4,7 @@
 // examples/tethered_pair/README.md.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -58,7 +59,36 @@ struct Scenario {
   double log_rate = 10.0, node_rate = 1.0;
 };
 
+/// The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
+/// needs 4. nlohmann-json parses iteratively but copies, compares and dumps recursively, so a file
+/// nested a hundred thousand levels deep would overflow the stack after parsing.
+inline constexpr int max_json_depth = 64;
+
 namespace detail {
+
+/// Nesting depth of the arrays and objects in JSON text (brackets inside strings do not count);
+/// the scan stops as soon as the depth exceeds `limit`. Exact for valid JSON.
+inline int json_depth(const std::string& text, int limit) {
+  int depth = 0, deepest = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > limit) break;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
 
 class Reader {
  public:
@@ -152,6 +182,9 @@ class Reader {
 /// Reads and validates a scenario from JSON text; `file` names it in error messages.
 inline Scenario parse_scenario(const std::string& text, const std::string& file) {
   const detail::Reader r(file);
+  if (detail::json_depth(text, max_json_depth) > max_json_depth)
+    r.fail("", "arrays and objects nested more than " + std::to_string(max_json_depth) +
+                   " levels deep");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);

@@ -4,7 +4,8 @@
 - shards 0..2 of 3 merged give the unsharded table, byte for byte (CSV and Markdown);
 - deleting one run's result and rerunning reruns that run only, and the table is unchanged;
 - bad sweep files (unknown JSON path, empty axis, non-finite value, a value the scenario
-  refuses, a bad --shard) are refused with exit status 3 and a message naming the path;
+  refuses, a bad --shard, nesting too deep, an index past an array's end, too many runs) are
+  refused with exit status 3 and a message naming the path;
 - plot_sweep.py draws the figure from the table.
 """
 import json
@@ -84,6 +85,16 @@ def main(program, small, work):
          "/tether/length"),
         ("bad pointer", {"axes": [{"path": "tether/length", "values": [5]}]}, "/axes/0/path"),
         ("bad seeds", {"seeds": [1, -2]}, "/seeds/1"),
+        # Found by fuzz/fuzz_sweep: a file nested 100000 levels deep overflowed the stack, an
+        # index past the end of an array allocated gigabytes, 10^7 runs ran out of time and
+        # memory, and a pointer 100000 levels deep built a scenario as deep.
+        ("nested too deep", '{"base": {"x": ' + "[" * 100000 + "]" * 100000 + "}}",
+         "nested more than 64 levels"),
+        ("index past the end",
+         {"axes": [{"path": "/mission/waypoints/0/900000000", "values": [1]}]}, "/axes/0/path"),
+        ("too many runs",
+         {"axes": [{"path": "/duration", "values": list(range(1, 11))}] * 7}, "/axes/5/values"),
+        ("pointer too deep", {"axes": [{"path": "/a" * 100000, "values": [1]}]}, "/axes/0/path"),
     ]
     for name, content, path in cases:
         f = os.path.join(work, "bad.json")
