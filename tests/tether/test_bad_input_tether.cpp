@@ -429,6 +429,26 @@ TEST_CASE("Catenary solvers answer bad input with invalid_input and valid input 
     CHECK(kt::solve_catenary(8.0, 3.0, 10.0, o).status == kt::CatenaryStatus::invalid_input);
   }
   CHECK(kt::solve_catenary(8.0, 3.0, 10.0).status == kt::CatenaryStatus::converged);
+  // Found by fuzz_catenary: D/L so small that the solve over- or underflows is vertical, even
+  // with vertical_tolerance = 0 (before: max_iterations with a = c = NaN in double, a = 0 and a
+  // NaN residual in float).
+  kt::CatenaryOptionsd zero;
+  zero.vertical_tolerance = 0;
+  const kt::CatenaryResultd d = kt::solve_catenary(1e-310, 0.0, 3.0, zero);
+  CHECK(d.status == kt::CatenaryStatus::vertical);
+  CHECK((std::isfinite(d.a) && std::isfinite(d.c)));
+  kt::CatenaryOptionsf zero_f;
+  zero_f.vertical_tolerance = 0;
+  const kt::CatenaryResultf f = kt::solve_catenary(1e-43f, 0.0f, 40.0f, zero_f);
+  CHECK(f.status == kt::CatenaryStatus::vertical);
+  // Just above the floor the solve still converges with a > 0.
+  const kt::CatenaryResultd above = kt::solve_catenary(1e-150, 0.0, 3.0, zero);
+  CHECK(above.status == kt::CatenaryStatus::converged);
+  CHECK(above.a > 0);
+  CHECK(std::isfinite(above.residual));
+  const kt::CatenaryResultf above_f = kt::solve_catenary(1e-17f, 0.0f, 40.0f, zero_f);
+  CHECK(above_f.status == kt::CatenaryStatus::converged);
+  CHECK(above_f.a > 0);
 }
 
 TEST_CASE("Tether presets refuse lengths they cannot cut into segments", "[tether][bad_input]") {

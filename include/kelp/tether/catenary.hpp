@@ -94,7 +94,8 @@ struct CatenaryOptions {
   int max_iterations = 30;
   /// Ends closer horizontally than `vertical_tolerance`·L are treated as vertically aligned
   /// (status `vertical`). Must be ≥ 0 (else invalid_input); the default keeps D/L = 1e-6 on the
-  /// regular path.
+  /// regular path. Values below √(smallest normal) of the scalar (1.5e-154 in double, 1.1e-19 in
+  /// float) act as that floor, below which the solve's numbers overflow or underflow.
   double vertical_tolerance = 1e-12;
   /// Axial stiffness EA [N] used only for the tension of a taut (stretched) line:
   /// T = EA·(chord − L)/L. 0 (the default) means inextensible: a taut line then reports T = 0
@@ -344,7 +345,12 @@ CatenaryStatus classify_catenary(double D, double dz, double L,
         L <= limits::max_catenary_length) ||
       !catenary_options_valid(options))
     return CatenaryStatus::invalid_input;
-  const double vertical_tolerance = options.vertical_tolerance;
+  // Below √(smallest normal) of the scalar's value type, D/L is treated as vertical whatever
+  // vertical_tolerance says: the reduced equation's ρ ~ (L/D)² would overflow (double: L/D
+  // beyond ~1e154) or a = D/(2u) would underflow (float: D/L below ~1e-19).
+  using Value = std::conditional_t<std::is_same_v<Scalar, float>, float, double>;
+  const double floor_ratio = std::sqrt(double(std::numeric_limits<Value>::min()));
+  const double vertical_tolerance = std::max(options.vertical_tolerance, floor_ratio);
   excess = slack_excess(D, dz, L);
   if (!(excess > 0.0)) return CatenaryStatus::taut;
   if (D <= vertical_tolerance * L) return CatenaryStatus::vertical;
