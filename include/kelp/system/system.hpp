@@ -342,8 +342,8 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   check_all_finite(inputs.auv.control, "inputs.auv.control");
   check_all_finite(inputs.auv.external, "inputs.auv.external");
   KELP_CHECK(ws.tether.fits(model.tether().nodes()), "workspace was built for a different system");
-  detail::check_vehicle_pose(state.asv);
-  detail::check_vehicle_pose(state.auv);
+  vehicle::detail::check_state(state.asv);
+  vehicle::detail::check_state(state.auv);
   check_all_finite(state.asv_nu_dot, "state.asv_nu_dot");
   check_all_finite(state.auv_nu_dot, "state.auv_nu_dot");
   const SystemParameters<Scalar>& p = model.parameters();
@@ -412,8 +412,8 @@ SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorksp
                                   const vehicle::VehicleState<Scalar>& asv,
                                   const vehicle::VehicleState<Scalar>& auv, double t = 0.0,
                                   tether::StaticOptions<Scalar> options = {}) {
-  detail::check_vehicle_pose(asv);
-  detail::check_vehicle_pose(auv);
+  vehicle::detail::check_state(asv);
+  vehicle::detail::check_state(auv);
   SystemState<Scalar> s;
   s.asv = asv;
   s.auv = auv;

@@ -13,23 +13,12 @@
 #include "kelp/core/types.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/state.hpp"
 
 namespace kelp::system {
 
 namespace detail {
-/// Refuses a vehicle state that cannot place a tether end: non-finite position, velocity or
-/// attitude, or an attitude that is not a unit quaternion (Eigen would read it as some rotation).
-template <typename Scalar>
-void check_vehicle_pose(const vehicle::VehicleState<Scalar>& s) {
-  if (!(all_finite(s.position) && all_finite(s.nu) && all_finite(s.attitude.coeffs())))
-    ::kelp::detail::throw_invalid_argument(
-        "attached vehicle: state.position, state.nu and state.attitude must be finite");
-  using std::abs;
-  KELP_CHECK(abs(value_of(s.attitude.squaredNorm()) - 1.0) < 1e-3,
-             "attached vehicle: state.attitude must be a unit quaternion");
-}
-
 /// attachment_motion without the checks (the system's own, already checked, states).
 template <typename Scalar, typename Derived>
 tether::EndMotion<Scalar> motion_of_point(const vehicle::VehicleState<Scalar>& vehicle,
@@ -61,7 +50,7 @@ Vector6<Scalar> wrench_of_force(const vehicle::VehicleState<Scalar>& vehicle,
 template <typename Scalar, typename Derived>
 tether::EndMotion<Scalar> attachment_motion(const vehicle::VehicleState<Scalar>& vehicle,
                                             const Eigen::MatrixBase<Derived>& r_body) {
-  detail::check_vehicle_pose(vehicle);
+  ::kelp::vehicle::detail::check_state(vehicle);
   check_all_finite(r_body, "r_body");
   return detail::motion_of_point(vehicle, r_body);
 }
@@ -75,7 +64,7 @@ template <typename Scalar, typename D1, typename D2>
 Vector6<Scalar> attachment_wrench(const vehicle::VehicleState<Scalar>& vehicle,
                                   const Eigen::MatrixBase<D1>& r_body,
                                   const Eigen::MatrixBase<D2>& force_ned) {
-  detail::check_vehicle_pose(vehicle);
+  ::kelp::vehicle::detail::check_state(vehicle);
   check_all_finite(r_body, "r_body");
   check_all_finite(force_ned, "force_ned");
   return detail::wrench_of_force(vehicle, r_body, force_ned);

@@ -100,17 +100,23 @@ StateDerivative<Scalar> rk4(VehicleState<Scalar>& state, const Scalar& dt, Deriv
   return k4;
 }
 
-/// Checks what a step takes from the caller: dt > 0, a finite state and a unit attitude (a zero or
+/// Checks a vehicle state: finite position, velocity and attitude, and a unit attitude (a zero or
 /// badly scaled quaternion would otherwise be silently read as some rotation by Eigen).
 template <typename Scalar>
-void check_step_input(const VehicleState<Scalar>& state, identity_t<Scalar> dt) {
-  check_positive(dt, "dt");
+void check_state(const VehicleState<Scalar>& state) {
   check_all_finite(state.position, "state.position");
   check_all_finite(state.nu, "state.nu");
   check_all_finite(state.attitude.coeffs(), "state.attitude");
   using std::abs;
   KELP_CHECK(abs(value_of(state.attitude.squaredNorm()) - 1.0) < 1e-3,
              "state.attitude must be a unit quaternion");
+}
+
+/// Checks what a step takes from the caller: dt > 0 and a valid state (check_state).
+template <typename Scalar>
+void check_step_input(const VehicleState<Scalar>& state, identity_t<Scalar> dt) {
+  check_positive(dt, "dt");
+  check_state(state);
 }
 
 /// Checks the size of a wrench a step holds over its length: 6 entries. Its values are not
