@@ -26,6 +26,7 @@
 #include <fstream>
 #include <new>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "simulate.hpp"
@@ -67,9 +68,16 @@ double reference_elevation(const Waves& waves, double x, double y, long double t
 }
 
 int failures = 0;
-void expect(bool ok, const std::string& what) {
+// `what` is the message or, for the checks made at every step, a callable that builds it: passing
+// checks then format nothing.
+template <typename Message>
+void expect(bool ok, const Message& what) {
   if (ok) return;
-  if (++failures <= 20) std::fprintf(stderr, "soak: FAILED: %s\n", what.c_str());
+  if (++failures > 20) return;
+  if constexpr (std::is_invocable_v<Message>)
+    std::fprintf(stderr, "soak: FAILED: %s\n", std::string(what()).c_str());
+  else
+    std::fprintf(stderr, "soak: FAILED: %s\n", std::string(what).c_str());
 }
 
 }  // namespace
@@ -123,14 +131,17 @@ int main(int argc, char** argv) {
     const double ratio =
         v.report.tether.residual / (p.tether_options.acceleration_tolerance * p.max_tether_dt);
     worst_residual_ratio = std::max(worst_residual_ratio, ratio);
-    expect(ratio <= 1.0, "step " + std::to_string(v.step) + ": tether residual " +
-                             std::to_string(ratio) + " x tolerance");
+    expect(ratio <= 1.0, [&] {
+      return "step " + std::to_string(v.step) + ": tether residual " + std::to_string(ratio) +
+             " x tolerance";
+    });
     retries += v.report.tether.retries;
     fallbacks += v.report.tether_fallbacks;
     const double clock = std::abs(v.state.time() - static_cast<double>(v.step) * dt);
     worst_clock = std::max(worst_clock, clock);
-    expect(clock <= 1e-9,
-           "step " + std::to_string(v.step) + ": clock off by " + std::to_string(clock) + " s");
+    expect(clock <= 1e-9, [&] {
+      return "step " + std::to_string(v.step) + ": clock off by " + std::to_string(clock) + " s";
+    });
     if (v.step % 100 == 0) {  // every simulated second
       expect(kelp::all_finite(v.state.tether.position) && kelp::all_finite(v.state.tether.velocity),
              "tether state not finite");
@@ -148,8 +159,10 @@ int main(int argc, char** argv) {
           reference_elevation(waves, x, y, static_cast<long double>(v.step) * (long double)dt);
       const double err = std::abs(waves.elevation(x, y, v.state.time()) - ref);
       worst_wave = std::max(worst_wave, err);
-      expect(err <= 1e-6, "wave elevation off by " + std::to_string(err) +
-                              " m at t = " + std::to_string(v.state.time()) + " s");
+      expect(err <= 1e-6, [&] {
+        return "wave elevation off by " + std::to_string(err) +
+               " m at t = " + std::to_string(v.state.time()) + " s";
+      });
     }
     last_allocations = g_heap_allocations.load();
     // Between two observations only the controllers and the step run: no allocation allowed.
