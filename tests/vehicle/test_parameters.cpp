@@ -1,8 +1,10 @@
 // Bad user input is rejected with kelp::invalid_argument naming the field
 // (kelp/vehicle/model.hpp, rigid_body.hpp, damping.hpp, thrusters.hpp).
+#include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <functional>
 #include <limits>
+#include <random>
 
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
@@ -74,6 +76,61 @@ TEST_CASE("bad vehicle parameters name the field", "[vehicle][parameters]") {
         p.gm_transverse = kNan;
       },
       "gm_transverse");
+}
+
+TEST_CASE("definiteness checks agree with the eigenvalues", "[vehicle][parameters]") {
+  using M6 = Eigen::Matrix<double, 6, 6>;
+  const auto accepted = [](const M6& m, bool semi) {
+    try {
+      kv::check_symmetric_definite(m, "m", semi);
+      return true;
+    } catch (const kelp::invalid_argument& e) {
+      CHECK_THAT(e.what(), Catch::Contains("m must be positive"));
+      return false;
+    }
+  };
+  // Q diag(λ) Qᵀ with a random orthogonal Q and chosen eigenvalues (scale 1).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto with_eigenvalues = [&](const Eigen::Matrix<double, 6, 1>& lambda) {
+    M6 a;
+    for (int i = 0; i < 36; ++i) a(i) = u(rng);
+    const Eigen::HouseholderQR<M6> qr(a);
+    const M6 q = qr.householderQ();
+    const M6 m = q * lambda.asDiagonal() * q.transpose();
+    return M6(0.5 * (m + m.transpose()));
+  };
+  Eigen::Matrix<double, 6, 1> l;
+  for (int trial = 0; trial < 200; ++trial) {
+    l << 1.0, u(rng), u(rng), u(rng), u(rng), u(rng);
+    const double lowest = l.minCoeff();
+    if (std::abs(lowest) < 1e-6) continue;  // verdicts compared away from the thresholds
+    const M6 m = with_eigenvalues(l);
+    INFO("lowest eigenvalue " << lowest);
+    CHECK(accepted(m, false) == (lowest > 0));
+    CHECK(accepted(m, true) == (lowest > 0));
+  }
+  // The thresholds: semi-definite accepts λ_min down to −1e-12 of the largest entry, definite
+  // needs λ_min > 0.
+  l << 1.0, 0.5, 0.2, 0.1, 0.05, 0.0;
+  CHECK(accepted(with_eigenvalues(l), true));  // singular: semi-definite
+  CHECK_FALSE(accepted(with_eigenvalues(l), false));
+  l(5) = -1e-14;
+  CHECK(accepted(with_eigenvalues(l), true));  // within rounding of singular
+  l(5) = -1e-9;
+  CHECK_FALSE(accepted(with_eigenvalues(l), true));
+  l(5) = 1e-9;
+  CHECK(accepted(with_eigenvalues(l), false));
+  CHECK(accepted(M6::Zero(), true));  // no added mass at all
+  CHECK_FALSE(accepted(M6::Zero(), false));
+  // A 3x3 inertia with one negative principal moment hidden by rotation.
+  Eigen::Matrix3d inertia = Eigen::Vector3d(0.3, 0.4, -0.01).asDiagonal();
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  inertia = r * inertia * r.transpose();
+  inertia = 0.5 * (inertia + inertia.transpose()).eval();
+  CHECK(inertia.diagonal().minCoeff() > 0);  // positive diagonal, yet indefinite
+  CHECK_THROWS_WITH(kv::check_symmetric_definite(inertia, "inertia", false),
+                    Catch::Contains("inertia must be positive definite"));
 }
 
 TEST_CASE("bad thruster layouts name the field", "[vehicle][parameters]") {

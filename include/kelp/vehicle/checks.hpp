@@ -37,16 +37,19 @@ void check_symmetric_definite(const Eigen::MatrixBase<Derived>& m, const char* f
   KELP_CHECK((v - v.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale,
              std::string(field) + " must be symmetric");
   if (n == 0) return;
-  // Definiteness by Cholesky (Eigen::LLT), which succeeds exactly when every pivot is positive,
-  // i.e. when the matrix is positive definite (its backward error, ~n·ε·‖m‖, is far below the
-  // semi-definite tolerance). Semi-definite: m + 1e-12·‖m‖·I must be positive definite, which is
-  // λ_min(m) > −1e-12·‖m‖ (the zero matrix passes). A factorisation instead of an eigen-solver:
-  // the same answer, and far less for the compiler to instantiate in every user's translation unit.
+  // Definiteness from a pivoted LDLᵀ factorisation (Eigen::LDLT): by Sylvester's law of inertia
+  // D has as many positive entries as the matrix has positive eigenvalues, so the matrix is
+  // positive definite when every D_i > 0 (the factorisation's backward error, ~n·ε·‖m‖, is far
+  // below the semi-definite tolerance). Semi-definite: m + 1e-12·‖m‖·I must be positive
+  // definite, i.e. λ_min(m) > −1e-12·‖m‖ (the zero matrix passes). A factorisation instead of an
+  // eigen-solver: the same answer, and far less for the compiler to instantiate in every
+  // translation unit that builds a vehicle model (the 6×6 one is VehicleModel's own).
   if (semi) {
     if (scale == 0.0) return;
     v.diagonal().array() += 1e-12 * scale;
   }
-  const bool definite = Eigen::LLT<Mat>(v).info() == Eigen::Success;
+  const Eigen::LDLT<Mat> ldlt(v);
+  const bool definite = ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0.0;
   if (semi) {
     KELP_CHECK(definite, std::string(field) + " must be positive semi-definite");
   } else {

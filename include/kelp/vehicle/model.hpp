@@ -199,7 +199,9 @@ class VehicleModel {
                "mass matrix M = M_RB + M_A must be positive definite");
     // M⁻¹ formed once here from the factorisation (never per step): for a 6×6 system one
     // matrix-vector product per evaluation is several times faster than two triangular solves.
-    mass_inverse_ = ldlt_.solve(Matrix6<Scalar>::Identity());
+    // Column by column: a vector right-hand side keeps Eigen's blocked matrix kernels (GEBP/TRSM),
+    // heavy to compile, out of every translation unit that builds a model.
+    for (int j = 0; j < 6; ++j) mass_inverse_.col(j) = ldlt_.solve(Vector6<Scalar>::Unit(j));
     check_all_finite(mass_, "mass matrix M = M_RB + M_A (mass, inertia, r_g, added_mass)");
     check_all_finite(mass_inverse_, "inverse mass matrix (mass, inertia, r_g, added_mass)");
     weight_ = parameters_.weight();
