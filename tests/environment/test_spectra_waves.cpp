@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "kelp/environment/environment.hpp"
 #include "kelp/environment/fast_math.hpp"
 #include "kelp/environment/spectra.hpp"
 #include "kelp/environment/waves.hpp"
@@ -245,6 +246,40 @@ TEST_CASE("the velocity gradient matches finite differences and is symmetric and
     // Above the free surface: no water, no gradient.
     const auto air = w.kinematics(Vector3<double>(4.0, -3.0, -50.0), 3.0);
     CHECK(air.velocity_gradient.norm() == 0.0);
+  }
+}
+
+TEST_CASE("the single-point query's slope is slope(), below, at and above the surface",
+          "[environment][waves]") {
+  // The slope summed with the kinematics (SIMD single-point kernel, baseline and dispatched; the
+  // exact path for a huge t) against WaveField::slope, and against central differences of the
+  // elevation; through Environment::sample too.
+  for (const double depth : {std::numeric_limits<double>::infinity(), 15.0}) {
+    auto p = sea(3.0, 7.5, SpectrumKind::jonswap);
+    p.spreading = 2.0;
+    p.depth = depth;
+    WaveField<double> fast(p), base(p);
+    base.set_force_baseline_kernel(true);
+    Environment<double> env;
+    env.set_waves(fast);
+    const double h = 1e-5;
+    for (const double t : {0.5, 3.0, 11.0, 1e17}) {
+      for (const double z : {2.5, 0.0, -50.0}) {
+        const double x = 4.0, y = -3.0;
+        INFO("depth " << depth << ", t " << t << ", z " << z);
+        const Eigen::Vector2d ref = fast.slope(x, y, t);
+        const double tol = 1e-12 * (1.0 + ref.norm());
+        CHECK((fast.kinematics(Vector3<double>(x, y, z), t).slope - ref).norm() <= tol);
+        CHECK((base.kinematics(Vector3<double>(x, y, z), t).slope - ref).norm() <= tol);
+        CHECK((env.sample(Vector3<double>(x, y, z), t).surface_slope - ref).norm() <= tol);
+        if (t < 1e6) {
+          const Eigen::Vector2d fd((fast.elevation(x + h, y, t) - fast.elevation(x - h, y, t)),
+                                   (fast.elevation(x, y + h, t) - fast.elevation(x, y - h, t)));
+          CHECK((ref - fd / (2 * h)).norm() < 1e-6);
+          CHECK(ref.norm() > 1e-3);  // not trivially zero here
+        }
+      }
+    }
   }
 }
 

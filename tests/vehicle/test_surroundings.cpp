@@ -380,3 +380,60 @@ TEST_CASE("the current-vector overloads are the Surroundings forward dynamics wi
   CHECK((y.nu - z.nu).norm() == 0.0);
   CHECK((y.position - z.position).norm() == 0.0);
 }
+
+namespace {
+
+// An environment whose samples carry no surface slope: the vehicle must ask surface_slope().
+struct SampleWithoutSlope {
+  Vector3<double> current = Vector3<double>::Zero(), wave_velocity = Vector3<double>::Zero(),
+                  wave_acceleration = Vector3<double>::Zero(), wind = Vector3<double>::Zero();
+  double surface_elevation = 0.0;
+};
+struct EnvironmentWithoutSampledSlope {
+  const ke::Environmentd& env;
+  SampleWithoutSlope sample(const Vector3<double>& p, double t) const {
+    const auto e = env.sample(p, t);
+    SampleWithoutSlope s;
+    s.current = e.current;
+    s.wave_velocity = e.wave_velocity;
+    s.wave_acceleration = e.wave_acceleration;
+    s.wind = e.wind;
+    s.surface_elevation = e.surface_elevation;
+    return s;
+  }
+  Eigen::Vector2d surface_slope(double x, double y, double t) const {
+    return env.surface_slope(x, y, t);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a surface vessel's surroundings carry the slope of the surface at its position",
+          "[vehicle][environment][surface]") {
+  // A short-crested sea, so that both slope components are non-zero.
+  ke::WaveFieldParameters wp;
+  wp.spectrum.kind = ke::SpectrumKind::jonswap;
+  wp.spectrum.significant_height = 2.0;
+  wp.spectrum.peak_period = 7.0;
+  wp.n_components = 24;
+  wp.spreading = 2.0;
+  ke::Environmentd env;
+  env.set_waves(ke::WaveField<double>(wp));
+  const EnvironmentWithoutSampledSlope other{env};
+  const kv::VehicleModeld boat(kv::blueboat<double>().parameters);
+  const kv::VehicleModeld rov(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleStated x;
+  for (const double t : {0.3, 4.1, 9.7}) {
+    x.position << 3.0 * t, -2.0, 0.05;
+    const Eigen::Vector2d ref = env.surface_slope(x.position(0), x.position(1), t);
+    INFO("t " << t);
+    REQUIRE(std::min(std::abs(ref(0)), std::abs(ref(1))) > 1e-4);
+    // From Environment::sample (the slope summed with the kinematics) ...
+    CHECK((kv::surroundings(boat, env, x, t).surface_slope - ref).norm() <= 1e-12);
+    CHECK((kv::surroundings(env, x, t).surface_slope - ref).norm() <= 1e-12);
+    // ... or from surface_slope() for an environment whose samples have none.
+    CHECK((kv::surroundings(boat, other, x, t).surface_slope - ref).norm() <= 1e-15);
+    // A submerged vehicle's restoring reads no slope: left at zero.
+    CHECK(kv::surroundings(rov, env, x, t).surface_slope.norm() == 0.0);
+  }
+}

@@ -52,6 +52,9 @@ struct EnvironmentSample {
   Eigen::Matrix<Scalar, 3, 3> wave_velocity_gradient = Eigen::Matrix<Scalar, 3, 3>::Zero();
   /// Free-surface elevation ζ above the mean level at the point's (x, y) [m], positive UP.
   Scalar surface_elevation = Scalar(0);
+  /// Free-surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at the point's (x, y), as `surface_slope` gives it
+  /// (summed with the kinematics, from the same sines: cheaper than a separate query).
+  Eigen::Matrix<Scalar, 2, 1> surface_slope = Eigen::Matrix<Scalar, 2, 1>::Zero();
   /// Wind velocity at 10 m above the sea (the direction the air moves towards), NED [m/s].
   Vector3<Scalar> wind = Vector3<Scalar>::Zero();
 };
@@ -160,10 +163,10 @@ class Environment {
   const WindField<Scalar>& wind() const { return wind_; }
 
   /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
-  /// and acceleration (zero above the free surface), surface elevation at (x, y), wind at 10 m
-  /// (left at zero when `with_wind` is false: the gust sum costs as much as the waves at a point).
-  /// \throws kelp::invalid_argument when t is not finite and a wave field, a varying current or
-  /// gusts read it (a NaN position gives NaN values, no exception).
+  /// and acceleration (zero above the free surface), surface elevation and slope at (x, y), wind at
+  /// 10 m (left at zero when `with_wind` is false: the gust sum costs as much as the waves at a
+  /// point). \throws kelp::invalid_argument when t is not finite and a wave field, a varying
+  /// current or gusts read it (a NaN position gives NaN values, no exception).
   EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t,
                                    bool with_wind = true) const {
     EnvironmentSample<Scalar> s;
@@ -174,6 +177,7 @@ class Environment {
       s.wave_acceleration = k.acceleration;
       s.wave_velocity_gradient = k.velocity_gradient;
       s.surface_elevation = k.elevation;
+      s.surface_slope = k.slope;
     }
     if (with_wind) s.wind = wind_.velocity(t);
     return s;

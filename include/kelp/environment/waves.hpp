@@ -79,6 +79,8 @@ struct WaveBlock {
   /// Velocity gradient ∂v_i/∂x_k of a single-point query (point 0): xx, xy, yy, xz, yz
   /// (symmetric; zz = −xx − yy).
   double gxx, gxy, gyy, gxz, gyz;
+  /// Surface slope (∂ζ/∂x, ∂ζ/∂y) of a single-point query (point 0).
+  double sx, sy;
 };
 
 /// Accumulators of elevation, velocity and acceleration for kLanes lanes.
@@ -87,6 +89,7 @@ struct WaveLanes {
   double zeta[kLanes] = {}, vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, ax[kLanes] = {},
          ay[kLanes] = {}, az[kLanes] = {};
   double gxx[kLanes] = {}, gxy[kLanes] = {}, gyy[kLanes] = {}, gxz[kLanes] = {}, gyz[kLanes] = {};
+  double sx[kLanes] = {}, sy[kLanes] = {};
 };
 
 /// Adds component j's contribution at (x, y, −nze), phase alpha = φ_j − ω_j t, to lane l of
@@ -97,7 +100,8 @@ struct WaveLanes {
 /// lane is below any trough). With kGrad the velocity gradient is summed too: for one component
 /// (c = cos θ, s = sin θ) ∂v/∂x_k = a ω k [−F_h s cos²β, −F_h s cos β sin β, −F_v c cos β; ·,
 /// −F_h s sin²β, −F_v c sin β; ·, ·, F_h s] (symmetric: the flow is irrotational; trace-free:
-/// incompressible), using ∂F_h/∂z = −k F_v and ∂F_v/∂z = −k F_h.
+/// incompressible), using ∂F_h/∂z = −k F_v and ∂F_v/∂z = −k F_h; and so is the surface slope,
+/// ∂ζ/∂x = −Σ a k_x sin θ, ∂ζ/∂y = −Σ a k_y sin θ (the sines are already there).
 template <bool kFinite, bool kZeta, int kLanes, bool kGrad = false>
 KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::size_t j,
                                              double alpha, double x, double y, double nze,
@@ -138,6 +142,9 @@ KELP_ENV_ALWAYS_INLINE inline void wave_term(const WaveComponentsView& c, std::s
     acc.gyy[l] -= c.gss[j] * hs;
     acc.gxz[l] -= c.gc[j] * fvc;
     acc.gyz[l] -= c.gs[j] * fvc;
+    const double as = c.amp[j] * flip_sign(sn, sign);  // a sin θ
+    acc.sx[l] -= c.kx[j] * as;
+    acc.sy[l] -= c.ky[j] * as;
   }
 }
 
@@ -225,6 +232,7 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
       if (j0 == 0) {
         b.zeta[0] = b.vx[0] = b.vy[0] = b.vz[0] = b.ax[0] = b.ay[0] = b.az[0] = 0.0;
         b.gxx = b.gxy = b.gyy = b.gxz = b.gyz = 0.0;
+        b.sx = b.sy = 0.0;
       }
       for (int l = 0; l < kLanes; ++l) {
         b.zeta[0] += acc.zeta[l];
@@ -239,6 +247,8 @@ KELP_ENV_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView
         b.gyy += acc.gyy[l];
         b.gxz += acc.gxz[l];
         b.gyz += acc.gyz[l];
+        b.sx += acc.sx[l];
+        b.sy += acc.sy[l];
       }
       continue;
     }
@@ -380,6 +390,9 @@ struct WaveKinematics {
   /// single-point query only; (v·∇)v = velocity_gradient · velocity is the convective part of
   /// the water's material acceleration.
   Eigen::Matrix<Scalar, 3, 3> velocity_gradient = Eigen::Matrix<Scalar, 3, 3>::Zero();
+  /// Surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at the point's (x, y), as `WaveField::slope` gives it
+  /// (also above the free surface). Filled by the single-point query only, from the same sines.
+  Eigen::Matrix<Scalar, 2, 1> slope = Eigen::Matrix<Scalar, 2, 1>::Zero();
 };
 
 /// \brief A linear irregular sea: N regular components with precomputed constants.
@@ -594,6 +607,7 @@ class WaveField {
           static_cast<Scalar>(b.vz[0]);
       out.acceleration << static_cast<Scalar>(b.ax[0]), static_cast<Scalar>(b.ay[0]),
           static_cast<Scalar>(b.az[0]);
+      out.slope << static_cast<Scalar>(b.sx), static_cast<Scalar>(b.sy);
       if (!(b.z[0] < -b.zeta[0])) {
         const double gzz = -b.gxx - b.gyy;
         out.velocity_gradient << b.gxx, b.gxy, b.gxz, b.gxy, b.gyy, b.gyz, b.gxz, b.gyz, gzz;
@@ -785,6 +799,8 @@ class WaveField {
         b.gyy = k.velocity_gradient(1, 1);
         b.gxz = k.velocity_gradient(0, 2);
         b.gyz = k.velocity_gradient(1, 2);
+        b.sx = k.slope(0);
+        b.sy = k.slope(1);
       }
     }
   }
@@ -813,6 +829,7 @@ class WaveField {
         fv = (e - e2) * T(q_[j]);
       }
       out.elevation += T(amp_[j]) * c;
+      out.slope -= Eigen::Matrix<T, 2, 1>(T(kx_[j]) * T(amp_[j]) * s, T(ky_[j]) * T(amp_[j]) * s);
       const T hv = T(aw_[j]) * fh * c, ha = T(aw2_[j]) * fh * s;
       out.velocity += Vector3<T>(hv * T(cosb_[j]), hv * T(sinb_[j]), -T(aw_[j]) * fv * s);
       out.acceleration += Vector3<T>(ha * T(cosb_[j]), ha * T(sinb_[j]), T(aw2_[j]) * fv * c);

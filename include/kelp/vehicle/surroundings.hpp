@@ -61,6 +61,12 @@ struct has_windless_sample<
     std::void_t<decltype(std::declval<const Env&>().sample(std::declval<const P&>(), 0.0, false))>>
     : std::true_type {};
 
+template <typename Sample, typename = void>
+struct has_surface_slope : std::false_type {};
+template <typename Sample>
+struct has_surface_slope<Sample, std::void_t<decltype(std::declval<const Sample&>().surface_slope)>>
+    : std::true_type {};
+
 /// env.sample(p, t), told to skip the wind when it can be (`sample(p, t, false)`).
 template <typename Env, typename P>
 auto sample(const Env& env, const P& p, double t, bool wind) {
@@ -79,7 +85,13 @@ Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scal
   s.water_velocity = e.current + e.wave_velocity;
   s.water_acceleration = detail::material_acceleration<Scalar>(e);
   s.surface_elevation = e.surface_elevation;
-  if (slope) s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
+  if (slope) {
+    // From the sample when it carries the slope (Environment's does, from the same sines).
+    if constexpr (has_surface_slope<std::decay_t<decltype(e)>>::value)
+      s.surface_slope = e.surface_slope;
+    else
+      s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
+  }
   if (wind) s.wind_velocity = e.wind;
   return s;
 }
@@ -87,12 +99,12 @@ Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scal
 }  // namespace detail
 
 /// \brief Samples `env` at the vehicle's CO at time t (no allocation): `env.sample(p, t)` gives
-/// current, wave orbital velocity and acceleration, elevation and wind; `env.surface_slope(x, y,
-/// t)` the slope. `Env` is `kelp::environment::Environment` or any type with those two queries.
-/// The water acceleration is the material one, ∂v/∂t + (v·∇)v, when the sample carries the
-/// wave velocity gradient (as Environment's does).
-/// \param[in] env environment \param[in] x vehicle state (its CO position is used)
-/// \param[in] t time [s]
+/// current, wave orbital velocity and acceleration, elevation and wind, and the slope when its
+/// sample has a `surface_slope` (else `env.surface_slope(x, y, t)` gives it). `Env` is
+/// `kelp::environment::Environment` or any type with those two queries. The water acceleration is
+/// the material one, ∂v/∂t + (v·∇)v, when the sample carries the wave velocity gradient (as
+/// Environment's does). \param[in] env environment \param[in] x vehicle state (its CO position is
+/// used) \param[in] t time [s]
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x, double t) {
   return detail::sample_surroundings(env, x, t, true, true);
