@@ -361,6 +361,13 @@ TEST_CASE("Stable time step estimate refuses non-physical water and safety facto
                       kelp::invalid_argument);
   REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, static_cast<kt::Integrator>(9)),
                     kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, static_cast<kt::Integrator>(-1)),
+                    kelp::invalid_argument);
+  for (const kt::Integrator i :
+       {kt::Integrator::symplectic_euler, kt::Integrator::rk2, kt::Integrator::rk4,
+        kt::Integrator::implicit_euler, kt::Integrator::bdf2})
+    CHECK(kt::is_valid(i));
+  CHECK_FALSE(kt::is_valid(static_cast<kt::Integrator>(5)));
   for (const double rho : {nan_, -1.0})
     REQUIRE_THROWS_AS(kt::highest_axial_frequency(model, rho), kelp::invalid_argument);
   // Vacuum (ρ = 0) is allowed and gives a finite step, shorter than in water when the line has

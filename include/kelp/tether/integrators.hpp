@@ -56,6 +56,12 @@ inline const char* integrator_name(Integrator i) {
   return "unknown";
 }
 
+/// \brief True for a value of the enumeration (false for an out-of-range cast).
+inline bool is_valid(Integrator i) {
+  return static_cast<int>(i) >= static_cast<int>(Integrator::symplectic_euler) &&
+         static_cast<int>(i) <= static_cast<int>(Integrator::bdf2);
+}
+
 /// \brief True for the Newton-solved schemes.
 inline bool is_implicit(Integrator i) {
   return i == Integrator::implicit_euler || i == Integrator::bdf2;
@@ -1232,8 +1238,7 @@ Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrato
   check_positive(safety, "safety");
   check_at_most(safety, 1.0, "safety");
   detail::check_water_density(water_density);
-  KELP_CHECK(std::string(integrator_name(integrator)) != "unknown",
-             "integrator is not a kelp::tether::Integrator value");
+  KELP_CHECK(is_valid(integrator), "integrator is not a kelp::tether::Integrator value");
   if (is_implicit(integrator)) return std::numeric_limits<Scalar>::infinity();
   const Scalar w = highest_axial_frequency(model, water_density);
   if (!(w > Scalar(0))) return std::numeric_limits<Scalar>::infinity();
