@@ -26,6 +26,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/limits.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 
 namespace kelp::tether {
@@ -1173,11 +1174,12 @@ namespace detail {
 /// Number of segment springs on node i of a line of n segments (1 at an end, else 2).
 inline int node_springs(int i, int n) { return (i > 0 ? 1 : 0) + (i < n ? 1 : 0); }
 
-/// Water densities from 0 (air, vacuum) to 1e5 kg/m³ (seven times mercury's); NaN and Inf refused.
+/// Water densities from 0 (air, vacuum) to the environment's `limits::max_fluid_density` (1e5
+/// kg/m³, seven times mercury's); NaN and Inf refused.
 template <typename Scalar>
 void check_water_density(const Scalar& rho) {
   check_non_negative(rho, "water_density");
-  check_at_most(rho, 1e5, "water_density");
+  check_at_most(rho, ::kelp::environment::limits::max_fluid_density, "water_density");
 }
 
 /// Axial mass of node i [kg]: structural plus tangential added mass, the node taken as
