@@ -21,10 +21,18 @@ namespace {
 std::size_t g_operator_new_calls = 0;
 }  // namespace
 
+// Every non-array, non-aligned form is replaced, new and delete together, all on malloc/free: an
+// allocator that replaces the library's (AddressSanitizer's, in the sanitizer build) must not
+// see memory from one family freed by the other (Catch2 allocates with `new (std::nothrow)`).
+// The array forms stay the library's, new[] and delete[] both.
 void* operator new(std::size_t size) {
   ++g_operator_new_calls;
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
+}
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  ++g_operator_new_calls;
+  return std::malloc(size == 0 ? 1 : size);
 }
 // GCC (12, -O1) inlines these into a test's `::operator delete(::operator new(16))` and then
 // takes std::free of a pointer from operator new for a mismatch; here both are malloc/free.
@@ -34,6 +42,7 @@ void* operator new(std::size_t size) {
 #endif
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
