@@ -39,8 +39,9 @@ void check_symmetric_definite(const Eigen::MatrixBase<Derived>& m, const char* f
   if (n == 0) return;
   // Definiteness from a pivoted LDLᵀ factorisation (Eigen::LDLT): by Sylvester's law of inertia
   // D has as many positive entries as the matrix has positive eigenvalues, so the matrix is
-  // positive definite when every D_i > 0 (the factorisation's backward error, ~n·ε·‖m‖, is far
-  // below the semi-definite tolerance). Semi-definite: m + 1e-12·‖m‖·I must be positive
+  // positive definite when every D_i > 0 (for such a matrix the factorisation is backward stable,
+  // its error ~n·ε·‖m‖ far below the semi-definite tolerance; an indefinite one gives a D_i ≤ 0
+  // or a failed factorisation). Semi-definite: m + 1e-12·‖m‖·I must be positive
   // definite, i.e. λ_min(m) > −1e-12·‖m‖ (the zero matrix passes). A factorisation instead of an
   // eigen-solver: the same answer, and far less for the compiler to instantiate in every
   // translation unit that builds a vehicle model (the 6×6 one is VehicleModel's own).
