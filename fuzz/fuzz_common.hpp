@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "kelp/core/error.hpp"
+
 namespace kelp_fuzz {
 
 /// Reads the fuzzer's bytes front to back.
@@ -112,5 +114,17 @@ class Writer {
       ::kelp_fuzz::finding(std::string(what) + " [" #cond "] at " __FILE__ ":" + \
                            std::to_string(__LINE__));                            \
   } while (false)
+
+/// The body of a target whose `run(data, size)` catches every kelp::error its checked calls
+/// may throw: one escaping it is a finding. Returns 0 for LLVMFuzzerTestOneInput.
+template <typename Run>
+int run_catching_stray_errors(Run&& run, const std::uint8_t* data, std::size_t size) {
+  try {
+    run(data, size);
+  } catch (const kelp::error& e) {
+    finding(std::string("kelp::error outside the checked calls: ") + e.what());
+  }
+  return 0;
+}
 
 }  // namespace kelp_fuzz

@@ -114,10 +114,5 @@ void run(const std::uint8_t* data, std::size_t size) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  try {
-    run(data, size);
-  } catch (const kelp::error& e) {
-    kelp_fuzz::finding(std::string("kelp::error outside the checked calls: ") + e.what());
-  }
-  return 0;
+  return kelp_fuzz::run_catching_stray_errors(run, data, size);
 }
