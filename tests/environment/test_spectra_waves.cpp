@@ -7,8 +7,8 @@
 #include <limits>
 #include <random>
 
+#include "kelp/core/fast_math.hpp"
 #include "kelp/environment/environment.hpp"
-#include "kelp/environment/fast_math.hpp"
 #include "kelp/environment/spectra.hpp"
 #include "kelp/environment/waves.hpp"
 
@@ -34,17 +34,17 @@ TEST_CASE("fast sin/cos/exp agree with the standard library", "[environment][wav
   for (int i = 0; i < 200000; ++i) {
     const double x = (i % 2) ? big(rng) : small(rng);
     double s, c;
-    detail::fast_sincos(x, s, c);
+    kelp::simd::fast_sincos(x, s, c);
     es = std::max(es, std::abs(s - std::sin(x)));
     ec = std::max(ec, std::abs(c - std::cos(x)));
     const double y = (i % 3) ? neg(rng) : small(rng) - 4.0;
-    ee = std::max(ee, std::abs(detail::fast_exp_nonpositive(y) - std::exp(y)) / std::exp(y));
+    ee = std::max(ee, std::abs(kelp::simd::fast_exp_nonpositive(y) - std::exp(y)) / std::exp(y));
   }
   CHECK(es < 1e-11);  // |x| up to 1e5: the reduction loses ~|x|·ε of the argument
   CHECK(ec < 1e-11);
   CHECK(ee < 2e-14);
-  CHECK(detail::fast_exp_nonpositive(-1e6) >= 0.0);
-  CHECK(detail::fast_exp_nonpositive(-1e6) < 1e-300);
+  CHECK(kelp::simd::fast_exp_nonpositive(-1e6) >= 0.0);
+  CHECK(kelp::simd::fast_exp_nonpositive(-1e6) < 1e-300);
 }
 
 TEST_CASE("PM and JONSWAP discretised variance is Hs^2/16 within 1 %", "[environment][waves]") {
@@ -403,12 +403,12 @@ TEST_CASE("the wave kernel's exp and sign-split sin/cos keep their error bounds"
   double worst_exp = 0, worst_sc = 0;
   for (int i = 0; i < 100000; ++i) {
     const double x = (i % 2) ? neg(rng) : small(rng);
-    const double e = detail::fast_exp_nonpositive_unchecked<false>(x);
+    const double e = kelp::simd::fast_exp_nonpositive_unchecked<false>(x);
     worst_exp = std::max(worst_exp, std::abs(e - std::exp(x)) / (1.3e-17 + 1e-15 * std::exp(x)));
     const double a = ang(rng);
     double s, c;
     std::uint64_t sign;
-    detail::fast_sincos_unsigned(a, s, c, sign);
+    kelp::simd::fast_sincos_unsigned(a, s, c, sign);
     const double sg = sign ? -1.0 : 1.0;
     worst_sc = std::max({worst_sc, std::abs(sg * s - std::sin(a)), std::abs(sg * c - std::cos(a))});
   }

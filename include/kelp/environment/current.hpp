@@ -19,9 +19,9 @@
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/fast_math.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
-#include "kelp/environment/fast_math.hpp"
 #include "kelp/environment/limits.hpp"
 
 namespace kelp {
@@ -255,7 +255,7 @@ class CurrentModel {
       if (std::fabs(t) <= time_fast_limit) {
         for (std::size_t k = 0; k < omega.size(); ++k) {
           double s, c;
-          detail::fast_sincos(detail::wrap_two_pi(omega[k] * t + phase[k]), s, c);
+          simd::fast_sincos(simd::wrap_two_pi(omega[k] * t + phase[k]), s, c);
           sum += c;
         }
       } else {
@@ -270,7 +270,7 @@ class CurrentModel {
       if (!std::isfinite(t)) detail::throw_bad_value("current: time t", "finite", t);
       double sum = 0.0;
       for (std::size_t k = 0; k < omega.size(); ++k)
-        sum += std::cos(detail::reduce_phase_exact(omega[k] * t + phase[k]));
+        sum += std::cos(simd::reduce_phase_exact(omega[k] * t + phase[k]));
       return sum;
     }
   };
@@ -301,7 +301,7 @@ class CurrentModel {
       ::kelp::detail::throw_invalid_argument(msg.str());
     }
     // ω_k ≤ max_frequency; |ω_k t + φ_k| ≤ max_frequency |t| + 2π.
-    h.time_fast_limit = (detail::kWrapTwoPiLimit - 8.0) / params_.max_frequency;
+    h.time_fast_limit = (simd::kWrapTwoPiLimit - 8.0) / params_.max_frequency;
   }
 
   CurrentParameters params_;

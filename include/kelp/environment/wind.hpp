@@ -19,9 +19,9 @@
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/fast_math.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
-#include "kelp/environment/fast_math.hpp"
 #include "kelp/environment/limits.hpp"
 
 namespace kelp {
@@ -183,7 +183,7 @@ class WindField {
       }
     }
     // |ω_j t + φ_j| ≤ ω_max |t| + 2π stays within wrap_two_pi's exact range up to this |t|.
-    time_fast_limit_ = (detail::kWrapTwoPiLimit - 8.0) / omega_.back();
+    time_fast_limit_ = (simd::kWrapTwoPiLimit - 8.0) / omega_.back();
   }
 
   /// \brief The parameters the field was built from.
@@ -202,7 +202,7 @@ class WindField {
     double u = params_.speed, sn, cs;
     if (!(std::fabs(t) <= time_fast_limit_)) return Scalar(speed_exact(t));
     for (std::size_t j = 0; j < amp_.size(); ++j) {
-      detail::fast_sincos(detail::wrap_two_pi(omega_[j] * t + phase_[j]), sn, cs);
+      simd::fast_sincos(simd::wrap_two_pi(omega_[j] * t + phase_[j]), sn, cs);
       u += amp_[j] * cs;
     }
     return Scalar(u);
@@ -223,7 +223,7 @@ class WindField {
       ::kelp::environment::detail::throw_bad_value("wind: time t", "finite", t);
     double u = params_.speed;
     for (std::size_t j = 0; j < amp_.size(); ++j)
-      u += amp_[j] * std::cos(detail::reduce_phase_exact(omega_[j] * t + phase_[j]));
+      u += amp_[j] * std::cos(simd::reduce_phase_exact(omega_[j] * t + phase_[j]));
     return u;
   }
 

@@ -1,6 +1,7 @@
 /// \file
 /// \brief Branch-free double-precision sin/cos and exp written so that loops over them
-/// auto-vectorise (plain SSE2 is enough); used by the wave kinematics kernel.
+/// auto-vectorise (plain SSE2 is enough): with kelp/core/simd.hpp, kelp's one SIMD layer. Used by
+/// the wave kinematics kernel and the wind and current variations.
 ///
 /// Accuracy: |error| ≲ 1e-15 relative for exp on [−700, 0] and ≲ 1e-15 absolute for sin/cos
 /// with |x| ≤ 10 rad, ≲ 1e-11 with |x| ≤ 1e5 rad (Cody–Waite reduction by multiples of π with a
@@ -17,19 +18,17 @@
 
 #if defined(__GNUC__) || defined(__clang__)
 /// Forces inlining, so that the math inlines into kernels compiled for a wider instruction set.
-#define KELP_ENV_ALWAYS_INLINE __attribute__((always_inline))
+#define KELP_ALWAYS_INLINE __attribute__((always_inline))
 #else
-#define KELP_ENV_ALWAYS_INLINE
+#define KELP_ALWAYS_INLINE
 #endif
 
-namespace kelp {
-namespace environment {
-namespace detail {
+namespace kelp::simd {
 
 /// Round to nearest (ties to even) for |x| < 2^51 without a branch or an intrinsic: adding and
 /// subtracting 1.5·2^52 pushes the fraction out of the mantissa. A translation unit compiled with
 /// -ffast-math (-fassociative-math) may fold this away; kelp's kernels must not be built so.
-KELP_ENV_ALWAYS_INLINE inline double round_nearest(double x) {
+KELP_ALWAYS_INLINE inline double round_nearest(double x) {
   constexpr double magic = 6755399441055744.0;  // 1.5 * 2^52
   return (x + magic) - magic;
 }
@@ -37,8 +36,8 @@ KELP_ENV_ALWAYS_INLINE inline double round_nearest(double x) {
 /// sin and cos of x (|x| ≤ 1e5 for full accuracy) up to a common sign: sin x = ±s, cos x = ±c,
 /// with the sign bit of ± in `sign` (0 or 2^63, to be applied by XOR, see `flip_sign`). A
 /// caller that multiplies both by one factor applies the sign once, to that factor.
-KELP_ENV_ALWAYS_INLINE inline void fast_sincos_unsigned(double x, double& s, double& c,
-                                                        std::uint64_t& sign) {
+KELP_ALWAYS_INLINE inline void fast_sincos_unsigned(double x, double& s, double& c,
+                                                    std::uint64_t& sign) {
   constexpr double inv_pi = 0.318309886183790671538;
   // π ≈ p1 + p2 (twice fdlibm's pio2_1, pio2_2; the remainder is 4.1e-21): p1 has 33
   // significant bits, so n·p1 is exact for |n| < 2^20.
@@ -77,7 +76,7 @@ KELP_ENV_ALWAYS_INLINE inline void fast_sincos_unsigned(double x, double& s, dou
 }
 
 /// x with its sign bit XORed with `sign` (0 or 2^63): x or −x without a branch.
-KELP_ENV_ALWAYS_INLINE inline double flip_sign(double x, std::uint64_t sign) {
+KELP_ALWAYS_INLINE inline double flip_sign(double x, std::uint64_t sign) {
   std::uint64_t b;
   std::memcpy(&b, &x, sizeof b);
   b ^= sign;
@@ -86,7 +85,7 @@ KELP_ENV_ALWAYS_INLINE inline double flip_sign(double x, std::uint64_t sign) {
 }
 
 /// sin and cos of x (|x| ≤ 1e5 for full accuracy).
-KELP_ENV_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
+KELP_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
   std::uint64_t sign;
   fast_sincos_unsigned(x, s, c, sign);
   s = flip_sign(s, sign);
@@ -99,7 +98,7 @@ KELP_ENV_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
 /// n·h2 are exact for |n| < 2^27 (|x| < 8e8 rad), so the reduced phase carries only the rounding
 /// of x itself and ≲ 1e-16 rad of its own. Used to bring a wave phase φ − ω t (formed in double)
 /// into the range where `fast_sincos` and a single-precision cast are accurate, however large t.
-KELP_ENV_ALWAYS_INLINE inline double wrap_two_pi(double x) {
+KELP_ALWAYS_INLINE inline double wrap_two_pi(double x) {
   constexpr double inv_two_pi = 0.15915494309189535;
   constexpr double h1 = 6.283185243606567;       // 26 significant bits
   constexpr double h2 = 6.357301884918343e-08;   // next 26 bits
@@ -141,7 +140,7 @@ inline double reduce_phase(double x) {
 /// x = −700), so the absolute error |x|·1.44·2.3e-17·e^x stays below 1.3e-17 for every x ≤ 0.
 /// The wave kernel sums terms a e^{−kz}, for which that absolute bound is what counts.
 template <bool kSplitLn2 = true>
-KELP_ENV_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
+KELP_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
   constexpr double log2e = 1.44269504088896340736;
   constexpr double ln2_hi = 6.93147180369123816490e-01;  // fdlibm's ln2_hi / ln2_lo split
   constexpr double ln2_lo = 1.90821492927058770002e-10;
@@ -181,7 +180,7 @@ KELP_ENV_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
 }
 
 /// e^x for x ≤ 0 (x below −700 is treated as −700, giving ≈ 1e-304 instead of a subnormal).
-KELP_ENV_ALWAYS_INLINE inline double fast_exp_nonpositive(double x) {
+KELP_ALWAYS_INLINE inline double fast_exp_nonpositive(double x) {
   // max(x, −700) written with fabs: GCC (without -ffast-math) does not if-convert a compare here,
   // and a branch would stop the loop around this function from vectorising. For x ≥ −700 the
   // correction is exactly zero, so x passes unchanged.
@@ -189,6 +188,4 @@ KELP_ENV_ALWAYS_INLINE inline double fast_exp_nonpositive(double x) {
   return fast_exp_nonpositive_unchecked(x);
 }
 
-}  // namespace detail
-}  // namespace environment
-}  // namespace kelp
+}  // namespace kelp::simd

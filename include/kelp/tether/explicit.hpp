@@ -1,0 +1,143 @@
+/// \file
+/// \brief The explicit tether steps: semi-implicit (symplectic) Euler, explicit midpoint (RK2)
+/// and classical RK4. End forces are those at the start of the step. See
+/// kelp/tether/stable_dt.hpp for the largest stable step.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+#include "kelp/core/simd.hpp"
+#include "kelp/tether/forces.hpp"
+#include "kelp/tether/model.hpp"
+#include "kelp/tether/state.hpp"
+#include "kelp/tether/stepping.hpp"
+
+namespace kelp::tether {
+
+/// \brief One semi-implicit (symplectic) Euler step of length `dt` [s]:
+/// v_{n+1} = v_n + h M⁻¹F(x_n, v_n), x_{n+1} = x_n + h v_{n+1}. Stable for h ω_max < 2.
+/// End forces (`ws.end_forces`) are those at the start of the step.
+/// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
+/// the result is not finite.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
+                                         TetherWorkspace<Scalar>& ws, const Env& env,
+                                         TetherState<Scalar>& state,
+                                         const TetherBoundary<Scalar>& boundary, double dt) {
+  detail::begin_explicit_step(model, ws, state, boundary, dt);
+  const double t = state.time;
+  const Scalar h = Scalar(dt);
+  detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
+  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  ws.end_impulse = {h * ws.end_forces.on_start, h * ws.end_forces.on_end};
+  ws.v1.noalias() = ws.v0 + h * ws.acceleration;
+  ws.x1.noalias() = ws.x0 + h * ws.v1;
+  detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
+  detail::commit(state, ws.x1, ws.v1, dt, "step_symplectic_euler");
+  StepReport<Scalar> r;
+  r.substeps = 1;
+  r.force_evaluations = 1;
+  return r;
+}
+
+/// \brief One explicit-midpoint (RK2) step of length `dt` [s]. End forces are those at the start
+/// of the step. \throws as step_symplectic_euler.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                            const Env& env, TetherState<Scalar>& state,
+                            const TetherBoundary<Scalar>& boundary, double dt) {
+  detail::begin_explicit_step(model, ws, state, boundary, dt);
+  const double t = state.time;
+  const Scalar h = Scalar(dt), h2 = Scalar(0.5) * h;
+  detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
+  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  ws.xs.noalias() = ws.x0 + h2 * ws.v0;
+  ws.vs.noalias() = ws.v0 + h2 * ws.acceleration;
+  detail::apply_boundary(model, boundary, h2, ws.xs, ws.vs);
+  detail::derivative(model, ws, env, t + 0.5 * dt, boundary, ws.xs, ws.vs, ws.acceleration);
+  detail::add_end_impulse(model, ws, boundary, h);
+  ws.x1.noalias() = ws.x0 + h * ws.vs;
+  ws.v1.noalias() = ws.v0 + h * ws.acceleration;
+  detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
+  detail::commit(state, ws.x1, ws.v1, dt, "step_rk2");
+  StepReport<Scalar> r;
+  r.substeps = 1;
+  r.force_evaluations = 2;
+  return r;
+}
+
+namespace detail {
+
+/// One RK4 stage's state update in one vectorised pass over the flat 3 × (N+1) arrays: with the
+/// stage accelerations ws.acceleration at the stage point (·, vs), accumulates x1 += w vs,
+/// v1 += w a (the first stage starts them from x0, v0) and, unless this is the last stage, moves
+/// the stage point to xs = x0 + ch vs, vs = v0 + ch a. `vs` is ws.v0 (first stage) or ws.vs
+/// (updated in place). The kinematic end columns are overwritten by apply_boundary afterwards.
+template <typename Scalar>
+void rk4_stage_update(TetherWorkspace<Scalar>& ws, const Matrix3X<Scalar>& vs, Scalar w, Scalar ch,
+                      bool first, bool last) {
+  const Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *a = ws.acceleration.data();
+  const Scalar* vin = vs.data();
+  Scalar *x1 = ws.x1.data(), *v1 = ws.v1.data(), *xs = ws.xs.data(), *vo = ws.vs.data();
+  const auto update = [&](auto lanes, Eigen::Index j) {
+    using P = decltype(lanes);
+    const P wp = P::all(w), vj = P::load(vin + j), aj = P::load(a + j);
+    if (first) {
+      (P::load(x0 + j) + wp * vj).store(x1 + j);
+      (P::load(v0 + j) + wp * aj).store(v1 + j);
+    } else {
+      (P::load(x1 + j) + wp * vj).store(x1 + j);
+      (P::load(v1 + j) + wp * aj).store(v1 + j);
+    }
+    if (!last) {
+      const P cp = P::all(ch);
+      (P::load(x0 + j) + cp * vj).store(xs + j);
+      (P::load(v0 + j) + cp * aj).store(vo + j);
+    }
+  };
+  simd::for_each_pack<Scalar>(0, ws.x1.size(), update);
+}
+
+}  // namespace detail
+
+/// \brief One classical RK4 step of length `dt` [s]. End forces are those at the start of the
+/// step. Four force evaluations (each also giving the accelerations M⁻¹F in its last pass), each
+/// followed by one vectorised pass for the stage's state update. \throws as
+/// step_symplectic_euler.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                            const Env& env, TetherState<Scalar>& state,
+                            const TetherBoundary<Scalar>& boundary, double dt) {
+  detail::begin_explicit_step(model, ws, state, boundary, dt);
+  const double t = state.time;
+  const Scalar h = Scalar(dt);
+  const Scalar c[4] = {Scalar(0), Scalar(0.5), Scalar(0.5), Scalar(1)};
+  const Scalar w[4] = {h / Scalar(6), h / Scalar(3), h / Scalar(3), h / Scalar(6)};
+  const double tc[4] = {t, t + 0.5 * dt, t + 0.5 * dt, t + dt};
+  for (int k = 0; k < 4; ++k) {
+    const Matrix3X<Scalar>& xk = k == 0 ? ws.x0 : ws.xs;
+    const Matrix3X<Scalar>& vk = k == 0 ? ws.v0 : ws.vs;
+    detail::evaluate_forces<false>(model, ws, env, tc[k], xk, vk, ws.acceleration.data());
+    if (k == 0) ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+    detail::add_end_impulse(model, ws, boundary, w[k]);
+    const bool last = k == 3;
+    detail::rk4_stage_update(ws, vk, w[k], last ? Scalar(0) : c[k + 1] * h, k == 0, last);
+    if (!last) detail::apply_boundary(model, boundary, c[k + 1] * h, ws.xs, ws.vs);
+  }
+  detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
+  detail::commit(state, ws.x1, ws.v1, dt, "step_rk4");
+  StepReport<Scalar> r;
+  r.substeps = 1;
+  r.force_evaluations = 4;
+  return r;
+}
+
+}  // namespace kelp::tether

@@ -1,0 +1,560 @@
+/// \file
+/// \brief Lumped-mass tether force evaluation: `compute_forces` (axial tension, internal
+/// damping, optional bending stiffness, weight and buoyancy, Morison drag, added mass,
+/// fluid-inertia forcing, seabed contact with friction), the accelerations and end forces derived
+/// from it, and the line's mechanical energy. The scalar node pass lives here; the SIMD packet
+/// kernels in kelp/tether/force_kernels.hpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <type_traits>
+#include <utility>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/simd.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/force_kernels.hpp"
+#include "kelp/tether/model.hpp"
+#include "kelp/tether/state.hpp"
+
+namespace kelp::tether {
+
+namespace detail {
+
+/// True for environments that can say they are still water at all times through
+/// `bool is_still_water() const`, as kelp::environment::Environment can. Other environments are
+/// always queried.
+template <typename Env, typename = void>
+struct has_still_water_query : std::false_type {};
+template <typename Env>
+struct has_still_water_query<
+    Env, std::void_t<decltype(bool(std::declval<const Env&>().is_still_water()))>>
+    : std::true_type {};
+
+/// True for environments that sample the free-surface elevation along with the water
+/// kinematics: `sample_water(points, t, velocity, acceleration, elevation)`, as
+/// kelp::environment::Environment can. Other environments are asked `surface_elevation(x, y, t)`
+/// node by node.
+template <typename Env, typename Scalar, typename = void>
+struct has_batch_surface : std::false_type {};
+template <typename Env, typename Scalar>
+struct has_batch_surface<
+    Env, Scalar,
+    std::void_t<decltype(std::declval<const Env&>().sample_water(
+        std::declval<const Matrix3X<Scalar>&>(), 0.0, std::declval<Matrix3X<Scalar>&>(),
+        std::declval<Matrix3X<Scalar>&>(), std::declval<VectorX<Scalar>&>()))>> : std::true_type {};
+
+/// Water velocity, acceleration and surface elevation at the points `x` into the workspace.
+template <typename Scalar, typename Env, typename DX>
+void sample_water_at_nodes(const Env& env, const Eigen::MatrixBase<DX>& x, double t,
+                           TetherWorkspace<Scalar>& ws) {
+  if constexpr (has_batch_surface<Env, Scalar>::value) {
+    env.sample_water(x, t, ws.water_velocity, ws.water_acceleration, ws.surface_elevation);
+  } else {
+    env.sample_water(x, t, ws.water_velocity, ws.water_acceleration);
+    for (Eigen::Index i = 0; i < x.cols(); ++i)
+      ws.surface_elevation(i) = Scalar(env.surface_elevation(x(0, i), x(1, i), t));
+  }
+}
+
+/// True when `env` reports still water: its water velocity and acceleration are zero everywhere
+/// and at all times.
+template <typename Env>
+bool is_still_water(const Env& env) {
+  if constexpr (has_still_water_query<Env>::value)
+    return env.is_still_water();
+  else
+    return false;
+}
+
+/// Tangent of node i of a line of n segments: the chord c = r_{i+1} − r_{i−1} inside (the
+/// adjacent segment at the ends), 1/|c|² and 1/|c| (both zero for a zero chord) and the unit
+/// tangent q = c/|c| (zero for a zero chord).
+template <typename Scalar>
+struct NodeTangent {
+  Vector3<Scalar> chord;
+  Scalar inv_c2, inv_c;
+  Vector3<Scalar> q;
+};
+
+/// The NodeTangent of node i of positions `x` (3 × (n+1)).
+template <typename Scalar, typename DX>
+NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n) {
+  using std::sqrt;
+  NodeTangent<Scalar> t;
+  t.chord = x.col(i < n ? i + 1 : n) - x.col(i > 0 ? i - 1 : 0);
+  const Scalar c2 = t.chord.squaredNorm();
+  t.inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
+  t.inv_c = sqrt(t.inv_c2);
+  t.q = t.chord * t.inv_c;
+  return t;
+}
+
+/// Submerged fraction φ of a node at NED depth z [m] under a free surface at elevation ζ [m]:
+/// the cable's cross-section of diameter D goes under over one diameter, taken as a linear ramp
+/// φ = clamp(1 + (z + ζ)/D, 0, 1) (1: wet, a node at the surface included; 0: in air, at least
+/// one diameter above the surface). Buoyancy, drag, fluid inertia and
+/// added mass scale with φ, so the node forces are continuous in the positions (an on/off switch
+/// at the surface would leave Newton's method no solution to converge to when a floating line
+/// rests at the surface).
+template <typename Scalar>
+Scalar submerged_fraction(Scalar z, Scalar zeta, Scalar diameter,
+                          Scalar inv_diameter = Scalar(-1)) {
+  if (inv_diameter < Scalar(0)) inv_diameter = Scalar(1) / diameter;
+  const Scalar f = Scalar(1) + (z + zeta) * inv_diameter;
+  return f >= Scalar(1) ? Scalar(1) : (f > Scalar(0) ? f : Scalar(0));
+}
+
+/// Antiderivative Φ of submerged_fraction in the depth d = z + ζ, zero in air and d + D/2 when
+/// wet: the buoyancy potential of a node is −ρ V g Φ [J].
+template <typename Scalar>
+Scalar submerged_depth_integral(Scalar z, Scalar zeta, Scalar diameter) {
+  const Scalar d = z + zeta;
+  if (d >= Scalar(0)) return d + Scalar(0.5) * diameter;
+  if (d <= -diameter) return Scalar(0);
+  return (d + diameter) * (d + diameter) / (Scalar(2) * diameter);
+}
+
+/// Node i, any kind and state (end node, surface band, in air, on the seabed): tangent, node
+/// force without the added-mass coupling to the neighbours, that coupling term w_i, masses,
+/// submerged fraction, seabed force and the Jacobian terms.
+template <bool WithJacobian, typename Scalar>
+void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i) {
+  using std::abs;
+  using std::sqrt;
+  using V3 = Vector3<Scalar>;
+  const TetherParameters<Scalar>& p = *c.p;
+  const int n = c.n;
+  // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends. The drag below
+  // is written with the unnormalised chord and 1/|c|² so that its square root and the
+  // tangent's run in parallel instead of one after the other.
+  const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
+  const NodeTangent<Scalar> nt = node_tangent<Scalar>(c.positions(), i, n);
+  const V3& chord = nt.chord;
+  const Scalar inv_c2 = nt.inv_c2, inv_c = nt.inv_c;
+  const V3& q = nt.q;
+  ws.tangent.col(i) = q;
+  V3 f;
+  for (int k = 0; k < 3; ++k) {
+    const Scalar in = i < n ? ws.pass_buffer(i, kSegmentForce + k) : Scalar(0);
+    const Scalar out = i > 0 ? ws.pass_buffer(i - 1, kSegmentForce + k) : Scalar(0);
+    f(k) = in - out;
+  }
+  const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
+  const Scalar li = c.kinds[kind].li;
+  const Scalar z = c.X(2, i);
+  const Scalar zeta = c.still ? Scalar(0) : ws.surface_elevation(i);
+  // (Below the surface φ = 1 without the ramp's arithmetic.)
+  const Scalar phi =
+      z + zeta >= Scalar(0) ? Scalar(1) : submerged_fraction(z, zeta, p.diameter, c.inv_d);
+  ws.submerged(i) = phi;
+  const bool wet = phi > Scalar(0);
+  // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
+  NodeConstants<Scalar> band;
+  const bool in_band = wet && phi < Scalar(1);
+  const NodeConstants<Scalar>& nc = in_band ? (band = c.kinds[kind].submerged(phi)) : c.kinds[kind];
+  // −∂F_i/∂v_i (symmetric: xx, yx, zx, yy, zy, zz), filled only WithJacobian.
+  Scalar dv[6] = {Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0), Scalar(0)};
+  V3 w = V3::Zero();
+  if (wet) {
+    f(2) += nc.wet_weight;
+    // Morison drag on the relative velocity, split along q.
+    const V3 vi(c.V(0, i), c.V(1, i), c.V(2, i));
+    const V3 vr = ws.water_velocity.col(i) - vi;
+    const Scalar vc = (vr(0) * chord(0) + vr(1) * chord(1)) + vr(2) * chord(2);  // = |c| v_q
+    const Scalar sc = vc * inv_c2;
+    const V3 vn = vr - sc * chord;
+    const Scalar vn_abs = sqrt((vn(0) * vn(0) + vn(1) * vn(1)) + vn(2) * vn(2));
+    const Scalar vq = vc * inv_c;
+    const Scalar kn = nc.kn, kt = nc.kt;
+    const Scalar dn = kn * vn_abs, dt = (kt * abs(vq)) * vq;
+    for (int k = 0; k < 3; ++k) f(k) += dn * vn(k) + dt * q(k);
+    if (!c.still) {
+      // Froude–Krylov plus added-mass forcing from the water acceleration.
+      const V3 aw = ws.water_acceleration.col(i);
+      const Scalar qa = (c.cat - c.can) * ((q(0) * aw(0) + q(1) * aw(1)) + q(2) * aw(2));
+      for (int k = 0; k < 3; ++k) f(k) += nc.rho_vol * ((Scalar(1) + c.can) * aw(k) + qa * q(k));
+    }
+    ws.mass_iso(i) = nc.mass_iso_wet;
+    ws.mass_tan(i) = nc.mass_tan_wet;
+    if (c.mass_turns) {
+      // Added-mass rate terms, written with w_r = u_water − v = −v_r (vr above; both factors
+      // of each term flip sign): G_i = b[(q̇·w_r) q + s q̇] and ∂T/∂x = ±b s P w_r/|c| with
+      // s = q·w_r = vq, P w_r = vn, q̇ = P (v_hi − v_lo)/|c|.
+      // With k = b/|c| and dc = v_hi − v_lo: G_i = k[s dc + (dc·vn − s q·dc) q], w = k s vn,
+      // which goes to node hi with a plus sign and to node lo with a minus sign.
+      const Scalar k = nc.mass_tan_wet * inv_c, ks = k * vq;
+      const V3 dc(c.V(0, hi) - c.V(0, lo), c.V(1, hi) - c.V(1, lo), c.V(2, hi) - c.V(2, lo));
+      const Scalar m = k * ((dc(0) * vn(0) + dc(1) * vn(1)) + dc(2) * vn(2)) -
+                       ks * ((q(0) * dc(0) + q(1) * dc(1)) + q(2) * dc(2));
+      for (int j = 0; j < 3; ++j) f(j) += ks * dc(j) + m * q(j);
+      w = ks * vn;
+    }
+    if constexpr (WithJacobian) {
+      // −∂F/∂v of the drag (q held fixed): kn(|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |v_q| q qᵀ
+      // = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
+      const Scalar cn = vn_abs > Scalar(0) ? kn / vn_abs : Scalar(0);
+      const Scalar c31 = (Scalar(2) * kt) * abs(vq) - dn;
+      dv[0] = dn + c31 * q(0) * q(0) + cn * vn(0) * vn(0);
+      dv[1] = c31 * q(1) * q(0) + cn * vn(1) * vn(0);
+      dv[2] = c31 * q(2) * q(0) + cn * vn(2) * vn(0);
+      dv[3] = dn + c31 * q(1) * q(1) + cn * vn(1) * vn(1);
+      dv[4] = c31 * q(2) * q(1) + cn * vn(2) * vn(1);
+      dv[5] = dn + c31 * q(2) * q(2) + cn * vn(2) * vn(2);
+    }
+  } else {
+    f(2) += nc.dry_weight;
+    ws.mass_iso(i) = nc.mass_dry;
+    ws.mass_tan(i) = Scalar(0);
+  }
+  // Seabed: spring–damper normal force (never pulling) and saturated-viscous friction.
+  Scalar normal(0), kz(0);
+  const Scalar pen = z - c.bed;
+  if (pen > Scalar(0)) {
+    const Scalar vz = c.V(2, i);
+    const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
+    normal = (pen * c.bed_k + vz * c.bed_c * ramp) * li;
+    if (normal > Scalar(0)) {
+      f(2) -= normal;
+      kz = c.bed_k * li;
+      // The ramp's ∂/∂z while landing (ż > 0); left out when rising, where it is negative.
+      if (ramp < Scalar(1) && vz > Scalar(0)) kz += vz * c.bed_c * li / p.seabed_damping_depth;
+      if constexpr (WithJacobian) dv[5] += c.bed_c * ramp * li;
+      if (p.seabed_friction > Scalar(0)) {
+        const Scalar vx = c.V(0, i), vy = c.V(1, i);
+        const Scalar vh2 = vx * vx + vy * vy;
+        const Scalar vf = p.friction_velocity;
+        // The implicit steps hold the normal force of the start of the step (see
+        // TetherWorkspace::frozen_friction).
+        const Scalar fmax =
+            p.seabed_friction * (ws.frozen_friction ? ws.friction_normal(i) : normal);
+        const Scalar coef = vh2 > vf * vf ? fmax / sqrt(vh2) : fmax / vf;
+        f(0) -= coef * vx;
+        f(1) -= coef * vy;
+        if constexpr (WithJacobian) {
+          dv[0] += coef;
+          dv[3] += coef;
+        }
+      }
+    } else {
+      normal = Scalar(0);
+    }
+  }
+  ws.seabed_force(i) = normal;
+  ws.mass_iso_inv(i) = Scalar(1) / ws.mass_iso(i);
+  ws.mass_tan_ratio(i) = ws.mass_tan(i) / (ws.mass_iso(i) + ws.mass_tan(i));
+  // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
+  if (in_band) kz += c.kinds[kind].rho_vol * c.g / p.diameter;
+  if constexpr (WithJacobian) {
+    for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
+    ws.node_kz(i) = kz;
+  }
+  for (int k = 0; k < 3; ++k) {
+    ws.pass_buffer(i, kNodeForce + k) = f(k);
+    ws.pass_buffer(i, kMassRate + k) = w(k);
+  }
+}
+
+/// Bending forces into ws.bending from the segment pass (see compute_forces).
+template <typename Scalar>
+void bending_forces(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  using V3 = Vector3<Scalar>;
+  // E_i = k (1 − c), c = u_a·u_b, k = EI/l at interior node i between segment a (i−1) and b (i);
+  // F_{i−1} = −k (u_b − c u_a)/l_a, F_{i+1} = k (u_a − c u_b)/l_b, F_i = −F_{i−1} − F_{i+1}.
+  ws.bending.setZero();
+  const Scalar k = c.p->bending_stiffness * c.inv_l;
+  for (int i = 1; i < c.n; ++i) {
+    const Scalar la = ws.stretched_length(i - 1), lb = ws.stretched_length(i);
+    if (!(la > Scalar(0) && lb > Scalar(0))) continue;
+    const V3 ua = ws.direction.col(i - 1), ub = ws.direction.col(i);
+    const Scalar cs = ua.dot(ub);
+    const V3 fa = (-k / la) * (ub - cs * ua);
+    const V3 fb = (k / lb) * (ua - cs * ub);
+    ws.bending.col(i - 1) += fa;
+    ws.bending.col(i + 1) += fb;
+    ws.bending.col(i) -= fa + fb;
+  }
+}
+
+/// Points `data`/`stride` at the columns of `m` when it is column-major storage with unit inner
+/// stride; otherwise evaluates `m` into `copy` (sized by the workspace) and points at that.
+template <typename Scalar, typename D>
+void bind_columns(const Eigen::MatrixBase<D>& m, Matrix3X<Scalar>& copy, const Scalar*& data,
+                  Eigen::Index& stride) {
+  using M = typename D::PlainObject;
+  constexpr int flags = Eigen::internal::traits<D>::Flags;
+  if constexpr (bool(flags & Eigen::DirectAccessBit) && !bool(flags & Eigen::RowMajorBit) &&
+                std::is_same_v<typename M::Scalar, Scalar>) {
+    if (m.derived().innerStride() == 1) {
+      data = m.derived().data();
+      stride = m.derived().outerStride();
+      return;
+    }
+  }
+  copy = m;
+  data = copy.data();
+  stride = 3;
+}
+
+/// The passes of compute_forces on positions and velocities stored column-major with the given
+/// column strides.
+template <bool WithJacobian, typename Scalar>
+void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  constexpr bool wide = simd::vectorized<Scalar>;
+  constexpr int lanes = simd::Pack<Scalar, wide>::lanes;
+  const int n = c.n;
+  const PackedConstants<Scalar, wide> packed(c);
+  const PackedConstants<Scalar, false> single(c);
+  int s = 0;
+  if constexpr (wide)
+    for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, packed, ws, s);
+  for (; s < n; ++s) segment_block<WithJacobian, false>(c, single, ws, s);
+  if (c.bending) bending_forces(c, ws);
+  node_general<WithJacobian>(c, ws, 0);
+  int i = 1;
+  if constexpr (wide)
+    for (; i + lanes <= n; i += lanes)
+      if (!interior_block<WithJacobian, true>(c, packed, ws, i))
+        for (int j = i; j < i + lanes; ++j)
+          if (!interior_block<WithJacobian, false>(c, single, ws, j))
+            node_general<WithJacobian>(c, ws, j);
+  for (; i < n; ++i)
+    if (!interior_block<WithJacobian, false>(c, single, ws, i))
+      node_general<WithJacobian>(c, ws, i);
+  if (n > 0) node_general<WithJacobian>(c, ws, n);
+  finish_block<false>(c, ws, 0);
+  i = 1;
+  if constexpr (wide)
+    for (; i + lanes <= n; i += lanes) finish_block<true>(c, ws, i);
+  for (; i <= n; ++i) finish_block<false>(c, ws, i);
+}
+
+/// compute_forces, and when `acc` is not null the node accelerations M⁻¹F of every node into
+/// `acc` (3 × (N+1), column-major; the kinematic ends' entries are M⁻¹F too, not their
+/// prescribed accelerations).
+template <bool WithJacobian, typename Scalar, typename Env, typename DX, typename DV>
+void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v,
+                     Scalar* acc) {
+  const TetherParameters<Scalar>& p = model.parameters();
+  const int n = model.segments();
+  ForcePass<Scalar> c;
+  c.p = &p;
+  c.n = n;
+  c.rho = Scalar(env.water_density());
+  c.g = Scalar(env.gravity());
+  c.bed = Scalar(env.seabed_depth());
+  c.l = model.segment_length();
+  c.l2 = c.l * c.l;
+  c.inv_l = model.inverse_segment_length();
+  c.ea_l = model.axial_spring();
+  c.ba_l = model.axial_damper();
+  c.ea = p.axial_stiffness;
+  c.ba = p.internal_damping;
+  c.can = p.normal_added_mass;
+  c.cat = p.tangential_added_mass;
+  c.inv_d = Scalar(1) / p.diameter;
+  c.bed_k = p.seabed_stiffness * p.diameter;
+  c.bed_c = p.seabed_damping * p.diameter;
+  c.clamp = !p.compressive_damping;
+  c.damping = c.ba != Scalar(0);
+  c.bending = p.bending_stiffness > Scalar(0);
+  // Added-mass rate terms (see above); none when Cat = Can (b = 0).
+  c.mass_turns = c.cat != c.can;
+
+  // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
+  // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
+  c.still = is_still_water(env);
+  if (!c.still) {
+    if (!ws.water_frozen) {
+      ws.water_is_zero = false;
+      sample_water_at_nodes(env, x, t, ws);
+    }
+  } else if (!ws.water_is_zero) {
+    ws.water_velocity.setZero();
+    ws.water_acceleration.setZero();
+    ws.surface_elevation.setZero();
+    ws.water_is_zero = true;
+  }
+
+  // The constants of the three kinds of node (start, interior, end), once per evaluation.
+  const Scalar half_rho_d = Scalar(0.5) * c.rho * p.diameter;
+  const Scalar kn_per_l = half_rho_d * p.normal_drag;
+  const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
+  const auto node_constants = [&](int i) {
+    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
+    return NodeConstants<Scalar>{li,
+                                 m * c.g,
+                                 (m - c.rho * vol) * c.g,
+                                 c.rho * vol,
+                                 kn_per_l * li,
+                                 kt_per_l * li,
+                                 m,
+                                 m + c.rho * vol * c.can,
+                                 c.rho * vol * (c.cat - c.can)};
+  };
+  c.kinds[0] = node_constants(0);
+  c.kinds[1] = node_constants(n > 1 ? 1 : 0);
+  c.kinds[2] = node_constants(n);
+
+  // The passes read the coordinates through a pointer and a column stride: straight from
+  // column-major storage, or from a copy of any other expression.
+  bind_columns(x, ws.x_eval, c.x, c.xs);
+  bind_columns(v, ws.v_eval, c.v, c.vs);
+  c.acc = acc;
+  force_passes<WithJacobian>(c, ws);
+}
+
+}  // namespace detail
+
+/// \brief Net force on every node of the tether at positions `x`, velocities `v`, time `t`.
+///
+/// Fills `ws.force` (NED [N]) and the per-node mass matrices M_i = a_i I + b_i q_i q_iᵀ
+/// (`ws.mass_iso`, `ws.mass_tan`), plus tensions, tangents and seabed forces. Per node i:
+/// \f[ F_i = T_i u_i − T_{i−1} u_{i−1} + (m_i − ρ V_i) g e_z + F^{drag}_i + F^{FK}_i + F^{bed}_i
+/// \f]
+/// - axial: T_s = max(0, EA·max(0, ε_s) + BA ε̇_s): the elastic part acts only when l_s > l, the
+///   dashpot at any length, and the sum is clamped at zero so that a segment never pushes
+///   (`compressive_damping` drops the clamp, as MoorDyn does);
+/// - drag (Morison, on v_r = u_water − v_i): ½ρ d l_i Cdn |v_rn| v_rn + ½ρ π d l_i Cdt |v_rt| v_rt;
+/// - fluid inertia: ρ V_i [(1 + Can)(I − q qᵀ) + (1 + Cat) q qᵀ] a_water;
+/// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force from a
+///   previous acceleration), with the terms of its rate of change: the added mass is part of the
+///   kinetic energy ½ v_rᵀ M_i v_r (v_r = v_i − u_water), and since M_i = a_i I + b_i q_i q_iᵀ
+///   turns with the tangent, Lagrange's equations add G_i = −b_i[(q̇_i·v_r) q_i + (q_i·v_r) q̇_i]
+///   on node i and ±b_i (q_i·v_r)(I − q_i q_iᵀ) v_r/|c_i| on the two nodes of its chord c_i
+///   (∂T/∂x). Without them the line gains energy whenever Cat ≠ Can; with them the model is
+///   passive (Lamb 1932, Hydrodynamics §137: fluid kinetic energy in Lagrange's equations);
+/// - seabed (z_i > h): upward (z_i − h) kb d l_i + ż_i cb d l_i (≥ 0), and saturated-viscous
+///   friction −μ_f N v_h / max(|v_h|, v_f);
+/// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,
+///   which goes from 1 to 0 as the node rises through the free surface over one cable diameter
+///   (detail::submerged_fraction): nodes in air get none.
+/// Evaluated in passes over SIMD packets (kelp/core/simd.hpp): the segments, then the interior
+/// nodes of the wet line a packet at a time (the ends and nodes in the surface band, in air or
+/// on the seabed one by one, with every branch), then the added-mass coupling of neighbours and
+/// bending. Also fills `ws.mass_iso_inv` and `ws.mass_tan_ratio`. No heap allocation.
+/// \tparam WithJacobian also fill the Jacobian ingredients (`ws.seg_*`, `ws.node_dv`,
+/// `ws.node_kz`); the Jacobian leaves out the added-mass rate terms G_i (quadratic in the
+/// velocities, small beside the mass term M/h of a step).
+/// \param[in] model the tether \param[in,out] ws workspace \param[in] env environment
+/// \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v velocities [m/s]
+/// \throws kelp::invalid_argument when `ws` was not built for `model` (TetherWorkspace::fits),
+/// x or v is not 3×(N+1), or t, x or v is not finite (O(N) check; the integrators call the
+/// evaluation behind it directly, after checking the state once per step).
+template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
+void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                    double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
+  detail::check_workspace(model, ws);
+  KELP_CHECK(
+      x.rows() == 3 && x.cols() == model.nodes() && v.rows() == 3 && v.cols() == model.nodes(),
+      "compute_forces: x and v must be 3 x (segments + 1)");
+  check_finite(t, "compute_forces: t");
+  // One pass over the inputs: NaN and ±Inf survive the sum (a sum that overflows is refused
+  // too, rightly: coordinates of 1e307 m are not a tether).
+  if (!is_finite(x.sum() + v.sum())) {
+    check_all_finite(x, "compute_forces: x");
+    check_all_finite(v, "compute_forces: v");
+    ::kelp::detail::throw_invalid_argument("compute_forces: x and v overflow");
+  }
+  detail::evaluate_forces<WithJacobian>(model, ws, env, t, x, v, static_cast<Scalar*>(nullptr));
+}
+
+/// \brief Node accelerations a_i = M_i⁻¹ F_i from the last `compute_forces` (free nodes only;
+/// kinematic ends get the prescribed acceleration `a_start`, `a_end`).
+///
+/// M_i = a I + b q qᵀ is inverted in closed form: M⁻¹ F = (F − b/(a+b) q (q·F)) / a, with
+/// 1/a and b/(a+b) from compute_forces (constants along the wet part of the line).
+/// \throws kelp::invalid_argument when `ws` was not built for `model`, `acc` is not 3×(N+1) or
+/// an end acceleration is not finite.
+template <typename Scalar, typename DA>
+void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                               const Vector3<Scalar>& a_start, const Vector3<Scalar>& a_end,
+                               Eigen::MatrixBase<DA>& acc) {
+  detail::check_workspace(model, ws);
+  KELP_CHECK(acc.rows() == 3 && acc.cols() == model.nodes(),
+             "accelerations_from_forces: acc must be 3 x (segments + 1)");
+  check_all_finite(a_start, "accelerations_from_forces: a_start");
+  check_all_finite(a_end, "accelerations_from_forces: a_end");
+  const int n = model.segments();
+  for (int i = model.first_free_node(); i <= model.last_free_node(); ++i) {
+    const auto q = ws.tangent.col(i);
+    const auto f = ws.force.col(i);
+    acc.col(i) = (f - (ws.mass_tan_ratio(i) * q.dot(f)) * q) * ws.mass_iso_inv(i);
+  }
+  if (model.first_free_node() == 1) acc.col(0) = a_start;
+  if (model.last_free_node() == n - 1) acc.col(n) = a_end;
+}
+
+/// \brief Forces the tether exerts on its kinematic attachment points from the last
+/// `compute_forces`: F_end = F_node − M_node a_end (the negative of the constraint force that
+/// holds the end node on its prescribed path), NED [N]. Zero for a free end.
+/// \throws kelp::invalid_argument when `ws` was not built for `model` or `boundary` is not finite.
+template <typename Scalar>
+EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
+                                            const TetherWorkspace<Scalar>& ws,
+                                            const TetherBoundary<Scalar>& boundary) {
+  detail::check_workspace(model, ws);
+  check_boundary(boundary);
+  EndForces<Scalar> out;
+  const int n = model.segments();
+  const auto inertia = [&](int i, const Vector3<Scalar>& a) -> Vector3<Scalar> {
+    const Vector3<Scalar> q = ws.tangent.col(i);
+    return ws.mass_iso(i) * a + ws.mass_tan(i) * q.dot(a) * q;
+  };
+  if (model.parameters().start_mode == EndMode::kinematic)
+    out.on_start = ws.force.col(0) - inertia(0, boundary.start.acceleration);
+  if (model.parameters().end_mode == EndMode::kinematic)
+    out.on_end = ws.force.col(n) - inertia(n, boundary.end.acceleration);
+  return out;
+}
+
+/// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
+/// the weight −Σ mᵢ g zᵢ (NED z down) and of the buoyancy Σ ρVᵢ g Φ(zᵢ + ζ) (Φ the depth of a
+/// wet node plus D/2, see detail::submerged_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
+/// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
+/// tangents and wetness itself.
+/// \throws kelp::invalid_argument when the state does not fit the model or is not finite.
+template <typename Scalar, typename Env>
+Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
+                     const TetherState<Scalar>& state) {
+  using std::sqrt;
+  check_state(model, state);
+  const TetherParameters<Scalar>& p = model.parameters();
+  const int n = model.segments();
+  const Scalar rho = Scalar(env.water_density()), g = Scalar(env.gravity());
+  const Scalar l = model.segment_length();
+  Scalar e(0);
+  for (int s = 0; s < n; ++s) {
+    const Scalar ls = (state.position.col(s + 1) - state.position.col(s)).norm();
+    if (ls > l) e += Scalar(0.5) * model.axial_spring() * (ls - l) * (ls - l);
+  }
+  if (p.bending_stiffness > Scalar(0))
+    for (int i = 1; i < n; ++i) {
+      const Vector3<Scalar> a = state.position.col(i) - state.position.col(i - 1);
+      const Vector3<Scalar> b = state.position.col(i + 1) - state.position.col(i);
+      const Scalar na = a.norm(), nb = b.norm();
+      if (na > Scalar(0) && nb > Scalar(0))
+        e += p.bending_stiffness / l * (Scalar(1) - a.dot(b) / (na * nb));
+    }
+  for (int i = 0; i <= n; ++i) {
+    const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n).q;
+    const Scalar zeta =
+        Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
+    const Scalar z = state.position(2, i);
+    const Scalar phi = detail::submerged_fraction(z, zeta, p.diameter);
+    const Scalar m = model.node_mass(i), rv = phi * rho * model.node_volume(i);
+    const Vector3<Scalar> vi = state.velocity.col(i);
+    const Scalar vq = vi.dot(q);
+    e += Scalar(0.5) * ((m + rv * p.normal_added_mass) * vi.squaredNorm() +
+                        rv * (p.tangential_added_mass - p.normal_added_mass) * vq * vq);
+    e -= m * g * z -
+         rho * model.node_volume(i) * g * detail::submerged_depth_integral(z, zeta, p.diameter);
+  }
+  return e;
+}
+
+}  // namespace kelp::tether

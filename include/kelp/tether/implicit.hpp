@@ -1,0 +1,337 @@
+/// \file
+/// \brief The implicit tether steps: backward Euler and BDF2, solved by Newton's method with the
+/// analytic block-tridiagonal Jacobian (kelp/tether/block_solve.hpp), with backtracking and
+/// step halving; a step that cannot be completed throws and leaves the state as it was. End
+/// forces are those at the end of the step.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/simd.hpp"
+#include "kelp/core/types.hpp"
+
+#include "kelp/tether/block_solve.hpp"
+#include "kelp/tether/forces.hpp"
+#include "kelp/tether/model.hpp"
+#include "kelp/tether/state.hpp"
+#include "kelp/tether/stepping.hpp"
+
+namespace kelp::tether {
+
+namespace detail {
+
+/// Seabed normal force of every node of `state` into ws.friction_normal (as compute_forces).
+template <typename Scalar>
+void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                             Scalar bed, const TetherState<Scalar>& state) {
+  const TetherParameters<Scalar>& p = model.parameters();
+  const Scalar k = p.seabed_stiffness * p.diameter, c = p.seabed_damping * p.diameter;
+  for (int i = 0; i < model.nodes(); ++i) {
+    const Scalar pen = state.position(2, i) - bed;
+    const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
+    const Scalar normal = (pen * k + state.velocity(2, i) * c * ramp) * model.node_length(i);
+    ws.friction_normal(i) = pen > Scalar(0) && normal > Scalar(0) ? normal : Scalar(0);
+  }
+}
+
+/// One attempt at an implicit step of length dt (see step_implicit): commits the new state and
+/// returns true when Newton's method converged (or options.check_convergence is false); returns
+/// false with the state untouched otherwise. Adds its work to `report`. Inputs already checked.
+template <typename Scalar, typename Env>
+bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                      TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
+                      bool bdf2, const ImplicitOptions<Scalar>& options,
+                      StepReport<Scalar>& report) {
+  using std::abs;
+  const double t1 = state.time + dt;
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  // The history (BDF2, velocity predictor) is used only if it is this state's previous step.
+  const bool history = history_matches(state, dt);
+  const bool use_bdf2 = bdf2 && history;
+  const Scalar gamma = use_bdf2 ? Scalar(2) / Scalar(3) : Scalar(1);
+  const Scalar gh = gamma * Scalar(dt);
+  const Scalar tolerance = options.acceleration_tolerance * Scalar(dt);
+  // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
+  // One vectorised pass over the flat 3 × (N+1) arrays for the history, the predictor and its
+  // positions. Predictor: linear extrapolation of the velocity when the last step had the same
+  // dt.
+  const int cols = model.nodes();
+  {
+    const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
+    const Scalar *xn = state.position.data(), *vn = state.velocity.data();
+    const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
+    Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
+    const auto predict = [&](auto lanes, Eigen::Index j) {
+      using P = decltype(lanes);
+      const P xnj = P::load(xn + j), vnj = P::load(vn + j);
+      if (use_bdf2) {
+        const P vpj = P::load(vp + j);
+        const P xh = P::all(four_thirds) * xnj - P::all(third) * P::load(xp + j);
+        const P vg = P::all(Scalar(2)) * vnj - vpj;
+        xh.store(x0 + j);
+        (P::all(four_thirds) * vnj - P::all(third) * vpj).store(v0 + j);
+        vg.store(v1 + j);
+        (xh + P::all(gh) * vg).store(x1 + j);
+      } else {
+        const P vg = history ? P::all(Scalar(2)) * vnj - P::load(vp + j) : vnj;
+        xnj.store(x0 + j);
+        vnj.store(v0 + j);
+        vg.store(v1 + j);
+        (xnj + P::all(gh) * vg).store(x1 + j);
+      }
+    };
+    simd::for_each_pack<Scalar>(0, 3 * Eigen::Index(cols), predict);
+  }
+  apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
+  // Seabed friction limit from the normal force at the start of the step, for the whole Newton
+  // iteration (TetherWorkspace::frozen_friction); reset on every exit.
+  struct FrictionGuard {
+    TetherWorkspace<Scalar>& w;
+    ~FrictionGuard() { w.frozen_friction = false; }
+  } friction_guard{ws};
+  if (model.parameters().seabed_friction > Scalar(0)) {
+    freeze_friction_normals(model, ws, Scalar(env.seabed_depth()), state);
+    ws.frozen_friction = true;
+  }
+  bool converged = false;
+  Scalar res(0);
+  // Evaluates F at (x, v), writes rhs = −R = γh F − M (v − v̂) on the free nodes and sets `res`
+  // to the scaled max-norm max_i |R_i|/a_i.
+  const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& r_max,
+                            bool with_jacobian) {
+    if (with_jacobian)
+      compute_forces<true>(model, ws, env, t1, x, v);
+    else
+      compute_forces<false>(model, ws, env, t1, x, v);
+    ++report.force_evaluations;
+    // One vectorised pass over the free nodes: rhs = −R, its scaled max-norm and (for the
+    // finiteness test below) its sum.
+    const auto residual = [&](auto lanes, int i, auto& r_lanes, auto& sum_lanes) {
+      using P = decltype(lanes);
+      const Scalar *vi = v.data() + 3 * i, *v0 = ws.v0.data() + 3 * i;
+      const Scalar *qi = ws.tangent.data() + 3 * i, *fi = ws.force.data() + 3 * i;
+      const P d0 = P::gather(vi, 3) - P::gather(v0, 3);
+      const P d1 = P::gather(vi + 1, 3) - P::gather(v0 + 1, 3);
+      const P d2 = P::gather(vi + 2, 3) - P::gather(v0 + 2, 3);
+      const P q0 = P::gather(qi, 3), q1 = P::gather(qi + 1, 3), q2 = P::gather(qi + 2, 3);
+      const P a = P::load(&ws.mass_iso(i));
+      const P bqd = P::load(&ws.mass_tan(i)) * ((q0 * d0 + q1 * d1) + q2 * d2);
+      const P g = P::all(gh);
+      const P r0 = g * P::gather(fi, 3) - (a * d0 + bqd * q0);
+      const P r1 = g * P::gather(fi + 1, 3) - (a * d1 + bqd * q1);
+      const P r2 = g * P::gather(fi + 2, 3) - (a * d2 + bqd * q2);
+      Scalar* out = ws.rhs.data() + 3 * i;
+      r0.scatter(out, 3);
+      r1.scatter(out + 1, 3);
+      r2.scatter(out + 2, 3);
+      r_lanes = max(r_lanes, max(max(abs(r0), abs(r1)), abs(r2)) * P::load(&ws.mass_iso_inv(i)));
+      sum_lanes += (r0 + r1) + r2;
+    };
+    using Wide = simd::Pack<Scalar, true>;
+    using One = simd::Pack<Scalar, false>;
+    Wide r_wide = Wide::all(Scalar(0)), sum_wide = Wide::all(Scalar(0));
+    One r_one = One::all(Scalar(0)), sum_one = One::all(Scalar(0));
+    int i = f0;
+    for (; i + Wide::lanes <= f1 + 1; i += Wide::lanes) residual(Wide(), i, r_wide, sum_wide);
+    for (; i <= f1; ++i) residual(One(), i, r_one, sum_one);
+    r_max = std::max(r_wide.max_lane(), r_one.max_lane());
+    const Scalar sum = sum_wide.sum() + sum_one.sum();
+    // NaN fails every comparison and std::max keeps its first argument: test the sum instead.
+    if (!is_finite(sum))
+      ::kelp::detail::throw_numerical_error(
+          "step_implicit: non-finite residual; the state is unchanged");
+  };
+  // Water and free surface: sampled by the first evaluation (at the predictor), then held.
+  struct WaterGuard {
+    TetherWorkspace<Scalar>& w;
+    ~WaterGuard() { w.water_frozen = false; }
+  } water_guard{ws};
+  ws.water_frozen = false;
+  evaluate(ws.x1, ws.v1, res, true);
+  ws.water_frozen = !options.resample_water;
+  // The trial iterates take the kinematic end nodes from here (the free ones are overwritten).
+  for (int i = 0; i < cols; ++i) {
+    if (i >= f0 && i <= f1) {
+      i = f1;
+      continue;
+    }
+    ws.xs.col(i) = ws.x1.col(i);
+    ws.vs.col(i) = ws.v1.col(i);
+  }
+  for (int it = 0;; ++it) {
+    // At least one correction: the predictor alone never makes a step.
+    if (it >= 1 && res <= tolerance) {
+      converged = true;
+      break;
+    }
+    if (it >= options.max_iterations) break;
+    active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+    ++report.newton_iterations;
+    if (!options.check_convergence && it + 1 >= options.max_iterations) {
+      // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
+      // end segments: ΔF = (γh K_s + C_s) δv of the neighbouring free node.
+      for (int i = f0; i <= f1; ++i) {
+        ws.v1.col(i) += ws.delta.col(i);
+        ws.x1.col(i) = ws.x0.col(i) + gh * ws.v1.col(i);
+      }
+      ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+      const int n = model.segments();
+      if (f0 == 1 && n >= 2)
+        ws.end_forces.on_start += segment_block(ws, 0, Scalar(1), gh) * ws.delta.col(1);
+      if (f1 == n - 1 && n >= 2)
+        ws.end_forces.on_end += segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
+      commit(state, ws.x1, ws.v1, dt, "step_implicit");
+      ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
+      ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
+      report.residual = std::max(report.residual, res);
+      ++report.substeps;
+      return true;
+    }
+    // Line search. R is the gradient of the step's incremental potential
+    // Φ(v) = ½(v − v̂)ᵀM(v − v̂) + U(x̂ + γh v) + γh·(dissipation potential), which is convex for
+    // this model up to the tangent dependence of drag and added mass (elastic energy
+    // ½EA/l·max(0, l_s − l)² is convex in x). Along x(α) = x + αδ the slope φ'(α) = R(α)·δ is
+    // therefore increasing, with φ'(0) = −δᵀJδ < 0. The full Newton step is kept unless it
+    // overshoots the minimum along δ (φ'(1) > ½|φ'(0)|, e.g. across the kink of the tension at
+    // l_s = l, where plain Newton can cycle between the slack and the taut branch); then secant
+    // steps on φ' home in on the minimum. Each trial costs one force evaluation.
+    const Eigen::Index nf = f1 - f0 + 1;
+    const auto slope = [&]() {
+      return Scalar(-ws.rhs.middleCols(f0, nf).cwiseProduct(ws.delta.middleCols(f0, nf)).sum());
+    };
+    const Scalar g0 = slope();
+    const Scalar a_lo(0), g_lo = g0;
+    Scalar alpha(1), trial_res(0);
+    for (int ls = 0;; ++ls) {
+      ws.vs.middleCols(f0, nf).noalias() =
+          ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
+      ws.xs.middleCols(f0, nf).noalias() = ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
+      // The trial carries its Jacobian terms: when another Newton iteration follows (half the
+      // steps of a line near the surface) they are needed at this point, and filling them costs
+      // less than a second evaluation there (−6 % instructions per system step).
+      evaluate(ws.xs, ws.vs, trial_res, true);
+      if (ls >= options.max_backtracks || !(g0 < Scalar(0))) break;
+      const Scalar g = slope();
+      if (g <= Scalar(-0.5) * g0) break;
+      // Secant on φ' between (a_lo, g_lo < 0) and (alpha, g > 0).
+      const Scalar a_new = a_lo + (alpha - a_lo) * (-g_lo) / (g - g_lo);
+      if (!(a_new > a_lo && a_new < alpha)) break;
+      alpha = a_new;
+    }
+    ws.x1.swap(ws.xs);
+    ws.v1.swap(ws.vs);
+    res = trial_res;
+  }
+  if (!converged) {
+    report.rejected_residual = std::max(report.rejected_residual, res);
+    return false;
+  }
+  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  // commit() turns the pre-step state into the history.
+  commit(state, ws.x1, ws.v1, dt, "step_implicit");
+  ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
+  ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
+  report.residual = std::max(report.residual, res);
+  ++report.substeps;
+  return true;
+}
+
+/// implicit_attempt, with a non-finite iterate (numerical_error) counted as not converged: a
+/// shorter step may well succeed. Nothing is committed when it returns false.
+template <typename Scalar, typename Env>
+bool try_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                  TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
+                  bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report) {
+  try {
+    return implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report);
+  } catch (const kelp::numerical_error&) {
+    report.rejected_residual = std::numeric_limits<Scalar>::infinity();
+    return false;
+  }
+}
+
+/// Step of length dt split into two halves, each retried in halves again up to `depth_left`
+/// more times; the boundary motion is the step's, taken τ into it. True when all were committed.
+template <typename Scalar, typename Env>
+bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                     TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double tau,
+                     double dt, bool bdf2, const ImplicitOptions<Scalar>& options, int depth_left,
+                     StepReport<Scalar>& report) {
+  const double half = 0.5 * dt;
+  for (int k = 0; k < 2; ++k) {
+    const double t_k = tau + k * half;
+    const TetherBoundary<Scalar> b = boundary.after(Scalar(t_k));
+    if (try_implicit(model, ws, env, state, b, half, bdf2, options, report)) continue;
+    if (depth_left <= 0) return false;
+    ++report.retries;
+    if (!implicit_halves(model, ws, env, state, boundary, t_k, half, bdf2, options, depth_left - 1,
+                         report))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace detail
+
+/// \brief One implicit step (backward Euler, or BDF2 when `bdf2` is true and the state's previous
+/// step had the same dt) solved by Newton's method.
+///
+/// With x = x̂ + γh v (backward Euler: γ = 1, x̂ = x_n, v̂ = v_n; BDF2: γ = 2/3,
+/// x̂ = (4x_n − x_{n−1})/3, v̂ = (4v_n − v_{n−1})/3) the unknown node velocities solve
+/// R(v) = M (v − v̂) − γh F(x̂ + γh v, v) = 0. The Jacobian J = M + γh D_v + (γh)² D_x
+/// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
+/// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
+/// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
+/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
+/// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
+/// direction settles which segments are taut, slack or clamped with a primal–dual active set
+/// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
+/// when it overshoots. The initial guess extrapolates the velocity (2v_n − v_{n−1}) when the
+/// previous step had the same dt. At least one and up to `options.max_iterations` corrections,
+/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt. A step that does not converge is not
+/// committed: it is retried as two half steps, each halved again if needed, at most
+/// `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of step);
+/// if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
+/// (`ws.end_forces`) are those of the final iterate, at t + dt.
+/// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
+/// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
+/// the result is not finite or Newton's method does not converge.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                                 const Env& env, TetherState<Scalar>& state,
+                                 const TetherBoundary<Scalar>& boundary, double dt,
+                                 bool bdf2 = false, const ImplicitOptions<Scalar>& options = {}) {
+  detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::check_implicit_options(options);
+  detail::check_resolvable(model, state, options);
+  ws.end_impulse = EndForces<Scalar>{};
+  StepReport<Scalar> report;
+  if (detail::try_implicit(model, ws, env, state, boundary, dt, bdf2, options, report))
+    return report;
+  // Not converged, nothing committed: retry in halves from a backup.
+  ws.retry_backup.save(state);
+  bool done = false;
+  if (options.max_step_halvings > 0) {
+    ++report.retries;
+    done = detail::implicit_halves(model, ws, env, state, boundary, 0.0, dt, bdf2, options,
+                                   options.max_step_halvings - 1, report);
+  }
+  if (!done) {
+    ws.retry_backup.restore(state);
+    ::kelp::detail::throw_numerical_error(
+        "step_implicit: Newton's method did not converge at dt = " + detail::format_g(dt) +
+        " s, nor in sub-steps down to dt/2^" + std::to_string(options.max_step_halvings) +
+        " (worst residual " + detail::format_g(double(value_of(report.rejected_residual))) +
+        " m/s); the state is unchanged");
+  }
+  return report;
+}
+
+}  // namespace kelp::tether

@@ -1,0 +1,239 @@
+/// \file
+/// \brief Lumped-mass tether: the parameters (`TetherParameters`, their bounds and `validate`)
+/// and the model built from them (`TetherModel`: segment length, node masses, volumes and
+/// lengths, which ends are free). See kelp/tether/lumped_mass.hpp for the formulation.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "kelp/core/constants.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+
+namespace kelp::tether {
+
+/// \brief How a tether end moves.
+enum class EndMode {
+  /// Position and velocity prescribed each step (a fixed anchor or a point on a vehicle); the
+  /// tether reports the force it exerts on that point.
+  kinematic,
+  /// The end node moves freely under the tether forces (optionally carrying a point mass).
+  free
+};
+
+/// \brief Upper bounds of TetherParameters (validate() refuses values above them). Far above any
+/// real tether (a 1 km, 150 mm steel mooring chain has 450 kg/m and EA 2e9 N), they keep every
+/// force computed from the parameters finite.
+namespace limits {
+inline constexpr int max_segments = 100000;            ///< segments
+inline constexpr double max_length = 1e5;              ///< length, seabed_damping_depth [m]
+inline constexpr double min_segment_length = 1e-6;     ///< length / segments [m]
+inline constexpr double max_diameter = 10.0;           ///< diameter [m]
+inline constexpr double max_mass_per_length = 1e5;     ///< mass_per_length [kg/m]
+inline constexpr double max_axial_stiffness = 1e13;    ///< EA [N], internal damping BA [N s]
+inline constexpr double max_bending_stiffness = 1e12;  ///< EI [N m²]
+inline constexpr double max_coefficient = 100.0;       ///< drag, added-mass, friction coefficients
+inline constexpr double max_seabed_constant = 1e13;  ///< seabed stiffness [Pa/m], damping [Pa s/m]
+inline constexpr double max_speed = 1e3;             ///< friction_velocity [m/s]
+inline constexpr double max_point_mass = 1e9;        ///< end point masses [kg]
+}  // namespace limits
+
+/// \brief User-facing physical description of a lumped-mass tether (all magnitudes positive).
+///
+/// Defaults are a small ROV tether used as kelp's benchmark line (20 m, d 8 mm, 0.07 kg/m,
+/// EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1) with 100 segments and MoorDyn's seabed constants
+/// (MoorDyn v2 documentation: kBot 3e6 Pa/m, cBot 3e5 Pa s/m).
+/// \tparam Scalar double or float.
+template <typename Scalar>
+struct TetherParameters {
+  /// Number of segments N (≥ 1); the line has N + 1 nodes.
+  int segments = 100;
+  /// Unstretched length L [m].
+  Scalar length = Scalar(20);
+  /// Hydrodynamic (and volume-equivalent) diameter d [m].
+  Scalar diameter = Scalar(0.008);
+  /// Mass per unit unstretched length in air μ [kg/m].
+  Scalar mass_per_length = Scalar(0.07);
+  /// Axial stiffness EA [N].
+  Scalar axial_stiffness = Scalar(1e5);
+  /// Internal (axial) damping BA [N s]: the damping tension is BA · ε̇ (ε the strain). The total
+  /// axial force EA·max(0, ε) + BA·ε̇ is clamped at zero, so a contracting segment never pushes
+  /// (unless `compressive_damping`).
+  Scalar internal_damping = Scalar(0);
+  /// When true, the internal dashpot acts in compression too, as in MoorDyn v2 (Line.cpp: the
+  /// damping tension is added whether or not the segment is stretched, and the sum is not
+  /// clamped): use it to reproduce MoorDyn. Default false: a cable cannot push, so the total
+  /// axial force is max(0, EA·max(0, ε) + BA·ε̇).
+  bool compressive_damping = false;
+  /// Bending stiffness EI [N m²] (0: a perfectly flexible line). Discrete bending energy
+  /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
+  /// κ = θ/l. Enters the implicit schemes through the residual only (not the Jacobian: it would
+  /// couple nodes i−1 and i+1), so keep EI/l³ ≪ node mass / dt² there; the explicit stable-dt
+  /// estimate accounts for it.
+  Scalar bending_stiffness = Scalar(0);
+  /// Normal drag coefficient Cdn [-] (on the projected area d·l).
+  Scalar normal_drag = Scalar(1.2);
+  /// Tangential drag coefficient Cdt [-] (on the wetted surface π·d·l, as MoorDyn does).
+  Scalar tangential_drag = Scalar(0.008);
+  /// Normal added-mass coefficient Can [-].
+  Scalar normal_added_mass = Scalar(1);
+  /// Tangential added-mass coefficient Cat [-].
+  Scalar tangential_added_mass = Scalar(0);
+  /// Seabed stiffness kb [Pa/m] = [N/m³]: contact force per node (z − h)·kb·d·l_i
+  /// (MoorDyn's default 3e6).
+  Scalar seabed_stiffness = Scalar(3e6);
+  /// Seabed damping cb [Pa s/m]: contact damping ż·cb·d·l_i while in contact (MoorDyn's 3e5).
+  Scalar seabed_damping = Scalar(3e5);
+  /// Penetration [m] over which the seabed damping ramps up from zero at first touch to its full
+  /// value, so that the normal contact force is continuous (MoorDyn switches the damping on at
+  /// once, a force step of cb·d·l_i·ż at touchdown that leaves Newton's method nothing to
+  /// converge to when a node lands in a step; 0 reproduces it).
+  Scalar seabed_damping_depth = Scalar(1e-3);
+  /// Seabed Coulomb friction coefficient μ_f [-] (0 disables friction).
+  Scalar seabed_friction = Scalar(0);
+  /// Horizontal speed [m/s] below which seabed friction is viscous (saturated-viscous model).
+  Scalar friction_velocity = Scalar(0.01);
+  /// Motion of the start end (node 0).
+  EndMode start_mode = EndMode::kinematic;
+  /// Motion of the far end (node N).
+  EndMode end_mode = EndMode::kinematic;
+  /// Extra point mass lumped at node 0 [kg], used only when the start end is free (a kinematic
+  /// end's mass belongs to the body that moves it, so it is not reported as tether load).
+  Scalar start_point_mass = Scalar(0);
+  /// Extra point mass lumped at node N [kg], used only when the far end is free (see
+  /// start_point_mass).
+  Scalar end_point_mass = Scalar(0);
+};
+
+/// \brief Checks tether parameters.
+/// \throws kelp::invalid_argument naming the offending field: segments in [1, 100000]; length,
+/// diameter, mass_per_length, axial_stiffness, friction_velocity finite and > 0; the rest finite
+/// and ≥ 0; every magnitude at most its bound in kelp::tether::limits; segments at least 1 µm
+/// long; end modes EndMode values.
+template <typename Scalar>
+void validate(const TetherParameters<Scalar>& p) {
+  // Each magnitude finite and of the right sign, then below a generous physical bound (far above
+  // any cable, chain or umbilical, so that the forces computed from them cannot overflow).
+  const auto bounded = [](const Scalar& x, double bound, const char* name, bool zero_ok) {
+    if (zero_ok)
+      check_non_negative(x, name);
+    else
+      check_positive(x, name);
+    check_at_most(x, bound, name);
+  };
+  KELP_CHECK(p.segments >= 1 && p.segments <= limits::max_segments,
+             "segments must be in [1, " + std::to_string(limits::max_segments) + "]");
+  bounded(p.length, limits::max_length, "length", false);
+  bounded(p.diameter, limits::max_diameter, "diameter", false);
+  bounded(p.mass_per_length, limits::max_mass_per_length, "mass_per_length", false);
+  bounded(p.axial_stiffness, limits::max_axial_stiffness, "axial_stiffness", false);
+  bounded(p.internal_damping, limits::max_axial_stiffness, "internal_damping", true);
+  bounded(p.bending_stiffness, limits::max_bending_stiffness, "bending_stiffness", true);
+  bounded(p.normal_drag, limits::max_coefficient, "normal_drag", true);
+  bounded(p.tangential_drag, limits::max_coefficient, "tangential_drag", true);
+  bounded(p.normal_added_mass, limits::max_coefficient, "normal_added_mass", true);
+  bounded(p.tangential_added_mass, limits::max_coefficient, "tangential_added_mass", true);
+  bounded(p.seabed_stiffness, limits::max_seabed_constant, "seabed_stiffness", true);
+  bounded(p.seabed_damping, limits::max_seabed_constant, "seabed_damping", true);
+  bounded(p.seabed_damping_depth, limits::max_length, "seabed_damping_depth", true);
+  bounded(p.seabed_friction, limits::max_coefficient, "seabed_friction", true);
+  bounded(p.friction_velocity, limits::max_speed, "friction_velocity", false);
+  bounded(p.start_point_mass, limits::max_point_mass, "start_point_mass", true);
+  bounded(p.end_point_mass, limits::max_point_mass, "end_point_mass", true);
+  // Segments shorter than this make EA/l and the stable explicit step absurd.
+  check_at_least(p.length / Scalar(p.segments), limits::min_segment_length,
+                 "length / segments (the segment length)");
+  KELP_CHECK(p.start_mode == EndMode::kinematic || p.start_mode == EndMode::free,
+             "start_mode must be EndMode::kinematic or EndMode::free");
+  KELP_CHECK(p.end_mode == EndMode::kinematic || p.end_mode == EndMode::free,
+             "end_mode must be EndMode::kinematic or EndMode::free");
+}
+
+/// \brief Validated tether parameters with the per-step constants precomputed.
+///
+/// Build once from `TetherParameters`; constant afterwards.
+/// \tparam Scalar double or float.
+template <typename Scalar>
+class TetherModel {
+ public:
+  /// \brief Validates `p` (see validate(const TetherParameters&)) and precomputes constants.
+  /// \throws kelp::invalid_argument naming the offending field.
+  explicit TetherModel(const TetherParameters<Scalar>& p) : p_(p) {
+    validate(p);
+    const int n = p.segments;
+    const Scalar N = Scalar(n);
+    l_ = p.length / N;
+    inv_l_ = Scalar(1) / l_;
+    ea_over_l_ = p.axial_stiffness / l_;
+    ba_over_l_ = p.internal_damping / l_;
+    area_ = Scalar(kelp::pi) * p.diameter * p.diameter / Scalar(4);
+    node_mass_.resize(n + 1);
+    node_volume_.resize(n + 1);
+    node_length_.resize(n + 1);
+    for (int i = 0; i <= n; ++i) {
+      const Scalar li = (i == 0 || i == n) ? l_ / Scalar(2) : l_;
+      node_length_(i) = li;
+      node_mass_(i) = p.mass_per_length * li;
+      node_volume_(i) = area_ * li;
+    }
+    if (p.start_mode == EndMode::free) node_mass_(0) += p.start_point_mass;
+    if (p.end_mode == EndMode::free) node_mass_(n) += p.end_point_mass;
+    min_node_mass_ = node_mass_.minCoeff();
+    first_free_ = p.start_mode == EndMode::kinematic ? 1 : 0;
+    last_free_ = p.end_mode == EndMode::kinematic ? n - 1 : n;
+  }
+
+  /// \brief The parameters the model was built from.
+  const TetherParameters<Scalar>& parameters() const { return p_; }
+  /// \brief Number of segments N.
+  int segments() const { return p_.segments; }
+  /// \brief Number of nodes N + 1.
+  int nodes() const { return p_.segments + 1; }
+  /// \brief Unstretched segment length l = L/N [m].
+  Scalar segment_length() const { return l_; }
+  /// \brief 1/l [1/m].
+  Scalar inverse_segment_length() const { return inv_l_; }
+  /// \brief EA/l [N/m]: the axial spring constant of one segment.
+  Scalar axial_spring() const { return ea_over_l_; }
+  /// \brief BA/l [N s/m]: the axial damper constant of one segment.
+  Scalar axial_damper() const { return ba_over_l_; }
+  /// \brief Cross-section area A = π d²/4 [m²].
+  Scalar area() const { return area_; }
+  /// \brief Structural mass of node i [kg] (μ times its share of length, plus the point mass of a
+  /// free end).
+  Scalar node_mass(int i) const { return node_mass_(i); }
+  /// \brief Smallest structural node mass [kg]: a lower bound on every eigenvalue of every node
+  /// mass matrix (added mass only adds to it).
+  Scalar min_node_mass() const { return min_node_mass_; }
+  /// \brief Displaced volume of node i [m³] (A times its share of length).
+  Scalar node_volume(int i) const { return node_volume_(i); }
+  /// \brief Length of line lumped at node i [m] (l, or l/2 at the ends).
+  Scalar node_length(int i) const { return node_length_(i); }
+  /// \brief Index of the first node integrated (0 if the start end is free, else 1).
+  int first_free_node() const { return first_free_; }
+  /// \brief Index of the last node integrated (N if the far end is free, else N − 1).
+  int last_free_node() const { return last_free_; }
+  /// \brief Submerged weight per unit length w = (μ − ρA) g [N/m] (negative: buoyant line).
+  Scalar submerged_weight_per_length(Scalar water_density, Scalar gravity) const {
+    return (p_.mass_per_length - water_density * area_) * gravity;
+  }
+
+ private:
+  TetherParameters<Scalar> p_;
+  Scalar l_, inv_l_, ea_over_l_, ba_over_l_, area_, min_node_mass_;
+  VectorX<Scalar> node_mass_, node_volume_, node_length_;
+  int first_free_ = 1, last_free_ = 0;
+};
+
+/// \brief Double-precision aliases.
+using TetherParametersd = TetherParameters<double>;
+using TetherModeld = TetherModel<double>;
+/// \brief Single-precision aliases.
+using TetherParametersf = TetherParameters<float>;
+using TetherModelf = TetherModel<float>;
+
+}  // namespace kelp::tether

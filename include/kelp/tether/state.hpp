@@ -1,0 +1,361 @@
+/// \file
+/// \brief Lumped-mass tether: the state (positions, velocities, clock, integrator history), the
+/// prescribed end motion (`TetherBoundary`), the end forces, and the preallocated workspace
+/// (scratch and outputs of the force evaluation and the integrators), with their checks.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/model.hpp"
+
+namespace kelp::tether {
+
+/// \brief Everything that determines the tether's next step: positions and velocities of all
+/// N + 1 nodes (NED), the clock, and the integrator history (BDF2's previous step, also the
+/// implicit schemes' velocity predictor).
+///
+/// Saving a copy of a state and restoring it later reproduces the following steps bit for bit;
+/// the workspace holds scratch only. The clock is a double for every Scalar, so a float tether
+/// keeps exact time over any run length (10 ms steps for 24 h end within 1e-10 s relative).
+/// \tparam Scalar double or float.
+template <typename Scalar>
+struct TetherState {
+  /// Node positions, 3 × (N+1), NED [m].
+  Matrix3X<Scalar> position;
+  /// Node velocities, 3 × (N+1), NED [m/s].
+  Matrix3X<Scalar> velocity;
+  /// Simulation time [s] (double for every Scalar: one clock that does not drift).
+  double time = 0.0;
+  /// Rounding error of `time` carried by the compensated (Kahan) sum of the step lengths, so that
+  /// after n steps of dt the clock is n·dt to one rounding however long the run (a plain sum
+  /// drifts by up to n/2 units in the last place: microseconds after hours of 10 ms steps, and
+  /// the wave phase with it). Reset it to 0 when setting `time` by hand.
+  double time_carry = 0.0;
+  /// Positions one step before `position` (integrator history; valid when previous_dt > 0).
+  Matrix3X<Scalar> previous_position;
+  /// Velocities one step before `velocity` (integrator history; valid when previous_dt > 0).
+  Matrix3X<Scalar> previous_velocity;
+  /// Length of the step that led from the previous positions to `position` [s]; 0 when there
+  /// is no history (a new state, or one whose positions were set by hand: call clear_history()).
+  double previous_dt = 0.0;
+
+  TetherState() = default;
+  /// \brief Zero state sized for `model`, no history.
+  explicit TetherState(const TetherModel<Scalar>& model)
+      : position(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        previous_position(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {}
+
+  /// \brief True when the state carries the previous step (BDF2 history).
+  bool has_history() const { return previous_dt > 0.0; }
+  /// \brief Forgets the integrator history: the next implicit step starts with backward Euler.
+  /// Call it after editing `position` or `velocity` by hand.
+  void clear_history() { previous_dt = 0.0; }
+};
+
+/// \brief Motion of a kinematic end point over a step, NED.
+///
+/// Within a step of length h starting at t₀ the end is taken at p + v τ + ½ a τ², with velocity
+/// v + a τ (τ = t − t₀).
+template <typename Scalar>
+struct EndMotion {
+  /// Position at the start of the step, NED [m].
+  Vector3<Scalar> position = Vector3<Scalar>::Zero();
+  /// Velocity, NED [m/s].
+  Vector3<Scalar> velocity = Vector3<Scalar>::Zero();
+  /// Acceleration, NED [m/s²] (also enters the end force through the end node's inertia).
+  Vector3<Scalar> acceleration = Vector3<Scalar>::Zero();
+
+  /// \brief Position τ seconds into the step.
+  Vector3<Scalar> position_at(Scalar tau) const {
+    return position + tau * velocity + (Scalar(0.5) * tau * tau) * acceleration;
+  }
+  /// \brief Velocity τ seconds into the step.
+  Vector3<Scalar> velocity_at(Scalar tau) const { return velocity + tau * acceleration; }
+  /// \brief The same motion seen from τ seconds into the step (position and velocity at τ).
+  EndMotion after(Scalar tau) const { return {position_at(tau), velocity_at(tau), acceleration}; }
+};
+
+/// \brief Prescribed motion of both ends (an entry is ignored when that end is free).
+template <typename Scalar>
+struct TetherBoundary {
+  /// Node 0 (start, e.g. the ASV attachment point).
+  EndMotion<Scalar> start;
+  /// Node N (far end, e.g. the AUV attachment point).
+  EndMotion<Scalar> end;
+
+  /// \brief The same end motions seen from τ seconds into the step (for sub-steps).
+  TetherBoundary after(Scalar tau) const { return {start.after(tau), end.after(tau)}; }
+  /// \brief Both ends fixed at the given NED points [m].
+  template <typename D1, typename D2>
+  static TetherBoundary fixed(const Eigen::MatrixBase<D1>& start_ned,
+                              const Eigen::MatrixBase<D2>& end_ned) {
+    TetherBoundary b;
+    b.start.position = start_ned;
+    b.end.position = end_ned;
+    return b;
+  }
+};
+
+/// \brief Forces the tether exerts on its two attachment points, NED [N] (zero for a free end).
+template <typename Scalar>
+struct EndForces {
+  /// On the start attachment point (node 0).
+  Vector3<Scalar> on_start = Vector3<Scalar>::Zero();
+  /// On the far attachment point (node N).
+  Vector3<Scalar> on_end = Vector3<Scalar>::Zero();
+};
+
+/// \brief A copy of a TetherState kept in preallocated buffers (no allocation when saved or
+/// restored once sized), so that a failed driver or step can put the state back bit for bit.
+template <typename Scalar>
+struct StateBackup {
+  Matrix3X<Scalar> position, velocity, previous_position, previous_velocity;
+  double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
+
+  /// \brief Sizes the buffers for `nodes` nodes.
+  void resize(int nodes) {
+    for (Matrix3X<Scalar>* m : {&position, &velocity, &previous_position, &previous_velocity})
+      m->setZero(3, nodes);
+  }
+  /// \brief Copies `s` (history included).
+  void save(const TetherState<Scalar>& s) {
+    position = s.position;
+    velocity = s.velocity;
+    previous_position = s.previous_position;
+    previous_velocity = s.previous_velocity;
+    time = s.time;
+    time_carry = s.time_carry;
+    previous_dt = s.previous_dt;
+  }
+  /// \brief Puts the saved state back into `s`.
+  void restore(TetherState<Scalar>& s) const {
+    s.position = position;
+    s.velocity = velocity;
+    s.previous_position = previous_position;
+    s.previous_velocity = previous_velocity;
+    s.time = time;
+    s.time_carry = time_carry;
+    s.previous_dt = previous_dt;
+  }
+};
+
+/// \brief Preallocated mutable buffers for force evaluation and integration (Pinocchio's `Data`).
+///
+/// Built from a model; every step reuses these buffers, so no heap allocation happens in a step.
+/// Fields are public so that tests and diagnostics can read intermediate quantities; their
+/// content is valid after the last force evaluation.
+template <typename Scalar>
+struct TetherWorkspace {
+  // --- per evaluation, per node -------------------------------------------------------------
+  Matrix3X<Scalar> force;               ///< net force on each node (no constraint force), NED [N]
+  Matrix3X<Scalar> acceleration;        ///< node accelerations of the explicit steps, NED [m/s²]
+  Matrix3X<Scalar> tangent;             ///< unit node tangent q_i (zero if degenerate)
+  Matrix3X<Scalar> water_velocity;      ///< current + wave orbital velocity at each node [m/s]
+  Matrix3X<Scalar> water_acceleration;  ///< water acceleration at each node [m/s²]
+  VectorX<Scalar> surface_elevation;    ///< free-surface elevation ζ above each node [m]
+  Matrix3X<Scalar> bending;             ///< bending force on each node (when EI > 0) [N]
+  VectorX<Scalar> mass_iso;             ///< a_i: M_i = a_i I + b_i q qᵀ [kg]
+  VectorX<Scalar> mass_tan;             ///< b_i [kg]
+  VectorX<Scalar> mass_iso_inv;         ///< 1/a_i [1/kg]
+  VectorX<Scalar> mass_tan_ratio;  ///< b_i/(a_i + b_i): M_i⁻¹ = (I − (b/(a+b)) q qᵀ)/a [-]
+  VectorX<Scalar> seabed_force;    ///< upward normal seabed contact force on node i [N]
+  /// Seabed normal force that sets the friction limit μ_f N when `frozen_friction` [N]
+  VectorX<Scalar> friction_normal;
+  /// Set by the implicit steps for the duration of their Newton iteration: the friction limit
+  /// then uses the normal force at the start of the step (`friction_normal`), a first-order lag
+  /// that keeps the friction's dependence on the contact force (which is not symmetric, so not in
+  /// the block Jacobian) from stalling Newton's method at impacts.
+  bool frozen_friction = false;
+  VectorX<Scalar> submerged;  ///< submerged fraction φ_i of node i (1 wet, 0 in air)
+  // --- per evaluation, per segment ------------------------------------------------------------
+  Matrix3X<Scalar> direction;        ///< unit vector u_s from node s to s+1 (0 if zero length)
+  VectorX<Scalar> tension;           ///< axial force T_s: elastic (≥ 0) plus dashpot [N]
+  VectorX<Scalar> stretched_length;  ///< segment length l_s [m]
+  // --- Jacobian ingredients (filled when requested) --------------------------------------------
+  VectorX<Scalar> seg_k_uu;  ///< axial stiffness minus geometric term: EA/l − T⁺/l_s or −T⁺/l_s
+  VectorX<Scalar> seg_k_perp;  ///< geometric stiffness T/l_s [N/m]
+  VectorX<Scalar> seg_c_uu;    ///< BA/l, or 0 while the axial force is clamped at zero [N s/m]
+  /// −∂F_i/∂v_i from drag and seabed, symmetric (xx, yx, zx, yy, zy, zz) [N s/m]
+  Eigen::Matrix<Scalar, 6, Eigen::Dynamic> node_dv;
+  VectorX<Scalar> node_kz;  ///< −∂F_z/∂z from the seabed [N/m]
+  // --- linear solver and integrator buffers ----------------------------------------------------
+  /// What the block elimination of the Newton solve keeps for its back substitution, two
+  /// columns per elimination step (detail::solve_block_tridiagonal)
+  Eigen::Matrix<Scalar, 17, Eigen::Dynamic> block_inv;
+  Matrix3X<Scalar> rhs, delta;    ///< Newton right-hand side and correction
+  Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
+  VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
+  VectorX<Scalar> seg_true_c_uu;  ///< seg_c_uu saved while the active-set passes modify it
+  VectorX<Scalar> seg_rate;       ///< segment stretch rate u_s·(v_{s+1} − v_s) [m/s]
+  /// Branch of segment s in the Newton step's linear model: 0 no force (slack, or clamped at
+  /// zero), 1 dashpot only (slack), 2 elastic plus dashpot (taut)
+  VectorX<Scalar> seg_branch;
+  Matrix3X<Scalar> x0, v0, x1, v1, xs, vs;  ///< integrator stages and Newton/line-search iterates
+  /// compute_forces' scratch, one contiguous column per component: T_s u_s of each segment
+  /// (columns 0–2), each node's force before the added-mass coupling to its neighbours (3–5),
+  /// and that coupling term (6–8)
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 9> pass_buffer;
+  /// Copies of positions and velocities given to compute_forces as expressions rather than as
+  /// column-major storage
+  Matrix3X<Scalar> x_eval, v_eval;
+  /// State at entry of a driver (`advance`, `solve_static_equilibrium`), restored if it fails
+  StateBackup<Scalar> entry_backup;
+  /// State at entry of an implicit step that is retried in sub-steps, restored if they fail
+  StateBackup<Scalar> retry_backup;
+  /// water_velocity, water_acceleration and surface_elevation hold zeros (set by resize and by
+  /// compute_forces in a still environment, whose water query it then skips; cleared when the
+  /// query runs)
+  bool water_is_zero = false;
+  /// Set by the implicit steps after their first force evaluation (unless
+  /// ImplicitOptions::resample_water): compute_forces then reuses water_velocity,
+  /// water_acceleration and surface_elevation, sampled at the step's predicted node positions
+  /// at t + h, instead of querying the environment at every Newton iterate.
+  bool water_frozen = false;
+  EndForces<Scalar> end_forces;  ///< forces on the attachment points after the last step
+  /// Impulse the tether delivered to its attachment points over the last step (the step
+  /// functions) or the last `advance` (summed over its sub-steps) [N s]: the end force weighted
+  /// as the integrator weights the node forces in its momentum update (symplectic Euler h F(t),
+  /// RK2 h F(t + h/2), RK4 h/6 (F₁ + 2F₂ + 2F₃ + F₄), implicit Euler and BDF2 h F(t + h)). A body
+  /// that carries an end and receives exactly this impulse keeps the momentum of body and tether
+  /// balanced whatever the integrator (kelp::system::step does so).
+  EndForces<Scalar> end_impulse;
+
+  TetherWorkspace() = default;
+  /// \brief Buffers sized for `model`.
+  explicit TetherWorkspace(const TetherModel<Scalar>& model) { resize(model.nodes()); }
+
+  /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
+  void resize(int nodes) {
+    for_each_buffer(*this, nodes,
+                    [](auto& m, Eigen::Index rows, Eigen::Index cols) { m.setZero(rows, cols); });
+    entry_backup.resize(nodes);
+    retry_backup.resize(nodes);
+    water_is_zero = true;
+  }
+
+  /// \brief True when every buffer has the size resize(nodes) gives it (false for a
+  /// default-constructed workspace, one built for another tether, or one edited by hand). O(1).
+  bool fits(int nodes) const {
+    bool ok = nodes >= 2;
+    for_each_buffer(*this, nodes, [&ok](const auto& m, Eigen::Index rows, Eigen::Index cols) {
+      ok = ok && m.rows() == rows && m.cols() == cols;
+    });
+    return ok;
+  }
+
+ private:
+  // Calls f(buffer, rows, cols) for every per-node and per-segment buffer of a workspace sized
+  // for `nodes` nodes (Self: TetherWorkspace, const or not).
+  template <typename Self, typename F>
+  static void for_each_buffer(Self& w, int nodes, F&& f) {
+    const Eigen::Index n = nodes, s = nodes - 1;
+    for (auto* m : {&w.force, &w.bending, &w.acceleration, &w.tangent, &w.water_velocity,
+                    &w.water_acceleration, &w.rhs, &w.rhs_true, &w.delta, &w.x0, &w.v0, &w.x1,
+                    &w.v1, &w.xs, &w.vs, &w.x_eval, &w.v_eval})
+      f(*m, 3, n);
+    for (auto* v : {&w.mass_iso, &w.mass_tan, &w.mass_iso_inv, &w.mass_tan_ratio, &w.seabed_force,
+                    &w.friction_normal, &w.submerged, &w.node_kz, &w.surface_elevation})
+      f(*v, n, 1);
+    f(w.direction, 3, s);
+    for (auto* v : {&w.tension, &w.stretched_length, &w.seg_k_uu, &w.seg_k_perp, &w.seg_c_uu,
+                    &w.seg_true_k_uu, &w.seg_true_c_uu, &w.seg_rate, &w.seg_branch})
+      f(*v, s, 1);
+    f(w.node_dv, 6, n);
+    f(w.pass_buffer, n, 9);
+    f(w.block_inv, 17, n);
+  }
+};
+
+namespace detail {
+
+/// \throws kelp::invalid_argument unless `ws` was built for `model` (TetherWorkspace::fits).
+template <typename Scalar>
+void check_workspace(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws) {
+  KELP_CHECK(ws.fits(model.nodes()),
+             "the workspace was not built for this tether: use TetherWorkspace(model)");
+}
+
+/// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.
+template <typename Scalar, typename DX, typename DV>
+void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scalar>& b, Scalar tau,
+                    Eigen::MatrixBase<DX>& x, Eigen::MatrixBase<DV>& v) {
+  const int n = model.segments();
+  if (model.parameters().start_mode == EndMode::kinematic) {
+    x.col(0) = b.start.position_at(tau);
+    v.col(0) = b.start.velocity_at(tau);
+  }
+  if (model.parameters().end_mode == EndMode::kinematic) {
+    x.col(n) = b.end.position_at(tau);
+    v.col(n) = b.end.velocity_at(tau);
+  }
+}
+
+}  // namespace detail
+
+/// \brief Checks that a state fits the model and is finite (its history too, when it has one).
+/// \throws kelp::invalid_argument naming `state.position` / `state.velocity` / `state.time` /
+/// `state.previous_position` / `state.previous_velocity` / `state.previous_dt`.
+template <typename Scalar>
+void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  KELP_CHECK(state.position.rows() == 3 && state.velocity.rows() == 3 &&
+                 state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
+             "state.position and state.velocity must have segments + 1 columns");
+  check_all_finite(state.position, "state.position");
+  check_all_finite(state.velocity, "state.velocity");
+  check_finite(state.time, "state.time");
+  check_non_negative(state.previous_dt, "state.previous_dt");
+  if (state.has_history()) {
+    KELP_CHECK(state.previous_position.cols() == model.nodes() &&
+                   state.previous_velocity.cols() == model.nodes(),
+               "state.previous_position and state.previous_velocity must have segments + 1 "
+               "columns when state.previous_dt > 0");
+    check_all_finite(state.previous_position, "state.previous_position");
+    check_all_finite(state.previous_velocity, "state.previous_velocity");
+  }
+}
+
+/// \brief Checks that the boundary motion is finite.
+/// \throws kelp::invalid_argument naming the field.
+template <typename Scalar>
+void check_boundary(const TetherBoundary<Scalar>& b) {
+  check_all_finite(b.start.position, "boundary.start.position");
+  check_all_finite(b.start.velocity, "boundary.start.velocity");
+  check_all_finite(b.start.acceleration, "boundary.start.acceleration");
+  check_all_finite(b.end.position, "boundary.end.position");
+  check_all_finite(b.end.velocity, "boundary.end.velocity");
+  check_all_finite(b.end.acceleration, "boundary.end.acceleration");
+}
+
+/// \brief Straight-line state: nodes evenly spaced from `start_ned` to `end_ned`, at rest.
+template <typename Scalar, typename D1, typename D2>
+TetherState<Scalar> straight_line_state(const TetherModel<Scalar>& model,
+                                        const Eigen::MatrixBase<D1>& start_ned,
+                                        const Eigen::MatrixBase<D2>& end_ned) {
+  check_all_finite(start_ned, "start_ned");
+  check_all_finite(end_ned, "end_ned");
+  TetherState<Scalar> s(model);
+  const int n = model.segments();
+  const Vector3<Scalar> a(start_ned), b(end_ned);
+  for (int i = 0; i <= n; ++i) s.position.col(i) = a + (Scalar(i) / Scalar(n)) * (b - a);
+  return s;
+}
+
+/// \brief Double-precision aliases.
+using TetherStated = TetherState<double>;
+using TetherWorkspaced = TetherWorkspace<double>;
+using TetherBoundaryd = TetherBoundary<double>;
+/// \brief Single-precision aliases.
+using TetherStatef = TetherState<float>;
+using TetherWorkspacef = TetherWorkspace<float>;
+using TetherBoundaryf = TetherBoundary<float>;
+
+}  // namespace kelp::tether
