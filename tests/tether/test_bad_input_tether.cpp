@@ -470,3 +470,38 @@ TEST_CASE("Tether presets refuse lengths they cannot cut into segments", "[tethe
   CHECK_THROWS_AS(kt::presets::rov_tether(100.0, 0.9e-3), kelp::invalid_argument);
   CHECK(kt::presets::bead_chain(30.0).segments == 60);
 }
+
+TEST_CASE("Workspace resize refuses node counts no tether has, naming the count",
+          "[tether][bad_input]") {
+  // resize(0) and resize(-5) used to reach Eigen with a negative segment count and throw
+  // std::bad_alloc. A tether has segments + 1 nodes, segments in [1, limits::max_segments].
+  const auto refused_naming = [](auto&& buffers, int nodes) {
+    try {
+      buffers.resize(nodes);
+    } catch (const kelp::invalid_argument& e) {
+      const std::string what = e.what();
+      CHECK(what.find("nodes") != std::string::npos);
+      CHECK(what.find("got " + std::to_string(nodes)) != std::string::npos);
+      return true;
+    } catch (...) {
+      return false;
+    }
+    return false;
+  };
+  const kt::TetherModeld model(kt::TetherParametersd{});
+  for (const int nodes :
+       {0, -5, 1, kt::limits::max_segments + 2, std::numeric_limits<int>::min()}) {
+    INFO("nodes = " << nodes);
+    kt::TetherWorkspaced ws(model);
+    CHECK(refused_naming(ws, nodes));
+    CHECK(ws.fits(model.nodes()));  // left as it was
+    kt::TetherWorkspacef wf;
+    CHECK(refused_naming(wf, nodes));
+    kt::StateBackup<double> backup;
+    CHECK(refused_naming(backup, nodes));
+  }
+  // The smallest tether (one segment) still fits.
+  kt::TetherWorkspaced two;
+  two.resize(2);
+  CHECK(two.fits(2));
+}

@@ -114,6 +114,17 @@ struct EndForces {
   Vector3<Scalar> on_end = Vector3<Scalar>::Zero();
 };
 
+namespace detail {
+/// \throws kelp::invalid_argument naming `who` and the count unless `nodes` is a tether's node
+/// count: segments + 1 with segments in [1, limits::max_segments].
+inline void check_node_count(int nodes, const char* who) {
+  if (!(nodes >= 2 && nodes <= limits::max_segments + 1))
+    ::kelp::detail::throw_invalid_argument(std::string(who) + ": nodes must be in [2, " +
+                                           std::to_string(limits::max_segments + 1) +
+                                           "] (segments + 1), got " + std::to_string(nodes));
+}
+}  // namespace detail
+
 /// \brief A copy of a TetherState kept in preallocated buffers (no allocation when saved or
 /// restored once sized), so that a failed driver or step can put the state back bit for bit.
 template <typename Scalar>
@@ -122,7 +133,9 @@ struct StateBackup {
   double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
 
   /// \brief Sizes the buffers for `nodes` nodes.
+  /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1].
   void resize(int nodes) {
+    detail::check_node_count(nodes, "StateBackup::resize");
     for (Matrix3X<Scalar>* m : {&position, &velocity, &previous_position, &previous_velocity})
       m->setZero(3, nodes);
   }
@@ -234,7 +247,10 @@ struct TetherWorkspace {
   explicit TetherWorkspace(const TetherModel<Scalar>& model) { resize(model.nodes()); }
 
   /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
+  /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1]
+  /// (a tether has at least one segment; the buffers are left as they were).
   void resize(int nodes) {
+    detail::check_node_count(nodes, "TetherWorkspace::resize");
     for_each_buffer(*this, nodes,
                     [](auto& m, Eigen::Index rows, Eigen::Index cols) { m.setZero(rows, cols); });
     entry_backup.resize(nodes);
