@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "kelp/core/compiler_checks.hpp"
+
 #if defined(__GNUC__) || defined(__clang__)
 #define KELP_COLD __attribute__((cold, noinline))
 #else

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "kelp/core/compiler_checks.hpp"
 #include "kelp/core/error.hpp"
 
 #if defined(__GNUC__) || defined(__clang__)

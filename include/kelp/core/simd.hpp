@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 #include <type_traits>
 
+#include "kelp/core/compiler_checks.hpp"
+
 // Packet types carry vector attributes that GCC drops (and warns about) when they are template
 // arguments, as Eigen's own headers do (Eigen/src/Core/util/DisableStupidWarnings.h).
 #if defined(__GNUC__)
