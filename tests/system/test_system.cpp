@@ -191,10 +191,8 @@ TEST_CASE("bad vehicle states, attachment points and workspaces are refused, sta
   const ks::SystemStated before = s;
   CHECK_THROWS_AS(ks::step(model, foreign, s, in, 0.01), kelp::invalid_argument);
   CHECK(bitwise_equal(s, before));
-  // advance_attached_tether with a NaN attachment point.
-  CHECK_THROWS_AS(ks::advance_attached_tether(model.tether(), ws.tether, model.environment(),
-                                              s.tether, s.asv, Vector3<double>(nan, 0, 0), s.auv, r,
-                                              0.01, 0.01, kt::Integrator::bdf2),
+  // A tether boundary with a NaN attachment point.
+  CHECK_THROWS_AS(ks::tether_boundary(s.asv, Vector3<double>(nan, 0, 0), s.auv, r),
                   kelp::invalid_argument);
   CHECK(bitwise_equal(s, before));
   // The system still steps.

@@ -1,20 +1,19 @@
 // Attaching tether ends to vehicles: end motion of a body-fixed point, the body-frame wrench of
-// an NED force, and a tether step between two vehicles.
+// an NED force, and a tether advanced between two vehicles through those two.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 
 #include "kelp/core/rotation.hpp"
 #include "kelp/environment/environment.hpp"
 #include "kelp/system/tether_attachment.hpp"
 #include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/integrators.hpp"
 
 namespace kt = kelp::tether;
 namespace ks = kelp::system;
 using kelp::Vector3;
 using kelp::Vector6;
-
-template struct ks::TetherLoads<double>;
-template struct ks::TetherLoads<float>;
 
 TEMPLATE_TEST_CASE("attachment motion is the body-fixed point's position and velocity",
                    "[system][attachment]", double, float) {
@@ -81,42 +80,55 @@ TEST_CASE("tether between two vehicles: loads balance the line and follow the ve
               .converged);
   CHECK((state.position.col(0) - Vector3<double>(0, 0, 0)).norm() < 1e-12);
   CHECK((state.position.col(20) - Vector3<double>(10, 0, 5)).norm() < 1e-12);
+  // The loads on both vehicles over one advance: the tether's end forces, NED, and the wrenches
+  // they exert through the attachment points.
+  struct Loads {
+    Vector3<double> start, end;
+    Vector6<double> tau_start, tau_end;
+    kt::StepReportd report;
+  };
+  const auto advance = [&](const kelp::vehicle::VehicleStated& a,
+                           const kelp::vehicle::VehicleStated& b, kt::Integrator integrator) {
+    Loads l;
+    l.report = kt::advance(model, ws, env, state, ks::tether_boundary(a, r_asv, b, r_auv), 0.1,
+                           0.01, integrator);
+    l.start = ws.end_forces.on_start;
+    l.end = ws.end_forces.on_end;
+    l.tau_start = ks::attachment_wrench(a, r_asv, l.start);
+    l.tau_end = ks::attachment_wrench(b, r_auv, l.end);
+    return l;
+  };
   // Both vehicles at rest: a 0.1 s advance keeps the static loads. The vertical forces carry the
   // submerged weight of the line; the horizontal ones are equal and opposite (H).
-  const auto loads = ks::advance_attached_tether(model, ws, env, state, asv, r_asv, auv, r_auv, 0.1,
-                                                 0.01, kt::Integrator::bdf2);
+  const Loads loads = advance(asv, auv, kt::Integrator::bdf2);
   CHECK(loads.report.substeps == 10);
   const double w = model.submerged_weight_per_length(env.water_density(), env.gravity());
-  CHECK(loads.force_start_ned.z() + loads.force_end_ned.z() == Approx(w * p.length).epsilon(1e-4));
-  CHECK(loads.force_start_ned.x() == Approx(-loads.force_end_ned.x()).epsilon(1e-4));
-  CHECK(loads.force_start_ned.x() > 0);  // the ASV is pulled towards the AUV
+  CHECK(loads.start.z() + loads.end.z() == Approx(w * p.length).epsilon(1e-4));
+  CHECK(loads.start.x() == Approx(-loads.end.x()).epsilon(1e-4));
+  CHECK(loads.start.x() > 0);  // the ASV is pulled towards the AUV
   // The AUV's tether point is 0.2 m forward (r_x > 0) and 0.2 m above (r_z < 0) its CO and the
   // line pulls it backward (f_x < 0) and down (f_z > 0). In the pitch moment M = r_z f_x − r_x f_z
   // the first term is nose-up and the second nose-down; the downward pull is larger than the
   // backward one here, so the r_x f_z term dominates and the nose pitches down (M < 0).
   CHECK(loads.tau_end(4) < 0);
-  CHECK(loads.tau_start.head<3>().isApprox(loads.force_start_ned));  // ASV level, heading north
+  CHECK(loads.tau_start.head<3>().isApprox(loads.start));  // ASV level, heading north
   // Moving the AUV away tightens the tether: after 2 s at 1 m/s north the pull grows. The
-  // coupled steps allocate nothing.
+  // boundary, the advance and the wrenches allocate nothing.
   kelp::vehicle::VehicleStated moving = auv;
   moving.nu(0) = 1.0;
-  ks::TetherLoadsd last;
+  Loads last;
   Eigen::internal::set_is_malloc_allowed(false);
   for (int k = 0; k < 20; ++k) {
-    last = ks::advance_attached_tether(model, ws, env, state, asv, r_asv, moving, r_auv, 0.1, 0.01,
-                                       kt::Integrator::implicit_euler);
+    last = advance(asv, moving, kt::Integrator::implicit_euler);
     moving.position.x() += 0.1;
   }
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(state.position(0, 20) == Approx(12.0).epsilon(1e-9));
-  CHECK(last.force_end_ned.norm() > 1.5 * loads.force_end_ned.norm());
-  // Free tether ends cannot be attached.
-  kt::TetherParametersd pf = p;
-  pf.end_mode = kt::EndMode::free;
-  const kt::TetherModeld free_model(pf);
-  kt::TetherWorkspaced wf(free_model);
-  kt::TetherStated sf(free_model);
-  CHECK_THROWS_AS(ks::advance_attached_tether(free_model, wf, env, sf, asv, r_asv, auv, r_auv, 0.1,
-                                              0.01, kt::Integrator::bdf2),
+  CHECK(last.end.norm() > 1.5 * loads.end.norm());
+  // A bad attachment point is refused before anything moves.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(ks::tether_boundary(asv, Vector3<double>(nan, 0, 0), auv, r_auv),
+                  kelp::invalid_argument);
+  CHECK_THROWS_AS(ks::tether_boundary(asv, r_asv, auv, Vector3<double>(0, 0, nan)),
                   kelp::invalid_argument);
 }

@@ -11,7 +11,6 @@
 
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
-#include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/state.hpp"
@@ -82,51 +81,5 @@ tether::TetherBoundary<Scalar> tether_boundary(const vehicle::VehicleState<Scala
   b.end = attachment_motion(end, r_end_body);
   return b;
 }
-
-/// \brief What the tether does to the two vehicles over a step.
-template <typename Scalar>
-struct TetherLoads {
-  /// Force on the start attachment point, NED [N].
-  Vector3<Scalar> force_start_ned = Vector3<Scalar>::Zero();
-  /// Force on the far attachment point, NED [N].
-  Vector3<Scalar> force_end_ned = Vector3<Scalar>::Zero();
-  /// Generalized force on the start vehicle, body frame (N, N m).
-  Vector6<Scalar> tau_start = Vector6<Scalar>::Zero();
-  /// Generalized force on the far vehicle, body frame (N, N m).
-  Vector6<Scalar> tau_end = Vector6<Scalar>::Zero();
-  /// What the tether integration did: committed sub-steps, Newton iterations, worst residual,
-  /// retries (see tether::StepReport).
-  tether::StepReport<Scalar> report;
-};
-
-/// \brief Advances the tether by `dt` [s] (in sub-steps no longer than `max_dt`) with its ends
-/// attached to `r_start_body` on `start` and `r_end_body` on `end` (the vehicles are taken to
-/// move with their current velocities through the interval), and returns the loads on both
-/// vehicles from the last sub-step, ready to be added to their τ, with the integration's report.
-/// The tether model's ends must be `kinematic`. No heap allocation.
-/// \throws kelp::invalid_argument for bad input or free tether ends; kelp::numerical_error (tether
-/// state unchanged) when a sub-step fails.
-template <typename Scalar, typename Env, typename D1, typename D2>
-TetherLoads<Scalar> advance_attached_tether(
-    const tether::TetherModel<Scalar>& model, tether::TetherWorkspace<Scalar>& ws, const Env& env,
-    tether::TetherState<Scalar>& state, const vehicle::VehicleState<Scalar>& start,
-    const Eigen::MatrixBase<D1>& r_start_body, const vehicle::VehicleState<Scalar>& end,
-    const Eigen::MatrixBase<D2>& r_end_body, double dt, double max_dt,
-    tether::Integrator integrator, const tether::ImplicitOptions<Scalar>& options = {}) {
-  KELP_CHECK(model.parameters().start_mode == tether::EndMode::kinematic &&
-                 model.parameters().end_mode == tether::EndMode::kinematic,
-             "advance_attached_tether: both tether ends (start_mode, end_mode) must be kinematic");
-  const tether::TetherBoundary<Scalar> b = tether_boundary(start, r_start_body, end, r_end_body);
-  TetherLoads<Scalar> loads;
-  loads.report = tether::advance(model, ws, env, state, b, dt, max_dt, integrator, options);
-  loads.force_start_ned = ws.end_forces.on_start;
-  loads.force_end_ned = ws.end_forces.on_end;
-  loads.tau_start = attachment_wrench(start, r_start_body, loads.force_start_ned);
-  loads.tau_end = attachment_wrench(end, r_end_body, loads.force_end_ned);
-  return loads;
-}
-
-using TetherLoadsd = TetherLoads<double>;  ///< TetherLoads<double>
-using TetherLoadsf = TetherLoads<float>;   ///< TetherLoads<float>
 
 }  // namespace kelp::system

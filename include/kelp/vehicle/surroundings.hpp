@@ -110,15 +110,6 @@ Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x,
   return detail::sample_surroundings(env, x, t, true, true);
 }
 
-/// \brief Surroundings of a vehicle that does not need the surface slope (a submerged vehicle's
-/// restoring reads only the elevation): as `surroundings()` with the slope left at zero, which
-/// saves one pass over the wave components.
-template <typename Scalar, typename Env>
-Surroundings<Scalar> surroundings_without_slope(const Env& env, const VehicleState<Scalar>& x,
-                                                double t) {
-  return detail::sample_surroundings(env, x, t, false, true);
-}
-
 /// \brief Replaces the water velocity and acceleration of `s` by those at depth `z` [m, NED]
 /// under the vehicle's CO (x, y), keeping the surface and the wind.
 template <typename Scalar, typename Env>
