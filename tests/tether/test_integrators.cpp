@@ -303,6 +303,55 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
     CHECK_NOTHROW(kt::step(model20, ws20, env, s20, kt::TetherBoundaryd::fixed(a, b), 1e-5,
                            kt::Integrator::bdf2));
   }
+  SECTION("a stiff float line steps to float's resolution instead of failing at step 196") {
+    // 1 m of the default line in 2 segments between (0, 0, 10) and (0.5, 0, 10.5): EA/l = 2e5 N/m
+    // on coordinates rounded to ~1e-6 m in float resolves node forces to ~0.2 N, far above the
+    // 0.1 m/s² Newton tolerance on a 0.06 kg node. Newton's method chased that noise and BDF2
+    // at 10 ms threw numerical_error at step 196; the tolerance is now raised to the resolution
+    // and the float run follows the double one.
+    const auto run = [](auto scalar) {
+      using S = decltype(scalar);
+      kt::TetherParameters<S> p;
+      p.segments = 2;
+      p.length = S(1);
+      const kt::TetherModel<S> model(p);
+      kt::TetherWorkspace<S> ws(model);
+      const kelp::environment::Environment<S> water;
+      const Vector3<S> a(0, 0, 10), b(S(0.5), 0, S(10.5));
+      auto s = kt::straight_line_state(model, a, b);
+      const auto boundary = kt::TetherBoundary<S>::fixed(a, b);
+      for (int k = 0; k < 3000; ++k)
+        kt::step(model, ws, water, s, boundary, 0.01, kt::Integrator::bdf2);
+      return Vector3<double>(s.position.col(1).template cast<double>());
+    };
+    Vector3<double> node_f = Vector3<double>::Zero();
+    REQUIRE_NOTHROW(node_f = run(0.0f));
+    const Vector3<double> node_d = run(0.0);
+    // At rest after 30 s, hanging below the start (the vertical segment taut): the float node
+    // within a millimetre of the double one.
+    CHECK((node_f - node_d).norm() < 1e-3);
+    CHECK((node_d - Vector3<double>(0, 0, 10.5)).norm() < 1e-3);
+  }
+  SECTION("a float line its precision cannot resolve is refused up front, naming float") {
+    // The same 1 m line cut into 200 segments: EA/l = 2e7 N/m rounds the axial force to ~30 N
+    // in float, a million times the 2e-5 N tolerance of its lightest node. The check used
+    // double's epsilon for every Scalar, so float lines were never refused.
+    kt::TetherParametersf p;
+    p.segments = 200;
+    p.length = 1.0f;
+    const kt::TetherModelf model(p);
+    kt::TetherWorkspacef ws(model);
+    const kelp::environment::Environmentf water;
+    const Vector3<float> a(0, 0, 10), b(0.5f, 0, 10.5f);
+    const auto s0 = kt::straight_line_state(model, a, b);
+    auto s = s0;
+    CHECK_THROWS_WITH(
+        kt::step(model, ws, water, s, kt::TetherBoundaryf::fixed(a, b), 0.01, kt::Integrator::bdf2),
+        Catch::Contains("cannot be resolved") && Catch::Contains("single precision") &&
+            Catch::Contains("or double precision"));
+    CHECK(s.position == s0.position);
+    CHECK(s.time == s0.time);
+  }
   SECTION("a 10 km line with 200 segments reaches its static equilibrium") {
     auto p = kelp_test::benchmark_line<double>(200);
     p.length = 10000.0;

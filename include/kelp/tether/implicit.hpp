@@ -295,10 +295,11 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
 /// when it overshoots. The initial guess extrapolates the velocity (2v_n − v_{n−1}) when the
 /// previous step had the same dt. At least one and up to `options.max_iterations` corrections,
-/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt. A step that does not converge is not
-/// committed: it is retried as two half steps, each halved again if needed, at most
-/// `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of step);
-/// if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
+/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt (the tolerance raised to the arithmetic's
+/// resolution where it is below it, see ImplicitOptions::acceleration_tolerance). A step that does
+/// not converge is not committed: it is retried as two half steps, each halved again if needed, at
+/// most `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of
+/// step); if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
 /// (`ws.end_forces`) are those of the final iterate, at t + dt.
 /// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
@@ -311,16 +312,22 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
   detail::check_step_inputs(model, ws, state, boundary, dt);
   detail::check_implicit_options(options);
   detail::check_resolvable(model, state, options);
+  // A tolerance below what the arithmetic resolves asks Newton's method for noise (a stiff float
+  // line: 0.1 m/s² against ~10 m/s² of rounding): raised to the resolution.
+  ImplicitOptions<Scalar> resolved = options;
+  using std::max;
+  resolved.acceleration_tolerance =
+      max(options.acceleration_tolerance, detail::force_resolution(model, state));
   ws.end_impulse = EndForces<Scalar>{};
   StepReport<Scalar> report;
-  if (detail::try_implicit(model, ws, env, state, boundary, dt, bdf2, options, report))
+  if (detail::try_implicit(model, ws, env, state, boundary, dt, bdf2, resolved, report))
     return report;
   // Not converged, nothing committed: retry in halves from a backup.
   ws.retry_backup.save(state);
   bool done = false;
   if (options.max_step_halvings > 0) {
     ++report.retries;
-    done = detail::implicit_halves(model, ws, env, state, boundary, 0.0, dt, bdf2, options,
+    done = detail::implicit_halves(model, ws, env, state, boundary, 0.0, dt, bdf2, resolved,
                                    options.max_step_halvings - 1, report);
   }
   if (!done) {

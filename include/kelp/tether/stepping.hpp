@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
@@ -70,7 +71,10 @@ struct ImplicitOptions {
   /// predictor alone never makes a step. Default 1.5e-4 m/s² in double (1.5e-6 m/s at 10 ms, node
   /// forces to ~3e-6 N on the benchmark line); 0.1 m/s² in single precision, whose rounding of
   /// ~10 m coordinates already costs EA/l · 6e-7 m of tension (use a softer line or double for
-  /// stiff tethers).
+  /// stiff tethers). The arithmetic resolves node forces only to the rounding of the positions
+  /// (EA/l·ε|x| per segment, ε of Scalar): a tolerance below that resolution over the lightest
+  /// node's mass is raised to it for the step (in float, a 1 m line of 2 segments at 10 m depth
+  /// resolves ~16 m/s²), and one more than 1000 times below it is refused up front.
   Scalar acceleration_tolerance =
       Scalar(std::numeric_limits<Scalar>::epsilon() > Scalar(1e-10) ? 0.1 : 1.5e-4);
   /// Segments at least (1 − band)·l long start each Newton iteration's active set in the taut
@@ -222,33 +226,56 @@ inline std::string format_g(double x) {
   return buf;
 }
 
-/// Refuses a Newton tolerance that the arithmetic cannot resolve: positions of magnitude |x| are
-/// rounded to ε|x| (ε of double), which rounds each segment's axial force EA/l·Δl by about
-/// EA/l·ε|x|; when that is above a thousand times the tolerance a_min·acceleration_tolerance on
+/// Rounding [N] of a segment's axial force in the arithmetic of Scalar: positions of magnitude
+/// |x| are rounded to ε|x| (ε of Scalar: 1.2e-7 in float, 2.2e-16 in double), which rounds each
+/// segment's axial force EA/l·Δl by about EA/l·ε|x|. |x| is bounded by the end nodes' distance
+/// from the origin plus the line's length. O(1).
+template <typename Scalar>
+double axial_force_rounding(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
+                            double& reach) {
+  const int n = model.segments();
+  reach = std::max(double(value_of(state.position.col(0).norm())),
+                   double(value_of(state.position.col(n).norm()))) +
+          double(value_of(model.parameters().length));
+  return double(value_of(model.axial_spring())) *
+         double(value_of(std::numeric_limits<Scalar>::epsilon())) * reach;
+}
+
+/// The acceleration [m/s²] to which Newton's method can resolve the node forces: the axial
+/// force rounding (axial_force_rounding) over the lightest node's mass. A residual below it is
+/// noise, which no iteration reduces.
+template <typename Scalar>
+Scalar force_resolution(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  double reach;
+  const double rounding = axial_force_rounding(model, state, reach);
+  return Scalar(rounding / double(value_of(model.min_node_mass())));
+}
+
+/// Refuses a Newton tolerance that the arithmetic cannot resolve: when the axial force rounding
+/// (axial_force_rounding) is above a thousand times the tolerance a_min·acceleration_tolerance on
 /// the lightest node, no step can converge (e.g. a 1 cm line cut into 200 segments: EA/l = 2e9 N/m
-/// at 5 m depth rounds the force to 2e-6 N against a tolerance of 3e-10 N). |x| is bounded by the
-/// end nodes' distance from the origin plus the line's length. O(1).
+/// at 5 m depth rounds the force to 2e-6 N against a tolerance of 3e-10 N in double; a 1 m float
+/// line cut into 200 segments rounds it to ~30 N against 2e-5 N). Below that, step_implicit
+/// raises the tolerance to the resolution (force_resolution). O(1).
 /// \throws kelp::invalid_argument saying what to change.
 template <typename Scalar>
 void check_resolvable(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
                       const ImplicitOptions<Scalar>& options) {
-  const int n = model.segments();
-  const double reach = std::max(double(value_of(state.position.col(0).norm())),
-                                double(value_of(state.position.col(n).norm()))) +
-                       double(value_of(model.parameters().length));
-  const double rounding =
-      double(value_of(model.axial_spring())) * std::numeric_limits<double>::epsilon() * reach;
+  double reach;
+  const double rounding = axial_force_rounding(model, state, reach);
   const double tolerance =
       double(value_of(model.min_node_mass())) * double(value_of(options.acceleration_tolerance));
   if (rounding > 1000.0 * tolerance)
     ::kelp::detail::throw_invalid_argument(
-        "step_implicit: this tether cannot be resolved to the Newton tolerance: segments of " +
+        std::string("step_implicit: this tether cannot be resolved to the Newton tolerance in ") +
+        (std::is_same_v<Scalar, float> ? "single" : "double") + " precision: segments of " +
         format_g(double(value_of(model.segment_length()))) + " m (EA/l = " +
         format_g(double(value_of(model.axial_spring()))) + " N/m) at coordinates up to " +
         format_g(reach) + " m round the axial force to ~" + format_g(rounding) +
         " N, over 1000 times the tolerance of the lightest node (" + format_g(tolerance) +
-        " N); use fewer, longer segments, coordinates nearer the origin, or a larger "
-        "ImplicitOptions::acceleration_tolerance");
+        " N); use fewer, longer segments, coordinates nearer the origin, a larger "
+        "ImplicitOptions::acceleration_tolerance" +
+        (std::is_same_v<Scalar, float> ? ", or double precision" : ""));
 }
 
 /// Acceleration of every node at (x, v) [boundary already applied] into `acc`.
