@@ -183,10 +183,11 @@ void reference_compute_forces(const kt::TetherModel<Scalar>& model, kt::TetherWo
     const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
     const Scalar li = kinds[kind].li;
     const Scalar zeta = still ? Scalar(0) : ws.surface_elevation(i);
-    // (Below the surface φ = 1 without the ramp's arithmetic.)
-    const Scalar phi = x(2, i) + zeta >= Scalar(0) ? Scalar(1)
-                                                   : kt::detail::submerged_fraction(
-                                                         Scalar(x(2, i)), zeta, p.diameter, inv_d);
+    // (Half a diameter or more below the surface φ = 1 without the ramp's arithmetic.)
+    const Scalar phi =
+        x(2, i) + zeta >= Scalar(0.5) * p.diameter
+            ? Scalar(1)
+            : kt::detail::submerged_fraction(Scalar(x(2, i)), zeta, p.diameter, inv_d);
     ws.submerged(i) = phi;
     const bool wet = phi > Scalar(0);
     // A node in the surface band (0 < φ < 1) scales its wet constants by φ.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
@@ -728,6 +729,50 @@ TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is
         CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 1e-4, integ), Catch::Contains(c.field));
         CHECK(same(s, before));
       }
+    }
+  }
+}
+
+TEMPLATE_TEST_CASE("the surface band is centred on the node: a node at the surface is half wet",
+                   "[tether][forces][surface]", double, float) {
+  // φ = clamp((z + ζ)/D + ½, 0, 1), the vehicles' convention (band centred on the reference
+  // point). The tether used φ = clamp(1 + (z + ζ)/D, 0, 1): a node at the surface fully wet.
+  using S = TestType;
+  const S d = S(0.008);
+  CHECK(kt::detail::submerged_fraction(S(0), S(0), d) == S(0.5));
+  CHECK(kt::detail::submerged_fraction(S(0.004), S(0), d) == S(1));   // D/2 below: wet
+  CHECK(kt::detail::submerged_fraction(S(-0.004), S(0), d) == S(0));  // D/2 above: dry
+  CHECK(kt::detail::submerged_fraction(S(0.5), S(0.5), d) == S(1));   // under a crest
+  CHECK(kt::detail::submerged_fraction(S(0.5), S(-0.5), d) == S(0.5));
+  // A still, straight, unstretched line lying on the surface: each interior node carries its
+  // weight minus half its buoyancy, has half its added mass, and sits in the band.
+  kelp_test::TestWater<S> env;
+  const kt::TetherModel<S> m(kelp_test::benchmark_line<S>(10));
+  kt::TetherWorkspace<S> ws(m);
+  const auto s = kt::straight_line_state(m, Vector3<S>(0, 0, 0), Vector3<S>(20, 0, 0));
+  kt::compute_forces<true>(m, ws, env, 0.0, s.position, s.velocity);
+  const S rho_v = env.rho * m.node_volume(5);
+  CHECK(ws.submerged(5) == S(0.5));
+  CHECK(ws.force(2, 5) == Approx(double((m.node_mass(5) - S(0.5) * rho_v) * env.g)).epsilon(1e-5));
+  CHECK(ws.mass_iso(5) == Approx(double(m.node_mass(5) + S(0.5) * rho_v)).epsilon(1e-6));
+  // In the band the buoyancy is a spring ρ V g / D (the Jacobian's vertical stiffness).
+  CHECK(ws.node_kz(5) == Approx(double(rho_v * env.g / d)).epsilon(1e-6));
+  // The energy's buoyancy potential ρ V g Φ is consistent with that force: −∂E/∂z = F_z at a
+  // node in the band, on either side of the surface (central differences, no tension: the line
+  // stays unstretched to first order).
+  if constexpr (std::is_same_v<S, double>) {
+    for (const double z0 : {-0.003, -0.001, 0.0, 0.002, 0.0035}) {
+      auto at = [&](double z) {
+        auto t = s;
+        t.position(2, 5) = z;
+        return kt::tether_energy(m, env, t);
+      };
+      auto t = s;
+      t.position(2, 5) = z0;
+      kt::compute_forces(m, ws, env, 0.0, t.position, t.velocity);
+      const double h = 1e-7;
+      INFO("z = " << z0);
+      CHECK(-(at(z0 + h) - at(z0 - h)) / (2 * h) == Approx(ws.force(2, 5)).epsilon(1e-5));
     }
   }
 }

@@ -49,7 +49,11 @@ TEST_CASE("reference catenary constants", "[tether][statics]") {
 TEST_CASE("static equilibrium matches the analytic catenary, error ~ 1/N^2", "[tether][statics]") {
   const AnalyticCatenary cat;
   kelp::environment::Environmentd env;  // seawater 1025, g = 9.80665, no seabed
-  const kelp::Vector3<double> start(0, 0, 0), end(cat.D, 0, cat.dz);  // ASV at the surface
+  // ASV end half a diameter under the surface: its node wholly wet, as the analytic line is (a
+  // node at the surface is half wet, docs/equations.md section 4). The catenary is the same
+  // shape moved down by that much.
+  const double sink = 0.5 * kelp_test::benchmark_line<double>(20).diameter;
+  const kelp::Vector3<double> start(0, 0, sink), end(cat.D, 0, cat.dz + sink);
   double prev_err = 0;
   for (int n : {20, 40, 80}) {
     const kt::TetherModeld model(kelp_test::benchmark_line<double>(n));
@@ -63,7 +67,8 @@ TEST_CASE("static equilibrium matches the analytic catenary, error ~ 1/N^2", "[t
     const double z_ned = -cat.z_up(x);
     const double chord_z = cat.dz * x / cat.D;
     const double sag = z_ned - chord_z;  // depth below the chord at that x
-    const kelp::Vector3<double> node = state.position.col(n / 2);
+    const kelp::Vector3<double> node =
+        state.position.col(n / 2) - kelp::Vector3<double>(0, 0, sink);
     const double err = (node - kelp::Vector3<double>(x, 0, z_ned)).norm() / sag;
     INFO("mid-node relative error " << err);
     if (n == 20) CHECK(err <= 2e-3);
@@ -168,6 +173,37 @@ TEST_CASE("a buoyant line between two anchors arches up as the inverted catenary
   // The end forces pull the anchors up (negative NED z).
   CHECK(ws.end_forces.on_start.z() < 0);
   CHECK(ws.end_forces.on_end.z() < 0);
+}
+
+TEST_CASE("a floating line rests half a diameter's band into the surface, at the buoyancy balance",
+          "[tether][statics][buoyant][surface]") {
+  // A buoyant line (μ = 0.03 kg/m < ρA = 0.0515 kg/m) between two points of the still surface
+  // floats where the buoyancy of its submerged fraction carries its weight: φ ρ A = μ with
+  // φ = (z + ζ)/D + ½ gives z = (μ/(ρA) − ½) D = 0.66 mm below the surface (φ = 0.58). The
+  // band used to start at the surface (φ = 1 + z/D), which floated the line 3.3 mm above it.
+  kelp::environment::Environmentd env;
+  auto p = kelp_test::benchmark_line<double>(20);
+  p.mass_per_length = 0.03;
+  const kt::TetherModeld model(p);
+  kt::TetherWorkspaced ws(model);
+  const double rho_a = env.water_density() * kelp::pi / 4 * p.diameter * p.diameter;
+  const double phi_eq = p.mass_per_length / rho_a;
+  const double z_eq = (phi_eq - 0.5) * p.diameter;
+  REQUIRE(z_eq > 0);
+  REQUIRE(z_eq < 0.5 * p.diameter);
+  // Ends held at the surface, the line as long as their distance, released two diameters deep.
+  const kelp::Vector3<double> a(0, 0, z_eq), b(p.length, 0, z_eq);
+  auto s = kt::straight_line_state(model, a, b);
+  for (int i = 1; i < p.segments; ++i) s.position(2, i) += 2 * p.diameter;
+  const auto r = kt::solve_static_equilibrium(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b));
+  REQUIRE(r.converged);
+  for (int i = 1; i < p.segments; ++i) {
+    INFO("node " << i);
+    CHECK(s.position(2, i) == Approx(z_eq).margin(1e-3 * p.diameter));
+    CHECK(ws.submerged(i) == Approx(phi_eq).epsilon(1e-3));
+  }
+  // Floating by buoyancy, not hanging on the ends: no tension.
+  CHECK(ws.tension.cwiseAbs().maxCoeff() < 1e-3);
 }
 
 TEST_CASE("float and double agree on the static equilibrium and a dynamic run",

@@ -44,6 +44,8 @@ struct ForcePass {
   const TetherParameters<Scalar>* p;
   int n;
   Scalar rho, g, bed, l, l2, inv_l, ea_l, ba_l, ea, ba, can, cat, inv_d, bed_k, bed_c;
+  /// Half the cable diameter [m]: a node at least this deep under the surface is wholly wet.
+  Scalar half_d;
   bool clamp, damping, still, bending, mass_turns;
   NodeConstants<Scalar> kinds[3];
   const Scalar* x;
@@ -68,7 +70,7 @@ enum PassColumn : int { kSegmentForce = 0, kNodeForce = 3, kMassRate = 6 };
 template <typename Scalar, bool Wide>
 struct PackedConstants {
   using P = simd::Pack<Scalar, Wide>;
-  P zero, one, two, l, l2, inv_l, ea, ea_l, ba, ba_l, bed, wet_weight, kn, kt, rho_vol,
+  P zero, one, two, l, l2, inv_l, ea, ea_l, ba, ba_l, bed, half_d, wet_weight, kn, kt, rho_vol,
       one_plus_can, cat_minus_can, mass_iso_wet, mass_tan_wet, mass_iso_inv, mass_tan_ratio;
   explicit PackedConstants(const ForcePass<Scalar>& c) {
     const NodeConstants<Scalar>& nc = c.kinds[1];
@@ -83,6 +85,7 @@ struct PackedConstants {
     ba = P::all(c.ba);
     ba_l = P::all(c.ba_l);
     bed = P::all(c.bed);
+    half_d = P::all(c.half_d);
     wet_weight = P::all(nc.wet_weight);
     kn = P::all(nc.kn);
     kt = P::all(nc.kt);
@@ -155,9 +158,9 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
 }
 
 /// Interior nodes i … i + lanes − 1 (1 ≤ i, i + lanes ≤ N) when all of them are below the
-/// surface band and off the seabed (returns false, writing nothing, otherwise): tangent, node
-/// force without the added-mass coupling to the neighbours, that coupling term w_i, masses and
-/// the Jacobian terms. The same arithmetic as node_general for such nodes.
+/// surface band (at least half a diameter deep) and off the seabed (returns false, writing nothing,
+/// otherwise): tangent, node force without the added-mass coupling to the neighbours, that coupling
+/// term w_i, masses and the Jacobian terms. The same arithmetic as node_general for such nodes.
 template <bool WithJacobian, bool Wide, typename Scalar>
 EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
                                         const PackedConstants<Scalar, Wide>& pc,
@@ -166,11 +169,12 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   const P zero = pc.zero;
   const Scalar* a = c.x + i * c.xs;
   const P z = P::gather(a + 2, c.xs);
+  // Wholly wet (at least half a diameter under the surface, φ = 1) and off the seabed.
   if (c.still) {
-    if (simd::any(simd::less(z, zero) || simd::greater(z - pc.bed, zero))) return false;
+    if (simd::any(simd::less(z, pc.half_d) || simd::greater(z - pc.bed, zero))) return false;
   } else {
     const P zeta = P::load(&ws.surface_elevation(i));
-    if (simd::any(simd::less(z + zeta, zero) || simd::greater(z - pc.bed, zero))) return false;
+    if (simd::any(simd::less(z + zeta, pc.half_d) || simd::greater(z - pc.bed, zero))) return false;
   }
   const P c0 = P::gather(a + c.xs, c.xs) - P::gather(a - c.xs, c.xs);
   const P c1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a - c.xs + 1, c.xs);

@@ -94,28 +94,31 @@ NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n) {
 }
 
 /// Submerged fraction φ of a node at NED depth z [m] under a free surface at elevation ζ [m]:
-/// the cable's cross-section of diameter D goes under over one diameter, taken as a linear ramp
-/// φ = clamp(1 + (z + ζ)/D, 0, 1) (1: wet, a node at the surface included; 0: in air, at least
-/// one diameter above the surface). Buoyancy, drag, fluid inertia and
-/// added mass scale with φ, so the node forces are continuous in the positions (an on/off switch
-/// at the surface would leave Newton's method no solution to converge to when a floating line
-/// rests at the surface).
+/// the cable's cross-section of diameter D goes under over one diameter centred on the node,
+/// taken as a linear ramp φ = clamp((z + ζ)/D + ½, 0, 1): ½ for a node exactly at the surface,
+/// 1 (wet) at least half a diameter below it, 0 (in air) at least half a diameter above it. This
+/// is the convention of the vehicles, whose band of one hull height is centred on the centre of
+/// buoyancy (vehicle::submerged_fraction). Buoyancy, drag, fluid inertia and added mass scale
+/// with φ, so the node forces are continuous in the positions (an on/off switch at the surface
+/// would leave Newton's method no solution to converge to when a floating line rests at the
+/// surface).
 template <typename Scalar>
 Scalar submerged_fraction(Scalar z, Scalar zeta, Scalar diameter,
                           Scalar inv_diameter = Scalar(-1)) {
   if (inv_diameter < Scalar(0)) inv_diameter = Scalar(1) / diameter;
-  const Scalar f = Scalar(1) + (z + zeta) * inv_diameter;
+  const Scalar f = (z + zeta) * inv_diameter + Scalar(0.5);
   return f >= Scalar(1) ? Scalar(1) : (f > Scalar(0) ? f : Scalar(0));
 }
 
-/// Antiderivative Φ of submerged_fraction in the depth d = z + ζ, zero in air and d + D/2 when
-/// wet: the buoyancy potential of a node is −ρ V g Φ [J].
+/// Antiderivative Φ of submerged_fraction in the depth d = z + ζ: 0 in air (d ≤ −D/2),
+/// (d + D/2)²/(2D) in the band and d when wet (d ≥ D/2). The buoyancy potential of a node is
+/// +ρ V g Φ [J] (NED z down: its force −ρ V g φ e_z is −∂/∂z of it).
 template <typename Scalar>
 Scalar submerged_depth_integral(Scalar z, Scalar zeta, Scalar diameter) {
-  const Scalar d = z + zeta;
-  if (d >= Scalar(0)) return d + Scalar(0.5) * diameter;
-  if (d <= -diameter) return Scalar(0);
-  return (d + diameter) * (d + diameter) / (Scalar(2) * diameter);
+  const Scalar d = z + zeta, half = Scalar(0.5) * diameter;
+  if (d >= half) return d;
+  if (d <= -half) return Scalar(0);
+  return (d + half) * (d + half) / (Scalar(2) * diameter);
 }
 
 /// Node i, any kind and state (end node, surface band, in air, on the seabed): tangent, node
@@ -147,9 +150,9 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
   const Scalar li = c.kinds[kind].li;
   const Scalar z = c.X(2, i);
   const Scalar zeta = c.still ? Scalar(0) : ws.surface_elevation(i);
-  // (Below the surface φ = 1 without the ramp's arithmetic.)
+  // (Half a diameter or more below the surface φ = 1 without the ramp's arithmetic.)
   const Scalar phi =
-      z + zeta >= Scalar(0) ? Scalar(1) : submerged_fraction(z, zeta, p.diameter, c.inv_d);
+      z + zeta >= c.half_d ? Scalar(1) : submerged_fraction(z, zeta, p.diameter, c.inv_d);
   ws.submerged(i) = phi;
   const bool wet = phi > Scalar(0);
   // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
@@ -246,7 +249,8 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
   ws.seabed_force(i) = normal;
   ws.mass_iso_inv(i) = Scalar(1) / ws.mass_iso(i);
   ws.mass_tan_ratio(i) = ws.mass_tan(i) / (ws.mass_iso(i) + ws.mass_tan(i));
-  // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
+  // In the surface band the buoyancy −φ ρ V g grows with depth (∂φ/∂z = 1/D): a restoring
+  // spring ρ V g / D.
   if (in_band) kz += c.kinds[kind].rho_vol * c.g / p.diameter;
   if constexpr (WithJacobian) {
     for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
@@ -357,6 +361,7 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   c.can = p.normal_added_mass;
   c.cat = p.tangential_added_mass;
   c.inv_d = Scalar(1) / p.diameter;
+  c.half_d = Scalar(0.5) * p.diameter;
   c.bed_k = p.seabed_stiffness * p.diameter;
   c.bed_c = p.seabed_damping * p.diameter;
   c.clamp = !p.compressive_damping;
@@ -432,7 +437,7 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 ///   friction −μ_f N v_h / max(|v_h|, v_f);
 /// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,
 ///   which goes from 1 to 0 as the node rises through the free surface over one cable diameter
-///   (detail::submerged_fraction): nodes in air get none.
+///   centred on the surface, ½ at the surface (detail::submerged_fraction): nodes in air get none.
 /// Evaluated in passes over SIMD packets (kelp/core/simd.hpp): the segments, then the interior
 /// nodes of the wet line a packet at a time (the ends and nodes in the surface band, in air or
 /// on the seabed one by one, with every branch), then the added-mass coupling of neighbours and
@@ -514,7 +519,7 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
 
 /// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
 /// the weight −Σ mᵢ g zᵢ (NED z down) and of the buoyancy Σ ρVᵢ g Φ(zᵢ + ζ) (Φ the depth of a
-/// wet node plus D/2, see detail::submerged_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
+/// wet node, see detail::submerged_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
 /// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
 /// tangents and wetness itself.
 /// \throws kelp::invalid_argument when the state does not fit the model or is not finite.
