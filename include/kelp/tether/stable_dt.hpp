@@ -12,6 +12,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/limits.hpp"
 
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/stepping.hpp"
