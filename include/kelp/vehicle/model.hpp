@@ -407,8 +407,8 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   ws.wind.setZero();
   if (p.hydrostatics == Hydrostatics::surface) {
     const Vector3<Scalar> ah(s.water_acceleration(0), s.water_acceleration(1), Scalar(0));
-    ws.froude_krylov.template head<3>() =
-        (p.density * p.displaced_volume) * (ws.rotation.transpose() * ah);
+    ws.froude_krylov.template head<3>() = environment::froude_krylov_force(
+        p.density, p.displaced_volume, Vector3<Scalar>(ws.rotation.transpose() * ah));
     if (p.wind_areas.frontal_area > 0.0 || p.wind_areas.lateral_area > 0.0) {
       using std::atan2;
       const Scalar psi = atan2(ws.rotation(1, 0), ws.rotation(0, 0));
@@ -420,8 +420,8 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
       ws.wind(5) = w(2);
     }
   } else {
-    ws.froude_krylov.template head<3>() =
-        (p.density * p.displaced_volume * ws.submerged_fraction) * aw;
+    ws.froude_krylov.template head<3>() = environment::froude_krylov_force(
+        p.density, Scalar(p.displaced_volume * ws.submerged_fraction), aw);
   }
   ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext) - ws.coriolis_rigid_body -
            ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot +
@@ -475,21 +475,6 @@ Scalar energy(const VehicleModel<Scalar>& model, const VehicleState<Scalar>& sta
               const Surroundings<Scalar>& s = Surroundings<Scalar>()) {
   const Scalar kinetic = Scalar(0.5) * state.nu.dot(model.mass_matrix() * state.nu);
   return kinetic + model.restoring_potential(state, s.surface_elevation, s.surface_slope);
-}
-
-/// \brief The hull data of a surface-vessel model as the environment layer's
-/// environment::SurfaceHydrostatics (for its wave_restoring()/surface_following_restoring()),
-/// so that the vehicle preset stays the one copy of the hull data.
-template <typename Scalar>
-environment::SurfaceHydrostatics surface_hydrostatics(const VehicleParameters<Scalar>& p) {
-  environment::SurfaceHydrostatics h;
-  h.rho = value_of(p.density);
-  h.gravity = value_of(p.gravity);
-  h.waterplane_area = value_of(p.waterplane_area);
-  h.displaced_volume = value_of(p.displaced_volume);
-  h.gm_transverse = value_of(p.gm_transverse);
-  h.gm_longitudinal = value_of(p.gm_longitudinal);
-  return h;
 }
 
 /// \brief Vehicle parameters in double precision.
