@@ -264,6 +264,36 @@ TEST_CASE("wind: an ASV drifts downwind where the wind load balances the hull's 
   CHECK(std::abs(x.nu(0)) < 1e-3);
 }
 
+TEST_CASE("wind: the boat's wind load reads the environment's air density (one air)",
+          "[vehicle][environment][wind]") {
+  // Wind abeam on a boat at rest: the load is ½ ρ_air U² c_y A_L (Fossen 2021, §10.1.1), so it
+  // scales with the environment's air density. Before the fix the model used the constant
+  // 1.225 kg/m³ whatever the environment said (10× the air gave the same 5.51 N).
+  ke::WindParameters wp;
+  wp.speed = 8.0;
+  wp.direction = 0.5 * kelp::pi;
+  wp.gust = ke::GustSpectrum::none;
+  const auto boat = kv::blueboat<double>();
+  const kv::VehicleModeld model(boat.parameters);
+  kv::VehicleWorkspaced ws;
+  const kv::VehicleStated x;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  double sway[2];
+  for (int k = 0; k < 2; ++k) {
+    ke::Environmentd env;
+    env.set_wind(ke::WindField<double>(wp));
+    env.set_air_density(k == 0 ? kelp::air_density : 10 * kelp::air_density);
+    const kv::Surroundings<double> s = kv::surroundings(model, env, x, 0.0);
+    CHECK(s.air_density == env.air_density());
+    kv::forward_dynamics(model, ws, x, zero, zero, s);
+    sway[k] = ws.wind(1);
+  }
+  const double expected = 0.5 * kelp::air_density * 64.0 * boat.parameters.wind_coefficients.cy *
+                          boat.parameters.wind_areas.lateral_area;
+  CHECK(sway[0] == Approx(expected).epsilon(1e-12));
+  CHECK(sway[1] == Approx(10 * sway[0]).epsilon(1e-12));
+}
+
 TEST_CASE(
     "ASV: restoring follows the wave surface and is bounded when the hull emerges or "
     "submerges",

@@ -268,6 +268,7 @@ vehicle::Surroundings<Scalar> lerp(const vehicle::Surroundings<Scalar>& a,
   s.surface_elevation = a.surface_elevation + c * (b.surface_elevation - a.surface_elevation);
   s.surface_slope = a.surface_slope + c * (b.surface_slope - a.surface_slope);
   s.wind_velocity = a.wind_velocity + c * (b.wind_velocity - a.wind_velocity);
+  s.air_density = a.air_density + c * (b.air_density - a.air_density);
   return s;
 }
 

@@ -368,7 +368,8 @@ struct VehicleWorkspace {
 /// horizontal part of a_w enters τ_FK: the vertical pressure of the wave is already in the
 /// restoring that follows the local surface. The moments of τ_FK are neglected (small body).
 /// Wind (surface vessels): environment::wind_load() with the model's `wind_areas` and
-/// `wind_coefficients`, on the heading ψ and the body velocity over ground (Fossen 2021,
+/// `wind_coefficients` and the surroundings' air density (the environment's: one air, as there
+/// is one water), on the heading ψ and the body velocity over ground (Fossen 2021,
 /// §10.1.1). With still water, no wind and a flat surface this is the irrotational-current
 /// model of the file comment.
 ///
@@ -412,9 +413,9 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
     if (p.wind_areas.frontal_area > 0.0 || p.wind_areas.lateral_area > 0.0) {
       using std::atan2;
       const Scalar psi = atan2(ws.rotation(1, 0), ws.rotation(0, 0));
-      const Vector3<Scalar> w = environment::detail::wind_load_unchecked(
-          p.wind_coefficients, p.wind_areas, Scalar(kelp::air_density), s.wind_velocity, psi,
-          state.nu(0), state.nu(1));
+      const Vector3<Scalar> w =
+          environment::detail::wind_load_unchecked(p.wind_coefficients, p.wind_areas, s.air_density,
+                                                   s.wind_velocity, psi, state.nu(0), state.nu(1));
       ws.wind(0) = w(0);
       ws.wind(1) = w(1);
       ws.wind(5) = w(2);
