@@ -268,6 +268,17 @@ class VehicleModel {
     return restoring_force(weight_, buoyancy_, p.r_g, p.r_b, R);
   }
 
+  /// \brief Submerged fraction φ ∈ [0, 1] of the state under a surface at elevation ζ [m]
+  /// (`submerged_free_surface`: submerged_fraction() of the box hull about the CB; 1 for the other
+  /// models). Every fluid term of a `submerged_free_surface` vehicle scales with it (see
+  /// forward_dynamics()).
+  Scalar submerged_fraction(const VehicleState<Scalar>& state, const Scalar& zeta) const {
+    if (parameters_.hydrostatics != Hydrostatics::submerged_free_surface) return Scalar(1);
+    const Scalar z_cb =
+        state.position(2) + state.attitude.toRotationMatrix().row(2).dot(parameters_.r_b);
+    return vehicle::submerged_fraction(z_cb, zeta, parameters_.hull_height);
+  }
+
   /// \brief Hydrostatic potential energy U [J] of which restoring() is the gradient for a fixed
   /// surface (ζ, slope): see restoring_potential_free_surface() and
   /// restoring_potential_surface_following(); −W z_CG + B z_CB for `submerged`.
@@ -340,6 +351,9 @@ struct VehicleWorkspace {
   Vector6<Scalar> wind = Vector6<Scalar>::Zero();
   /// Submerged fraction φ of the last evaluation (1 unless `submerged_free_surface`).
   Scalar submerged_fraction = Scalar(1);
+  /// Force of the changing added mass of a vehicle crossing the surface,
+  /// −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ [N, N m] (zero when φ is 0 or 1; see forward_dynamics).
+  Vector6<Scalar> added_mass_change = Vector6<Scalar>::Zero();
   /// Right-hand side M ν̇ [N, N m].
   Vector6<Scalar> rhs = Vector6<Scalar>::Zero();
   /// ν̇ [m/s², rad/s²].
@@ -424,10 +438,41 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
     ws.froude_krylov.template head<3>() = environment::froude_krylov_force(
         p.density, Scalar(p.displaced_volume * ws.submerged_fraction), aw);
   }
+  ws.added_mass_change.setZero();
+  const Scalar& phi = ws.submerged_fraction;
+  // Fast path: fully submerged (or not a submerged-fraction model): M is the factored M_RB + M_A.
+  if (p.hydrostatics != Hydrostatics::submerged_free_surface || !(value_of(phi) < 1.0)) {
+    ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext) - ws.coriolis_rigid_body -
+             ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot +
+             ws.froude_krylov + ws.wind;
+    ws.nu_dot.noalias() = model.mass_inverse() * ws.rhs;
+    return ws.nu_dot;
+  }
+  // Breaking the surface: every fluid term scales with φ (buoyancy and Froude–Krylov above; added
+  // mass, its Coriolis and the flow's inertia force, and damping here), the mass matrix is
+  // M_RB + φ M_A (factored here, a fixed-size LDLT: no allocation), and the added mass changing
+  // with the position adds −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ, the terms of Lagrange's equations
+  // for T = ½ νᵀ (M_RB + φ(η) M_A) ν (d/dt(M ν) = M ν̇ + φ̇ M_A ν, minus ∂T/∂η), so that T + U is
+  // still conserved without damping (no energy from the changing mass). ∇φ in body axes is
+  // (1/h)(d, r_b × d), d = Rᵀ e_z, inside the band and 0 outside; φ̇ = ∇φᵀ ν_r, which in waves
+  // counts the surface's own motion through the orbital velocity.
+  const Matrix6<Scalar>& ma = model.added_mass();
+  ws.coriolis_added_mass *= phi;
+  ws.damping *= phi;
+  if (value_of(phi) > 0.0) {
+    const Vector3<Scalar> d = ws.rotation.row(2).transpose();
+    Vector6<Scalar> grad;
+    grad.template head<3>() = d / p.hull_height;
+    grad.template tail<3>() = Vector3<Scalar>(p.r_b).cross(d) / p.hull_height;
+    const Vector6<Scalar> ma_nu_r = ma * ws.nu_r;
+    ws.added_mass_change = -grad.dot(ws.nu_r) * ma_nu_r + Scalar(0.5) * ws.nu_r.dot(ma_nu_r) * grad;
+  }
   ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext) - ws.coriolis_rigid_body -
-           ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot +
-           ws.froude_krylov + ws.wind;
-  ws.nu_dot.noalias() = model.mass_inverse() * ws.rhs;
+           ws.coriolis_added_mass - ws.damping - ws.restoring + phi * (ma * ws.nu_c_dot) +
+           ws.froude_krylov + ws.wind + ws.added_mass_change;
+  const Matrix6<Scalar> mass = model.rigid_body_mass() + phi * ma;
+  const Eigen::LDLT<Matrix6<Scalar>> ldlt(mass);
+  ws.nu_dot = ldlt.solve(ws.rhs);
   return ws.nu_dot;
 }
 
@@ -464,7 +509,8 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   return forward_dynamics(model, ws, state, tau, tau_env, Vector3<Scalar>::Zero());
 }
 
-/// \brief Mechanical energy [J] of a vehicle: kinetic ½ νᵀ (M_RB + M_A) ν plus the hydrostatic
+/// \brief Mechanical energy [J] of a vehicle: kinetic ½ νᵀ (M_RB + φ M_A) ν (φ the submerged
+/// fraction, 1 unless `submerged_free_surface`) plus the hydrostatic
 /// potential U of VehicleModel::restoring_potential() for the surface in `s` (elevation and slope
 /// at the CO). U is the integral of the restoring force, so without damping, forcing, current or
 /// waves (flat surface) the energy is conserved: e.g. for `submerged_free_surface`
@@ -474,7 +520,9 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
 template <typename Scalar>
 Scalar energy(const VehicleModel<Scalar>& model, const VehicleState<Scalar>& state,
               const Surroundings<Scalar>& s = Surroundings<Scalar>()) {
-  const Scalar kinetic = Scalar(0.5) * state.nu.dot(model.mass_matrix() * state.nu);
+  const Scalar phi = model.submerged_fraction(state, s.surface_elevation);
+  const Scalar kinetic = Scalar(0.5) * state.nu.dot(model.rigid_body_mass() * state.nu) +
+                         Scalar(0.5) * phi * state.nu.dot(model.added_mass() * state.nu);
   return kinetic + model.restoring_potential(state, s.surface_elevation, s.surface_slope);
 }
 
