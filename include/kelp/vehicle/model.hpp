@@ -13,6 +13,9 @@
 /// where the last term is the irrotational-current correction. M is factored once (LDLT) when the
 /// model is built and M⁻¹ is taken from that factorisation at the same time; a step then costs one
 /// 6×6 matrix-vector product, with no factorisation, no inverse and no allocation per step.
+/// Exception: a `submerged_free_surface` vehicle breaking the surface (submerged fraction φ < 1)
+/// has M = M_RB + φ M_A, factored per evaluation (fixed size, no allocation); see
+/// forward_dynamics().
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -222,7 +225,8 @@ class VehicleModel {
   const Matrix6<Scalar>& rigid_body_mass() const { return rigid_body_mass_; }
   /// \brief M_A (symmetric part of the given matrix).
   const Matrix6<Scalar>& added_mass() const { return added_mass_; }
-  /// \brief M = M_RB + M_A.
+  /// \brief M = M_RB + M_A (fully submerged; a `submerged_free_surface` vehicle at the surface has
+  /// M_RB + φ M_A, see forward_dynamics()).
   const Matrix6<Scalar>& mass_matrix() const { return mass_; }
   /// \brief LDLT factorisation of M, computed once.
   const Eigen::LDLT<Matrix6<Scalar>>& mass_ldlt() const { return ldlt_; }
@@ -386,6 +390,11 @@ struct VehicleWorkspace {
 /// is one water), on the heading ψ and the body velocity over ground (Fossen 2021,
 /// §10.1.1). With still water, no wind and a flat surface this is the irrotational-current
 /// model of the file comment.
+/// Free surface (`submerged_free_surface`, docs/equations.md "Free surface"): every fluid term
+/// scales with the submerged fraction φ of the box hull about the CB: buoyancy, τ_FK, the added
+/// mass (M = M_RB + φ M_A in the mass matrix, φ C_A, φ M_A ν̇_w) and the damping φ D; the
+/// position-dependent added mass adds ws.added_mass_change = −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ
+/// (Lagrange's equations for T = ½ νᵀ M(φ) ν), so that T + U is conserved without damping.
 ///
 /// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
 /// \param[in] state pose (NED, unit quaternion) and ν (body).
