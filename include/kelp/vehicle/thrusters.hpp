@@ -169,9 +169,11 @@ Scalar thrust(const ThrusterModel& m, const Scalar& u_in) {
   Scalar u = u_in;
   if (value_of(u) > 1.0) u = Scalar(1);
   if (value_of(u) < -1.0) u = Scalar(-1);
-  Scalar f;
-  detail::thrust_polynomial<Scalar>(m, u, f, nullptr);
-  return f;
+  // The value alone (the hot path of every thruster evaluation): Horner in u².
+  const Scalar x = u * u;
+  Scalar p(m.odd_coefficients[ThrusterModel::order - 1]);
+  for (int k = ThrusterModel::order - 2; k >= 0; --k) p = p * x + Scalar(m.odd_coefficients[k]);
+  return u * p;
 }
 
 /// \brief dF/du [N] of thrust() (same clamping: 0 outside [−1, 1]).
