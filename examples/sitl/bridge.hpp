@@ -285,8 +285,7 @@ class Bridge {
       ++p.counters.pwm_out_of_range;
       return 0;
     }
-    command = kv::command_from_pwm(static_cast<double>(pwm), m);
-    return kv::t200_thrust(command);
+    return kv::thrust_from_pwm(kv::t200_model, static_cast<double>(pwm), m, &command);
   }
   void set_pwm(int slot, const ServoPacket& pkt) {
     Peer& p = peers_[static_cast<std::size_t>(slot)];

@@ -9,6 +9,7 @@
 #include "kelp/core/fast_math.hpp"
 #include "kelp/environment/current.hpp"
 #include "kelp/environment/environment.hpp"
+#include "kelp/environment/paper.hpp"
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/environment/spectra.hpp"
 #include "kelp/environment/wave_loads.hpp"

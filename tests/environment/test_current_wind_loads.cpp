@@ -8,6 +8,7 @@
 #include "kelp/core/rotation.hpp"
 #include "kelp/environment/current.hpp"
 #include "kelp/environment/environment.hpp"
+#include "kelp/environment/paper.hpp"
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/wind.hpp"

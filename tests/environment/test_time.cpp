@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kelp/environment/environment.hpp"
+#include "kelp/environment/paper.hpp"
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/environment/wave_loads.hpp"
 

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "kelp/environment/environment.hpp"
+#include "kelp/environment/paper.hpp"
 #include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/waves.hpp"
 

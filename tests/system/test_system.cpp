@@ -70,7 +70,10 @@ bool bitwise_equal(const ks::SystemStated& a, const ks::SystemStated& b) {
 Vector3<double> momentum(const ks::SystemModeld& model, ks::SystemWorkspaced& ws,
                          const ks::SystemStated& s) {
   const auto body = [](const kv::VehicleModeld& m, const kv::VehicleStated& x) {
-    const Vector6<double> p = m.mass_matrix() * x.nu;
+    // Body momentum (M_RB + phi M_A) nu: a vehicle breaking the (calm) surface carries the added
+    // mass of its submerged fraction phi only (docs/equations.md, "Free surface").
+    const Vector6<double> p =
+        (m.rigid_body_mass() + m.submerged_fraction(x, 0.0) * m.added_mass()) * x.nu;
     return Vector3<double>(x.attitude * Vector3<double>(p.head<3>()));
   };
   Vector3<double> total = body(model.asv(), s.asv) + body(model.auv(), s.auv);

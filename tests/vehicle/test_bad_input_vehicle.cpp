@@ -13,6 +13,7 @@
 #include "kelp/vehicle/added_mass.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/paper.hpp"
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/restoring.hpp"
 #include "kelp/vehicle/rigid_body.hpp"

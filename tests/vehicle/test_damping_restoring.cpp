@@ -172,21 +172,25 @@ TEMPLATE_TEST_CASE("a pitched vehicle with r_b above r_g rights itself", "[vehic
 
 TEST_CASE("surface restoring: heave stiffness and righting moments", "[vehicle][restoring]") {
   // Independent values: ρ g A_wp z = 1025 · 9.80665 · 0.19 · 0.05 = 95.4923 N (pushes up, so g_z >
-  // 0); roll righting ρ g ∇ GM_T sin φ with ∇ = 15/1025 m³: 15 · 9.80665 · 2.0 · sin 0.1 = 29.37094
-  // N m.
+  // 0); roll righting ρ g ∇ GM_T sin φ cos φ (the gradient of ½ ρ g ∇ GM_T sin²φ) with ∇ = 15/1025
+  // m³: 15 · 9.80665 · 2.0 · sin 0.1 cos 0.1 = 29.22421 N m, Fossen's linear ρ g ∇ GM_T φ to first
+  // order (Fossen 2021, §4.2). Calm water (ζ = 0, no slope), no hull-depth bound.
   const auto p = kv::blueboat<double>().parameters;
-  const Vector6<double> gz = kv::restoring_force_surface(
-      p.density, p.gravity, p.displaced_volume, p.waterplane_area, p.gm_transverse,
-      p.gm_longitudinal, 0.05, Matrix3<double>::Identity());
+  const Eigen::Vector2d flat = Eigen::Vector2d::Zero();
+  const auto g = [&](double z, const Matrix3<double>& R) {
+    return kv::restoring_force_surface_following(p.density, p.gravity, p.displaced_volume,
+                                                 p.waterplane_area, p.gm_transverse,
+                                                 p.gm_longitudinal, 0.0, z, 0.0, flat, R);
+  };
+  const Vector6<double> gz = g(0.05, Matrix3<double>::Identity());
   CHECK(gz(2) == Approx(95.4923).epsilon(1e-5));
   CHECK(gz.norm() == Approx(gz(2)));
-  const Vector6<double> gr = kv::restoring_force_surface(
-      p.density, p.gravity, p.displaced_volume, p.waterplane_area, p.gm_transverse,
-      p.gm_longitudinal, 0.0, kelp::rotation_zyx(0.1, 0.0, 0.3));
-  CHECK(gr(3) == Approx(15 * 9.80665 * 2.0 * std::sin(0.1)).epsilon(1e-12));
-  CHECK(gr(3) == Approx(29.37094).epsilon(1e-6));
-  const Vector6<double> gp = kv::restoring_force_surface(
-      p.density, p.gravity, p.displaced_volume, p.waterplane_area, p.gm_transverse,
-      p.gm_longitudinal, 0.0, kelp::rotation_zyx(0.0, 0.1, 0.0));
-  CHECK(gp(4) == Approx(15 * 9.80665 * 1.3 * std::sin(0.1)).epsilon(1e-12));
+  const Vector6<double> gr = g(0.0, kelp::rotation_zyx(0.1, 0.0, 0.3));
+  CHECK(gr(3) == Approx(15 * 9.80665 * 2.0 * std::sin(0.1) * std::cos(0.1)).epsilon(1e-12));
+  CHECK(gr(3) == Approx(29.22421).epsilon(1e-6));
+  const Vector6<double> gp = g(0.0, kelp::rotation_zyx(0.0, 0.1, 0.0));
+  CHECK(gp(4) == Approx(15 * 9.80665 * 1.3 * std::sin(0.1) * std::cos(0.1)).epsilon(1e-12));
+  // Small angles: Fossen's linear righting moment.
+  const Vector6<double> gs = g(0.0, kelp::rotation_zyx(1e-4, 0.0, 0.0));
+  CHECK(gs(3) == Approx(15 * 9.80665 * 2.0 * 1e-4).epsilon(1e-7));
 }

@@ -294,6 +294,7 @@ TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage"
   const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
   kv::VehicleWorkspace<double> ws;
   kv::VehicleState<double> x;
+  x.position.z() = 5.0;  // fully submerged: M = M_RB + M_A (at the surface it is M_RB + phi M_A)
   x.nu << 0.2, 0.1, -0.1, 0.05, 0.02, -0.1;
   Vector6<double> t1, t2;
   t1 << 10, 0, 5, 0, 1, 0;

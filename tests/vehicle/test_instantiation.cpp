@@ -28,6 +28,8 @@ template struct StateDerivative<double>;
 template struct StateDerivative<float>;
 template class ThrusterAllocation<double>;
 template class ThrusterAllocation<float>;
+template class ThrusterChain<double>;
+template class ThrusterChain<float>;
 template struct PwmMapping<double>;
 template struct PwmMapping<float>;
 template struct VehiclePreset<double>;

@@ -24,6 +24,7 @@ template struct VehicleWorkspace<Jet>;
 template struct PoseRate<Jet>;
 template struct StateDerivative<Jet>;
 template class ThrusterAllocation<Jet>;
+template class ThrusterChain<Jet>;
 template struct PwmMapping<Jet>;
 template struct VehiclePreset<Jet>;
 }  // namespace kelp::vehicle

@@ -140,3 +140,59 @@ TEMPLATE_TEST_CASE("PWM <-> command mapping with deadband", "[vehicle][thrusters
   bad.max_us = S(1400);
   CHECK_THROWS_WITH(kv::validate(bad), Catch::Contains("max_us"));
 }
+
+TEMPLATE_TEST_CASE(
+    "the thruster chain PWM -> command -> thrust -> wrench is the composition of its "
+    "parts",
+    "[vehicle][thrusters]", double, float) {
+  using S = TestType;
+  const auto rov = kv::bluerov2_heavy<S>();
+  const kv::ThrusterAllocation<S> alloc(rov.thruster_positions, rov.thruster_directions);
+  const kv::ThrusterChain<S> chain(alloc, kv::t200_model, rov.pwm);
+  Eigen::Matrix<S, 8, 1> pwm, u, f, u_ref, f_ref;
+  pwm << S(1100), S(1300), S(1490), S(1510), S(1530), S(1700), S(1900), S(2000);
+  const Vector6<S> w = chain.wrench_from_pwm(pwm, u, f);
+  for (int i = 0; i < 8; ++i) {
+    u_ref(i) = kv::command_from_pwm(pwm(i), rov.pwm);
+    f_ref(i) = kv::t200_thrust(u_ref(i));
+    CHECK(u(i) == u_ref(i));
+    CHECK(f(i) == f_ref(i));
+    S c(-7);
+    CHECK(chain.thrust_of_pwm(pwm(i), &c) == f_ref(i));
+    CHECK(c == u_ref(i));
+  }
+  CHECK(u(2) == S(0));  // inside the dead band
+  CHECK(u(7) == S(1));  // clamped
+  const Vector6<S> w_ref = alloc.wrench(f_ref);
+  CHECK((w - w_ref).norm() <= S(1e-5) * w_ref.norm());
+  // The other way, as the controllers use it: desired force -> command -> delivered thrust,
+  // saturated at the curve's peak.
+  Eigen::Matrix<S, 8, 1> want, cmd, got;
+  want << S(-40), S(-30), S(-5), S(0), S(0.5), S(12), S(30.6), S(100);
+  chain.commands_for(want, cmd, got);
+  for (int i = 0; i < 8; ++i) {
+    CHECK(cmd(i) == kv::t200_command(want(i)));
+    CHECK(got(i) == kv::t200_thrust(cmd(i)));
+    if (std::abs(double(want(i))) < kv::t200_max_thrust)
+      CHECK(double(got(i)) == Approx(double(want(i))).margin(1e-3));
+    else
+      CHECK(std::abs(double(got(i))) == Approx(kv::t200_max_thrust).epsilon(1e-5));
+  }
+  // One curve, written once: the slope is the derivative of the thrust (central differences).
+  for (double x = -0.95; x <= 0.95; x += 0.05) {
+    const double h = 1e-6;
+    const double fd = (kv::t200_thrust(x + h) - kv::t200_thrust(x - h)) / (2 * h);
+    CHECK(kv::t200_thrust_slope(x) == Approx(fd).epsilon(1e-6));
+  }
+  // A model with other coefficients changes the chain in one place.
+  kv::ThrusterModel half = kv::t200_model;
+  for (double& c : half.odd_coefficients) c *= 0.5;
+  half.max_thrust *= 0.5;
+  const kv::ThrusterChain<S> weak(alloc, half, rov.pwm);
+  Eigen::Matrix<S, 8, 1> u2, f2;
+  const Vector6<S> w2 = weak.wrench_from_pwm(pwm, u2, f2);
+  CHECK((w2 - S(0.5) * w).norm() <= S(1e-5) * w.norm());
+  kv::ThrusterModel bad = kv::t200_model;
+  bad.peak_command = 1.5;
+  CHECK_THROWS_AS(kv::ThrusterChain<S>(alloc, bad), kelp::invalid_argument);
+}

@@ -1,6 +1,7 @@
 /// \file
 /// \brief Controllers for the tethered pair: an AUV controller (depth, heading and position hold,
-/// waypoint following) through an eight-thruster allocation and the T200 curve, and an ASV
+/// waypoint following) through an eight-thruster allocation and the thruster chain
+/// (vehicle::ThrusterChain, the T200 curve by default), and an ASV
 /// controller (station keeping, follow the AUV) through two skid-steering thrusters with the
 /// PID gains of Buchholz et al. (2025, arXiv:2508.02264). Both can add the paper's
 /// "disturbance-aware" feedforward.
@@ -132,6 +133,8 @@ struct AuvControllerSettings {
   PidGains yaw{5.0, 0.2, 3.4, 15.0, 2.0};        ///< heading error → N [N m]
   double period = 0.02;                          ///< update period [s] (50 Hz)
   double max_thrust = vehicle::t200_max_thrust;  ///< per thruster [N]
+  /// The thrusters' curve (the chain command → thrust; vehicle::ThrusterChain).
+  vehicle::ThrusterModel thruster_model = vehicle::t200_model;
   /// Largest horizontal error fed to the PIDs [m]: a far waypoint is approached at a steady
   /// pace instead of with the full error (a carrot on the line to it).
   double max_horizontal_error = 2.0;
@@ -144,7 +147,7 @@ struct AuvControllerSettings {
 struct AuvCommand {
   Vector6<double> wrench = Vector6<double>::Zero();  ///< body wrench the thrusters deliver
   Eigen::VectorXd thrust;                            ///< per thruster [N], after saturation
-  Eigen::VectorXd command;  ///< normalised T200 commands (t200_command of thrust)
+  Eigen::VectorXd command;  ///< normalised commands (the thruster model's inverse of thrust)
   Vector3<double> position_error = Vector3<double>::Zero();  ///< target − position, NED [m]
   double heading_error = 0.0;                                ///< [rad]
   bool saturated = false;  ///< the allocation had to scale the thrust down
@@ -160,7 +163,7 @@ class AuvController {
                 const vehicle::ThrusterAllocation<double>& thrusters,
                 const AuvControllerSettings& s = {})
       : settings_(s),
-        thrusters_(thrusters),
+        thrusters_(thrusters, s.thruster_model),
         surge_(s.surge, "surge"),
         sway_(s.sway, "sway"),
         heave_(s.heave, "heave"),
@@ -234,7 +237,7 @@ class AuvController {
         pitch_.update(-rpy(1), dt, -nav.nu(4)), yaw_.update(e_psi, dt, -nav.nu(5));
     if (settings_.compensate) tau -= observer_.estimate();
     // Allocation, then uniform scaling so that no thruster exceeds max_thrust.
-    thrusters_.distribute(tau, force_);
+    thrusters_.allocation().distribute(tau, force_);
     const double peak = force_.cwiseAbs().maxCoeff();
     command_.saturated = peak > settings_.max_thrust;
     if (command_.saturated) {
@@ -245,10 +248,8 @@ class AuvController {
       heave_.set_integral(i_saved[2]);
       yaw_.set_integral(i_saved[3]);
     }
-    for (Eigen::Index i = 0; i < force_.size(); ++i) {
-      command_.command(i) = vehicle::t200_command(force_(i));
-      command_.thrust(i) = vehicle::t200_thrust(command_.command(i));
-    }
+    // The thrust the thrusters deliver for these commands (the curve saturates at its peak).
+    thrusters_.commands_for(force_, command_.command, command_.thrust);
     command_.wrench = thrusters_.wrench(command_.thrust);
     return command_;
   }
@@ -259,7 +260,7 @@ class AuvController {
 
  private:
   AuvControllerSettings settings_;
-  vehicle::ThrusterAllocation<double> thrusters_;
+  vehicle::ThrusterChain<double> thrusters_;
   Pid surge_, sway_, heave_, roll_, pitch_, yaw_;
   DisturbanceObserver observer_;
   std::vector<Vector3<double>> waypoints_;
@@ -288,12 +289,14 @@ struct AsvControllerSettings {
   Vector3<double> follow_offset = Vector3<double>::Zero();
   bool compensate = false;              ///< feed the estimated disturbance forward
   double observer_time_constant = 2.0;  ///< [s]
+  /// The thrusters' curve (the chain command → thrust; vehicle::ThrusterChain).
+  vehicle::ThrusterModel thruster_model = vehicle::t200_model;
 };
 
 /// \brief One ASV controller output.
 struct AsvCommand {
   double left = 0.0, right = 0.0;  ///< thrust of the port and starboard thrusters [N]
-  Eigen::Vector2d command = Eigen::Vector2d::Zero();         ///< normalised T200 commands
+  Eigen::Vector2d command = Eigen::Vector2d::Zero();         ///< normalised commands
   Vector6<double> wrench = Vector6<double>::Zero();          ///< body wrench delivered
   Vector3<double> position_error = Vector3<double>::Zero();  ///< target − position, NED [m]
   double heading_error = 0.0;  ///< bearing (or heading, once there) error [rad]
@@ -308,7 +311,7 @@ class AsvController {
                 const vehicle::ThrusterAllocation<double>& thrusters,
                 const AsvControllerSettings& s = {})
       : settings_(s),
-        thrusters_(thrusters),
+        thrusters_(thrusters, s.thruster_model),
         linear_(s.linear, "linear"),
         angular_(s.angular, "angular"),
         yaw_(s.yaw, "yaw"),
@@ -373,9 +376,9 @@ class AsvController {
     // More thrust on the port side turns the bow to starboard (positive yaw, NED).
     command_.left = std::clamp(common + differential, -clip, clip);
     command_.right = std::clamp(common - differential, -clip, clip);
-    command_.command << vehicle::t200_command(command_.left), vehicle::t200_command(command_.right);
-    const Eigen::Vector2d f(vehicle::t200_thrust(command_.command(0)),
-                            vehicle::t200_thrust(command_.command(1)));
+    const Eigen::Vector2d wanted(command_.left, command_.right);
+    Eigen::Vector2d f;
+    thrusters_.commands_for(wanted, command_.command, f);
     command_.wrench = thrusters_.wrench(f);
     return command_;
   }
@@ -386,7 +389,7 @@ class AsvController {
 
  private:
   AsvControllerSettings settings_;
-  vehicle::ThrusterAllocation<double> thrusters_;
+  vehicle::ThrusterChain<double> thrusters_;
   Pid linear_, angular_, yaw_;
   DisturbanceObserver observer_;
   Vector3<double> target_ = Vector3<double>::Zero();

@@ -1,7 +1,8 @@
 /// \file
-/// \brief Ocean current: the paper's formula, Fossen's 3-D current vector, depth profiles
+/// \brief Ocean current: Fossen's 3-D current vector, depth profiles
 /// (uniform, power-law, linear) and a seeded, bounded first-order Gauss–Markov variation of speed
-/// and direction that keeps varying for any run length.
+/// and direction that keeps varying for any run length. The paper's current formula is in
+/// `kelp/environment/paper.hpp`.
 ///
 /// Frames: world NED, z down, mean sea surface at z = 0. Angles: β_c is the horizontal direction
 /// the current flows TOWARDS (NED azimuth from north, clockwise) and α_c the vertical angle of
@@ -26,22 +27,6 @@
 
 namespace kelp {
 namespace environment {
-
-/// \brief The paper's current formula (eq:current): v_c = V_c cos α_c cos β_c [m/s].
-///
-/// The paper writes this one component only. It is the first (north, x) component of Fossen's 3-D
-/// current vector (`current_velocity_ned`); with α_c = β_c = 0 it is the whole current, flowing
-/// north. \param[in] speed V_c [m/s] \param[in] alpha α_c vertical angle [rad]
-/// \param[in] beta β_c horizontal direction [rad]
-/// \throws kelp::invalid_argument when V_c, α_c or β_c is not finite.
-template <typename Scalar>
-Scalar paper_current(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
-  using std::cos;
-  check_finite(speed, "current speed");
-  check_finite(alpha, "current vertical angle alpha");
-  check_finite(beta, "current direction beta");
-  return speed * cos(alpha) * cos(beta);
-}
 
 /// \brief Fossen's 3-D current velocity in NED [m/s] from speed and direction angles:
 /// \f$ \mathbf v_c^n = V_c [\cos\alpha_c\cos\beta_c,\ \sin\beta_c,\ \sin\alpha_c\cos\beta_c]^T \f$

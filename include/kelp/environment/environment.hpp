@@ -4,11 +4,12 @@
 ///
 /// One water: the `Environment` is the single source of truth for the water density, gravity and
 /// air density. Models that carry their own copy (they need it inside their force laws) are
-/// checked against it where they meet it, with `check_same_water`: here for the pieces of the
-/// environment layer (`SurfaceHydrostatics`, `PaperWave`; a `WaveField`'s gravity is checked by
-/// `set_waves` / `set_gravity`), in `kelp/vehicle/water.hpp` for vehicle models. A mismatch throws
-/// `kelp::invalid_argument` naming both values. Build such a model from the environment (e.g.
-/// `h.rho = env.water_density(); h.gravity = env.gravity();`) and the check passes.
+/// checked against it where they meet it, with `check_same_water`: here for a `WaveField` (its
+/// gravity, also checked by `set_waves` / `set_gravity`), in `kelp/environment/paper.hpp` for the
+/// paper's `SurfaceHydrostatics` and `PaperWave`, in `kelp/vehicle/water.hpp` for vehicle models. A
+/// mismatch throws `kelp::invalid_argument` naming both values. Build such a model from the
+/// environment (e.g. `h.rho = env.water_density(); h.gravity = env.gravity();`) and the check
+/// passes.
 ///
 /// Frames and signs: world NED (x north, y east, z down, mean sea surface at z = 0). The surface
 /// elevation ζ is positive UP, so the free surface lies at NED z = −ζ. Units SI.
@@ -27,7 +28,6 @@
 #include "kelp/core/types.hpp"
 #include "kelp/environment/current.hpp"
 #include "kelp/environment/limits.hpp"
-#include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/waves.hpp"
 #include "kelp/environment/wind.hpp"
 
@@ -307,20 +307,6 @@ void check_same_water(double density, double gravity, const Environment<Scalar>&
     msg << " (build the model from env.water_density() and env.gravity())";
     ::kelp::detail::throw_invalid_argument(msg.str());
   }
-}
-
-/// \brief Checks a surface vessel's hydrostatics (`rho`, `gravity`) against the environment.
-/// \throws kelp::invalid_argument naming both values when they differ.
-template <typename Scalar>
-void check_same_water(const SurfaceHydrostatics& h, const Environment<Scalar>& env) {
-  check_same_water(h.rho, h.gravity, env, "SurfaceHydrostatics");
-}
-
-/// \brief Checks the paper's wave-load parameters (`rho`, `gravity`) against the environment.
-/// \throws kelp::invalid_argument naming both values when they differ.
-template <typename Scalar>
-void check_same_water(const PaperWave& w, const Environment<Scalar>& env) {
-  check_same_water(w.rho, w.gravity, env, "PaperWave");
 }
 
 /// \brief Checks a wave field's gravity (its dispersion relation) against the environment (the

@@ -1,7 +1,8 @@
 /// \file
-/// \brief Wind: the paper's force formula, a mean wind with gusts from a wind spectrum (Harris or
+/// \brief Wind: a mean wind with gusts from a wind spectrum (Harris or
 /// NORSEPP) with seeded phases, and the wind forces and yaw moment on a surface vessel from
-/// coefficients (constant-coefficient model by default, an Isherwood-style table as option).
+/// coefficients (constant-coefficient model by default, an Isherwood-style table as option). The
+/// paper's wind force formula is in `kelp/environment/paper.hpp`.
 ///
 /// Frames: world NED; body x forward, y starboard, z down. The wind velocity is the velocity of
 /// the air (the direction it blows TOWARDS), horizontal, at 10 m above the sea. Units SI.
@@ -26,50 +27,6 @@
 
 namespace kelp {
 namespace environment {
-
-namespace detail {
-/// The preconditions of the paper's wind forces (see `paper_wind_force`).
-template <typename Scalar>
-void check_paper_wind_arguments(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& c,
-                                const Scalar& area, const char* c_name, const char* area_name) {
-  check_positive_at_most(value_of(rho_air), limits::max_fluid_density, "rho_air",
-                         "finite and in (0, 1e5] kg/m^3");
-  check_finite(wind_speed, "wind_speed");
-  check_finite(c, c_name);
-  check_non_negative(area, area_name);
-}
-}  // namespace detail
-
-/// \brief The paper's wind force (eq:wind): F_wind = ½ ρ_air V_w² C_x A_w [N].
-///
-/// Implicit in the paper: V_w is the wind speed relative to the vessel, the force acts along the
-/// wind, C_x is the drag coefficient for the frontal (transverse) projected area A_w, and both
-/// are constant (independent of the wind's angle to the hull).
-/// \param[in] rho_air air density [kg/m³] \param[in] wind_speed V_w [m/s]
-/// \param[in] cx C_x [-] \param[in] frontal_area A_w [m²]
-/// \throws kelp::invalid_argument when ρ_air is not in (0, 1e5] kg/m³
-/// (`limits::max_fluid_density`), V_w or C_x is not finite, the area is negative or not finite,
-/// or the force overflows.
-template <typename Scalar>
-Scalar paper_wind_force(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cx,
-                        const Scalar& frontal_area) {
-  detail::check_paper_wind_arguments(rho_air, wind_speed, cx, frontal_area, "cx", "frontal_area");
-  const Scalar f = Scalar(0.5) * rho_air * wind_speed * wind_speed * cx * frontal_area;
-  check_finite(f, "paper_wind_force: the force");
-  return f;
-}
-
-/// \brief The lateral twin of the paper's wind force: F = ½ ρ_air V_w² C_y A_lw [N], with the
-/// lateral coefficient C_y and the lateral projected area A_lw (paper, text after eq:wind).
-/// \throws kelp::invalid_argument as `paper_wind_force` (naming cy and lateral_area).
-template <typename Scalar>
-Scalar paper_wind_force_lateral(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cy,
-                                const Scalar& lateral_area) {
-  detail::check_paper_wind_arguments(rho_air, wind_speed, cy, lateral_area, "cy", "lateral_area");
-  const Scalar f = Scalar(0.5) * rho_air * wind_speed * wind_speed * cy * lateral_area;
-  check_finite(f, "paper_wind_force_lateral: the force");
-  return f;
-}
 
 /// \brief Harris wind-gust spectrum S(f) [(m/s)²/Hz] at frequency f [Hz]:
 /// \f$ S(f) = \frac{4\kappa L U_{10}}{(2 + \tilde f^2)^{5/6}},\ \tilde f = L f / U_{10} \f$

@@ -45,6 +45,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
@@ -117,7 +118,8 @@ void validate(const SystemParameters<Scalar>& p) {
 }
 
 /// \brief A system built once from SystemParameters and an environment (copied; it is the one
-/// source of water density and gravity, and both vehicles are checked against it).
+/// source of water density and gravity, and both vehicles are checked against it). The
+/// environment may be replaced between steps (set_environment()); the parts may not.
 /// \throws kelp::invalid_argument naming the field, or the vehicle whose water differs.
 template <typename Scalar>
 class SystemModel {
@@ -133,6 +135,23 @@ class SystemModel {
   }
   const SystemParameters<Scalar>& parameters() const { return parameters_; }
   const environment::Environment<Scalar>& environment() const { return environment_; }
+
+  /// \brief Replaces the environment of a built (possibly running) system: the sea state,
+  /// current, wind, air density or seabed may change between two steps (a squall, a tide turning
+  /// the current); the next step() samples the new one. The water must stay the vehicles' (it is
+  /// checked as at construction: their density and gravity are built into their models).
+  /// Typical use: `auto env = model.environment(); env.set_current(...);
+  /// model.set_environment(env);`. Copies the environment (it allocates: call it between steps,
+  /// not inside one).
+  /// \throws kelp::invalid_argument naming the vehicle whose water differs; the system keeps its
+  /// old environment then (strong guarantee).
+  void set_environment(const environment::Environment<Scalar>& env) {
+    vehicle::check_same_water(asv_, env, "asv");
+    vehicle::check_same_water(auv_, env, "auv");
+    environment::Environment<Scalar> copy(env);  // may throw: environment_ untouched
+    environment_ = std::move(copy);
+  }
+
   const vehicle::VehicleModel<Scalar>& asv() const { return asv_; }
   const vehicle::VehicleModel<Scalar>& auv() const { return auv_; }
   const tether::TetherModel<Scalar>& tether() const { return tether_; }
@@ -268,6 +287,7 @@ vehicle::Surroundings<Scalar> lerp(const vehicle::Surroundings<Scalar>& a,
   s.surface_elevation = a.surface_elevation + c * (b.surface_elevation - a.surface_elevation);
   s.surface_slope = a.surface_slope + c * (b.surface_slope - a.surface_slope);
   s.wind_velocity = a.wind_velocity + c * (b.wind_velocity - a.wind_velocity);
+  s.air_density = a.air_density + c * (b.air_density - a.air_density);
   return s;
 }
 

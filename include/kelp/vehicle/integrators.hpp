@@ -201,8 +201,9 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 /// (where the wave kinematics are zero). The water velocity and acceleration are therefore
 /// taken no higher than the centroid of the submerged part: for a surface vessel half its
 /// still-water draft ∇/A_wp below the local surface; for a submerged vehicle whose hull box
-/// (`hull_height`, Hydrostatics::submerged_free_surface) pierces the surface, halfway between
-/// the surface and the bottom of the box. One more environment sample when that applies.
+/// (`hull_height` about the CB, Hydrostatics::submerged_free_surface) pierces the surface,
+/// halfway between the surface and the bottom of the box. One more environment sample when that
+/// applies.
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& env,
                                   const VehicleState<Scalar>& x, double t) {
@@ -218,9 +219,11 @@ Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& 
     if (value_of(centroid) > value_of(z)) z_wet = centroid;
   } else if (p.hydrostatics == Hydrostatics::submerged_free_surface &&
              value_of(p.hull_height) > 0.0) {
+    // The box is centred on the CB, as the submerged fraction's band (restoring.hpp).
+    const Scalar z_cb = z + x.attitude.toRotationMatrix().row(2).dot(p.r_b);
     const Scalar half = Scalar(0.5) * p.hull_height;
-    if (value_of(z - half) < value_of(z_surface)) {  // the box pierces the surface
-      const Scalar bottom = z + half;
+    if (value_of(z_cb - half) < value_of(z_surface)) {  // the box pierces the surface
+      const Scalar bottom = z_cb + half;
       z_wet =
           value_of(bottom) > value_of(z_surface) ? Scalar(0.5) * (z_surface + bottom) : z_surface;
     }

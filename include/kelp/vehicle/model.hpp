@@ -13,6 +13,9 @@
 /// where the last term is the irrotational-current correction. M is factored once (LDLT) when the
 /// model is built and M⁻¹ is taken from that factorisation at the same time; a step then costs one
 /// 6×6 matrix-vector product, with no factorisation, no inverse and no allocation per step.
+/// Exception: a `submerged_free_surface` vehicle breaking the surface (submerged fraction φ < 1)
+/// has M = M_RB + φ M_A, factored per evaluation (fixed size, no allocation); see
+/// forward_dynamics().
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -222,7 +225,8 @@ class VehicleModel {
   const Matrix6<Scalar>& rigid_body_mass() const { return rigid_body_mass_; }
   /// \brief M_A (symmetric part of the given matrix).
   const Matrix6<Scalar>& added_mass() const { return added_mass_; }
-  /// \brief M = M_RB + M_A.
+  /// \brief M = M_RB + M_A (fully submerged; a `submerged_free_surface` vehicle at the surface has
+  /// M_RB + φ M_A, see forward_dynamics()).
   const Matrix6<Scalar>& mass_matrix() const { return mass_; }
   /// \brief LDLT factorisation of M, computed once.
   const Eigen::LDLT<Matrix6<Scalar>>& mass_ldlt() const { return ldlt_; }
@@ -266,6 +270,17 @@ class VehicleModel {
         break;
     }
     return restoring_force(weight_, buoyancy_, p.r_g, p.r_b, R);
+  }
+
+  /// \brief Submerged fraction φ ∈ [0, 1] of the state under a surface at elevation ζ [m]
+  /// (`submerged_free_surface`: submerged_fraction() of the box hull about the CB; 1 for the other
+  /// models). Every fluid term of a `submerged_free_surface` vehicle scales with it (see
+  /// forward_dynamics()).
+  Scalar submerged_fraction(const VehicleState<Scalar>& state, const Scalar& zeta) const {
+    if (parameters_.hydrostatics != Hydrostatics::submerged_free_surface) return Scalar(1);
+    const Scalar z_cb =
+        state.position(2) + state.attitude.toRotationMatrix().row(2).dot(parameters_.r_b);
+    return vehicle::submerged_fraction(z_cb, zeta, parameters_.hull_height);
   }
 
   /// \brief Hydrostatic potential energy U [J] of which restoring() is the gradient for a fixed
@@ -340,6 +355,9 @@ struct VehicleWorkspace {
   Vector6<Scalar> wind = Vector6<Scalar>::Zero();
   /// Submerged fraction φ of the last evaluation (1 unless `submerged_free_surface`).
   Scalar submerged_fraction = Scalar(1);
+  /// Force of the changing added mass of a vehicle crossing the surface,
+  /// −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ [N, N m] (zero when φ is 0 or 1; see forward_dynamics).
+  Vector6<Scalar> added_mass_change = Vector6<Scalar>::Zero();
   /// Right-hand side M ν̇ [N, N m].
   Vector6<Scalar> rhs = Vector6<Scalar>::Zero();
   /// ν̇ [m/s², rad/s²].
@@ -368,9 +386,15 @@ struct VehicleWorkspace {
 /// horizontal part of a_w enters τ_FK: the vertical pressure of the wave is already in the
 /// restoring that follows the local surface. The moments of τ_FK are neglected (small body).
 /// Wind (surface vessels): environment::wind_load() with the model's `wind_areas` and
-/// `wind_coefficients`, on the heading ψ and the body velocity over ground (Fossen 2021,
+/// `wind_coefficients` and the surroundings' air density (the environment's: one air, as there
+/// is one water), on the heading ψ and the body velocity over ground (Fossen 2021,
 /// §10.1.1). With still water, no wind and a flat surface this is the irrotational-current
 /// model of the file comment.
+/// Free surface (`submerged_free_surface`, docs/equations.md "Free surface"): every fluid term
+/// scales with the submerged fraction φ of the box hull about the CB: buoyancy, τ_FK, the added
+/// mass (M = M_RB + φ M_A in the mass matrix, φ C_A, φ M_A ν̇_w) and the damping φ D; the
+/// position-dependent added mass adds ws.added_mass_change = −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ
+/// (Lagrange's equations for T = ½ νᵀ M(φ) ν), so that T + U is conserved without damping.
 ///
 /// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
 /// \param[in] state pose (NED, unit quaternion) and ν (body).
@@ -407,26 +431,57 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   ws.wind.setZero();
   if (p.hydrostatics == Hydrostatics::surface) {
     const Vector3<Scalar> ah(s.water_acceleration(0), s.water_acceleration(1), Scalar(0));
-    ws.froude_krylov.template head<3>() =
-        (p.density * p.displaced_volume) * (ws.rotation.transpose() * ah);
+    ws.froude_krylov.template head<3>() = environment::froude_krylov_force(
+        p.density, p.displaced_volume, Vector3<Scalar>(ws.rotation.transpose() * ah));
     if (p.wind_areas.frontal_area > 0.0 || p.wind_areas.lateral_area > 0.0) {
       using std::atan2;
       const Scalar psi = atan2(ws.rotation(1, 0), ws.rotation(0, 0));
-      const Vector3<Scalar> w = environment::detail::wind_load_unchecked(
-          p.wind_coefficients, p.wind_areas, Scalar(kelp::air_density), s.wind_velocity, psi,
-          state.nu(0), state.nu(1));
+      const Vector3<Scalar> w =
+          environment::detail::wind_load_unchecked(p.wind_coefficients, p.wind_areas, s.air_density,
+                                                   s.wind_velocity, psi, state.nu(0), state.nu(1));
       ws.wind(0) = w(0);
       ws.wind(1) = w(1);
       ws.wind(5) = w(2);
     }
   } else {
-    ws.froude_krylov.template head<3>() =
-        (p.density * p.displaced_volume * ws.submerged_fraction) * aw;
+    ws.froude_krylov.template head<3>() = environment::froude_krylov_force(
+        p.density, Scalar(p.displaced_volume * ws.submerged_fraction), aw);
+  }
+  ws.added_mass_change.setZero();
+  const Scalar& phi = ws.submerged_fraction;
+  // Fast path: fully submerged (or not a submerged-fraction model): M is the factored M_RB + M_A.
+  if (p.hydrostatics != Hydrostatics::submerged_free_surface || !(value_of(phi) < 1.0)) {
+    ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext) - ws.coriolis_rigid_body -
+             ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot +
+             ws.froude_krylov + ws.wind;
+    ws.nu_dot.noalias() = model.mass_inverse() * ws.rhs;
+    return ws.nu_dot;
+  }
+  // Breaking the surface: every fluid term scales with φ (buoyancy and Froude–Krylov above; added
+  // mass, its Coriolis and the flow's inertia force, and damping here), the mass matrix is
+  // M_RB + φ M_A (factored here, a fixed-size LDLT: no allocation), and the added mass changing
+  // with the position adds −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ, the terms of Lagrange's equations
+  // for T = ½ νᵀ (M_RB + φ(η) M_A) ν (d/dt(M ν) = M ν̇ + φ̇ M_A ν, minus ∂T/∂η), so that T + U is
+  // still conserved without damping (no energy from the changing mass). ∇φ in body axes is
+  // (1/h)(d, r_b × d), d = Rᵀ e_z, inside the band and 0 outside; φ̇ = ∇φᵀ ν_r, which in waves
+  // counts the surface's own motion through the orbital velocity.
+  const Matrix6<Scalar>& ma = model.added_mass();
+  ws.coriolis_added_mass *= phi;
+  ws.damping *= phi;
+  if (value_of(phi) > 0.0) {
+    const Vector3<Scalar> d = ws.rotation.row(2).transpose();
+    Vector6<Scalar> grad;
+    grad.template head<3>() = d / p.hull_height;
+    grad.template tail<3>() = Vector3<Scalar>(p.r_b).cross(d) / p.hull_height;
+    const Vector6<Scalar> ma_nu_r = ma * ws.nu_r;
+    ws.added_mass_change = -grad.dot(ws.nu_r) * ma_nu_r + Scalar(0.5) * ws.nu_r.dot(ma_nu_r) * grad;
   }
   ws.rhs = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext) - ws.coriolis_rigid_body -
-           ws.coriolis_added_mass - ws.damping - ws.restoring + model.added_mass() * ws.nu_c_dot +
-           ws.froude_krylov + ws.wind;
-  ws.nu_dot.noalias() = model.mass_inverse() * ws.rhs;
+           ws.coriolis_added_mass - ws.damping - ws.restoring + phi * (ma * ws.nu_c_dot) +
+           ws.froude_krylov + ws.wind + ws.added_mass_change;
+  const Matrix6<Scalar> mass = model.rigid_body_mass() + phi * ma;
+  const Eigen::LDLT<Matrix6<Scalar>> ldlt(mass);
+  ws.nu_dot = ldlt.solve(ws.rhs);
   return ws.nu_dot;
 }
 
@@ -463,7 +518,8 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   return forward_dynamics(model, ws, state, tau, tau_env, Vector3<Scalar>::Zero());
 }
 
-/// \brief Mechanical energy [J] of a vehicle: kinetic ½ νᵀ (M_RB + M_A) ν plus the hydrostatic
+/// \brief Mechanical energy [J] of a vehicle: kinetic ½ νᵀ (M_RB + φ M_A) ν (φ the submerged
+/// fraction, 1 unless `submerged_free_surface`) plus the hydrostatic
 /// potential U of VehicleModel::restoring_potential() for the surface in `s` (elevation and slope
 /// at the CO). U is the integral of the restoring force, so without damping, forcing, current or
 /// waves (flat surface) the energy is conserved: e.g. for `submerged_free_surface`
@@ -473,23 +529,10 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
 template <typename Scalar>
 Scalar energy(const VehicleModel<Scalar>& model, const VehicleState<Scalar>& state,
               const Surroundings<Scalar>& s = Surroundings<Scalar>()) {
-  const Scalar kinetic = Scalar(0.5) * state.nu.dot(model.mass_matrix() * state.nu);
+  const Scalar phi = model.submerged_fraction(state, s.surface_elevation);
+  const Scalar kinetic = Scalar(0.5) * state.nu.dot(model.rigid_body_mass() * state.nu) +
+                         Scalar(0.5) * phi * state.nu.dot(model.added_mass() * state.nu);
   return kinetic + model.restoring_potential(state, s.surface_elevation, s.surface_slope);
-}
-
-/// \brief The hull data of a surface-vessel model as the environment layer's
-/// environment::SurfaceHydrostatics (for its wave_restoring()/surface_following_restoring()),
-/// so that the vehicle preset stays the one copy of the hull data.
-template <typename Scalar>
-environment::SurfaceHydrostatics surface_hydrostatics(const VehicleParameters<Scalar>& p) {
-  environment::SurfaceHydrostatics h;
-  h.rho = value_of(p.density);
-  h.gravity = value_of(p.gravity);
-  h.waterplane_area = value_of(p.waterplane_area);
-  h.displaced_volume = value_of(p.displaced_volume);
-  h.gm_transverse = value_of(p.gm_transverse);
-  h.gm_longitudinal = value_of(p.gm_longitudinal);
-  return h;
 }
 
 /// \brief Vehicle parameters in double precision.

@@ -65,36 +65,6 @@ Vector6<Scalar> restoring_force_euler(const Scalar& weight, const Scalar& buoyan
   return g;
 }
 
-/// \brief Restoring vector of a floating (surface) vessel about its equilibrium draft, written
-/// with the rotation matrix so that it needs no Euler angles (Fossen 2021, §4.2: heave stiffness
-/// ρ g A_wp, righting moments ρ g ∇ GM_T sin φ cos θ and ρ g ∇ GM_L sin θ):
-/// \f[ g = \big(R^\top (0, 0, \rho g A_{wp} z)^n,\; \rho g \nabla GM_T R_{32},\;
-///     -\rho g \nabla GM_L R_{31},\; 0\big), \f]
-/// where R₃₂ = cos θ sin φ and R₃₁ = −sin θ. Weight and buoyancy balance at z = 0; the model is
-/// linear in the heave displacement and in the righting arms (small to moderate angles, hull not
-/// emerging nor submerging).
-/// \param[in] density ρ [kg/m³] \param[in] gravity g [m/s²] \param[in] displaced_volume ∇ [m³]
-/// \param[in] waterplane_area A_wp [m²] \param[in] gm_transverse GM_T [m]
-/// \param[in] gm_longitudinal GM_L [m]
-/// \param[in] z NED depth of the CO below its equilibrium (still-water) position [m]
-/// \param[in] R rotation matrix body → NED.
-/// \return g [N, N m], body axes.
-template <typename Scalar, typename DR>
-Vector6<Scalar> restoring_force_surface(const Scalar& density, const Scalar& gravity,
-                                        const Scalar& displaced_volume,
-                                        const Scalar& waterplane_area, const Scalar& gm_transverse,
-                                        const Scalar& gm_longitudinal, const Scalar& z,
-                                        const Eigen::MatrixBase<DR>& R) {
-  const Vector3<Scalar> down = R.template bottomRows<1>().transpose();
-  const Scalar rho_g = density * gravity;
-  Vector6<Scalar> g;
-  g.template head<3>() = (rho_g * waterplane_area * z) * down;
-  g(3) = rho_g * displaced_volume * gm_transverse * R(2, 1);
-  g(4) = -rho_g * displaced_volume * gm_longitudinal * R(2, 0);
-  g(5) = Scalar(0);
-  return g;
-}
-
 /// \brief Submerged fraction φ ∈ [0, 1] of a hull modelled as a box of vertical extent h centred
 /// on its centre of buoyancy: φ = clamp((z_CB + ζ)/h + ½, 0, 1), where z_CB is the NED depth of
 /// the CB and the free surface lies at z = −ζ. The box stays vertical whatever the attitude (the

@@ -11,6 +11,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "kelp/core/constants.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/vehicle/state.hpp"
 
@@ -31,6 +32,9 @@ struct Surroundings {
   Eigen::Matrix<Scalar, 2, 1> surface_slope = Eigen::Matrix<Scalar, 2, 1>::Zero();
   /// Wind (air motion) at 10 m above the sea, or the environment's reference height, NED [m/s].
   Vector3<Scalar> wind_velocity = Vector3<Scalar>::Zero();
+  /// Air density ρ_air [kg/m³] of the environment (one air, as there is one water): the wind
+  /// load reads it. Default: kelp::air_density (1.225 kg/m³, ISA sea level).
+  Scalar air_density = Scalar(kelp::air_density);
 };
 
 namespace detail {
@@ -59,6 +63,12 @@ template <typename Env, typename P>
 struct has_windless_sample<
     Env, P,
     std::void_t<decltype(std::declval<const Env&>().sample(std::declval<const P&>(), 0.0, false))>>
+    : std::true_type {};
+
+template <typename Env, typename = void>
+struct has_air_density : std::false_type {};
+template <typename Env>
+struct has_air_density<Env, std::void_t<decltype(std::declval<const Env&>().air_density())>>
     : std::true_type {};
 
 template <typename Sample, typename = void>
@@ -93,6 +103,7 @@ Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scal
       s.surface_slope = env.surface_slope(x.position(0), x.position(1), t);
   }
   if (wind) s.wind_velocity = e.wind;
+  if constexpr (has_air_density<Env>::value) s.air_density = Scalar(env.air_density());
   return s;
 }
 
@@ -100,7 +111,8 @@ Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scal
 
 /// \brief Samples `env` at the vehicle's CO at time t (no allocation): `env.sample(p, t)` gives
 /// current, wave orbital velocity and acceleration, elevation and wind, and the slope when its
-/// sample has a `surface_slope` (else `env.surface_slope(x, y, t)` gives it). `Env` is
+/// sample has a `surface_slope` (else `env.surface_slope(x, y, t)` gives it), and the air
+/// density when `env.air_density()` exists (else kelp::air_density). `Env` is
 /// `kelp::environment::Environment` or any type with those two queries. The water acceleration is
 /// the material one, ∂v/∂t + (v·∇)v, when the sample carries the wave velocity gradient (as
 /// Environment's does). \param[in] env environment \param[in] x vehicle state (its CO position is

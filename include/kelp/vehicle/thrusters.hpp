@@ -1,6 +1,7 @@
 /// \file
-/// \brief Thrusters: the allocation matrix from thruster positions and directions, the Blue
-/// Robotics T200 static thrust curve and its inverse, and the PWM ↔ normalised command mapping.
+/// \brief Thrusters: the allocation matrix from thruster positions and directions, a thruster
+/// model (its static thrust curve, written once; the Blue Robotics T200 preset) and its inverse,
+/// the PWM ↔ normalised command mapping, and the chain PWM → command → thrust → wrench.
 #pragma once
 
 #include <Eigen/Core>
@@ -113,72 +114,102 @@ class ThrusterAllocation {
   Eigen::Index rank_ = 0;
 };
 
-/// \brief Blue Robotics T200 static thrust [N] for a normalised command u ∈ [−1, 1] (clamped):
-/// F(u) = −140.3u⁹ + 389.9u⁷ − 404.1u⁵ + 176.0u³ + 8.9u, F(1) ≈ 30.4 N (von Benzon et al. 2022,
-/// J. Mar. Sci. Eng. 10(12):1898, fit to the Blue Robotics T200 data; odd, so reverse = forward).
-/// \param[in] u normalised command (positive: thrust along the thruster direction).
+/// \brief The static thrust curve of one thruster model: an odd polynomial
+/// F(u) = Σₖ cₖ u^(2k+1) of the normalised command u ∈ [−1, 1] (clamped), with the command at
+/// which it peaks on [0, 1] and that peak. It is the one place a thruster's curve is written: the
+/// thrust, its slope and its inverse (thrust(), thrust_slope(), command_for_thrust()) and the
+/// chain PWM → command → thrust → wrench (ThrusterChain) all read it.
+struct ThrusterModel {
+  /// Number of odd coefficients.
+  static constexpr int order = 5;
+  /// c₀ … c₄ [N]: the coefficients of u, u³, u⁵, u⁷, u⁹.
+  double odd_coefficients[order] = {0, 0, 0, 0, 0};
+  /// u_peak ∈ (0, 1]: F rises monotonically on [0, u_peak] (the inverse's branch).
+  double peak_command = 1.0;
+  /// F(u_peak) [N], rounded down (the largest thrust the inverse delivers).
+  double max_thrust = 0.0;
+};
+
+/// \brief Blue Robotics T200 static thrust curve: F(u) = −140.3u⁹ + 389.9u⁷ − 404.1u⁵ + 176.0u³
+/// + 8.9u, F(1) ≈ 30.4 N (von Benzon et al. 2022, J. Mar. Sci. Eng. 10(12):1898, fit to the Blue
+/// Robotics T200 data; odd, so reverse = forward). The polynomial rises monotonically on
+/// [0, 0.971656] to 30.62 N and then falls slightly to 30.40 N at u = 1 (root of dF/du at
+/// 0.97165617, found by bisection in double and rounded down; F(u_peak) = 30.621753 N rounded
+/// down; the unit test re-checks both).
+inline constexpr ThrusterModel t200_model{{8.9, 176.0, -404.1, 389.9, -140.3}, 0.971656, 30.62175};
+
+/// \brief Command at which the T200 curve peaks (`t200_model.peak_command`).
+inline constexpr double t200_peak_command = t200_model.peak_command;
+/// \brief Largest T200 thrust the curve gives [N] (`t200_model.max_thrust`).
+inline constexpr double t200_max_thrust = t200_model.max_thrust;
+
+namespace detail {
+/// F(u) and dF/du of an odd polynomial, u unclamped: with P(x) = Σ cₖ xᵏ and x = u², F = u P(x)
+/// and F' = P(x) + 2x P'(x); P and P' by one Horner pass (the coefficients are written once).
 template <typename Scalar>
-Scalar t200_thrust(const Scalar& u_in) {
+void thrust_polynomial(const ThrusterModel& m, const Scalar& u, Scalar& f, Scalar* slope) {
+  const Scalar x = u * u;
+  Scalar p(m.odd_coefficients[ThrusterModel::order - 1]);
+  Scalar dp(0);
+  for (int k = ThrusterModel::order - 2; k >= 0; --k) {
+    if (slope != nullptr) dp = dp * x + p;
+    p = p * x + Scalar(m.odd_coefficients[k]);
+  }
+  f = u * p;
+  if (slope != nullptr) *slope = p + Scalar(2) * x * dp;
+}
+}  // namespace detail
+
+/// \brief Static thrust F(u) [N] of thruster model `m` for a normalised command u (clamped to
+/// [−1, 1]; positive: thrust along the thruster direction).
+/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+template <typename Scalar>
+Scalar thrust(const ThrusterModel& m, const Scalar& u_in) {
   check_finite(u_in, "thruster command u");
   Scalar u = u_in;
   if (value_of(u) > 1.0) u = Scalar(1);
   if (value_of(u) < -1.0) u = Scalar(-1);
-  const Scalar u2 = u * u;
-  return u *
-         (Scalar(8.9) + u2 * (Scalar(176.0) +
-                              u2 * (Scalar(-404.1) + u2 * (Scalar(389.9) + u2 * Scalar(-140.3)))));
+  // The value alone (the hot path of every thruster evaluation): Horner in u².
+  const Scalar x = u * u;
+  Scalar p(m.odd_coefficients[ThrusterModel::order - 1]);
+  for (int k = ThrusterModel::order - 2; k >= 0; --k) p = p * x + Scalar(m.odd_coefficients[k]);
+  return u * p;
 }
 
-/// \brief dF/du of t200_thrust() [N] (same clamping: 0 outside [−1, 1]).
+/// \brief dF/du [N] of thrust() (same clamping: 0 outside [−1, 1]).
 /// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
 template <typename Scalar>
-Scalar t200_thrust_slope(const Scalar& u) {
+Scalar thrust_slope(const ThrusterModel& m, const Scalar& u) {
   check_finite(u, "thruster command u");
   if (value_of(u) > 1.0 || value_of(u) < -1.0) return Scalar(0);
-  const Scalar u2 = u * u;
-  return Scalar(8.9) +
-         u2 * (Scalar(3 * 176.0) +
-               u2 * (Scalar(-5 * 404.1) + u2 * (Scalar(7 * 389.9) + u2 * Scalar(-9 * 140.3))));
+  Scalar f, d;
+  detail::thrust_polynomial<Scalar>(m, u, f, &d);
+  return d;
 }
 
-/// \brief Command at which the T200 curve peaks: the polynomial rises monotonically on
-/// [0, 0.971656] to 30.62 N and then falls slightly to 30.40 N at u = 1 (root of dF/du at
-/// 0.97165617, found by bisection in double and rounded down; the unit test re-checks it).
-inline constexpr double t200_peak_command = 0.971656;
-/// \brief Largest T200 thrust the curve gives, F(t200_peak_command) = 30.621753 N, rounded down
-/// [N].
-inline constexpr double t200_max_thrust = 30.62175;
-
-/// \brief Inverse of the T200 curve on its monotone branch: the command u ∈ [−u_peak, u_peak]
-/// with t200_thrust(u) = force; forces beyond ±t200_max_thrust saturate at ±u_peak.
+/// \brief Inverse of the curve on its monotone branch: the command u ∈ [−u_peak, u_peak] with
+/// thrust(m, u) = force; forces beyond ±max_thrust saturate at ±u_peak.
 /// Newton's method safeguarded by bisection on the value (the bracket shrinks at every step; a
 /// Newton step that leaves it is replaced by the midpoint; 5–8 iterations instead of 60
 /// bisections), then one Newton correction in Scalar so that ceres::Jet derivatives follow the
 /// implicit-function theorem (du/dF = 1/F'(u)).
-/// \param[in] force desired thrust [N] along the thruster direction.
+/// \param[in] m thruster model \param[in] force desired thrust [N] along the thruster direction.
+/// \throws kelp::invalid_argument naming `thruster force` when the force is not finite.
 template <typename Scalar>
-Scalar t200_command(const Scalar& force) {
+Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force) {
   check_finite(force, "thruster force");
   const double f = value_of(force);
-  if (f >= t200_max_thrust) return Scalar(t200_peak_command);
-  if (f <= -t200_max_thrust) return Scalar(-t200_peak_command);
+  if (f >= m.max_thrust) return Scalar(m.peak_command);
+  if (f <= -m.max_thrust) return Scalar(-m.peak_command);
   const double target = f < 0 ? -f : f;
-  // The curve and its slope as plain polynomials (no checks: x stays in [0, u_peak]).
-  const auto curve = [](double u) {
-    const double u2 = u * u;
-    return u * (8.9 + u2 * (176.0 + u2 * (-404.1 + u2 * (389.9 + u2 * -140.3))));
-  };
-  const auto slope = [](double u) {
-    const double u2 = u * u;
-    return 8.9 + u2 * (3 * 176.0 + u2 * (-5 * 404.1 + u2 * (7 * 389.9 + u2 * -9 * 140.3)));
-  };
-  double lo = 0.0, hi = t200_peak_command;
-  double x = t200_peak_command * target / t200_max_thrust;  // chord of the curve
+  double lo = 0.0, hi = m.peak_command;
+  double x = m.peak_command * target / m.max_thrust;  // chord of the curve
   for (int i = 0; i < 100 && hi - lo > 1e-15; ++i) {
-    const double r = curve(x) - target;
+    double value = 0.0, d = 0.0;  // x stays in [0, u_peak]: no clamping, no checks
+    detail::thrust_polynomial<double>(m, x, value, &d);
+    const double r = value - target;
     if (r == 0.0) break;
     (r < 0.0 ? lo : hi) = x;
-    const double d = slope(x);
     double next = d > 0.0 ? x - r / d : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     const bool done = std::abs(next - x) <= 1e-16;
@@ -187,7 +218,30 @@ Scalar t200_command(const Scalar& force) {
   }
   const double u0 = f < 0 ? -x : x;  // x stays inside the bracket
   const Scalar u(u0);
-  return u + (force - t200_thrust(u)) / t200_thrust_slope(u);
+  return u + (force - thrust(m, u)) / thrust_slope(m, u);
+}
+
+/// \brief Blue Robotics T200 static thrust [N]: thrust(t200_model, u) (see t200_model).
+/// \param[in] u normalised command (clamped to [−1, 1]).
+/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+template <typename Scalar>
+Scalar t200_thrust(const Scalar& u) {
+  return thrust(t200_model, u);
+}
+
+/// \brief dF/du of t200_thrust() [N] (0 outside [−1, 1]): thrust_slope(t200_model, u).
+/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+template <typename Scalar>
+Scalar t200_thrust_slope(const Scalar& u) {
+  return thrust_slope(t200_model, u);
+}
+
+/// \brief Inverse of the T200 curve: command_for_thrust(t200_model, force).
+/// \param[in] force desired thrust [N] along the thruster direction.
+/// \throws kelp::invalid_argument naming `thruster force` when the force is not finite.
+template <typename Scalar>
+Scalar t200_command(const Scalar& force) {
+  return command_for_thrust(t200_model, force);
 }
 
 /// \brief PWM pulse-width ↔ normalised command mapping of a bidirectional ESC.
@@ -258,6 +312,115 @@ Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMap
                          : m.neutral_us + u * (m.neutral_us - m.min_us);
 }
 
+/// \brief Thrust [N] of a pulse width [µs] through the chain's first two links: the command
+/// u = command_from_pwm(pwm, pwm_map) (dead band, clamped) and the curve thrust(m, u).
+/// \param[out] command u, if not null.
+/// \throws kelp::invalid_argument when the pulse width is not finite or `pwm_map` is invalid.
+template <typename Scalar>
+Scalar thrust_from_pwm(const ThrusterModel& m, const Scalar& pwm_us,
+                       const PwmMapping<Scalar>& pwm_map, Scalar* command = nullptr) {
+  const Scalar u = command_from_pwm(pwm_us, pwm_map);
+  if (command != nullptr) *command = u;
+  return thrust(m, u);
+}
+
+/// \brief The whole thruster chain of a vehicle, in one place: PWM pulse width → normalised
+/// command (PwmMapping, dead band) → thrust (ThrusterModel's curve) → body wrench (the
+/// ThrusterAllocation). Controllers go the other way for their output (desired force → command →
+/// the thrust it really delivers) and the SITL bridge goes the whole way from the autopilot's PWM:
+/// both call it, so a new thruster curve is one ThrusterModel. Allocation-free after construction.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+class ThrusterChain {
+ public:
+  /// \param[in] allocation the thruster set \param[in] model the thrusters' curve (all alike)
+  /// \param[in] pwm the ESCs' PWM mapping
+  /// \throws kelp::invalid_argument when `pwm` is invalid (see `validate(const PwmMapping&)`)
+  /// or the model's peak command is not in (0, 1] or its max thrust not > 0.
+  explicit ThrusterChain(const ThrusterAllocation<Scalar>& allocation,
+                         const ThrusterModel& model = t200_model,
+                         const PwmMapping<Scalar>& pwm = PwmMapping<Scalar>())
+      : allocation_(allocation), model_(model), pwm_(pwm) {
+    validate(pwm_);
+    KELP_CHECK(model.peak_command > 0.0 && model.peak_command <= 1.0,
+               "ThrusterModel: peak_command must be in (0, 1]");
+    check_positive(model.max_thrust, "ThrusterModel: max_thrust");
+    for (double c : model.odd_coefficients) check_finite(c, "ThrusterModel: odd_coefficients");
+  }
+
+  /// \brief Number of thrusters.
+  Eigen::Index size() const { return allocation_.size(); }
+  /// \brief The allocation.
+  const ThrusterAllocation<Scalar>& allocation() const { return allocation_; }
+  /// \brief The thruster model.
+  const ThrusterModel& model() const { return model_; }
+  /// \brief The PWM mapping.
+  const PwmMapping<Scalar>& pwm() const { return pwm_; }
+
+  /// \brief Normalised command of a pulse width [µs] (command_from_pwm()).
+  Scalar command_from_pwm(const Scalar& pwm_us) const {
+    return vehicle::command_from_pwm(pwm_us, pwm_);
+  }
+  /// \brief Thrust [N] of a normalised command (thrust()).
+  Scalar thrust_of_command(const Scalar& u) const { return thrust(model_, u); }
+  /// \brief Thrust [N] of a pulse width [µs]: thrust(command_from_pwm(pwm)).
+  /// \param[out] command the normalised command, if not null.
+  Scalar thrust_of_pwm(const Scalar& pwm_us, Scalar* command = nullptr) const {
+    return thrust_from_pwm(model_, pwm_us, pwm_, command);
+  }
+  /// \brief Command for a desired thrust [N] (command_for_thrust(); saturates at ±max_thrust).
+  Scalar command_for(const Scalar& force) const { return command_for_thrust(model_, force); }
+
+  /// \brief For desired per-thruster forces [N]: the commands and the thrust they deliver
+  /// (saturated on the curve's monotone branch). All three have one entry per thruster.
+  /// \throws kelp::invalid_argument for a wrong size or a non-finite force.
+  template <typename DF, typename DC, typename DT>
+  void commands_for(const Eigen::MatrixBase<DF>& forces, Eigen::MatrixBase<DC>& commands,
+                    Eigen::MatrixBase<DT>& delivered) const {
+    KELP_CHECK(forces.size() == size() && commands.size() == size() && delivered.size() == size(),
+               "ThrusterChain: forces, commands and thrust need one entry per thruster");
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      commands(i) = command_for(forces(i));
+      delivered(i) = thrust_of_command(commands(i));
+    }
+  }
+
+  /// \brief Body wrench [N, N m] of normalised commands: B F(u); `thrusts` receives F(u) [N].
+  /// \throws kelp::invalid_argument for a wrong size or a non-finite command.
+  template <typename DC, typename DT>
+  Vector6<Scalar> wrench_from_commands(const Eigen::MatrixBase<DC>& commands,
+                                       Eigen::MatrixBase<DT>& thrusts) const {
+    KELP_CHECK(commands.size() == size() && thrusts.size() == size(),
+               "ThrusterChain: commands and thrust need one entry per thruster");
+    for (Eigen::Index i = 0; i < size(); ++i) thrusts(i) = thrust_of_command(commands(i));
+    return allocation_.wrench(thrusts);
+  }
+
+  /// \brief Body wrench [N, N m] of pulse widths [µs]: B F(u(pwm)); `commands` and `thrusts`
+  /// receive u and F(u).
+  /// \throws kelp::invalid_argument for a wrong size or a non-finite pulse width.
+  template <typename DP, typename DC, typename DT>
+  Vector6<Scalar> wrench_from_pwm(const Eigen::MatrixBase<DP>& pwm_us,
+                                  Eigen::MatrixBase<DC>& commands,
+                                  Eigen::MatrixBase<DT>& thrusts) const {
+    KELP_CHECK(pwm_us.size() == size() && commands.size() == size() && thrusts.size() == size(),
+               "ThrusterChain: pwm, commands and thrust need one entry per thruster");
+    for (Eigen::Index i = 0; i < size(); ++i) commands(i) = command_from_pwm(pwm_us(i));
+    return wrench_from_commands(commands, thrusts);
+  }
+
+  /// \brief Body wrench [N, N m] of thrusts [N] (the allocation's wrench()).
+  template <typename DT>
+  Vector6<Scalar> wrench(const Eigen::MatrixBase<DT>& thrusts) const {
+    return allocation_.wrench(thrusts);
+  }
+
+ private:
+  ThrusterAllocation<Scalar> allocation_;
+  ThrusterModel model_;
+  PwmMapping<Scalar> pwm_;
+};
+
 /// \brief Thruster allocation in double precision.
 using ThrusterAllocationd = ThrusterAllocation<double>;
 /// \brief Thruster allocation in single precision.
@@ -266,5 +429,9 @@ using ThrusterAllocationf = ThrusterAllocation<float>;
 using PwmMappingd = PwmMapping<double>;
 /// \brief PWM mapping in single precision.
 using PwmMappingf = PwmMapping<float>;
+/// \brief Thruster chain in double precision.
+using ThrusterChaind = ThrusterChain<double>;
+/// \brief Thruster chain in single precision.
+using ThrusterChainf = ThrusterChain<float>;
 
 }  // namespace kelp::vehicle
