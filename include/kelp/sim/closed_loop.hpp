@@ -87,7 +87,8 @@ struct ClosedLoopOptions {
   /// Named in errors and in the summary.
   std::string scenario_file = "(embedded default)";
   /// Where samples (at the scenario's log rate) and tether snapshots (at its node rate) are
-  /// written; not owned, must outlive the loop; null: no log.
+  /// written, the first ones (t = 0) when the loop is built; not owned, must outlive the loop;
+  /// null: no log.
   RunLog* log = nullptr;
   /// Called after every step, before the new state is sampled (e.g. the soak test's checks);
   /// empty: nothing is called.
