@@ -1,6 +1,6 @@
 // libFuzzer target: kelp-sitl's lockstep bridge fed arbitrary datagrams from both autopilots
 // (examples/sitl/bridge.hpp: Bridge::receive and check_timeouts over parse_servo_packet), with
-// the calm default world of kelp-tethered-pair (its tether in two segments).
+// the calm default world of kelp::sim (its tether in two segments).
 //
 // Input: byte 0 = settings (bit 0: start_together), then records, at most 48:
 //   op [u8: bit 0 slot, bit 1 check_timeouts instead of a datagram, bits 2-7 wall-clock advance
@@ -14,19 +14,19 @@
 
 #include "bridge.hpp"
 #include "fuzz_common.hpp"
-#include "world.hpp"
+#include "kelp/sim/world.hpp"
 
 using namespace kelp_sitl;
 
 namespace {
 
 struct World {
-  tethered_pair::WorldSetup setup;
+  kelp::sim::WorldSetup setup;
   kelp::system::SystemModeld model;
   kelp::system::SystemWorkspaced ws;
   kelp::system::SystemStated initial;
-  static tethered_pair::Scenario calm() {
-    tethered_pair::Scenario s;
+  static kelp::sim::Scenario calm() {
+    kelp::sim::Scenario s;
     s.sea = "calm";
     // Two segments instead of twenty: the bridge's state machine is the target, and with the
     // coverage instrumentation's comparison tracing the tether's loops took half of every run.
@@ -34,7 +34,7 @@ struct World {
     return s;
   }
   World()
-      : setup(tethered_pair::world_setup(calm(), "fuzz")),
+      : setup(kelp::sim::world_setup(calm(), "fuzz")),
         model(setup.parameters, setup.environment),
         ws(model),
         initial(kelp::system::initial_state(model, ws, setup.start.asv, setup.start.auv)) {}

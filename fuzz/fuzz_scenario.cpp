@@ -1,6 +1,6 @@
-// libFuzzer target: kelp-tethered-pair's scenario reader (examples/tethered_pair/scenario.hpp).
+// libFuzzer target: kelp::sim's scenario reader (include/kelp/sim/scenario.hpp).
 //
-// Oracle: parse_scenario(input) either throws tethered_pair::scenario_error (the documented
+// Oracle: parse_scenario(input) either throws kelp::sim::scenario_error (the documented
 // error, whose message names the file) or returns a scenario whose every number is finite and
 // within the schema's ranges; to_json() of it parses back to the same scenario (the echo in the
 // run's summary is a valid scenario file). Any other exception, crash or sanitizer report is a
@@ -8,11 +8,11 @@
 #include <string>
 
 #include "fuzz_common.hpp"
-#include "scenario.hpp"
+#include "kelp/sim/scenario.hpp"
 
 namespace {
 
-void check_ranges(const tethered_pair::Scenario& s) {
+void check_ranges(const kelp::sim::Scenario& s) {
   const auto in = [](double x, double lo, double hi) {
     return std::isfinite(x) && x >= lo && x <= hi;
   };
@@ -33,23 +33,23 @@ void check_ranges(const tethered_pair::Scenario& s) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  tethered_pair::Scenario s;
+  kelp::sim::Scenario s;
   try {
-    s = tethered_pair::parse_scenario(text, "fuzz.json");
-  } catch (const tethered_pair::scenario_error& e) {
+    s = kelp::sim::parse_scenario(text, "fuzz.json");
+  } catch (const kelp::sim::scenario_error& e) {
     KELP_FUZZ_REQUIRE(std::string(e.what()).rfind("fuzz.json: ", 0) == 0,
                       "scenario_error does not name the file");
     return 0;
   }
   check_ranges(s);
-  const std::string echo = tethered_pair::to_json(s).dump();
-  tethered_pair::Scenario again;
+  const std::string echo = kelp::sim::to_json(s).dump();
+  kelp::sim::Scenario again;
   try {
-    again = tethered_pair::parse_scenario(echo, "echo.json");
-  } catch (const tethered_pair::scenario_error& e) {
+    again = kelp::sim::parse_scenario(echo, "echo.json");
+  } catch (const kelp::sim::scenario_error& e) {
     kelp_fuzz::finding(std::string("to_json() of a valid scenario is refused: ") + e.what());
   }
-  KELP_FUZZ_REQUIRE(tethered_pair::to_json(again) == tethered_pair::to_json(s),
+  KELP_FUZZ_REQUIRE(kelp::sim::to_json(again) == kelp::sim::to_json(s),
                     "to_json() does not read back to the same scenario");
   return 0;
 }

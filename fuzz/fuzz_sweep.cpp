@@ -19,8 +19,7 @@ namespace {
 constexpr std::size_t kMaxFuzzRuns = 2000;
 
 bool too_costly(const std::string& text) {
-  if (tethered_pair::detail::json_depth(text, tethered_pair::max_json_depth) >
-      tethered_pair::max_json_depth)
+  if (kelp::sim::json_depth(text, kelp::sim::max_json_depth) > kelp::sim::max_json_depth)
     return false;
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (!j.is_object()) return false;

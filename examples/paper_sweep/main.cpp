@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "simulate.hpp"
+#include "kelp/sim/closed_loop.hpp"
 #include "sweep.hpp"
 
 namespace fs = std::filesystem;
@@ -137,7 +137,7 @@ int run(const RunOptions& o) {
                      {"seed", r.seed}};
       std::string error;
       try {
-        result["summary"] = tethered_pair::simulate(r.scenario);
+        result["summary"] = kelp::sim::simulate(r.scenario);
         write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
       } catch (const std::exception& e) {
         error = e.what();

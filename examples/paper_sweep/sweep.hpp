@@ -1,8 +1,8 @@
 // Sweep files of kelp-sweep, their runs and their table.
 //
-// A sweep is a base scenario (kelp-tethered-pair's schema) and axes, each a JSON path into the
-// scenario and a list of values; the runs are the Cartesian product of the axes (the first axis
-// varies slowest) times the seeds. Each run is keyed by a hash of its scenario as used (every
+// A sweep is a base scenario (kelp::sim's schema, kelp/sim/scenario.hpp) and axes, each a JSON path
+// into the scenario and a list of values; the runs are the Cartesian product of the axes (the first
+// axis varies slowest) times the seeds. Each run is keyed by a hash of its scenario as used (every
 // field, canonical JSON), so a result found on disk is the result of exactly that scenario.
 #pragma once
 
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "scenario.hpp"
+#include "kelp/sim/scenario.hpp"
 
 namespace paper_sweep {
 
@@ -37,8 +37,8 @@ struct Run {
   std::size_t index = 0;  ///< position in the sweep (grid point major, seed minor)
   std::size_t point = 0;  ///< grid point (the axes' values)
   std::uint64_t seed = 0;
-  tethered_pair::Scenario scenario;  ///< as used
-  std::string hash;                  ///< 16 hex digits of the canonical scenario JSON
+  kelp::sim::Scenario scenario;  ///< as used
+  std::string hash;              ///< 16 hex digits of the canonical scenario JSON
 };
 
 struct Sweep {
@@ -191,10 +191,9 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
     throw sweep_error(file + ": " + path + ": " + what);
   };
   Sweep s;
-  if (tethered_pair::detail::json_depth(text, tethered_pair::max_json_depth) >
-      tethered_pair::max_json_depth)
-    fail("/", "arrays and objects nested more than " +
-                  std::to_string(tethered_pair::max_json_depth) + " levels deep");
+  if (kelp::sim::json_depth(text, kelp::sim::max_json_depth) > kelp::sim::max_json_depth)
+    fail("/", "arrays and objects nested more than " + std::to_string(kelp::sim::max_json_depth) +
+                  " levels deep");
   try {
     s.source = json::parse(text);
   } catch (const json::exception& e) {
@@ -293,18 +292,17 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
       scenario["seed"] = seed;
       Run r;
       try {
-        r.scenario =
-            tethered_pair::parse_scenario(scenario.dump(), file + " (run with " + where + ")");
-      } catch (const tethered_pair::scenario_error& e) {
+        r.scenario = kelp::sim::parse_scenario(scenario.dump(), file + " (run with " + where + ")");
+      } catch (const kelp::sim::scenario_error& e) {
         throw sweep_error(e.what());
       }
       r.index = s.runs.size();
       r.point = point;
       r.seed = seed;
       char h[17];
-      std::snprintf(h, sizeof h, "%016llx",
-                    static_cast<unsigned long long>(
-                        detail::fnv1a(tethered_pair::to_json(r.scenario).dump())));
+      std::snprintf(
+          h, sizeof h, "%016llx",
+          static_cast<unsigned long long>(detail::fnv1a(kelp::sim::to_json(r.scenario).dump())));
       r.hash = h;
       s.runs.push_back(std::move(r));
     }

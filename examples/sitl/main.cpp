@@ -21,8 +21,9 @@
 #include <string>
 
 #include "bridge.hpp"
-#include "scenario.hpp"
-#include "world.hpp"
+#include "kelp/sim/run_log.hpp"
+#include "kelp/sim/scenario.hpp"
+#include "kelp/sim/world.hpp"
 
 namespace fs = std::filesystem;
 namespace ks = kelp::system;
@@ -34,14 +35,14 @@ void on_signal(int) { stop_requested = true; }
 
 // The embedded default: kelp-tethered-pair's (the paper's moderate sea, a 10 m tether), but the
 // ROV starts at the surface 4 m astern of the boat, so that ArduSub has a dive to fly.
-tethered_pair::Scenario default_scenario() {
-  tethered_pair::Scenario s;
+kelp::sim::Scenario default_scenario() {
+  kelp::sim::Scenario s;
   s.auv_start = {-4.0, 0.0, 0.3};
   return s;
 }
 
 struct Options {
-  tethered_pair::Scenario scenario = default_scenario();
+  kelp::sim::Scenario scenario = default_scenario();
   std::string scenario_file = "(embedded default)";
   std::string bind = "127.0.0.1";
   int sub_port = 9002, rover_port = 9012;
@@ -125,7 +126,7 @@ nlohmann::json counters_json(const kelp_sitl::PeerCounters& c, int port, bool jo
 }
 
 int run(const Options& o) {
-  const tethered_pair::WorldSetup setup = tethered_pair::world_setup(o.scenario, o.scenario_file);
+  const kelp::sim::WorldSetup setup = kelp::sim::world_setup(o.scenario, o.scenario_file);
   const ks::SystemModeld model(setup.parameters, setup.environment);
   ks::SystemWorkspaced ws(model);
   kelp_sitl::BridgeSettings settings = o.bridge;
@@ -136,7 +137,7 @@ int run(const Options& o) {
 
   UdpSocket sub(o.bind, o.sub_port), rover(o.bind, o.rover_port);
   fs::create_directories(o.log);
-  tethered_pair::RunLog log(o.log);
+  kelp::sim::RunLog log(o.log);
   std::ofstream events(fs::path(o.log) / "events.log");
   const double wall0 = wall_now();
   bridge.on_event = [&](const std::string& s) {
@@ -159,7 +160,7 @@ int run(const Options& o) {
     const ks::SystemStated& s = bridge.state();
     const double t = s.time();
     if (t + 1e-9 >= next_log) {
-      tethered_pair::LogRow row;
+      kelp::sim::LogRow row;
       row.t = t;
       row.asv = &s.asv;
       row.auv = &s.auv;
@@ -245,7 +246,7 @@ int run(const Options& o) {
   summary["ardusub"] = counters_json(bridge.counters(0), o.sub_port, bridge.joined(0));
   summary["ardurover"] = counters_json(bridge.counters(1), o.rover_port, bridge.joined(1));
   summary["scenario_file"] = o.scenario_file;
-  summary["scenario"] = tethered_pair::to_json(o.scenario);
+  summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
   std::fprintf(stderr,
                "kelp-sitl: stopped after %.2f s of physics (%llu steps) in %.1f s; malformed "
@@ -303,11 +304,11 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (!file.empty()) {
-      o.scenario = tethered_pair::load_scenario(file);
+      o.scenario = kelp::sim::load_scenario(file);
       o.scenario_file = file;
     }
     return run(o);
-  } catch (const tethered_pair::scenario_error& e) {
+  } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-sitl: invalid scenario: %s\n", e.what());
     return 3;
   } catch (const std::exception& e) {

@@ -12,16 +12,15 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "scenario.hpp"
-#include "simulate.hpp"
-#include "world.hpp"
+#include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/scenario.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
 struct Options {
-  tethered_pair::Scenario scenario;
+  kelp::sim::Scenario scenario;
   std::string scenario_file = "(embedded default)";
   std::string out = "kelp-run";
   bool quiet = false;
@@ -41,11 +40,11 @@ std::string plot_script() {
 }
 
 int run(const Options& o) {
-  tethered_pair::SimulateOptions so;
+  kelp::sim::SimulateOptions so;
   so.log_dir = o.out;
   so.progress = !o.quiet && isatty(2);
   so.scenario_file = o.scenario_file;
-  nlohmann::json summary = tethered_pair::simulate(o.scenario, so);
+  nlohmann::json summary = kelp::sim::simulate(o.scenario, so);
   summary["kelp_version"] = KELP_VERSION_STRING;
   std::ofstream(fs::path(o.out) / "summary.json") << summary.dump(2) << '\n';
   const double duration = summary["simulated_s"], wall = summary["wall_s"];
@@ -93,13 +92,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (!file.empty()) {
-      o.scenario = tethered_pair::load_scenario(file);
+      o.scenario = kelp::sim::load_scenario(file);
       o.scenario_file = file;
     }
     if (duration > 0) o.scenario.duration = duration;
     if (seed >= 0) o.scenario.seed = static_cast<std::uint64_t>(seed);
     return run(o);
-  } catch (const tethered_pair::scenario_error& e) {
+  } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-tethered-pair: invalid scenario: %s\n", e.what());
     return 3;
   } catch (const std::exception& e) {

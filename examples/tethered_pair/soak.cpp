@@ -29,7 +29,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "simulate.hpp"
+#include "kelp/sim/closed_loop.hpp"
 
 namespace {
 std::atomic<long> g_heap_allocations{0};
@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   namespace ke = kelp::environment;
-  tethered_pair::Scenario sc;
+  kelp::sim::Scenario sc;
   const ke::SeaState rough = ke::presets::rough();
   sc.sea = "custom";
   sc.significant_height = rough.significant_height;
@@ -151,9 +151,9 @@ int main(int argc, char** argv) {
   double worst_residual_ratio = 0, worst_clock = 0, worst_wave = 0;
   long retries = 0, fallbacks = 0, allocations_after_warm_up = 0, rss_start = 0;
   long last_allocations = 0;
-  tethered_pair::SimulateOptions o;
+  kelp::sim::SimulateOptions o;
   o.scenario_file = "(soak: rough sea, 0.5 m/s current)";
-  o.on_step = [&](const tethered_pair::StepView& v) {
+  o.on_step = [&](const kelp::sim::StepView& v) {
     Eigen::internal::set_is_malloc_allowed(true);
     const long allocated = g_heap_allocations.load() - last_allocations;
     if (v.step > warm_up) allocations_after_warm_up += allocated;
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
   };
   nlohmann::json summary;
   try {
-    summary = tethered_pair::simulate(sc, o);
+    summary = kelp::sim::simulate(sc, o);
   } catch (const std::exception& e) {
     Eigen::internal::set_is_malloc_allowed(true);
     std::fprintf(stderr, "soak: the run threw: %s\n", e.what());

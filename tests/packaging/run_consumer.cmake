@@ -23,10 +23,12 @@ else()
   set(header_check EACH)
 endif()
 
-# 1. Without the ceres component: kelp::kelp only, and Ceres must not be pulled in.
+# 1. Without a component: kelp::kelp only; neither Ceres nor nlohmann-json may be pulled in (they
+#    are hidden from find_package, so a find_dependency on either fails the configure).
 run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/plain -DCMAKE_BUILD_TYPE=Release
     -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DKELP_CONSUMER_WITH_CERES=OFF
-    -DKELP_CONSUMER_HEADER_CHECK=${header_check} ${prefix_args})
+    -DKELP_CONSUMER_HEADER_CHECK=${header_check} -DCMAKE_DISABLE_FIND_PACKAGE_Ceres=ON
+    -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON ${prefix_args})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/plain -j 2)
 run(${WORK_DIR}/plain/hello_kelp)
 
@@ -37,4 +39,19 @@ if(WITH_CERES)
       -DKELP_CONSUMER_HEADER_CHECK=ALL ${prefix_args})
   run(${CMAKE_COMMAND} --build ${WORK_DIR}/ceres -j 2)
   run(${WORK_DIR}/ceres/hello_kelp)
+endif()
+
+# 3. With the sim component: kelp::sim's headers (each on its own against the build tree) and
+#    hello_sim, which loads a scenario file and runs 10 s of the closed loop through the public API.
+if(WITH_SIM)
+  run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/sim -DCMAKE_BUILD_TYPE=Release
+      -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DKELP_CONSUMER_WITH_SIM=ON
+      -DKELP_CONSUMER_HEADER_CHECK=${header_check} -DCMAKE_DISABLE_FIND_PACKAGE_Ceres=ON
+      ${prefix_args})
+  run(${CMAKE_COMMAND} --build ${WORK_DIR}/sim -j 2)
+  execute_process(COMMAND ${WORK_DIR}/sim/hello_sim WORKING_DIRECTORY ${WORK_DIR}/sim
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "packaging: hello_sim failed (${rc})")
+  endif()
 endif()

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "bridge.hpp"
-#include "world.hpp"
+#include "kelp/sim/world.hpp"
 
 using namespace kelp_sitl;
 
@@ -34,8 +34,8 @@ std::vector<std::uint8_t> packet(std::uint16_t magic, std::uint32_t frame,
 }
 
 struct Fixture {
-  tethered_pair::Scenario scenario;
-  tethered_pair::WorldSetup setup;
+  kelp::sim::Scenario scenario;
+  kelp::sim::WorldSetup setup;
   kelp::system::SystemModeld model;
   kelp::system::SystemWorkspaced ws;
   Bridge bridge;
@@ -43,15 +43,15 @@ struct Fixture {
 
   explicit Fixture(bool together)
       : scenario(calm()),
-        setup(tethered_pair::world_setup(scenario, "test")),
+        setup(kelp::sim::world_setup(scenario, "test")),
         model(setup.parameters, setup.environment),
         ws(model),
         bridge(model, ws, kelp::system::initial_state(model, ws, setup.start.asv, setup.start.auv),
                setup.start, settings(together)) {
     bridge.on_event = [this](const std::string& s) { events.push_back(s); };
   }
-  static tethered_pair::Scenario calm() {
-    tethered_pair::Scenario s;
+  static kelp::sim::Scenario calm() {
+    kelp::sim::Scenario s;
     s.sea = "calm";
     return s;
   }

@@ -1,12 +1,20 @@
-// Scenario files of kelp-tethered-pair (JSON, nlohmann-json): the schema, its defaults and its
-// validation. Every field is optional; the defaults are the embedded default run. Errors name the
-// file, the JSON path and what was expected (`scenario_error`). The schema is documented in
-// examples/tethered_pair/README.md.
+/// \file
+/// \brief Scenario files (JSON, nlohmann-json): the schema, its defaults and its validation.
+///
+/// A scenario describes one run of the tethered pair (a BlueBoat and a BlueROV2 Heavy joined by a
+/// tether): the sea, the tether, the vehicles' attachment points and start, the controllers, the
+/// mission and the output rates. Every field is optional; the defaults are the embedded default
+/// run of kelp-tethered-pair. Errors name the file, the JSON path and what was expected
+/// (`scenario_error`). The schema is documented in examples/tethered_pair/README.md. Part of the
+/// optional `kelp::sim` component (`find_package(kelp CONFIG COMPONENTS sim)`).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -14,60 +22,89 @@
 #include <string>
 #include <vector>
 
+#include "kelp/core/error.hpp"
 #include "kelp/core/types.hpp"
 
-namespace tethered_pair {
+namespace kelp {
+namespace sim {
 
-/// A scenario that cannot be used: the message names the file and the JSON path.
-struct scenario_error : std::runtime_error {
-  using std::runtime_error::runtime_error;
+/// \brief A scenario that cannot be used: the message names the file and the JSON path (e.g.
+/// `scenario.json: /tether/length: expected a number in [0.5, 1000], got -3`).
+///
+/// It is bad user input, so it derives from kelp::invalid_argument (and so from kelp::error and
+/// std::runtime_error): a program may catch it first to tell a bad file from a failed run.
+class scenario_error : public invalid_argument {
+ public:
+  using invalid_argument::invalid_argument;
 };
 
+/// \brief PID gains of one controller axis.
 struct Gains {
-  double kp, ki, kd;
+  double kp;  ///< proportional gain
+  double ki;  ///< integral gain
+  double kd;  ///< derivative gain
 };
 
+/// \brief One run of the tethered pair, as a scenario file describes it (every field has the
+/// embedded default run's value until a file sets it). Angles in rad, lengths in m, NED.
 struct Scenario {
-  double duration = 120.0;  // [s]
-  std::uint64_t seed = 1;
-  // Sea: a preset ("calm", "moderate", "rough") or explicit values.
+  double duration = 120.0;  ///< simulated time [s]
+  std::uint64_t seed = 1;   ///< seed of the waves and gusts
+  /// \name Sea: a preset ("calm", "moderate", "rough": the paper's) or "custom" with the values
+  /// below (set by a `sea` object in the file; unused for a preset).
+  ///@{
   std::string sea = "moderate";
   double significant_height = 0, peak_period = 0, wave_direction = 0;
   double wind_speed = 0, wind_direction = 0, current_speed = 0, current_direction = 0;
   int wave_components = 64;
-  // Tether.
+  ///@}
+  /// \name Tether: its length, its kind ("rov_tether" or "bead_chain") and segment length [m].
+  ///@{
   double tether_length = 10.0;
-  std::string tether_kind = "rov_tether";  // or "bead_chain"
+  std::string tether_kind = "rov_tether";
   double segment_length = 0.5;
-  // Cable properties overriding the kind's (unset: keep the preset's).
+  ///@}
+  /// \name Cable properties overriding the kind's (unset, i.e. 0 or -1: keep the preset's).
+  ///@{
   double diameter = 0, mass_per_length = 0, axial_stiffness = 0, internal_damping = -1;
   double normal_drag = -1, tangential_drag = -1;
-  // Vehicles: attachment points (body axes) and the AUV's start (NED; empty: the paper's start).
+  ///@}
+  /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
+  /// empty: the paper's start, 5 m down astern of the boat).
+  ///@{
   kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
   std::vector<double> auv_start;
-  // Control.
+  ///@}
+  /// \name Control: the paper's disturbance compensation, the PID gains, the ASV's thrust clip
+  /// [N] and the controllers' rates [Hz].
+  ///@{
   bool compensation = false;
   Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
   double asv_thrust_clip = 15.0, asv_rate = 10.0;
   double auv_rate = 50.0;
   Gains auv_surge{40.0, 4.0, 56.0}, auv_sway{40.0, 4.0, 56.0}, auv_heave{60.0, 8.0, 88.0},
       auv_yaw{5.0, 0.2, 3.4};
-  // Mission: NED waypoints; empty: a square of side `square_side` at `depth` from the start.
+  ///@}
+  /// \name Mission: NED waypoints [m]; empty: a square of side `square_side` at `depth` from the
+  /// start.
+  ///@{
   std::vector<kelp::Vector3<double>> waypoints;
   double depth = 5.0, square_side = 10.0;
-  // Output.
+  ///@}
+  /// \name Output: rows of timeseries.csv and snapshots of nodes.csv per simulated second [Hz].
+  ///@{
   double log_rate = 10.0, node_rate = 1.0;
+  ///@}
 };
 
-/// The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
+/// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
 /// needs 4. nlohmann-json parses iteratively but copies, compares and dumps recursively, so a file
 /// nested a hundred thousand levels deep would overflow the stack after parsing.
 inline constexpr int max_json_depth = 64;
 
-namespace detail {
-
-/// Nesting depth of the arrays and objects in JSON text (brackets inside strings do not count);
-/// the scan stops as soon as the depth exceeds `limit`. Exact for valid JSON.
+/// \brief Nesting depth of the arrays and objects in JSON text (brackets inside strings do not
+/// count); the scan stops as soon as the depth exceeds `limit`. Exact for valid JSON. Readers of
+/// files that embed scenarios (e.g. kelp-sweep's sweep files) check it before parsing.
 inline int json_depth(const std::string& text, int limit) {
   int depth = 0, deepest = 0;
   bool in_string = false;
@@ -90,6 +127,9 @@ inline int json_depth(const std::string& text, int limit) {
   return deepest;
 }
 
+namespace detail {
+
+/// Checks JSON values against the schema; every failure names the file and the JSON path.
 class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
@@ -179,10 +219,12 @@ class Reader {
 
 }  // namespace detail
 
-/// Reads and validates a scenario from JSON text; `file` names it in error messages.
+/// \brief Reads and validates a scenario from JSON text.
+/// \param[in] text the JSON text \param[in] file names the scenario in error messages
+/// \throws scenario_error naming the file, the JSON path and what was expected.
 inline Scenario parse_scenario(const std::string& text, const std::string& file) {
   const detail::Reader r(file);
-  if (detail::json_depth(text, max_json_depth) > max_json_depth)
+  if (json_depth(text, max_json_depth) > max_json_depth)
     r.fail("", "arrays and objects nested more than " + std::to_string(max_json_depth) +
                    " levels deep");
   nlohmann::json j;
@@ -293,7 +335,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   return s;
 }
 
-/// Reads a scenario file. \throws scenario_error naming the file.
+/// \brief Reads a scenario file. \throws scenario_error naming the file (also when it cannot be
+/// read).
 inline Scenario load_scenario(const std::string& file) {
   std::ifstream in(file);
   if (!in) throw scenario_error(file + ": cannot be read");
@@ -301,7 +344,8 @@ inline Scenario load_scenario(const std::string& file) {
   return parse_scenario(text, file);
 }
 
-/// The scenario as JSON, every field with its value (echoed in the summary).
+/// \brief The scenario as JSON, every field with its value (echoed in the run's summary; it reads
+/// back through parse_scenario to the same scenario).
 inline nlohmann::json to_json(const Scenario& s) {
   const auto v3 = [](const kelp::Vector3<double>& v) {
     return nlohmann::json::array({v(0), v(1), v(2)});
@@ -353,4 +397,5 @@ inline nlohmann::json to_json(const Scenario& s) {
   return j;
 }
 
-}  // namespace tethered_pair
+}  // namespace sim
+}  // namespace kelp

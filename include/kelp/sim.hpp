@@ -1,0 +1,12 @@
+/// \file
+/// \brief kelp::sim, the optional component the programs sit on: scenario files, the world a
+/// scenario builds, the closed loop (kelp's controllers flying the tethered pair) and the run log.
+///
+/// Needs nlohmann-json besides Eigen: link the target kelp::sim, found with
+/// `find_package(kelp CONFIG REQUIRED COMPONENTS sim)`. Not included by kelp/kelp.hpp.
+#pragma once
+
+#include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/run_log.hpp"
+#include "kelp/sim/scenario.hpp"
+#include "kelp/sim/world.hpp"

@@ -1,0 +1,397 @@
+/// \file
+/// \brief The closed loop of the tethered pair: the system of a scenario flown by kelp's
+/// controllers (the ROV's survey, the boat following it), sampled at the scenario's log rate, with
+/// its error and tension statistics.
+///
+/// ClosedLoop is the steppable object (one call advances one step of 10 ms; the state, the
+/// commands and the latest sample can be read between calls); simulate() runs a whole scenario
+/// with an optional CSV log (RunLog) and returns the summary kelp-tethered-pair writes.
+/// kelp-tethered-pair runs it once with the log; kelp-sweep runs it many times without. Part of the
+/// optional `kelp::sim` component (`find_package(kelp CONFIG COMPONENTS sim)`, target kelp::sim).
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kelp/control/controllers.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/sim/run_log.hpp"
+#include "kelp/sim/scenario.hpp"
+#include "kelp/sim/world.hpp"
+#include "kelp/system/presets.hpp"
+#include "kelp/system/system.hpp"
+#include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/thrusters.hpp"
+
+namespace kelp {
+namespace sim {
+
+namespace detail {
+/// Distance from p to the segment a–b.
+inline double distance_to_segment(const kelp::Vector3<double>& p, const kelp::Vector3<double>& a,
+                                  const kelp::Vector3<double>& b) {
+  const kelp::Vector3<double> ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + s * ab - p).norm();
+}
+}  // namespace detail
+
+/// \brief What an observer of the run sees after every step (ClosedLoopOptions::on_step).
+struct StepView {
+  long step;                                  ///< steps taken so far (1 after the first)
+  const kelp::system::SystemModeld& model;    ///< the system being run
+  const kelp::system::SystemStated& state;    ///< its state after the step
+  const kelp::system::SystemReportd& report;  ///< what the step did
+};
+
+/// \brief The error and tension statistics of a run, accumulated at every sample after t = 0.
+///
+/// The AUV's error is its distance from the survey leg it flies, the ASV's its horizontal distance
+/// from the AUV; "late" values are over the second half of the run (after settling).
+struct RunMetrics {
+  long samples = 0;                     ///< samples accumulated
+  long slack_samples = 0;               ///< samples with under 0.1 N at the AUV's end
+  double auv_squared_error_sum = 0;     ///< Σ AUV error² [m²]
+  double auv_max_error = 0;             ///< largest AUV error [m]
+  double asv_squared_distance_sum = 0;  ///< Σ ASV distance² [m²]
+  double asv_max_distance = 0;          ///< largest ASV distance [m]
+  double max_tension = 0;               ///< largest end force, either end [N]
+  double auv_tension_sum = 0;           ///< Σ end force at the AUV [N]
+  double late_depth_error = 0;          ///< second half: largest |AUV depth − target depth| [m]
+  double late_auv_error = 0;            ///< second half: largest AUV error [m]
+  double late_asv_distance = 0;         ///< second half: largest ASV distance [m]
+
+  /// \brief The count the means divide by (at least 1, so that an empty run gives zeros).
+  double count() const { return std::max<double>(1, static_cast<double>(samples)); }
+  /// \brief RMS of the AUV's path error [m].
+  double auv_rms_error() const { return std::sqrt(auv_squared_error_sum / count()); }
+  /// \brief RMS of the ASV's horizontal distance to the AUV [m].
+  double asv_rms_distance() const { return std::sqrt(asv_squared_distance_sum / count()); }
+  /// \brief Mean end force at the AUV [N].
+  double auv_mean_tension() const { return auv_tension_sum / count(); }
+  /// \brief Fraction of the samples with a slack tether at the AUV (under 0.1 N).
+  double slack_fraction() const { return static_cast<double>(slack_samples) / count(); }
+};
+
+/// \brief Options of a ClosedLoop.
+struct ClosedLoopOptions {
+  /// Named in errors and in the summary.
+  std::string scenario_file = "(embedded default)";
+  /// Where samples (at the scenario's log rate) and tether snapshots (at its node rate) are
+  /// written, the first ones (t = 0) when the loop is built; not owned, must outlive the loop;
+  /// null: no log.
+  RunLog* log = nullptr;
+  /// Called after every step, before the new state is sampled (e.g. the soak test's checks);
+  /// empty: nothing is called.
+  std::function<void(const StepView&)> on_step;
+};
+
+/// \brief The tethered pair of a scenario flown by kelp's controllers, one step at a time.
+///
+/// Built from a scenario: the world (world_setup()), the system at its initial state, the AUV's
+/// controller following the scenario's waypoints (by default a square at the mission depth from
+/// the start) and the ASV's controller following the AUV. Every step (dt = 10 ms): the controllers'
+/// commands (computed from the current state) drive the system through `system::step`; then the
+/// new state is sampled (errors, thrusts, end forces), and at the scenario's log rate the sample
+/// is accumulated into the metrics and written to the log. A run of `duration` is
+/// `lround(duration / dt)` steps. No heap allocation in a step (without a log).
+///
+/// The loop holds references into itself (the controllers keep the models and allocations): it
+/// can be neither copied nor moved; hold it by value or through a pointer.
+class ClosedLoop {
+ public:
+  /// The step [s].
+  static constexpr double dt = 0.01;
+
+  /// \brief The loop of a scenario, its world built by world_setup().
+  /// \throws scenario_error, kelp::invalid_argument (see world_setup()).
+  explicit ClosedLoop(const Scenario& sc, const ClosedLoopOptions& options = {})
+      : ClosedLoop(sc, world_setup(sc, options.scenario_file), options) {}
+
+  /// \brief The loop of a scenario over an already built world (e.g. one a program has adjusted).
+  /// \throws kelp::invalid_argument for a world the library refuses.
+  ClosedLoop(const Scenario& sc, const WorldSetup& world, const ClosedLoopOptions& options = {})
+      : scenario_(sc),
+        options_(options),
+        model_(world.parameters, world.environment),
+        workspace_(model_),
+        state_(kelp::system::initial_state(model_, workspace_, world.start.asv, world.start.auv)),
+        rov_thrusters_(rov_allocation()),
+        boat_thrusters_(boat_allocation()),
+        auv_(model_.auv(), rov_thrusters_, auv_settings(sc)),
+        asv_(model_.asv(), boat_thrusters_, asv_settings(sc)),
+        start_(state_.auv.position),
+        steps_(std::lround(sc.duration / dt)),
+        log_every_(std::max(1L, std::lround(1.0 / (sc.log_rate * dt)))),
+        node_every_(std::max(1L, std::lround(1.0 / (sc.node_rate * dt)))) {
+    waypoints_ = sc.waypoints;
+    if (waypoints_.empty()) {
+      const kelp::Vector3<double> s0(start_.x(), start_.y(), sc.depth);
+      const double a = sc.square_side;
+      waypoints_ = {s0 + kelp::Vector3<double>(a, 0, 0), s0 + kelp::Vector3<double>(a, a, 0),
+                    s0 + kelp::Vector3<double>(0, a, 0), s0};
+    }
+    auv_.follow(waypoints_);
+    asv_.follow_auv();
+    observe();
+  }
+
+  ClosedLoop(const ClosedLoop&) = delete;
+  ClosedLoop& operator=(const ClosedLoop&) = delete;
+
+  /// \brief Advances one step: applies the current commands, steps the system, calls `on_step`,
+  /// then samples the new state (and logs it when due).
+  /// \returns the system's report of the step.
+  /// \throws kelp::error when the run is over (done()); kelp::invalid_argument,
+  /// kelp::numerical_error from `system::step` (the state is then as it was).
+  const kelp::system::SystemReportd& step() {
+    if (done())
+      throw kelp::error("ClosedLoop::step: the run is over (" + std::to_string(steps_) +
+                        " steps of the scenario's duration)");
+    inputs_.auv.control = auv_command_->wrench;
+    inputs_.asv.control = asv_command_->wrench;
+    report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
+    ++k_;
+    if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
+    observe();
+    return report_;
+  }
+
+  /// \brief Steps until the run is over.
+  void run() {
+    while (!done()) step();
+  }
+
+  /// \brief Steps for `seconds` of simulated time (rounded to whole steps), or until the run is
+  /// over. \returns the steps taken.
+  long run_for(double seconds) {
+    KELP_CHECK(std::isfinite(seconds) && seconds >= 0,
+               "ClosedLoop::run_for: seconds must be finite and non-negative");
+    const long n = std::min(std::lround(seconds / dt), steps_ - k_);
+    for (long i = 0; i < n; ++i) step();
+    return n;
+  }
+
+  /// \brief True once the scenario's duration has been simulated.
+  bool done() const { return k_ >= steps_; }
+  /// \brief Steps taken so far.
+  long steps_taken() const { return k_; }
+  /// \brief Steps of the whole run, `lround(duration / dt)`.
+  long total_steps() const { return steps_; }
+  /// \brief Simulation time [s].
+  double time() const { return state_.time(); }
+
+  /// \brief The scenario being run.
+  const Scenario& scenario() const { return scenario_; }
+  /// \brief The system being run.
+  const kelp::system::SystemModeld& model() const { return model_; }
+  /// \brief Its workspace (loads and reports of the last step).
+  const kelp::system::SystemWorkspaced& workspace() const { return workspace_; }
+  /// \brief Its state.
+  const kelp::system::SystemStated& state() const { return state_; }
+  /// \brief The report of the last step (zero before the first).
+  const kelp::system::SystemReportd& last_report() const { return report_; }
+  /// \brief The AUV's waypoints (NED [m]).
+  const std::vector<kelp::Vector3<double>>& waypoints() const { return waypoints_; }
+  /// \brief The AUV's controller.
+  const kelp::control::AuvController& auv_controller() const { return auv_; }
+  /// \brief The ASV's controller.
+  const kelp::control::AsvController& asv_controller() const { return asv_; }
+  /// \brief The AUV's command for the next step.
+  const kelp::control::AuvCommand& auv_command() const { return *auv_command_; }
+  /// \brief The ASV's command for the next step.
+  const kelp::control::AsvCommand& asv_command() const { return *asv_command_; }
+  /// \brief The sample of the current state (what a log row holds; its vehicle states point into
+  /// this loop), updated after every step.
+  const LogRow& sample() const { return sample_; }
+  /// \brief The statistics so far.
+  const RunMetrics& metrics() const { return metrics_; }
+
+  /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
+  /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, final
+  /// energy, the scenario file and the scenario with every field as used.
+  nlohmann::json summary() const {
+    const RunMetrics& m = metrics_;
+    nlohmann::json s;
+    s["simulated_s"] = scenario_.duration;
+    s["auv"] = {{"rms_path_error_m", m.auv_rms_error()},
+                {"max_path_error_m", m.auv_max_error},
+                {"waypoints_reached", auv_.next_waypoint()},
+                {"second_half_max_depth_error_m", m.late_depth_error},
+                {"second_half_max_path_error_m", m.late_auv_error}};
+    s["asv"] = {{"rms_distance_to_auv_m", m.asv_rms_distance()},
+                {"max_distance_to_auv_m", m.asv_max_distance},
+                {"second_half_max_distance_to_auv_m", m.late_asv_distance}};
+    s["tether"] = {{"max_tension_n", m.max_tension},
+                   {"mean_tension_auv_n", m.auv_mean_tension()},
+                   {"slack_fraction", m.slack_fraction()}};
+    s["energy_j"] = kelp::system::energy(model_, state_).total();
+    s["scenario_file"] = options_.scenario_file;
+    s["scenario"] = to_json(scenario_);
+    return s;
+  }
+
+ private:
+  static kelp::vehicle::ThrusterAllocationd rov_allocation() {
+    const auto rov = kelp::vehicle::bluerov2_heavy<double>();
+    return {rov.thruster_positions, rov.thruster_directions};
+  }
+  static kelp::vehicle::ThrusterAllocationd boat_allocation() {
+    const auto boat = kelp::vehicle::blueboat<double>();
+    return {boat.thruster_positions, boat.thruster_directions};
+  }
+  static void set_gains(kelp::control::PidGains& g, const Gains& x) {
+    g.kp = x.kp;
+    g.ki = x.ki;
+    g.kd = x.kd;
+  }
+  static kelp::control::AuvControllerSettings auv_settings(const Scenario& sc) {
+    kelp::control::AuvControllerSettings s;
+    s.compensate = sc.compensation;
+    s.period = 1.0 / sc.auv_rate;
+    set_gains(s.surge, sc.auv_surge);
+    set_gains(s.sway, sc.auv_sway);
+    set_gains(s.heave, sc.auv_heave);
+    set_gains(s.yaw, sc.auv_yaw);
+    return s;
+  }
+  static kelp::control::AsvControllerSettings asv_settings(const Scenario& sc) {
+    kelp::control::AsvControllerSettings s;
+    s.compensate = sc.compensation;
+    s.period = 1.0 / sc.asv_rate;
+    s.thrust_clip = sc.asv_thrust_clip;
+    const auto set = [&](kelp::control::PidGains& g, const Gains& x) {
+      set_gains(g, x);
+      g.output_limit = sc.asv_thrust_clip;
+    };
+    set(s.linear, sc.asv_linear);
+    set(s.angular, sc.asv_angular);
+    set(s.yaw, sc.asv_yaw);
+    return s;
+  }
+
+  // The controllers' commands at the current state, its sample, and at the log and node rates
+  // the metrics and the log.
+  void observe() {
+    const double t = state_.time();
+    auv_command_ = &auv_.update(kelp::control::navigation_of(state_.auv), t);
+    asv_command_ = &asv_.update(kelp::control::navigation_of(state_.asv), state_.auv.position, t);
+    // The AUV's error: distance from the survey path (the leg it is on); the boat's: its
+    // horizontal distance from the AUV.
+    const std::size_t leg = std::min(auv_.next_waypoint(), waypoints_.size() - 1);
+    const kelp::Vector3<double> from = leg == 0 ? start_ : waypoints_[leg - 1];
+    const double e_auv = detail::distance_to_segment(state_.auv.position, from, waypoints_[leg]);
+    const double e_asv = (state_.asv.position - state_.auv.position).head<2>().norm();
+    const double ta = report_.force_on_asv.norm(), tb = report_.force_on_auv.norm();
+    LogRow& row = sample_;
+    row.t = t;
+    row.asv = &state_.asv;
+    row.auv = &state_.auv;
+    row.auv_target = auv_.target();
+    row.auv_error = e_auv;
+    row.asv_error = e_asv;
+    row.asv_thrust << asv_command_->left, asv_command_->right;
+    row.auv_thrust = auv_command_->thrust;
+    row.asv_command = asv_command_->command;
+    row.auv_command = auv_command_->command;
+    row.tension_asv = ta;
+    row.tension_auv = tb;
+    if (k_ % log_every_ == 0) {
+      if (k_ > 0) {
+        RunMetrics& m = metrics_;
+        m.auv_squared_error_sum += e_auv * e_auv;
+        m.asv_squared_distance_sum += e_asv * e_asv;
+        m.auv_max_error = std::max(m.auv_max_error, e_auv);
+        m.asv_max_distance = std::max(m.asv_max_distance, e_asv);
+        m.max_tension = std::max(m.max_tension, std::max(ta, tb));
+        m.auv_tension_sum += tb;
+        m.slack_samples += tb < 0.1;
+        ++m.samples;
+        if (t >= 0.5 * scenario_.duration) {
+          m.late_depth_error =
+              std::max(m.late_depth_error, std::abs(state_.auv.position.z() - auv_.target().z()));
+          m.late_auv_error = std::max(m.late_auv_error, e_auv);
+          m.late_asv_distance = std::max(m.late_asv_distance, e_asv);
+        }
+      }
+      if (options_.log) options_.log->row(row);
+    }
+    if (options_.log && k_ % node_every_ == 0) options_.log->nodes(t, state_.tether);
+  }
+
+  Scenario scenario_;
+  ClosedLoopOptions options_;
+  kelp::system::SystemModeld model_;
+  kelp::system::SystemWorkspaced workspace_;
+  kelp::system::SystemStated state_;
+  kelp::vehicle::ThrusterAllocationd rov_thrusters_, boat_thrusters_;
+  kelp::control::AuvController auv_;
+  kelp::control::AsvController asv_;
+  kelp::Vector3<double> start_;  // the AUV's start: where its first leg begins
+  std::vector<kelp::Vector3<double>> waypoints_;
+  long steps_, log_every_, node_every_, k_ = 0;
+  kelp::system::SystemInputsd inputs_;
+  kelp::system::SystemReportd report_;
+  const kelp::control::AuvCommand* auv_command_ = nullptr;
+  const kelp::control::AsvCommand* asv_command_ = nullptr;
+  LogRow sample_;
+  RunMetrics metrics_;
+};
+
+/// \brief Options of simulate().
+struct SimulateOptions {
+  /// Where to write timeseries.csv and nodes.csv (at the scenario's rates), created once the
+  /// scenario is known to be valid; empty: no CSV.
+  std::string log_dir;
+  bool progress = false;                             ///< a progress bar on stderr
+  std::string scenario_file = "(embedded default)";  ///< named in errors and in the summary
+  /// Called after every step (e.g. the soak test's checks); empty: nothing is called.
+  std::function<void(const StepView&)> on_step;
+};
+
+/// \brief Runs a scenario to its end in a ClosedLoop and returns its summary (the JSON
+/// kelp-tethered-pair writes as summary.json, without the program's version): ClosedLoop::summary()
+/// with the wall time [s] and the real-time factor.
+/// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when the
+/// log cannot be written.
+inline nlohmann::json simulate(const Scenario& sc, const SimulateOptions& o = {}) {
+  const WorldSetup setup = world_setup(sc, o.scenario_file);
+  std::unique_ptr<RunLog> log;
+  if (!o.log_dir.empty()) log = std::make_unique<RunLog>(o.log_dir);
+  ClosedLoopOptions lo;
+  lo.scenario_file = o.scenario_file;
+  lo.log = log.get();
+  lo.on_step = o.on_step;
+  ClosedLoop loop(sc, setup, lo);
+  const long steps = loop.total_steps();
+  const auto wall0 = std::chrono::steady_clock::now();
+  while (!loop.done()) {
+    const long k = loop.steps_taken();
+    const double t = loop.time();
+    loop.step();
+    if (o.progress && k % 500 == 0)
+      std::fprintf(stderr, "\r[%-40s] %5.1f / %.0f s",
+                   std::string(static_cast<std::size_t>(40.0 * k / steps), '#').c_str(), t,
+                   sc.duration);
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (o.progress) std::fprintf(stderr, "\n");
+  if (log) log->close();
+  nlohmann::json summary = loop.summary();
+  summary["wall_s"] = wall;
+  summary["realtime_factor"] = sc.duration / wall;
+  return summary;
+}
+
+}  // namespace sim
+}  // namespace kelp

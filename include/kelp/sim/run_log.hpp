@@ -1,0 +1,123 @@
+/// \file
+/// \brief The log of a run of the tethered pair: timeseries.csv (one row per sample: both
+/// vehicles, the AUV's target and errors, thrusts, commands, end tensions) and nodes.csv (the
+/// tether's node positions).
+///
+/// The format is shared by kelp-tethered-pair and kelp-sitl and plotted by
+/// examples/tethered_pair/plot_run.py; its columns are documented in
+/// examples/tethered_pair/README.md. It knows vehicle and tether states only, not the scenario or
+/// the controllers: a program fills a LogRow from whatever flies the vehicles. Numbers are written
+/// with printf's `%.6g`. Part of the optional `kelp::sim` component (it needs no JSON itself).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/rotation.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/lumped_mass.hpp"
+#include "kelp/vehicle/state.hpp"
+
+namespace kelp {
+namespace sim {
+
+/// \brief One row of timeseries.csv. Quantities a run does not have (the AUV's target and path
+/// error when an autopilot flies it) are NaN, written as `nan`.
+///
+/// The vehicle states are pointed to, not copied: they must outlive the call to RunLog::row.
+struct LogRow {
+  /// The value of a quantity the run does not have.
+  static constexpr double none = std::numeric_limits<double>::quiet_NaN();
+  double t = 0;                                       ///< simulation time [s]
+  const kelp::vehicle::VehicleStated* asv = nullptr;  ///< the ASV's state (required)
+  const kelp::vehicle::VehicleStated* auv = nullptr;  ///< the AUV's state (required)
+  /// The AUV's current target (NED [m]).
+  kelp::Vector3<double> auv_target = kelp::Vector3<double>::Constant(none);
+  double auv_error = none;  ///< the AUV's distance from the survey leg it flies [m]
+  double asv_error = none;  ///< the ASV's horizontal distance from the AUV [m]
+  Eigen::Vector2d asv_thrust = Eigen::Vector2d::Constant(none);   ///< port, starboard [N]
+  Eigen::Vector2d asv_command = Eigen::Vector2d::Constant(none);  ///< normalised
+  Eigen::Matrix<double, 8, 1> auv_thrust =
+      Eigen::Matrix<double, 8, 1>::Constant(none);  ///< [N], motor order
+  Eigen::Matrix<double, 8, 1> auv_command =
+      Eigen::Matrix<double, 8, 1>::Constant(none);  ///< normalised
+  double tension_asv = 0, tension_auv = 0;          ///< tether force on each vehicle [N]
+};
+
+/// \brief timeseries.csv and nodes.csv of a run, in a directory (the columns are documented in
+/// examples/tethered_pair/README.md). Writes the header lines when constructed.
+class RunLog {
+ public:
+  /// \brief Creates `dir` (and its parents) and the two files in it, each with its header line.
+  /// \throws kelp::error when the files cannot be opened for writing; std::filesystem's error
+  /// when the directory cannot be created.
+  explicit RunLog(const std::filesystem::path& dir) {
+    std::filesystem::create_directories(dir);
+    ts_.open(dir / "timeseries.csv");
+    nodes_.open(dir / "nodes.csv");
+    if (!ts_ || !nodes_) throw kelp::error("cannot write the run's CSV files in " + dir.string());
+    ts_ << "t,asv_x,asv_y,asv_z,asv_roll,asv_pitch,asv_yaw,asv_u,asv_v,asv_r,"
+           "auv_x,auv_y,auv_z,auv_roll,auv_pitch,auv_yaw,auv_u,auv_v,auv_w,"
+           "auv_target_x,auv_target_y,auv_target_z,auv_error,asv_error,"
+           "asv_thrust_port,asv_thrust_starboard";
+    for (int i = 1; i <= 8; ++i) ts_ << ",auv_thrust_" << i;
+    ts_ << ",asv_command_port,asv_command_starboard";
+    for (int i = 1; i <= 8; ++i) ts_ << ",auv_command_" << i;
+    ts_ << ",tension_asv,tension_auv\n";
+    nodes_ << "t,node,x,y,z\n";
+  }
+
+  /// \brief Appends one row to timeseries.csv.
+  void row(const LogRow& r) {
+    const Eigen::Vector3d ea = kelp::euler_from_quaternion(r.asv->attitude);
+    const Eigen::Vector3d eb = kelp::euler_from_quaternion(r.auv->attitude);
+    const auto& a = *r.asv;
+    const auto& b = *r.auv;
+    ts_ << num(r.t);
+    for (double v :
+         {a.position.x(),   a.position.y(), a.position.z(), ea.x(),           ea.y(),
+          ea.z(),           a.nu(0),        a.nu(1),        a.nu(5),          b.position.x(),
+          b.position.y(),   b.position.z(), eb.x(),         eb.y(),           eb.z(),
+          b.nu(0),          b.nu(1),        b.nu(2),        r.auv_target.x(), r.auv_target.y(),
+          r.auv_target.z(), r.auv_error,    r.asv_error,    r.asv_thrust(0),  r.asv_thrust(1)})
+      ts_ << ',' << num(v);
+    for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_thrust(i));
+    ts_ << ',' << num(r.asv_command(0)) << ',' << num(r.asv_command(1));
+    for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_command(i));
+    ts_ << ',' << num(r.tension_asv) << ',' << num(r.tension_auv) << '\n';
+  }
+
+  /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv (one line a node).
+  void nodes(double t, const kelp::tether::TetherStated& tether) {
+    for (Eigen::Index i = 0; i < tether.position.cols(); ++i)
+      nodes_ << num(t) << ',' << i << ',' << num(tether.position(0, i)) << ','
+             << num(tether.position(1, i)) << ',' << num(tether.position(2, i)) << '\n';
+  }
+
+  /// \brief Writes what is buffered to the files (e.g. before a status line of a long run).
+  void flush() {
+    ts_.flush();
+    nodes_.flush();
+  }
+  /// \brief Closes both files (also done by the destructor).
+  void close() {
+    ts_.close();
+    nodes_.close();
+  }
+
+ private:
+  const char* num(double v) {
+    std::snprintf(buf_, sizeof buf_, "%.6g", v);
+    return buf_;
+  }
+  std::ofstream ts_, nodes_;
+  char buf_[64] = {};
+};
+
+}  // namespace sim
+}  // namespace kelp

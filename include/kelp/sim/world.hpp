@@ -1,0 +1,81 @@
+/// \file
+/// \brief The tethered pair a scenario describes: the system's parameters, its sea and the
+/// vehicles' start poses.
+///
+/// Shared by every program on kelp::sim (kelp-tethered-pair, kelp-sweep, kelp-sitl), so that a
+/// run flown by kelp's controllers and one flown by ArduPilot SITL are the same world. Part of the
+/// optional `kelp::sim` component.
+#pragma once
+
+#include <string>
+
+#include "kelp/environment/sea_state.hpp"
+#include "kelp/sim/scenario.hpp"
+#include "kelp/system/presets.hpp"
+#include "kelp/tether/presets.hpp"
+
+namespace kelp {
+namespace sim {
+
+/// \brief What a scenario builds: the system's parameters, its sea and the vehicles' start.
+/// `system::SystemModeld(parameters, environment)` is the system to step.
+struct WorldSetup {
+  kelp::system::SystemParametersd parameters;       ///< vehicles, tether, attachment points
+  kelp::environment::Environmentd environment;      ///< the sea (waves, wind, current)
+  kelp::system::presets::StartPoses<double> start;  ///< the vehicles' initial states
+};
+
+/// \brief The system, the sea and the start poses of a scenario.
+/// \param[in] sc the scenario \param[in] file names the scenario in errors
+/// \throws scenario_error when the tether cannot span the start poses; kelp::invalid_argument
+/// from the library for parameters it refuses.
+inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
+  namespace sp = kelp::system::presets;
+  namespace ke = kelp::environment;
+  const sp::TetherKind kind =
+      sc.tether_kind == "bead_chain" ? sp::TetherKind::bead_chain : sp::TetherKind::rov_tether;
+  kelp::system::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
+  if (kind == sp::TetherKind::rov_tether)
+    params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
+  auto& tp = params.tether;
+  if (sc.diameter > 0) tp.diameter = sc.diameter;
+  if (sc.mass_per_length > 0) tp.mass_per_length = sc.mass_per_length;
+  if (sc.axial_stiffness > 0) tp.axial_stiffness = sc.axial_stiffness;
+  if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
+  if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
+  if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
+  params.asv_attachment = sc.asv_attachment;
+  params.auv_attachment = sc.auv_attachment;
+  ke::SeaStateOptions sea_options;
+  sea_options.seed = sc.seed;
+  sea_options.wave_components = sc.wave_components;
+  ke::SeaState sea = ke::presets::calm();
+  if (sc.sea == "moderate") sea = ke::presets::moderate();
+  if (sc.sea == "rough") sea = ke::presets::rough();
+  if (sc.sea == "custom") {
+    sea = ke::SeaState{};  // no waves unless a height is given
+    sea.significant_height = sc.significant_height;
+    sea.peak_period = sc.peak_period;
+    if (sc.significant_height > 0)
+      sea.peak_enhancement = ke::dnv_peak_enhancement(sc.significant_height, sc.peak_period);
+    sea.wind_speed = sc.wind_speed;
+    sea.current_speed = sc.current_speed;
+    sea.wave_direction = sc.wave_direction;
+    sea.wind_direction = sc.wind_direction;
+    sea.current_direction = sc.current_direction;
+  }
+  sp::StartPoses<double> start = sp::paper_start(sc.tether_length);
+  if (!sc.auv_start.empty())
+    start.auv.position = kelp::Vector3<double>(sc.auv_start[0], sc.auv_start[1], sc.auv_start[2]);
+  const double span = (start.auv.point_position(params.auv_attachment) -
+                       start.asv.point_position(params.asv_attachment))
+                          .norm();
+  if (span > sc.tether_length)
+    throw scenario_error(file + ": /tether/length: " + std::to_string(sc.tether_length) +
+                         " m is shorter than the initial distance between its ends (" +
+                         std::to_string(span) + " m)");
+  return {params, ke::make_environment<double>(sea, sea_options), start};
+}
+
+}  // namespace sim
+}  // namespace kelp

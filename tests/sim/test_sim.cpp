@@ -1,0 +1,132 @@
+// kelp::sim: the closed loop stepped by hand gives simulate()'s run bit for bit, it samples and
+// logs at the scenario's rates, it refuses to step past its end and bad scenarios with errors
+// derived from kelp::error, and a step allocates nothing.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "kelp/sim.hpp"
+
+namespace ks = kelp::sim;
+
+namespace {
+
+// A short calm run on a coarse tether: 5 s, samples at 5 Hz, tether snapshots at 2 Hz.
+ks::Scenario short_calm_run() {
+  ks::Scenario sc;
+  sc.sea = "calm";
+  sc.duration = 5.0;
+  sc.segment_length = 1.0;
+  sc.log_rate = 5.0;
+  sc.node_rate = 2.0;
+  return sc;
+}
+
+// The summary without what depends on the wall clock.
+nlohmann::json deterministic(nlohmann::json s) {
+  s.erase("wall_s");
+  s.erase("realtime_factor");
+  return s;
+}
+
+std::size_t lines_of(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("a ClosedLoop stepped by hand runs what simulate() runs, bit for bit", "[sim]") {
+  const ks::Scenario sc = short_calm_run();
+  const nlohmann::json reference = deterministic(ks::simulate(sc));
+
+  ks::ClosedLoop loop(sc);
+  CHECK(loop.total_steps() == 500);
+  while (!loop.done()) loop.step();
+  CHECK(loop.summary() == reference);
+
+  // In chunks of simulated time: the same run.
+  ks::ClosedLoop chunked(sc);
+  CHECK(chunked.run_for(1.234) == 123);
+  CHECK(chunked.run_for(100.0) == 377);  // up to the end, not beyond
+  CHECK(chunked.done());
+  CHECK(chunked.summary() == reference);
+  CHECK(chunked.state().time() == loop.state().time());
+  CHECK(chunked.state().auv.position == loop.state().auv.position);
+}
+
+TEST_CASE("the closed loop samples at the log rate and flies the survey", "[sim]") {
+  const ks::Scenario sc = short_calm_run();
+  ks::ClosedLoop loop(sc);
+  const double d0 = (loop.state().auv.position - loop.waypoints().front()).norm();
+  loop.run();
+  // 5 s at 5 Hz: samples at 0.2, 0.4, ..., 5 s (the one at t = 0 is logged, not accumulated).
+  CHECK(loop.metrics().samples == 25);
+  CHECK(loop.sample().t == loop.time());
+  CHECK(std::abs(loop.time() - 5.0) < 1e-9);
+  // The default survey's first corner is 10 m ahead of the ROV's start; it heads there.
+  const double d1 = (loop.state().auv.position - loop.waypoints().front()).norm();
+  CHECK(d0 == Approx(10.0).margin(0.01));
+  CHECK(d1 < d0 - 1.0);
+  CHECK(loop.metrics().max_tension > 0.0);
+  CHECK(std::isfinite(loop.summary()["energy_j"].get<double>()));
+}
+
+TEST_CASE("a ClosedLoop with a RunLog writes a row per sample and a snapshot per node tick",
+          "[sim]") {
+  const ks::Scenario sc = short_calm_run();
+  const std::filesystem::path dir = std::filesystem::current_path() / "test_sim_log";
+  std::filesystem::remove_all(dir);
+  std::size_t nodes = 0;
+  {
+    ks::RunLog log(dir);
+    ks::ClosedLoopOptions o;
+    o.log = &log;
+    ks::ClosedLoop loop(sc, o);
+    nodes = static_cast<std::size_t>(loop.state().tether.position.cols());
+    loop.run();
+  }
+  CHECK(lines_of(dir / "timeseries.csv") == 1 + 26);     // header, t = 0, 0.2, ..., 5 s
+  CHECK(lines_of(dir / "nodes.csv") == 1 + 11 * nodes);  // header, t = 0, 0.5, ..., 5 s
+  CHECK(nodes == 11);                                    // 10 m in 1 m segments
+}
+
+TEST_CASE("the closed loop refuses a step past its end and counts its steps", "[sim]") {
+  ks::Scenario sc = short_calm_run();
+  sc.duration = 0.05;
+  ks::ClosedLoop loop(sc);
+  loop.run();
+  CHECK(loop.steps_taken() == 5);
+  const double t = loop.time();
+  CHECK_THROWS_AS(loop.step(), kelp::error);
+  CHECK(loop.time() == t);
+  CHECK_THROWS_AS(loop.run_for(-1.0), kelp::invalid_argument);
+}
+
+TEST_CASE("bad scenarios throw scenario_error, a kelp::invalid_argument naming the path", "[sim]") {
+  try {
+    (void)ks::parse_scenario(R"({"tether": {"length": -3}})", "bad.json");
+    FAIL("a negative tether length was accepted");
+  } catch (const kelp::invalid_argument& e) {
+    CHECK(dynamic_cast<const ks::scenario_error*>(&e) != nullptr);
+    CHECK(std::string(e.what()).rfind("bad.json: /tether/length: ", 0) == 0);
+  }
+  CHECK_THROWS_AS(ks::load_scenario("/nonexistent/scenario.json"), ks::scenario_error);
+  // A tether shorter than the distance between its ends at the start: refused by the world.
+  ks::Scenario sc = short_calm_run();
+  sc.auv_start = {30.0, 0.0, 5.0};  // some 30 m from the boat, on a 10 m tether
+  CHECK_THROWS_AS(ks::ClosedLoop(sc), ks::scenario_error);
+}
+
+TEST_CASE("a closed-loop step allocates nothing", "[sim][malloc]") {
+  ks::ClosedLoop loop(short_calm_run());
+  loop.run_for(0.1);  // past the first controller updates
+  Eigen::internal::set_is_malloc_allowed(false);
+  for (int k = 0; k < 100; ++k) loop.step();
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(loop.steps_taken() == 110);
+}
