@@ -291,3 +291,22 @@ TEST_CASE("a step keeps the attitude a unit quaternion however fast the vehicle 
     }
   }
 }
+
+// The README's bad-input table: forward_dynamics is the per-stage evaluation of the steps, so it
+// checks sizes (free for fixed-size vectors) but not values; a NaN in gives a NaN ν̇ (which a
+// step turns into numerical_error, state unchanged), never an exception from the middle of a step.
+TEST_CASE("bad input: forward_dynamics checks sizes only", "[vehicle][bad_input]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  x.position.z() = 5.0;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, Eigen::VectorXd::Zero(7), zero),
+                    kelp::invalid_argument);
+  CHECK(kv::forward_dynamics(model, ws, x, zero, zero).allFinite());
+  x.nu(0) = kNan;
+  const Vector6<double> nu_dot = kv::forward_dynamics(model, ws, x, zero, zero);  // no throw
+  CHECK_FALSE(nu_dot.allFinite());
+  // The step that takes the same state refuses it up front.
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero), kelp::invalid_argument);
+}
