@@ -3,7 +3,7 @@
 /// and semi-implicit (symplectic) Euler (`step_semi_implicit_euler`); kelp names every integrator
 /// step `step_<scheme>`, as the tether's. Both are allocation-free, renormalise the attitude
 /// quaternion and leave the state unchanged (throwing kelp::numerical_error) when a step produces a
-/// non-finite value.
+/// non-finite value or an attitude it cannot renormalise (the zero quaternion).
 ///
 /// `dt` is a non-deduced parameter (`kelp::identity_t<Scalar>`): Scalar comes from the model and
 /// state, so `step_rk4(model, ws, x, 0.01, ...)` compiles for a float model too.
