@@ -213,3 +213,38 @@ TEST_CASE("the 3-D helper does not allocate", "[catenary][shape]") {
   CHECK(grounded.on_seabed());
   CHECK(std::isfinite(f.sum()));
 }
+
+// The probe: point_at(NaN) and tension_at(NaN) returned NaN on a valid shape, silently.
+TEMPLATE_TEST_CASE("bad input: a NaN or infinite arc length is refused by the shape's queries",
+                   "[catenary][shape][bad_input]", float, double) {
+  using S = TestType;
+  using V = kelp::Vector3<S>;
+  const S nan = std::numeric_limits<S>::quiet_NaN(), inf = std::numeric_limits<S>::infinity();
+  const V start(S(0), S(0), S(2)), far_end(S(8), S(6), S(7)), taut_end(S(30), S(0), S(2)),
+      below(S(0), S(0), S(12));
+  kelp::tether::CatenaryOptions<S> grounded_options;
+  grounded_options.seabed_depth = 8.0;
+  // One shape of each status: slack (converged), taut, vertical, grounded, invalid input.
+  const kelp::tether::CatenaryShape<S> shapes[] = {
+      catenary_between(start, far_end, S(20), S(kW)),
+      catenary_between(start, taut_end, S(20), S(kW)), catenary_between(start, below, S(20), S(kW)),
+      catenary_between(start, far_end, S(20), S(kW), grounded_options),
+      catenary_between(start, V(nan, S(0), S(0)), S(20), S(kW))};
+  REQUIRE(shapes[0].status() == CatenaryStatus::converged);
+  REQUIRE(shapes[1].status() == CatenaryStatus::taut);
+  REQUIRE(shapes[2].status() == CatenaryStatus::vertical);
+  REQUIRE(shapes[3].on_seabed());
+  REQUIRE(shapes[4].status() == CatenaryStatus::invalid_input);
+  for (const auto& shape : shapes) {
+    INFO("status " << kelp::tether::to_string(shape.status()));
+    for (const S s : {nan, inf, -inf}) {
+      REQUIRE_THROWS_AS(shape.point_at(s), kelp::invalid_argument);
+      REQUIRE_THROWS_AS(shape.tension_at(s), kelp::invalid_argument);
+      REQUIRE_THROWS_WITH(shape.tension_at(s), Catch::Contains("arc length"));
+    }
+    // A finite arc length: finite answers, or NaN only as the invalid shape's status value.
+    const bool valid = shape.status() != CatenaryStatus::invalid_input;
+    CHECK(kelp::all_finite(shape.point_at(S(10))) == valid);
+    CHECK(std::isfinite(shape.tension_at(S(10))) == valid);
+  }
+}

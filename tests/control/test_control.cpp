@@ -136,7 +136,14 @@ TEST_CASE("AUV controller: the disturbance feedforward lowers the error in a cur
   const double off = run(false), on = run(true);
   INFO("RMS horizontal error over the 40 s after the current starts: " << off << " m without, "
                                                                        << on << " m with");
-  CHECK(on < off);
+  // The current does push the ROV off: without the feedforward the side drag (≈ 0.4 m/s on the
+  // sway damping) is taken up only as the PID's integral builds, over tens of seconds, so the
+  // error is tens of centimetres, far above the hold error of calm water (< 5 cm above).
+  CHECK(off > 0.1);
+  // With it the observer (time constant 1 s) estimates the drag within a few seconds and the
+  // thrusters cancel it, leaving only that transient: at least a factor of two less error
+  // (a feedforward that only nudged the result, on ≈ off, must fail here).
+  CHECK(on < 0.5 * off);
 }
 
 namespace {
@@ -158,28 +165,58 @@ TEST_CASE("ASV controller: station keeping and following with the paper's gains"
   kc::AsvController c(b.model, b.thrusters);
   c.station(Vector3<double>(0, 0, 0), 0.0);
   const ke::Environmentd env;
-  double t = 0, worst = 0, peak = 0;
+  // Within arrive_radius (1 m) the controller gives no surge thrust and only holds the heading,
+  // so the boat coasts: it may end anywhere in the circle, or drift out of it by as much as it
+  // coasts before the controller takes it back. With surge damping X_u u + X_|u|u |u| u and
+  // mass m + X_u̇, a boat at speed u₀ coasts s(u₀) = (m + X_u̇)/X_|u|u · ln(1 + X_|u|u u₀/X_u)
+  // (the integral of u du / u̇); surge coasts farthest (sway is damped harder). The bound on its
+  // distance from the target is therefore arrive_radius + s(fastest speed inside the circle).
+  const auto& bp = b.model.parameters();
+  const double coast_mass = bp.mass + bp.added_mass(0, 0), x_u = bp.damping.linear(0, 0),
+               x_uu = bp.damping.quadratic(0);
+  const auto coast = [&](double u0) { return coast_mass / x_uu * std::log1p(x_uu * u0 / x_u); };
+  const double radius = kc::AsvControllerSettings{}.arrive_radius;
+  double t = 0, worst = 0, peak = 0, inside_speed = 0, late_speed = 0;
   const double dt = 0.01;
   for (int k = 0; k < 24000; ++k) {  // 240 s
     const kc::AsvCommand& cmd = c.update(kc::navigation_of(b.x), Vector3<double>::Zero(), t);
     peak = std::max({peak, std::abs(cmd.left), std::abs(cmd.right)});
     kv::step_rk4(b.model, b.ws, b.x, dt, cmd.wrench, Vector6<double>::Zero(), env, t);
     t += dt;
-    if (t > 120.0) worst = std::max(worst, b.x.position.head<2>().norm());
+    const double d = b.x.position.head<2>().norm(), u = b.x.nu.head<2>().norm();
+    if (d < radius) inside_speed = std::max(inside_speed, u);
+    if (t > 120.0) worst = std::max(worst, d);
+    if (t > 180.0) late_speed = std::max(late_speed, u);
   }
-  INFO("station keeping: largest distance over the last 120 s " << worst << " m; peak thrust "
-                                                                << peak << " N");
-  CHECK(worst < 1.0);
+  INFO("station keeping: largest distance over the last 120 s "
+       << worst << " m; fastest inside the circle " << inside_speed << " m/s (coasts "
+       << coast(inside_speed) << " m); speed over the last 60 s " << late_speed
+       << " m/s; peak thrust " << peak << " N");
+  CHECK(inside_speed > 0.0);  // it did arrive
+  CHECK(worst <= radius + coast(inside_speed));
+  // It comes to rest: in calm water nothing acts on a coasting boat but its damping, which takes
+  // any speed below 3 m/s (its top speed) down by e^{−t X_u/(m + X_u̇)} = e^{−17} within
+  // 60 s, and at rest outside the circle the controller would push it, so it rests inside.
+  CHECK(late_speed < 1e-6);
+  CHECK(b.x.position.head<2>().norm() <= radius);
   CHECK(peak <= 15.0);
-  // Follow an AUV 6 m east of the station, 10 m below: the boat ends above it.
+  // Follow an AUV 6 m east of the station, 10 m below: the boat ends above it, at rest.
   c.follow_auv();
   const Vector3<double> auv(0, 6, 10);
+  double follow_inside_speed = 0;
   for (int k = 0; k < 24000; ++k) {
     const kc::AsvCommand& cmd = c.update(kc::navigation_of(b.x), auv, t);
     kv::step_rk4(b.model, b.ws, b.x, dt, cmd.wrench, Vector6<double>::Zero(), env, t);
     t += dt;
+    if ((b.x.position - auv).head<2>().norm() < radius)
+      follow_inside_speed = std::max(follow_inside_speed, b.x.nu.head<2>().norm());
   }
   const double off = (b.x.position - auv).head<2>().norm();
-  INFO("following: horizontal distance to the AUV after 240 s " << off << " m");
-  CHECK(off < 1.0);
+  INFO("following: horizontal distance to the AUV after 240 s "
+       << off << " m; fastest inside the circle " << follow_inside_speed << " m/s; final speed "
+       << b.x.nu.head<2>().norm() << " m/s");
+  CHECK(follow_inside_speed > 0.0);
+  CHECK(off <= radius + coast(follow_inside_speed));
+  CHECK(b.x.nu.head<2>().norm() < 1e-6);
+  CHECK(off <= radius);
 }

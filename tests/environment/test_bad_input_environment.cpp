@@ -458,3 +458,41 @@ TEST_CASE("bad input: the exact phase reduction beyond the fast range",
   // wrap_two_pi alone is what went wrong at t = 1e17 s (not even in [−π, π]).
   CHECK_FALSE(std::abs(kelp::simd::wrap_two_pi(4.2e17)) <= kelp::pi);
 }
+
+// The probe: profile_factor(p, NaN) returned NaN, though the header promises f ∈ [0, 1].
+TEST_CASE("bad input: a current profile's factor at a NaN depth", "[environment][bad_input]") {
+  for (const CurrentProfileKind kind :
+       {CurrentProfileKind::uniform, CurrentProfileKind::power_law, CurrentProfileKind::linear}) {
+    CurrentProfile p;
+    p.kind = kind;
+    p.depth = 40.0;
+    p.bottom_ratio = 0.25;
+    INFO("kind " << static_cast<int>(kind));
+    REQUIRE_THROWS_AS(profile_factor(p, kNan), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(profile_factor(p, kNan), Catch::Contains("z"));
+    REQUIRE_THROWS_AS(profile_factor(p, std::numeric_limits<float>::quiet_NaN()),
+                      kelp::invalid_argument);
+    // Every other depth, ±∞ included, has a factor in [0, 1]: 1 at and above the surface, the
+    // seabed value (0 for the power law, r for the linear profile) at and below the seabed.
+    for (const double z : {-kInf, -5.0, 0.0, 10.0, 20.0, 39.9, 40.0, 1e6, kInf}) {
+      const double f = profile_factor(p, z);
+      INFO("z " << z << " f " << f);
+      CHECK(f >= 0.0);
+      CHECK(f <= 1.0);
+    }
+    CHECK(profile_factor(p, -kInf) == 1.0);
+    const double bottom = kind == CurrentProfileKind::uniform     ? 1.0
+                          : kind == CurrentProfileKind::power_law ? 0.0
+                                                                  : 0.25;
+    CHECK(profile_factor(p, kInf) == bottom);
+  }
+  // Inside a step a NaN position stays the samplers' NaN (reported by the step as its
+  // numerical_error, state unchanged), not an exception from the middle of the step.
+  CurrentParameters cp;
+  cp.speed = 1.0;
+  cp.profile.kind = CurrentProfileKind::power_law;
+  cp.profile.depth = 40.0;
+  const CurrentModel<double> c(cp);
+  CHECK(std::isnan(c.velocity(Vector3<double>(0.0, 0.0, kNan), 0.0)(0)));
+  CHECK(c.velocity(Vector3<double>(0.0, 0.0, 20.0), 0.0)(0) == Approx(std::pow(0.5, 1.0 / 7.0)));
+}

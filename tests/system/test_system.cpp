@@ -1,5 +1,8 @@
 // The coupled system: construction checks, failure leaves the state bit-identical, no allocation,
-// equal and opposite forces as momentum balance, energy with the dissipation off.
+// equal and opposite forces as momentum balance, energy with the dissipation off, and the paper's
+// presets in the calm, moderate and rough seas against estimates from the sea state.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
@@ -8,6 +11,7 @@
 #include "kelp/environment/environment.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
+#include "kelp/tether/catenary.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
 #include "kelp/vehicle/presets.hpp"
@@ -414,22 +418,144 @@ TEST_CASE("energy: with every dissipation on and no forcing the system never gai
 TEST_CASE("the paper's system presets build, start from a static tether and step in every sea",
           "[system][presets]") {
   namespace sp = ks::presets;
-  for (const double length : {5.0, 10.0, 15.0})
-    for (const auto kind : {sp::TetherKind::rov_tether, sp::TetherKind::bead_chain}) {
-      sp::PaperWorld<double> w(length, sp::Sea::moderate, kind);
-      INFO("tether " << length << " m, kind " << int(kind));
-      const auto& p = w.model.parameters();
-      // The start state: the chord between the tether points is 80 % of the length.
-      const Vector3<double> a = w.state.asv.point_position(p.asv_attachment);
-      const Vector3<double> b = w.state.auv.point_position(p.auv_attachment);
-      CHECK((b - a).norm() == Approx(0.8 * w.model.tether().parameters().length).epsilon(1e-9));
-      CHECK((w.state.tether.position.col(0) - a).norm() < 1e-12);
-      CHECK((w.state.tether.position.col(w.model.tether().segments()) - b).norm() < 1e-12);
-      ks::SystemInputsd in;
-      for (int k = 0; k < 200; ++k) ks::step(w.model, w.workspace, w.state, in, 0.01);
-      CHECK(w.state.time() == Approx(2.0));
-      CHECK(w.state.tether.position.allFinite());
+  // Every tether length and kind in the calm, moderate and rough seas for 2 s: the start state,
+  // and the tether holding the vehicles together: the attachment points are never further apart
+  // than the line's stretched length L (1 + T/EA), T the largest end force seen.
+  for (const auto sea : {sp::Sea::calm, sp::Sea::moderate, sp::Sea::rough})
+    for (const double length : {5.0, 10.0, 15.0})
+      for (const auto kind : {sp::TetherKind::rov_tether, sp::TetherKind::bead_chain}) {
+        sp::PaperWorld<double> w(length, sea, kind);
+        INFO("sea " << int(sea) << ", tether " << length << " m, kind " << int(kind));
+        const auto& p = w.model.parameters();
+        const auto& tp = w.model.tether().parameters();
+        // The start state: the chord between the tether points is 80 % of the length.
+        const Vector3<double> a = w.state.asv.point_position(p.asv_attachment);
+        const Vector3<double> b = w.state.auv.point_position(p.auv_attachment);
+        CHECK((b - a).norm() == Approx(0.8 * tp.length).epsilon(1e-9));
+        CHECK((w.state.tether.position.col(0) - a).norm() < 1e-12);
+        CHECK((w.state.tether.position.col(w.model.tether().segments()) - b).norm() < 1e-12);
+        ks::SystemInputsd in;
+        double chord = 0, force = 0;
+        for (int k = 0; k < 200; ++k) {
+          const auto r = ks::step(w.model, w.workspace, w.state, in, 0.01);
+          force = std::max({force, r.force_on_asv.norm(), r.force_on_auv.norm()});
+          chord = std::max(chord, (w.state.auv.point_position(p.auv_attachment) -
+                                   w.state.asv.point_position(p.asv_attachment))
+                                      .norm());
+        }
+        INFO("largest chord " << chord << " m, largest end force " << force << " N");
+        CHECK(w.state.time() == Approx(2.0));
+        CHECK(w.state.tether.position.allFinite());
+        CHECK(chord <= tp.length * (1.0 + force / tp.axial_stiffness));
+      }
+
+  // The default world (10 m ROV tether, no thrust) for 30 s in each sea, against estimates from
+  // the sea state alone:
+  // - speeds (and so kinetic energies) bounded by what the water can give a free body: the
+  //   current plus 4 σ of the orbital speed at the surface, σ² = Σ ½ a_j² ω_j² (deep water:
+  //   horizontal and vertical orbital velocities each of that variance, so the speed exceeds
+  //   4 σ with probability e^{−8} ≈ 3e-4, and 30 s hold ~4 wave periods), plus 0.5 m/s for the
+  //   wind's drift and the tether's pull (the boat's top speed under full thrust is 2.97 m/s);
+  // - end forces bounded by the static catenary of the start state plus the drag of the whole
+  //   line held broadside to that largest flow, ½ ρ C_dn d L (U_c + 4 σ)²: a guard against
+  //   blow-ups and snap loads (a line jerked taut carries EA·strain, 290 N per 10 % strain for
+  //   this one), not a prediction: the line moves with the water, and the loads measured here
+  //   are ~2 % of the bound (14 N moderate, 26 N rough);
+  // - the boat (1.2 m long, heave period 0.81 s) on waves of 95–142 m and 7.8–9.6 s follows the
+  //   surface: heave RAO ≈ 1, so its heave has the standard deviation of the elevation under it;
+  // - and the wave-driven motion and the tether's loads grow with the sea.
+  double heave[3] = {0, 0, 0}, peak_force[3] = {0, 0, 0};
+  for (const auto sea : {sp::Sea::calm, sp::Sea::moderate, sp::Sea::rough}) {
+    const int i = static_cast<int>(sea);
+    INFO("sea " << i);
+    sp::PaperWorld<double> w(10.0, sea);
+    const auto& p = w.model.parameters();
+    const auto& tp = w.model.tether().parameters();
+    const auto& env = w.model.environment();
+    const double rho = env.water_density(), g = env.gravity();
+    double variance = 0;
+    for (std::size_t j = 0; j < env.waves().size(); ++j)
+      variance += 0.5 * std::pow(env.waves().amplitude(j) * env.waves().omega(j), 2);
+    const double u_orb = 4.0 * std::sqrt(variance);
+    const double u_current = sp::sea_state(sea).current_speed;
+    const double v_bound = u_current + u_orb + 0.5;
+    const Vector3<double> a0 = w.state.asv.point_position(p.asv_attachment);
+    const Vector3<double> b0 = w.state.auv.point_position(p.auv_attachment);
+    const double weight = w.model.tether().submerged_weight_per_length(rho, g);
+    const auto cat = kt::catenary_between(a0, b0, tp.length, weight);
+    REQUIRE(cat.status() == kt::CatenaryStatus::converged);
+    const double t_static = std::max(cat.force_on_start().norm(), cat.force_on_end().norm());
+    const double drag = 0.5 * rho * tp.normal_drag * tp.diameter * tp.length * (u_current + u_orb) *
+                        (u_current + u_orb);
+    const auto kinetic = [](const kv::VehicleModeld& m, const kv::VehicleStated& x) {
+      return 0.5 * x.nu.dot(m.mass_matrix() * x.nu);
+    };
+    const auto largest_mass = [](const kv::VehicleModeld& m) {
+      return Eigen::SelfAdjointEigenSolver<kelp::Matrix6<double>>(m.mass_matrix())
+          .eigenvalues()
+          .maxCoeff();
+    };
+    const double ke_bound_asv = 0.5 * largest_mass(w.model.asv()) * v_bound * v_bound;
+    const double ke_bound_auv = 0.5 * largest_mass(w.model.auv()) * v_bound * v_bound;
+    ks::SystemInputsd in;
+    double chord = 0, ke_asv = 0, ke_auv = 0, v_asv = 0, v_auv = 0;
+    double sum_z = 0, sum_zz = 0, sum_e = 0, sum_ee = 0, sum_d = 0, sum_dd = 0;
+    int n = 0;
+    for (int k = 0; k < 3000; ++k) {
+      const auto r = ks::step(w.model, w.workspace, w.state, in, 0.01);
+      peak_force[i] = std::max({peak_force[i], r.force_on_asv.norm(), r.force_on_auv.norm()});
+      chord = std::max(chord, (w.state.auv.point_position(p.auv_attachment) -
+                               w.state.asv.point_position(p.asv_attachment))
+                                  .norm());
+      v_asv = std::max(v_asv, w.state.asv.nu.head<3>().norm());
+      v_auv = std::max(v_auv, w.state.auv.nu.head<3>().norm());
+      ke_asv = std::max(ke_asv, kinetic(w.model.asv(), w.state.asv));
+      ke_auv = std::max(ke_auv, kinetic(w.model.auv(), w.state.auv));
+      if (w.state.time() < 10.0) continue;  // the boat settles on the sea in the first seconds
+      const Vector3<double>& x = w.state.asv.position;
+      const double z = x.z(), zeta = env.surface_elevation(x.x(), x.y(), w.state.time());
+      sum_z += z;
+      sum_zz += z * z;
+      sum_e += zeta;
+      sum_ee += zeta * zeta;
+      sum_d += z + zeta;  // draft below the local surface (NED z down, ζ up)
+      sum_dd += (z + zeta) * (z + zeta);
+      ++n;
     }
+    const auto deviation = [n](double s, double ss) {
+      return std::sqrt(std::max(0.0, ss / n - (s / n) * (s / n)));
+    };
+    heave[i] = deviation(sum_z, sum_zz);
+    const double elevation = deviation(sum_e, sum_ee), draft = deviation(sum_d, sum_dd);
+    INFO("u_orb " << u_orb << " m/s; speeds " << v_asv << " / " << v_auv << " m/s (bound "
+                  << v_bound << "); kinetic " << ke_asv << " / " << ke_auv << " J (bounds "
+                  << ke_bound_asv << " / " << ke_bound_auv << "); end force " << peak_force[i]
+                  << " N (static " << t_static << ", drag bound " << drag << "); chord " << chord
+                  << " m; heave " << heave[i] << " m, elevation " << elevation
+                  << " m, draft variation " << draft << " m");
+    CHECK(w.state.time() == Approx(30.0));
+    CHECK(w.state.tether.position.allFinite());
+    CHECK(v_asv <= v_bound);
+    CHECK(v_auv <= v_bound);
+    CHECK(ke_asv <= ke_bound_asv);
+    CHECK(ke_auv <= ke_bound_auv);
+    CHECK(peak_force[i] <= 1.5 * t_static + drag);
+    CHECK(chord <= tp.length * (1.0 + peak_force[i] / tp.axial_stiffness));
+    if (sea == sp::Sea::calm) {
+      // Nothing moves the water: the boat stays on the flat surface.
+      CHECK(heave[i] < 1e-3);
+    } else {
+      CHECK(heave[i] == Approx(elevation).epsilon(0.1));
+      CHECK(draft <= 0.1 * elevation);
+    }
+  }
+  INFO("heave " << heave[0] << " / " << heave[1] << " / " << heave[2] << " m, peak end force "
+                << peak_force[0] << " / " << peak_force[1] << " / " << peak_force[2] << " N");
+  CHECK(heave[0] < heave[1]);
+  CHECK(heave[1] < heave[2]);
+  CHECK(peak_force[0] < peak_force[1]);
+  CHECK(peak_force[1] < peak_force[2]);
+
   CHECK(sp::paper_system<double>(10.0).tether.segments == 20);
   CHECK_THROWS_AS(sp::paper_system<double>(-1.0), kelp::invalid_argument);
   CHECK_THROWS_AS(sp::sea_state(static_cast<sp::Sea>(7)), kelp::invalid_argument);

@@ -220,3 +220,94 @@ TEST_CASE("bad input: added mass, restoring and hull parameters", "[vehicle][bad
   const auto boat = kv::blueboat<double>().parameters;
   CHECK_NOTHROW(ke::validate(kv::surface_hydrostatics(boat)));
 }
+
+// Fuzz finding (fuzz/regressions/fuzz_vehicle_step/vehicle_step_non_unit_attitude.bin): a step
+// whose yaw rate grew to ~1e240 rad/s within one step committed the zero quaternion. RK4's stage
+// quaternion q + h q̇ had coefficients ~1e238, whose squared norm overflows to +Inf, so the
+// renormalisation q / √(q·q) divided by +Inf and gave (0, 0, 0, 0): finite, so the step's
+// finiteness check let it through, and Eigen reads a zero quaternion as a zero "rotation" matrix.
+// The norm of a quaternion is now taken on a rescaled copy when its square leaves the normal
+// range, and a step that ends with a non-unit attitude anyway is a numerical_error.
+TEST_CASE("a step keeps the attitude a unit quaternion however fast the vehicle turns",
+          "[vehicle][bad_input][fuzz]") {
+  SECTION("renormalize: squared norms that overflow or underflow") {
+    for (const double scale : {1e200, 1e-200, 1e160, 1e-170, 1e300, 4.9e-324}) {
+      INFO("scale " << scale);
+      kelp::Quaternion<double> q(scale, scale, -scale, 0.0);
+      kv::renormalize(q);
+      CHECK(q.squaredNorm() == Approx(1.0).epsilon(1e-15));
+      CHECK(q.w() == Approx(1.0 / std::sqrt(3.0)));
+      CHECK(q.y() == Approx(-1.0 / std::sqrt(3.0)));
+    }
+    for (const float scale : {1e30f, 1e-30f, 1e-40f}) {
+      INFO("float scale " << scale);
+      kelp::Quaternion<float> q(scale, 0.0f, 0.0f, scale);
+      kv::renormalize(q);
+      CHECK(q.squaredNorm() == Approx(1.0f).epsilon(1e-6));
+      CHECK(q.z() == Approx(1.0 / std::sqrt(2.0)).epsilon(1e-6));
+    }
+    // A unit quaternion in the normal range is divided by its norm as before (bit for bit).
+    kelp::Quaternion<double> q(0.5, 0.5, 0.5, 0.5), r = q;
+    q.coeffs() *= 1.1;
+    r.coeffs() *= 1.1;
+    kv::renormalize(q);
+    r.coeffs() /= std::sqrt(r.coeffs().squaredNorm());
+    CHECK(q.coeffs() == r.coeffs());
+  }
+
+  SECTION("a yaw wrench that spins the vehicle up to ~1e240 rad/s within one step") {
+    // No quadratic damping, so that ν̇ stays finite at these rates: the yaw rate grows by
+    // τ_N dt / (I_zz + N_ṙ) per step and the attitude turns through ~r dt rad, far beyond
+    // anything physical, but every number stays finite.
+    auto p = kv::bluerov2_heavy<double>().parameters;
+    p.damping.quadratic.setZero();
+    const kv::VehicleModel<double> model(p);
+    const ke::Environment<double> env;
+    kv::VehicleWorkspace<double> ws;
+    const Vector6<double> zero = Vector6<double>::Zero();
+    for (const double n : {1e200, 1e245, 1e280}) {
+      INFO("yaw moment " << n << " N m");
+      Vector6<double> tau = zero;
+      tau(5) = n;
+      for (int integrator = 0; integrator < 3; ++integrator) {
+        INFO("integrator " << integrator);
+        kv::VehicleState<double> x;
+        x.position.z() = 5.0;
+        const kv::VehicleState<double> before = x;
+        try {
+          if (integrator == 0)
+            kv::step_rk4(model, ws, x, 1e-3, tau, zero);
+          else if (integrator == 1)
+            kv::step_semi_implicit_euler(model, ws, x, 1e-3, tau, zero);
+          else
+            kv::step_rk4(model, ws, x, 1e-3, tau, zero, env, 0.0);
+        } catch (const kelp::numerical_error&) {
+          CHECK(same(x, before));  // refused: the state as it was
+          continue;
+        }
+        REQUIRE(x.attitude.coeffs().allFinite());
+        CHECK(x.attitude.squaredNorm() == Approx(1.0).epsilon(1e-12));
+        CHECK(x.nu(5) > 0.0);  // it did spin up, about +z
+      }
+    }
+  }
+}
+
+// The README's bad-input table: forward_dynamics is the per-stage evaluation of the steps, so it
+// checks sizes (free for fixed-size vectors) but not values; a NaN in gives a NaN ν̇ (which a
+// step turns into numerical_error, state unchanged), never an exception from the middle of a step.
+TEST_CASE("bad input: forward_dynamics checks sizes only", "[vehicle][bad_input]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws;
+  kv::VehicleState<double> x;
+  x.position.z() = 5.0;
+  const Vector6<double> zero = Vector6<double>::Zero();
+  REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, Eigen::VectorXd::Zero(7), zero),
+                    kelp::invalid_argument);
+  CHECK(kv::forward_dynamics(model, ws, x, zero, zero).allFinite());
+  x.nu(0) = kNan;
+  const Vector6<double> nu_dot = kv::forward_dynamics(model, ws, x, zero, zero);  // no throw
+  CHECK_FALSE(nu_dot.allFinite());
+  // The step that takes the same state refuses it up front.
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero), kelp::invalid_argument);
+}

@@ -70,10 +70,14 @@ inline void validate(const CurrentProfile& p) {
   check_non_negative(p.bottom_ratio, "profile.bottom_ratio");
 }
 
-/// \brief Profile factor f(z) ∈ [0, 1] at NED depth z [m]: 1 above the surface (z ≤ 0),
-/// the profile in between, and its seabed value at and below z = h.
+namespace detail {
+
+/// profile_factor() without the check of z, for the samplers that run per point inside a step
+/// (CurrentModel::velocity, Environment::sample_water): there a NaN position gives a NaN factor,
+/// which the step reports as its numerical_error with the state unchanged (their documented
+/// contract), instead of an invalid_argument from the middle of a step.
 template <typename Scalar>
-Scalar profile_factor(const CurrentProfile& p, const Scalar& z) {
+Scalar profile_factor_unchecked(const CurrentProfile& p, const Scalar& z) {
   using std::pow;
   if (p.kind == CurrentProfileKind::uniform || value_of(z) <= 0.0) return Scalar(1);
   if (value_of(z) >= p.depth)
@@ -81,6 +85,19 @@ Scalar profile_factor(const CurrentProfile& p, const Scalar& z) {
   const Scalar s = z / Scalar(p.depth);
   if (p.kind == CurrentProfileKind::power_law) return pow(Scalar(1) - s, p.exponent);
   return Scalar(1) - Scalar(1.0 - p.bottom_ratio) * s;
+}
+
+}  // namespace detail
+
+/// \brief Profile factor f(z) ∈ [0, 1] at NED depth z [m]: 1 above the surface (z ≤ 0),
+/// the profile in between, and its seabed value at and below z = h (z = ±∞ give those limits).
+/// \param[in] p a validated profile. \param[in] z NED depth [m], not NaN.
+/// \throws kelp::invalid_argument when z is NaN (it has no depth, so no factor in [0, 1]).
+template <typename Scalar>
+Scalar profile_factor(const CurrentProfile& p, const Scalar& z) {
+  if (std::isnan(value_of(z)))
+    ::kelp::detail::throw_invalid_argument("profile_factor: z must not be NaN");
+  return detail::profile_factor_unchecked(p, z);
 }
 
 /// \brief A first-order Gauss–Markov process x with bounds (Fossen 2021, §8.3.1:
@@ -224,7 +241,7 @@ class CurrentModel {
   /// \throws kelp::invalid_argument when the current varies and t is not finite.
   template <typename Derived>
   Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, double t) const {
-    return surface_velocity(t) * profile_factor(params_.profile, Scalar(p(2)));
+    return surface_velocity(t) * detail::profile_factor_unchecked(params_.profile, Scalar(p(2)));
   }
 
  private:

@@ -223,7 +223,8 @@ class Environment {
         return;
       }
       for (Eigen::Index i = 0; i < points.cols(); ++i)
-        velocity.col(i) = vs * profile_factor(current_.parameters().profile, points(2, i));
+        velocity.col(i) =
+            vs * detail::profile_factor_unchecked(current_.parameters().profile, points(2, i));
       return;
     }
     waves_.kinematics(points, t, velocity, acceleration);
@@ -261,7 +262,8 @@ class Environment {
       return;
     }
     for (Eigen::Index i = 0; i < points.cols(); ++i)
-      velocity.col(i) += vs * profile_factor(current_.parameters().profile, points(2, i));
+      velocity.col(i) +=
+          vs * detail::profile_factor_unchecked(current_.parameters().profile, points(2, i));
   }
 
   static void check_wave_gravity(const WaveField<Scalar>& waves, double g) {

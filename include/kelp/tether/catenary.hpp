@@ -553,7 +553,8 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
 /// forces and tension_at() are all those of the solver's last iterate (a, c in result()), so they
 /// agree with one another (|force_on_start()| = tension_at(0)) but satisfy the paper's equations
 /// only to result().residual; check status() before relying on them. `invalid_input` — every
-/// query returns NaN.
+/// query returns NaN. Whatever the status, point_at() and tension_at() refuse a NaN or infinite
+/// arc length with kelp::invalid_argument.
 ///
 /// **Seabed contact** (options.seabed_depth finite, w > 0, both ends at or above the seabed; an end
 /// below it gives `invalid_input`). When the free catenary's lowest point would lie below the
@@ -640,8 +641,12 @@ class CatenaryShape {
   /// start from the vertex, x(s) = c + a·asinh((σ₀ + s)/a) and
   /// z(x) = a cosh((x−c)/a) − a cosh(c/a) = 2a sinh(x/(2a)) sinh((x−2c)/(2a)).
   /// Taut: linear interpolation. Grounded: see the class description.
+  /// \param[in] s arc length [m] from the start, finite (meant in [0, L]).
+  /// \throws kelp::invalid_argument when s is NaN or ±Inf (a shape of status `invalid_input`
+  /// answers a finite s with NaN, its documented status value).
   Vector3S point_at(Scalar s) const {
     using std::sinh;
+    check_arc_length(s);
     const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
     if (grounded_) return grounded_point(s);
     switch (result_.status) {
@@ -711,9 +716,13 @@ class CatenaryShape {
 
   /// \brief Tension magnitude [N] at arc length s: H cosh((x(s) − c)/a) = |w|√(a² + σ²) for a
   /// slack line (σ the arc length from the vertex); H on the grounded part.
+  /// \param[in] s arc length [m] from the start, finite (meant in [0, L]).
+  /// \throws kelp::invalid_argument when s is NaN or ±Inf (a shape of status `invalid_input`
+  /// answers a finite s with NaN, its documented status value).
   Scalar tension_at(Scalar s) const {
     using std::sinh;
     using std::sqrt;
+    check_arc_length(s);
     if (grounded_) {
       const Scalar a = result_.a;
       if (s <= s1_) return weight_ * sqrt(a * a + (s1_ - s) * (s1_ - s));
@@ -740,6 +749,13 @@ class CatenaryShape {
   }
 
  private:
+  /// The queries' check of their arc length: a NaN s has no point on the line, and would give
+  /// NaN for every status (the probe found it answered silently with NaN).
+  static void check_arc_length(const Scalar& s) {
+    if (!is_finite(s))
+      ::kelp::detail::throw_invalid_argument("CatenaryShape: arc length s must be finite");
+  }
+
   /// Switches to the seabed-contact shape (see the class description).
   void ground(double seabed, const CatenaryOptions<Scalar>& options) {
     using std::sqrt;

@@ -3,7 +3,7 @@
 /// and semi-implicit (symplectic) Euler (`step_semi_implicit_euler`); kelp names every integrator
 /// step `step_<scheme>`, as the tether's. Both are allocation-free, renormalise the attitude
 /// quaternion and leave the state unchanged (throwing kelp::numerical_error) when a step produces a
-/// non-finite value.
+/// non-finite value or an attitude it cannot renormalise (the zero quaternion).
 ///
 /// `dt` is a non-deduced parameter (`kelp::identity_t<Scalar>`): Scalar comes from the model and
 /// state, so `step_rk4(model, ws, x, 0.01, ...)` compiles for a float model too.
@@ -68,12 +68,19 @@ VehicleState<Scalar> advance(const VehicleState<Scalar>& x, const StateDerivativ
   return y;
 }
 
+/// Commits `next` if it is finite with a unit attitude (renormalize() keeps a finite non-zero
+/// quaternion unit; a zero one, e.g. from a stage that cancelled it, is no rotation), else throws
+/// numerical_error naming `who`, state unchanged.
 template <typename Scalar>
 void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& next,
                       const char* who) {
   if (!(all_finite(next.position) && all_finite(next.attitude.coeffs()) && all_finite(next.nu)))
     ::kelp::detail::throw_numerical_error(std::string(who) +
                                           ": step produced a non-finite state; state unchanged");
+  using std::abs;
+  if (!(abs(value_of(next.attitude.squaredNorm()) - 1.0) < 1e-3))
+    ::kelp::detail::throw_numerical_error(
+        std::string(who) + ": step produced a non-unit attitude quaternion; state unchanged");
   state = next;
 }
 

@@ -5,7 +5,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/scalar.hpp"
@@ -40,12 +43,31 @@ PoseRate<Scalar> pose_rate(const Quaternion<Scalar>& attitude,
 
 /// \brief Renormalises a quaternion to unit length in place (integrators call this after every
 /// step; the quaternion ODE preserves the norm only in exact arithmetic).
-/// \throws nothing; a zero quaternion is left as it is (the caller's step check catches NaNs).
+///
+/// q / √(q·q), with q·q taken on q / max|q_i| when q·q itself leaves the normal range of the
+/// scalar (overflows to +Inf for coefficients beyond ~1e154 in double, ~1e19 in float, or
+/// underflows below ~1e-154 / ~1e-19): q / √(q·q) would then give the zero quaternion or leave q
+/// as it is (the fuzz finding `vehicle_step_non_unit_attitude`). The rescaling divides by a
+/// constant, so for `ceres::Jet` the derivatives are those of q / ‖q‖ too; a quaternion whose
+/// squared norm is normal is divided by √(q·q) exactly as before.
+/// \throws nothing; a zero or non-finite quaternion is left as it is (the integrators refuse a
+/// step that ends with one: kelp::numerical_error, state unchanged).
 template <typename Scalar>
 void renormalize(Quaternion<Scalar>& q) {
   using std::sqrt;
-  const Scalar n2 = q.coeffs().squaredNorm();
-  if (value_of(n2) > 0.0) q.coeffs() /= sqrt(n2);
+  using Value = std::conditional_t<std::is_same_v<Scalar, float>, float, double>;
+  Scalar n2 = q.coeffs().squaredNorm();
+  const double v = value_of(n2);
+  if (!(v >= static_cast<double>(std::numeric_limits<Value>::min()) &&
+        v <= static_cast<double>(std::numeric_limits<Value>::max()))) {
+    double largest = 0.0;
+    for (int i = 0; i < 4; ++i) largest = std::max(largest, std::abs(value_of(q.coeffs()(i))));
+    if (!(largest > 0.0 && largest <= static_cast<double>(std::numeric_limits<Value>::max())))
+      return;  // zero, NaN or Inf: nothing to scale
+    q.coeffs() /= Scalar(static_cast<Value>(largest));
+    n2 = q.coeffs().squaredNorm();  // in [1, 4]
+  }
+  q.coeffs() /= sqrt(n2);
 }
 
 /// \brief Euler-angle kinematics η̇ = J_Θ(η) ν with η = (x, y, z, φ, θ, ψ) (Fossen 2021, eq. 2.53).
