@@ -303,7 +303,7 @@ TEST_CASE("the clock is the state's: every step advances it by dt, a refused ste
   const kv::VehicleInputs<double> none;
   kv::step_rk4(model, ws, x, none, 0.01);
   CHECK(x.time == 2.5 + 0.01);
-  kv::step_symplectic_euler(model, ws, x, none, 0.01);
+  kv::step_symplectic_euler(model, ws, x, {Vector6<double>::Zero()}, 0.01);  // τ_ext = 0
   CHECK(x.time == 2.5 + 0.01 + 0.01);
   kv::step_rk4(model, ws, env, x, none, 0.02);
   CHECK(x.time == 2.5 + 0.01 + 0.01 + 0.02);

@@ -46,7 +46,8 @@ using VehicleStated = VehicleState<double>;
 using VehicleStatef = VehicleState<float>;
 
 /// \brief What the caller gives a vehicle for one step: wrenches held over the step
-/// (zero-order hold), body axes, about the CO.
+/// (zero-order hold), body axes, about the CO. Built from its fields in order (`{tau}`,
+/// `{tau, tau_ext}`), each zero by default.
 /// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 struct VehicleInputs {
@@ -54,6 +55,14 @@ struct VehicleInputs {
   Vector6<Scalar> tau = Vector6<Scalar>::Zero();
   /// τ_ext: every other external wrench (e.g. the tether's) [N, N m].
   Vector6<Scalar> tau_ext = Vector6<Scalar>::Zero();
+
+  /// \brief Zero wrenches.
+  VehicleInputs() = default;
+  /// \brief The wrenches τ and τ_ext [N, N m] (a constructor rather than an aggregate, so that
+  /// `{tau}` does not trip -Wmissing-field-initializers in users' builds).
+  VehicleInputs(const Vector6<Scalar>& tau_,  // NOLINT(google-explicit-constructor)
+                const Vector6<Scalar>& tau_ext_ = Vector6<Scalar>::Zero())
+      : tau(tau_), tau_ext(tau_ext_) {}
 };
 
 using VehicleInputsd = VehicleInputs<double>;
