@@ -107,7 +107,7 @@ void run(const std::uint8_t* data, std::size_t size) {
     kt::TetherStated s = s0;
     const std::string what = std::string("tether step ") + kt::integrator_name(integrator);
     try {
-      kt::step(*model, ws, env, s, ends, dt, integrator, opt);
+      kt::step(*model, ws, env, s, ends, dt, {integrator, opt});
     } catch (const kelp::numerical_error&) {
       KELP_FUZZ_REQUIRE(same_state(s, s0), what + ": numerical_error changed the state");
       continue;

@@ -5,7 +5,7 @@
 // BlueROV2 Heavy or BlueBoat, hydrostatics), the 107 numbers of VehicleParameters (mass, inertia,
 // r_g, r_b, displaced volume, density, gravity, added mass, linear and quadratic damping,
 // waterplane area, metacentric heights, hull height, wind areas and coefficients), the state
-// (position, attitude quaternion, ν), τ, τ_env, the current, the environment's water density and
+// (position, attitude quaternion, ν), τ, τ_ext, the current, the environment's water density and
 // gravity, dt and the time.
 // Oracle: VehicleModel and the environment setters either throw a kelp::error or succeed; each
 // step (RK4, semi-implicit Euler, RK4 in an Environment) either throws a kelp::error or leaves a
@@ -33,7 +33,8 @@ bool same_bits(const kv::VehicleStated& a, const kv::VehicleStated& b) {
   return std::memcmp(a.position.data(), b.position.data(), sizeof(double) * 3) == 0 &&
          std::memcmp(a.attitude.coeffs().data(), b.attitude.coeffs().data(), sizeof(double) * 4) ==
              0 &&
-         std::memcmp(a.nu.data(), b.nu.data(), sizeof(double) * 6) == 0;
+         std::memcmp(a.nu.data(), b.nu.data(), sizeof(double) * 6) == 0 &&
+         std::memcmp(&a.time, &b.time, sizeof(double)) == 0;
 }
 
 void run(const std::uint8_t* data, std::size_t size) {
@@ -70,13 +71,14 @@ void run(const std::uint8_t* data, std::size_t size) {
   x0.attitude.y() = in.f64(0.0);
   x0.attitude.z() = in.f64(0.0);
   read_matrix(in, x0.nu);
-  kelp::Vector6<double> tau = kelp::Vector6<double>::Zero(), tau_env = tau;
+  kelp::Vector6<double> tau = kelp::Vector6<double>::Zero(), tau_ext = tau;
   read_matrix(in, tau);
-  read_matrix(in, tau_env);
+  read_matrix(in, tau_ext);
   kelp::Vector3<double> current(0, 0, 0);
   read_matrix(in, current);
   const double rho = in.f64(p.density), g = in.f64(p.gravity);
-  const double dt = in.f64(1e-3), t = in.f64(0.0);
+  const double dt = in.f64(1e-3);
+  x0.time = in.f64(0.0);  // the clock the environment is sampled at
 
   std::optional<kv::VehicleModeld> model;
   kelp::environment::Environmentd env;
@@ -89,15 +91,15 @@ void run(const std::uint8_t* data, std::size_t size) {
   kv::VehicleWorkspaced ws;
   for (int integrator = 0; integrator < 3; ++integrator) {
     kv::VehicleStated x = x0;
-    const char* names[] = {"step_rk4", "step_semi_implicit_euler", "step_rk4 (environment)"};
+    const char* names[] = {"step_rk4", "step_symplectic_euler", "step_rk4 (environment)"};
     const std::string what = std::string("vehicle ") + names[integrator];
     try {
       if (integrator == 0)
-        kv::step_rk4(*model, ws, x, dt, tau, tau_env, current);
+        kv::step_rk4(*model, ws, x, {tau, tau_ext}, dt, current);
       else if (integrator == 1)
-        kv::step_semi_implicit_euler(*model, ws, x, dt, tau, tau_env, current);
+        kv::step_symplectic_euler(*model, ws, x, {tau, tau_ext}, dt, current);
       else
-        kv::step_rk4(*model, ws, x, dt, tau, tau_env, env, t);
+        kv::step_rk4(*model, ws, env, x, {tau, tau_ext}, dt);
     } catch (const kelp::numerical_error&) {
       KELP_FUZZ_REQUIRE(same_bits(x, x0), what + ": numerical_error changed the state");
       continue;

@@ -263,7 +263,7 @@ void vehicle_seed(const std::string& name, std::uint8_t flags, const kv::Vehicle
   for (double v : {x.attitude.w(), x.attitude.x(), x.attitude.y(), x.attitude.z()}) s.f64(v);
   m(x.nu);
   m(tau);
-  m(kelp::Vector6<double>::Zero().eval());  // τ_env
+  m(kelp::Vector6<double>::Zero().eval());  // τ_ext
   for (double v : {0.3, -0.1, 0.0, p.density, p.gravity, dt, 0.0}) s.f64(v);
   write("fuzz_vehicle_step", name, s.bytes);
 }

@@ -83,7 +83,7 @@ Timing run_for(double min_time, long batch, F&& body) {
 struct Kelp : kelp_bench::BenchmarkLine {
   using BenchmarkLine::BenchmarkLine;
   void step(double dt, kt::Integrator integ, const kt::ImplicitOptionsd& o = {}) {
-    kt::step(model, ws, env, state, boundary(state.time), dt, integ, o);
+    kt::step(model, ws, env, state, boundary(state.time), dt, {integ, o});
   }
 };
 
@@ -440,7 +440,7 @@ int main(int argc, char** argv) {
       long evb = 0;
       t = run_for(min_time, 16, [&] {
         evb += kt::step(kbd.model, kbd.ws, kbd.env, kbd.state, kbd.boundary(kbd.state.time), 0.01,
-                        kt::Integrator::bdf2)
+                        {kt::Integrator::bdf2})
                    .force_evaluations;
       });
       record("kelp_bdf2_10ms", S.kbdf2, r, t, double(evb) / t.iters, 0.01, 0.01);

@@ -37,8 +37,8 @@ struct Setup {
       p.coupling_corrections = corrections;
       world.model = ks::SystemModeld(p, world.model.environment());
     }
-    inputs.auv.control << 10, 0, 0, 0, 0, 0;
-    inputs.asv.control << 5, 0, 0, 0, 0, 0;
+    inputs.auv.tau << 10, 0, 0, 0, 0, 0;
+    inputs.asv.tau << 5, 0, 0, 0, 0, 0;
     for (int k = 0; k < 200; ++k) step();  // settle in
   }
   ks::SystemReportd step() {
@@ -72,13 +72,13 @@ void BM_SystemStepSplit(benchmark::State& st) {
   kelp::Matrix3X<double> vel(3, w.model.tether().nodes()), acc(3, w.model.tether().nodes());
   kelp::VectorX<double> zeta(w.model.tether().nodes());
   for (auto _ : st) {
-    const double t = w.state.time();
+    const double t = w.state.time;
     const auto t0 = clock::now();
     kt::TetherBoundaryd ends;
     ends.start = ks::detail::predicted_end(w.state.asv, w.state.asv_nu_dot, p.asv_attachment);
     ends.end = ks::detail::predicted_end(w.state.auv, w.state.auv_nu_dot, p.auv_attachment);
     kt::advance(w.model.tether(), w.workspace.tether, env, w.state.tether, ends, dt,
-                p.max_tether_dt, p.tether_integrator, p.tether_options);
+                {p.max_tether_dt, p.tether_integrator, p.tether_options});
     const Vector3<double> fa = w.workspace.tether.end_impulse.on_start / dt;
     const Vector3<double> fb = w.workspace.tether.end_impulse.on_end / dt;
     const auto t1 = clock::now();

@@ -55,7 +55,7 @@ void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_imp
   double evals = 0, newton = 0;
   for (auto _ : st) {
     const kt::StepReportd r =
-        kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, integ, options);
+        kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, {integ, options});
     evals += r.force_evaluations;
     newton += r.newton_iterations;
     benchmark::DoNotOptimize(s.state.position.data());
@@ -97,7 +97,7 @@ void BM_BlockSolve(benchmark::State& st) {
   Setup s(n);
   const double dt = 0.01, gh = 2.0 / 3.0 * dt;
   for (int k = 0; k < 20; ++k)
-    kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, kt::Integrator::bdf2);
+    kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, {kt::Integrator::bdf2});
   kt::compute_forces<true>(s.model, s.ws, s.env, s.state.time, s.state.position, s.state.velocity);
   for (int i = 0; i < s.model.nodes(); ++i)
     s.ws.rhs.col(i) = Vector3<double>(std::cos(i), 1.0, std::sin(0.5 * i));

@@ -21,14 +21,14 @@ struct Fixture {
   kv::VehicleModel<double> model{preset.parameters};
   kv::VehicleWorkspace<double> ws;
   kv::VehicleState<double> x;
-  Vector6<double> tau, tau_env;
+  Vector6<double> tau, tau_ext;
   Vector3<double> current{0.3, -0.1, 0.0};
   Fixture() {
     x.position << 1, 2, 5;
     x.attitude = kelp::quaternion_from_euler(0.05, -0.1, 0.7);
     x.nu << 0.4, -0.1, 0.05, 0.02, -0.03, 0.1;
     tau << 20, -5, 10, 0.2, -0.1, 1.0;
-    tau_env << 1, 0.5, -2, 0, 0.1, 0;
+    tau_ext << 1, 0.5, -2, 0, 0.1, 0;
   }
 };
 
@@ -36,7 +36,7 @@ void BM_ForwardDynamics(benchmark::State& st) {
   Fixture f;
   for (auto _ : st) {
     benchmark::DoNotOptimize(f.x);
-    Vector6<double> a = kv::forward_dynamics(f.model, f.ws, f.x, f.tau, f.tau_env, f.current);
+    Vector6<double> a = kv::forward_dynamics(f.model, f.ws, f.x, f.tau, f.tau_ext, f.current);
     benchmark::DoNotOptimize(a);
   }
 }
@@ -47,7 +47,7 @@ void BM_Rk4Step(benchmark::State& st) {
   const kv::VehicleState<double> x0 = f.x;
   int k = 0;
   for (auto _ : st) {
-    kv::step_rk4(f.model, f.ws, f.x, 0.001, f.tau, f.tau_env, f.current);
+    kv::step_rk4(f.model, f.ws, f.x, {f.tau, f.tau_ext}, 0.001, f.current);
     benchmark::DoNotOptimize(f.x);
     if (++k == 100000) {  // stay near the fixture's state
       f.x = x0;
@@ -73,11 +73,9 @@ void BM_Rk4StepInEnvironment(benchmark::State& st) {
     f.x.nu.setZero();
   }
   const kv::VehicleState<double> x0 = f.x;
-  double t = 0.0;
   int k = 0;
   for (auto _ : st) {
-    kv::step_rk4(model, f.ws, f.x, 0.01, f.tau, f.tau_env, env, t);
-    t += 0.01;
+    kv::step_rk4(model, f.ws, env, f.x, {f.tau, f.tau_ext}, 0.01);
     benchmark::DoNotOptimize(f.x);
     if (++k == 10000) {  // stay near the fixture's state
       f.x = x0;
@@ -92,7 +90,7 @@ void BM_SemiImplicitEulerStep(benchmark::State& st) {
   const kv::VehicleState<double> x0 = f.x;
   int k = 0;
   for (auto _ : st) {
-    kv::step_semi_implicit_euler(f.model, f.ws, f.x, 0.001, f.tau, f.tau_env, f.current);
+    kv::step_symplectic_euler(f.model, f.ws, f.x, {f.tau, f.tau_ext}, 0.001, f.current);
     benchmark::DoNotOptimize(f.x);
     if (++k == 100000) {
       f.x = x0;

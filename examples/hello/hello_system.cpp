@@ -10,7 +10,7 @@ int main() {
   // BlueBoat + BlueROV2 Heavy + 10 m ROV tether, moderate sea; ROV 5 m down astern of the boat.
   ks::presets::PaperWorld<double> w(10.0, ks::presets::Sea::moderate);
   ks::SystemInputsd in;
-  in.auv.control << -20, 0, 0, 0, 0, 0;  // body wrench [N, N m]: 20 N astern, away from the boat
+  in.auv.tau << -20, 0, 0, 0, 0, 0;  // body wrench [N, N m]: 20 N astern, away from the boat
   double peak = 0;
   for (int k = 0; k < 2000; ++k) {  // 20 s at 10 ms
     const ks::SystemReportd r = ks::step(w.model, w.workspace, w.state, in, 0.01);
@@ -19,7 +19,7 @@ int main() {
   const auto& s = w.state;
   std::printf(
       "after %.0f s: ROV at (%.2f, %.2f, %.2f) m, boat at (%.2f, %.2f) m, peak pull %.1f N\n",
-      s.time(), s.auv.position.x(), s.auv.position.y(), s.auv.position.z(), s.asv.position.x(),
+      s.time, s.auv.position.x(), s.auv.position.y(), s.auv.position.z(), s.asv.position.x(),
       s.asv.position.y(), peak);
   return peak > 0.0 ? 0 : 1;
 }

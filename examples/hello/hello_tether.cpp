@@ -21,7 +21,7 @@ int main() {
   ends.end.velocity = {0.5, 0, 0};
   for (int k = 0; k < 1000; ++k) {  // 10 s at 10 ms
     ends.end.position = auv + s.time * ends.end.velocity;
-    kt::step(tether, ws, sea, s, ends, 0.01, kt::Integrator::bdf2);
+    kt::step(tether, ws, sea, s, ends, 0.01, {kt::Integrator::bdf2});
   }
   const kelp::Vector3<double> pull = ws.end_forces.on_end;  // force on the AUV [N, NED]
   std::printf("pull on the AUV after 10 s: %.2f N (%.2f, %.2f, %.2f) NED\n", pull.norm(), pull.x(),

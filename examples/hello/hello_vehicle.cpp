@@ -18,7 +18,7 @@ int main() {
   const kelp::Vector6<double> tau = thrusters.wrench(f);  // body wrench [N, N m]
   const kelp::Vector3<double> current(0.2, 0.0, 0.0);     // NED current [m/s]
   for (int k = 0; k < 10000; ++k)                         // 10 s at 1 ms
-    kv::step_rk4(model, ws, x, 1e-3, tau, kelp::Vector6<double>::Zero(), current);
+    kv::step_rk4(model, ws, x, {tau, kelp::Vector6<double>::Zero()}, 1e-3, current);
   std::printf("surge %.3f m/s, position N %.2f m, depth %.3f m\n", x.nu(0), x.position(0),
               x.position(2));
   return x.nu(0) > 0.0 ? 0 : 1;

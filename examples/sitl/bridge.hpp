@@ -231,7 +231,7 @@ class Bridge {
     const kv::VehicleStated& x = is_sub ? state_.auv : state_.asv;
     const kelp::Vector6<double>& nu_dot = is_sub ? state_.auv_nu_dot : state_.asv_nu_dot;
     VehicleReply r;
-    r.timestamp = state_.time();
+    r.timestamp = state_.time;
     const kelp::Vector3<double> v = x.nu.head<3>(), w = x.nu.tail<3>();
     r.gyro = w;
     // Specific force: the acceleration of the body origin relative to NED, in body axes
@@ -262,7 +262,7 @@ class Bridge {
   }
   std::string time_string() const {
     char b[32];
-    std::snprintf(b, sizeof b, "%.4f s", state_.time());
+    std::snprintf(b, sizeof b, "%.4f s", state_.time);
     return b;
   }
 
@@ -319,7 +319,7 @@ class Bridge {
     }
     try {
       ks::SystemStated s = ks::initial_state(model_, ws_, is_sub ? other : fresh,
-                                             is_sub ? fresh : other, state_.time());
+                                             is_sub ? fresh : other, state_.time);
       state_ = std::move(s);
       state_.reset_coupling();
     } catch (const std::exception& e) {
@@ -347,9 +347,9 @@ class Bridge {
     if (active == 0) return;
     if (settings_.start_together && steps_ == 0 && joined < 2) return;
     ks::SystemInputsd in;
-    in.auv.control =
+    in.auv.tau =
         peers_[sub].active ? rov_thrusters_.wrench(auv_force_) : kelp::Vector6<double>::Zero();
-    in.asv.control =
+    in.asv.tau =
         peers_[rover].active ? boat_thrusters_.wrench(asv_force_) : kelp::Vector6<double>::Zero();
     report_ = ks::step(model_, ws_, state_, in, 1.0 / settings_.rate);
     ++steps_;

@@ -158,7 +158,7 @@ int run(const Options& o) {
   double next_log = 0, next_nodes = 0, next_status = wall0 + o.status_interval;
   const auto log_state = [&]() {
     const ks::SystemStated& s = bridge.state();
-    const double t = s.time();
+    const double t = s.time;
     if (t + 1e-9 >= next_log) {
       kelp::sim::LogRow row;
       row.t = t;
@@ -213,7 +213,7 @@ int run(const Options& o) {
         if (bridge.steps() != logged_steps) {
           logged_steps = bridge.steps();
           log_state();
-          if (o.duration > 0 && bridge.state().time() >= o.duration - 1e-9) done = true;
+          if (o.duration > 0 && bridge.state().time >= o.duration - 1e-9) done = true;
         }
       }
     }
@@ -227,7 +227,7 @@ int run(const Options& o) {
         std::fprintf(stderr,
                      "kelp-sitl: physics %.1f s (%.1fx real time), frames sub %llu rover %llu, "
                      "malformed sub %llu rover %llu\n",
-                     bridge.state().time(), bridge.state().time() / (now - wall0),
+                     bridge.state().time, bridge.state().time / (now - wall0),
                      static_cast<unsigned long long>(bridge.counters(0).frames),
                      static_cast<unsigned long long>(bridge.counters(1).frames),
                      static_cast<unsigned long long>(bridge.counters(0).malformed),
@@ -238,7 +238,7 @@ int run(const Options& o) {
   const double wall = wall_now() - wall0;
   nlohmann::json summary;
   summary["kelp_version"] = KELP_VERSION_STRING;
-  summary["physics_s"] = bridge.state().time();
+  summary["physics_s"] = bridge.state().time;
   summary["wall_s"] = wall;
   summary["steps"] = bridge.steps();
   summary["rate_hz"] = settings.rate;
@@ -251,7 +251,7 @@ int run(const Options& o) {
   std::fprintf(stderr,
                "kelp-sitl: stopped after %.2f s of physics (%llu steps) in %.1f s; malformed "
                "packets: ArduSub %llu, ArduRover %llu; summary in %s/summary.json\n",
-               bridge.state().time(), static_cast<unsigned long long>(bridge.steps()), wall,
+               bridge.state().time, static_cast<unsigned long long>(bridge.steps()), wall,
                static_cast<unsigned long long>(bridge.counters(0).malformed),
                static_cast<unsigned long long>(bridge.counters(1).malformed), o.log.c_str());
   return 0;

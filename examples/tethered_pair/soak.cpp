@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
     });
     retries += v.report.tether.retries;
     fallbacks += v.report.tether_fallbacks;
-    const double clock = std::abs(v.state.time() - static_cast<double>(v.step) * dt);
+    const double clock = std::abs(v.state.time - static_cast<double>(v.step) * dt);
     worst_clock = std::max(worst_clock, clock);
     expect(clock <= 1e-9, [&] {
       return "step " + std::to_string(v.step) + ": clock off by " + std::to_string(clock) + " s";
@@ -188,11 +188,11 @@ int main(int argc, char** argv) {
       const double x = v.state.auv.position.x(), y = v.state.auv.position.y();
       const double ref =
           reference_elevation(waves, x, y, static_cast<long double>(v.step) * (long double)dt);
-      const double err = std::abs(waves.elevation(x, y, v.state.time()) - ref);
+      const double err = std::abs(waves.elevation(x, y, v.state.time) - ref);
       worst_wave = std::max(worst_wave, err);
       expect(err <= 1e-6, [&] {
         return "wave elevation off by " + std::to_string(err) +
-               " m at t = " + std::to_string(v.state.time()) + " s";
+               " m at t = " + std::to_string(v.state.time) + " s";
       });
     }
     last_allocations = g_heap_allocations.load();

@@ -67,7 +67,7 @@ void dive() {
       std::printf("%6.1f %9.3f %9.3f %9.3f %10.0f %11.2f\n", t, x.position(2), v_ned(2),
                   euler(1) * 180 / kelp::pi, pwm(4), (x.attitude * tau.head<3>())(2));
     }
-    if (k < steps) kv::step_rk4(model, ws, x, dt, tau, Vector6<double>::Zero());
+    if (k < steps) kv::step_rk4(model, ws, x, {tau, Vector6<double>::Zero()}, dt);
   }
   std::printf("-> depth %.3f m at t = %.0f s; within 5 cm and at rest from t = %.1f s\n\n",
               x.position(2), t_end, settled_at);
@@ -98,7 +98,7 @@ void sprint() {
         std::printf("%6.1f %9.3f %9.2f %10.3f %10.2f\n", t, x.nu(0), x.position(0),
                     euler(1) * 180 / kelp::pi, x.position(2) * 100);
       }
-      if (k < steps) kv::step_rk4(model, ws, x, dt, tau, Vector6<double>::Zero());
+      if (k < steps) kv::step_rk4(model, ws, x, {tau, Vector6<double>::Zero()}, dt);
     }
     u_final = x.nu(0);
   }

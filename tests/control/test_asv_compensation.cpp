@@ -45,7 +45,7 @@ double follow(bool compensate, double& mean_speed) {
   int n = 0;
   for (int k = 0; k < 18000; ++k) {
     const kc::AsvCommand& cmd = c.update(kc::navigation_of(x), auv, t);
-    kv::step_rk4(model, ws, x, dt, cmd.wrench, Vector6<double>::Zero(), env, t);
+    kv::step_rk4(model, ws, env, x, {cmd.wrench, Vector6<double>::Zero()}, dt);
     t += dt;
     if (t > 120.0) {
       sum += (x.position - auv).head<2>().norm();

@@ -59,7 +59,7 @@ void fly(Rov& r, kc::AuvController& c, const ke::Environmentd& env, double& t, d
   const int n = static_cast<int>(std::lround(seconds / dt));
   for (int k = 0; k < n; ++k) {
     const kc::AuvCommand& cmd = c.update(kc::navigation_of(r.x), t);
-    kv::step_rk4(r.model, r.ws, r.x, dt, cmd.wrench, Vector6<double>::Zero(), env, t);
+    kv::step_rk4(r.model, r.ws, env, r.x, {cmd.wrench, Vector6<double>::Zero()}, dt);
     t += dt;
     f(t, cmd);
   }
@@ -181,7 +181,7 @@ TEST_CASE("ASV controller: station keeping and following with the paper's gains"
   for (int k = 0; k < 24000; ++k) {  // 240 s
     const kc::AsvCommand& cmd = c.update(kc::navigation_of(b.x), Vector3<double>::Zero(), t);
     peak = std::max({peak, std::abs(cmd.left), std::abs(cmd.right)});
-    kv::step_rk4(b.model, b.ws, b.x, dt, cmd.wrench, Vector6<double>::Zero(), env, t);
+    kv::step_rk4(b.model, b.ws, env, b.x, {cmd.wrench, Vector6<double>::Zero()}, dt);
     t += dt;
     const double d = b.x.position.head<2>().norm(), u = b.x.nu.head<2>().norm();
     if (d < radius) inside_speed = std::max(inside_speed, u);
@@ -206,7 +206,7 @@ TEST_CASE("ASV controller: station keeping and following with the paper's gains"
   double follow_inside_speed = 0;
   for (int k = 0; k < 24000; ++k) {
     const kc::AsvCommand& cmd = c.update(kc::navigation_of(b.x), auv, t);
-    kv::step_rk4(b.model, b.ws, b.x, dt, cmd.wrench, Vector6<double>::Zero(), env, t);
+    kv::step_rk4(b.model, b.ws, env, b.x, {cmd.wrench, Vector6<double>::Zero()}, dt);
     t += dt;
     if ((b.x.position - auv).head<2>().norm() < radius)
       follow_inside_speed = std::max(follow_inside_speed, b.x.nu.head<2>().norm());

@@ -50,7 +50,7 @@ TEST_CASE("Euler-rate and quaternion-rate kinematics describe the same motion", 
     theta += dt * de(1);
     psi += dt * de(2);
     const auto dq = kelp::quaternion_rate(q, w);
-    q.coeffs() += dt * Eigen::Vector4d(dq(1), dq(2), dq(3), dq(0));
+    q.coeffs() += dt * dq;  // (ẋ, ẏ, ż, ẇ): Eigen's coeffs() order
     q.normalize();
   }
   CHECK((kelp::rotation_zyx(phi, theta, psi) - q.toRotationMatrix()).norm() < 1e-4);

@@ -55,7 +55,7 @@ TEST_CASE("a ClosedLoop stepped by hand runs what simulate() runs, bit for bit",
   CHECK(chunked.run_for(100.0) == 377);  // up to the end, not beyond
   CHECK(chunked.done());
   CHECK(chunked.summary() == reference);
-  CHECK(chunked.state().time() == loop.state().time());
+  CHECK(chunked.state().time == loop.state().time);
   CHECK(chunked.state().auv.position == loop.state().auv.position);
 }
 

@@ -139,7 +139,7 @@ TEST_CASE("free surface: an unpowered, slightly buoyant ROV rises and floats at 
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < steps; ++k) {
     const double z_before = x.position.z();
-    kv::step_rk4(model, ws, x, dt, zero, zero, still, t);
+    kv::step_rk4(model, ws, still, x, {zero, zero}, dt);
     t += dt;
     if (z_before >= 3.0 && x.position.z() < 3.0) w_at_3m = (z_before - x.position.z()) / dt;
     z_min = std::min(z_min, x.position.z());
@@ -264,7 +264,7 @@ TEST_CASE("waves at depth: a neutrally buoyant ROV follows the orbits, amplitude
     x.position = V3(0, 0, run.depth);
     double t = 0;
     for (int i = 0; i < steps; ++i) {
-      kv::step_rk4(model, ws, x, dt, zero, zero, env, t);
+      kv::step_rk4(model, ws, env, x, {zero, zero}, dt);
       t += dt;
       run.t.push_back(t);
       run.x.push_back(x.position.x());
@@ -380,11 +380,9 @@ TEST_CASE("current: an unpowered boat drifts with the current", "[system][physic
   kv::VehicleStated x;
   const V6 zero = V6::Zero();
   const double dt = 0.01;
-  double t = 0;
   V3 p100 = V3::Zero();
   for (int i = 0; i < 12000; ++i) {
-    kv::step_rk4(model, ws, x, dt, zero, zero, env, t);
-    t += dt;
+    kv::step_rk4(model, ws, env, x, {zero, zero}, dt);
     if (i + 1 == 10000) p100 = x.position;
   }
   const V3 v_mean = (x.position - p100) / 20.0;
@@ -432,7 +430,7 @@ TEST_CASE(
   const double dt = 0.01;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < 60000; ++k) {  // 600 s
-    in.auv.control = hold_pose(s.auv, hold, V3::Zero(), 0.0, 300.0, 150.0, 200.0);
+    in.auv.tau = hold_pose(s.auv, hold, V3::Zero(), 0.0, 300.0, 150.0, 200.0);
     report = ks::step(model, ws, s, in, dt);
   }
   const double wall = seconds_since(t0);
@@ -492,7 +490,7 @@ TEST_CASE(
   // part; vehicle::surroundings), where this thin current is weaker than at its CO.
   const double half_draft = 0.5 * bp.displaced_volume / bp.waterplane_area;
   const V3 wet(s.asv.position.x(), s.asv.position.y(), std::max(s.asv.position.z(), half_draft));
-  const V3 vc = env.current().velocity(wet, s.time());
+  const V3 vc = env.current().velocity(wet, s.time);
   const V3 nu_r = V3(s.asv.nu.head<3>()) - Rb.transpose() * vc;
   V3 drag_body;
   for (int i = 0; i < 3; ++i)
@@ -561,8 +559,8 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
   // surface the environment has no water to sample).
   const auto water_at = [&](const kv::VehicleStated& x, double below) {
     V3 q = x.position;
-    q.z() = std::max(q.z(), -env.surface_elevation(q.x(), q.y(), s.time()) + below);
-    const auto e = env.sample(q, s.time());
+    q.z() = std::max(q.z(), -env.surface_elevation(q.x(), q.y(), s.time) + below);
+    const auto e = env.sample(q, s.time);
     return V3(e.current + e.wave_velocity);
   };
   struct Peaks {
@@ -601,7 +599,7 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
       // The filter lags a drifting boat by τ_f v; adding τ_f v back removes that lag.
       V3 target = asv_filtered + tau_f * asv_filtered_v + offset;
       target.z() = 5.0;
-      in.auv.control = hold_pose(s.auv, target, asv_filtered_v, 0.0, 200.0, 150.0, 80.0);
+      in.auv.tau = hold_pose(s.auv, target, asv_filtered_v, 0.0, 200.0, 150.0, 80.0);
       const ks::SystemReportd r = ks::step(model, world.workspace, s, in, dt);
       const V3 prev = asv_filtered;
       asv_filtered += (dt / tau_f) * (s.asv.position - asv_filtered);
@@ -631,14 +629,14 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
     }
   } catch (const kelp::error& e) {
     threw = true;
-    FAIL_CHECK("threw at t = " << s.time() << " s: " << e.what());
+    FAIL_CHECK("threw at t = " << s.time << " s: " << e.what());
   }
   const double wall = seconds_since(t0);
   boat.kinetic_bound = kinetic_bound(model.asv(), boat.water);
   rov.kinetic_bound = kinetic_bound(model.auv(), rov.water);
-  INFO("simulated " << s.time() << " s in " << wall << " s of wall time (" << 1e6 * wall / steps
+  INFO("simulated " << s.time << " s in " << wall << " s of wall time (" << 1e6 * wall / steps
                     << " us per 10 ms step); the boat ended at " << s.asv.position.transpose()
-                    << " m (mean drift " << s.asv.position.head<2>().norm() / s.time() << " m/s)");
+                    << " m (mean drift " << s.asv.position.head<2>().norm() / s.time << " m/s)");
   INFO("tether: worst Newton residual "
        << residual_max << " m/s (tolerance " << tolerance << "), steps retried in sub-steps "
        << retries << ", committed above tolerance " << unconverged << ", redone explicitly "
@@ -656,7 +654,7 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
                        << " N; distance between the tether's ends up to " << span_max << " m");
   CHECK_FALSE(threw);
   CHECK(nonfinite == 0);
-  CHECK(s.time() == Approx(tmax).epsilon(1e-9));
+  CHECK(s.time == Approx(tmax).epsilon(1e-9));
   CHECK(unconverged == 0);
   CHECK(fallbacks <= steps / 1000);  // explicit redos stay rare
   CHECK(boat.kinetic < boat.kinetic_bound);
@@ -698,7 +696,7 @@ TEST_CASE("waves at the surface: an unpowered boat follows the orbits of a long 
   std::vector<double> tt, xs, zs;
   int above = 0;
   for (int i = 0; i < 12000; ++i) {  // 120 s; the last 60 s are fitted
-    kv::step_rk4(model, ws, x, dt, zero, zero, env, t);
+    kv::step_rk4(model, ws, env, x, {zero, zero}, dt);
     t += dt;
     if (t <= 60.0) continue;
     tt.push_back(t);

@@ -31,9 +31,8 @@ TEMPLATE_TEST_CASE("attachment motion is the body-fixed point's position and vel
   kelp::vehicle::VehicleState<S> w = v;
   w.position += (v.attitude * Vector3<S>(v.nu.template head<3>())) * h;
   const Eigen::Matrix<S, 4, 1> qd = kelp::quaternion_rate(v.attitude, v.nu.template tail<3>());
-  w.attitude = kelp::Quaternion<S>(v.attitude.w() + h * qd(0), v.attitude.x() + h * qd(1),
-                                   v.attitude.y() + h * qd(2), v.attitude.z() + h * qd(3))
-                   .normalized();
+  w.attitude.coeffs() = v.attitude.coeffs() + h * qd;  // qd in coeffs() order (x, y, z, w)
+  w.attitude.normalize();
   const Vector3<S> fd = (w.point_position(r) - v.point_position(r)) / h;
   CHECK((fd - m.velocity).norm() < S(2e-3));
   CHECK(m.acceleration.isZero());
@@ -91,7 +90,7 @@ TEST_CASE("tether between two vehicles: loads balance the line and follow the ve
                            const kelp::vehicle::VehicleStated& b, kt::Integrator integrator) {
     Loads l;
     l.report = kt::advance(model, ws, env, state, ks::tether_boundary(a, r_asv, b, r_auv), 0.1,
-                           0.01, integrator);
+                           {0.01, integrator});
     l.start = ws.end_forces.on_start;
     l.end = ws.end_forces.on_end;
     l.tau_start = ks::attachment_wrench(a, r_asv, l.start);

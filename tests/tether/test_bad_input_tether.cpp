@@ -51,7 +51,7 @@ struct Line {
   Line() {
     state =
         kt::catenary_initial_state(model, water, boundary.start.position, boundary.end.position);
-    (void)kt::step(model, ws, water, state, boundary, 0.01, kt::Integrator::bdf2);
+    (void)kt::step(model, ws, water, state, boundary, 0.01, {kt::Integrator::bdf2});
   }
 };
 
@@ -170,7 +170,8 @@ TEST_CASE("Tether low-level functions refuse an empty or foreign workspace and m
     REQUIRE_THROWS_AS(kt::end_forces_from_workspace(model, *ws, line.boundary),
                       kelp::invalid_argument);
     require_refused("step with a foreign workspace", line.state, [&] {
-      (void)kt::step(model, *ws, line.water, line.state, line.boundary, 0.01, kt::Integrator::rk4);
+      (void)kt::step(model, *ws, line.water, line.state, line.boundary, 0.01,
+                     {kt::Integrator::rk4});
     });
     require_refused("static solve with a foreign workspace", line.state, [&] {
       (void)kt::solve_static_equilibrium(model, *ws, line.water, line.state, line.boundary);
@@ -224,8 +225,8 @@ TEST_CASE("Tether steps refuse bad input and leave the state unchanged", "[tethe
   const auto step = [&](double dt, kt::Integrator integrator,
                         const kt::ImplicitOptionsd& options = {},
                         const kt::TetherBoundaryd* b = nullptr) {
-    (void)kt::step(line.model, line.ws, line.water, state, b ? *b : line.boundary, dt, integrator,
-                   options);
+    (void)kt::step(line.model, line.ws, line.water, state, b ? *b : line.boundary, dt,
+                   {integrator, options});
   };
   const kt::Integrator all[] = {kt::Integrator::symplectic_euler, kt::Integrator::rk2,
                                 kt::Integrator::rk4, kt::Integrator::implicit_euler,
@@ -262,8 +263,8 @@ TEST_CASE("Tether steps refuse bad input and leave the state unchanged", "[tethe
     INFO("option case " << k);
     require_refused("implicit options", state, [&] { step(0.01, kt::Integrator::bdf2, o); });
     require_refused("advance with implicit options", state, [&] {
-      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, 0.05, 0.01,
-                        kt::Integrator::implicit_euler, o);
+      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, 0.05,
+                        {0.01, kt::Integrator::implicit_euler, o});
     });
   }
   // States that do not fit or are not finite are refused as they are.
@@ -271,7 +272,7 @@ TEST_CASE("Tether steps refuse bad input and leave the state unchanged", "[tethe
   wrong.position.conservativeResize(3, 4);
   require_refused("state of the wrong size", wrong, [&] {
     (void)kt::step(line.model, line.ws, line.water, wrong, line.boundary, 0.01,
-                   kt::Integrator::rk4);
+                   {kt::Integrator::rk4});
   });
   for (int k = 0; k < 5; ++k) {
     kt::TetherStated s = state;
@@ -282,19 +283,19 @@ TEST_CASE("Tether steps refuse bad input and leave the state unchanged", "[tethe
     if (k == 4) s.previous_dt = -1;
     for (const kt::Integrator integrator : all)
       require_refused("non-finite state", s, [&] {
-        (void)kt::step(line.model, line.ws, line.water, s, line.boundary, 0.01, integrator);
+        (void)kt::step(line.model, line.ws, line.water, s, line.boundary, 0.01, {integrator});
       });
   }
   // Driver arguments.
   for (const double d : {0.0, -1.0, nan_, inf_})
     require_refused("advance duration", state, [&] {
-      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, d, 0.01,
-                        kt::Integrator::rk4);
+      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, d,
+                        {0.01, kt::Integrator::rk4});
     });
   for (const double h : {0.0, -1.0, nan_, 1e-300})
     require_refused("advance max_dt", state, [&] {
-      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, 1.0, h,
-                        kt::Integrator::rk4);
+      (void)kt::advance(line.model, line.ws, line.water, state, line.boundary, 1.0,
+                        {h, kt::Integrator::rk4});
     });
   // The line still steps after all of this.
   const double t0 = state.time;

@@ -338,7 +338,7 @@ TEST_CASE("twisted block solve on the benchmark line's BDF2 Jacobian", "[tether]
     for (int k = 0; k < 20; ++k) {
       auto bnd = kt::TetherBoundaryd::fixed(a, b);
       bnd.end.position.z() = 5.0 + 0.1 * (1 - std::cos(0.4 * kelp::pi * state.time));
-      kt::step(model, ws, env, state, bnd, dt, kt::Integrator::bdf2);
+      kt::step(model, ws, env, state, bnd, dt, {kt::Integrator::bdf2});
     }
     kt::compute_forces<true>(model, ws, env, state.time, state.position, state.velocity);
     for (int i = 0; i < model.nodes(); ++i)

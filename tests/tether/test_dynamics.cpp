@@ -48,7 +48,7 @@ PendulumRun run_pendulum(kt::Integrator integ, double dt, double duration) {
   double prev_x = state.position(0, 10), first = -1, last = -1;
   const int steps = static_cast<int>(std::lround(duration / dt));
   for (int k = 0; k < steps; ++k) {
-    kt::step(model, ws, env, state, b, dt, integ);
+    kt::step(model, ws, env, state, b, dt, {integ});
     const double x = state.position(0, 10);
     if (prev_x > 0 && x <= 0) {  // downward zero crossing, interpolated
       const double tc = state.time - dt * x / (x - prev_x);
@@ -131,7 +131,7 @@ TEST_CASE("energy: conserved within 1 % without drag and damping, never increasi
       const double e0 = kt::tether_energy(model, env, s);
       double max_drift = 0, max_ke = 0;
       while (s.time < 10.0) {
-        kt::step(model, ws, env, s, bnd, dt, integ);
+        kt::step(model, ws, env, s, bnd, dt, {integ});
         max_drift = std::max(max_drift, std::abs(kt::tether_energy(model, env, s) - e0));
         max_ke = std::max(max_ke, kinetic_energy(model, s));
       }
@@ -159,7 +159,7 @@ TEST_CASE("energy: conserved within 1 % without drag and damping, never increasi
       const double e0 = e_prev;
       int increases = 0;
       while (s.time < 5.0) {
-        kt::step(model, ws, env, s, bnd, dt, integ, tight);
+        kt::step(model, ws, env, s, bnd, dt, {integ, tight});
         const double e = kt::tether_energy(model, env, s);
         if (e > e_prev + 1e-9 * std::abs(e0)) ++increases;
         e_prev = e;
@@ -214,7 +214,7 @@ TEST_CASE("implicit at dt = 10 ms matches RK4 at 0.1 ms under a forced heave of 
     kt::TetherWorkspaced w_imp(model);
     auto& out = integ == kt::Integrator::bdf2 ? t_bdf : t_imp;
     for (int k = 0; k < n_imp; ++k) {
-      const auto r = kt::step(model, w_imp, env, s, boundary_at(s.time), dt_imp, integ);
+      const auto r = kt::step(model, w_imp, env, s, boundary_at(s.time), dt_imp, {integ});
       retried += r.retries;
       max_newton = std::max(max_newton, r.newton_iterations);
       out[k] = w_imp.end_forces.on_end.norm();
@@ -251,7 +251,7 @@ TEST_CASE("a buoyant tether with a free end floats up to the surface",
   const Vector3<double> a(0, 0, 6);
   auto s = kt::straight_line_state(model, a, Vector3<double>(20, 0, 6));
   const auto bnd = kt::TetherBoundaryd::fixed(a, a);
-  for (int k = 0; k < 6000; ++k) kt::step(model, ws, env, s, bnd, 0.01, kt::Integrator::bdf2);
+  for (int k = 0; k < 6000; ++k) kt::step(model, ws, env, s, bnd, 0.01, {kt::Integrator::bdf2});
   // The line rises monotonically from the anchor and its free part floats at the surface
   // (nodes above it lose their buoyancy, so they bob at z ≈ 0).
   for (int i = 1; i <= 20; ++i) CHECK(s.position(2, i) < s.position(2, i - 1) + 0.05);
@@ -277,7 +277,7 @@ TEST_CASE("a slack line falls onto the seabed without compression and comes to r
   const auto bnd = kt::TetherBoundaryd::fixed(a, b);
   double min_tension = 0;
   for (int k = 0; k < 2000; ++k) {
-    kt::step(model, ws, env, s, bnd, 0.01, kt::Integrator::bdf2);
+    kt::step(model, ws, env, s, bnd, 0.01, {kt::Integrator::bdf2});
     // BA = 0: the axial force is purely elastic and must never be compressive.
     min_tension = std::min(min_tension, ws.tension.minCoeff());
   }
@@ -306,7 +306,7 @@ TEST_CASE("the sub-stepping driver equals the same steps taken by hand", "[tethe
   // 5 ms with max_dt 1.2 ms → 5 RK4 sub-steps of 1 ms (stable: 1.9 ms); the end moves with its
   // velocity.
   auto s1 = s0, s2 = s0;
-  CHECK(kt::advance(model, w1, env, s1, b, 0.005, 0.0012, kt::Integrator::rk4).substeps == 5);
+  CHECK(kt::advance(model, w1, env, s1, b, 0.005, {0.0012, kt::Integrator::rk4}).substeps == 5);
   for (int k = 0; k < 5; ++k) {
     auto bk = b;
     bk.end.position = b.end.position_at(0.001 * k);
@@ -316,7 +316,7 @@ TEST_CASE("the sub-stepping driver equals the same steps taken by hand", "[tethe
   CHECK(s1.time == Approx(0.005));
   CHECK((s1.position.col(10) - (b.end.position + 0.005 * b.end.velocity)).norm() < 1e-12);
   CHECK((w1.end_forces.on_end - w2.end_forces.on_end).norm() < 1e-12);
-  CHECK_THROWS_AS(kt::advance(model, w1, env, s1, b, 0.0, 0.01, kt::Integrator::rk4),
+  CHECK_THROWS_AS(kt::advance(model, w1, env, s1, b, 0.0, {0.01, kt::Integrator::rk4}),
                   kelp::invalid_argument);
 }
 
@@ -335,17 +335,17 @@ TEST_CASE("a state reset between implicit steps ignores the workspace's history"
     INFO(kt::integrator_name(integ));
     kt::TetherWorkspaced used(model), fresh(model);
     auto s = s0;
-    for (int k = 0; k < 3; ++k) kt::step(model, used, env, s, bnd, dt, integ);
+    for (int k = 0; k < 3; ++k) kt::step(model, used, env, s, bnd, dt, {integ});
     s = s0;  // reset
-    const auto r1 = kt::step(model, used, env, s, bnd, dt, integ);
+    const auto r1 = kt::step(model, used, env, s, bnd, dt, {integ});
     auto f = s0;
-    const auto r2 = kt::step(model, fresh, env, f, bnd, dt, integ);
+    const auto r2 = kt::step(model, fresh, env, f, bnd, dt, {integ});
     CHECK(r1.force_evaluations == r2.force_evaluations);
     CHECK((s.position - f.position).cwiseAbs().maxCoeff() == 0.0);
     CHECK((s.velocity - f.velocity).cwiseAbs().maxCoeff() == 0.0);
     // The next step continues with the history of the reset run, as the fresh one does.
-    kt::step(model, used, env, s, bnd, dt, integ);
-    kt::step(model, fresh, env, f, bnd, dt, integ);
+    kt::step(model, used, env, s, bnd, dt, {integ});
+    kt::step(model, fresh, env, f, bnd, dt, {integ});
     CHECK((s.position - f.position).cwiseAbs().maxCoeff() == 0.0);
   }
 }

@@ -100,7 +100,7 @@ TEST_CASE("a cable never pushes: the axial force stays >= 0 with internal dampin
       const double z1 = env.surface_elevation(0.0, 0.0, s.time + dt);
       bnd.start.position.z() = 0.1 - z0;
       bnd.start.velocity.z() = -(z1 - z0) / dt;
-      kt::step(model, ws, env, s, bnd, dt, kt::Integrator::bdf2);  // throws if not converged
+      kt::step(model, ws, env, s, bnd, dt, {kt::Integrator::bdf2});  // throws if not converged
       min_force[compressive] = std::min(min_force[compressive], ws.tension.minCoeff());
     }
   }
@@ -144,7 +144,7 @@ TEST_CASE("a smaller dt is never less accurate, at a cost linear in 1/dt",
     const int n = static_cast<int>(std::lround(duration / dt)), every = std::lround(0.01 / dt);
     for (int k = 1; k <= n; ++k) {
       r.evaluations +=
-          kt::step(model, ws, env, s, boundary_at(s.time), dt, integ).force_evaluations;
+          kt::step(model, ws, env, s, boundary_at(s.time), dt, {integ}).force_evaluations;
       if (k % every) continue;
       if (!kt::is_implicit(integ)) {  // explicit schemes report the start of the step
         kt::compute_forces(model, ws, env, s.time, s.position, s.velocity);
@@ -200,11 +200,11 @@ TEST_CASE("waves sampled once per implicit step agree with waves sampled at ever
   kt::StepReportd r_held, r_exact;
   double se = 0, sr = 0, se_dt = 0, dx = 0, dx_dt = 0;
   for (int k = 0; k < 2000; ++k) {
-    r_held += kt::step(model, ws, env, held, bnd, 0.01, kt::Integrator::bdf2);
+    r_held += kt::step(model, ws, env, held, bnd, 0.01, {kt::Integrator::bdf2});
     const double f_held = ws.end_forces.on_end.norm();
-    r_exact += kt::step(model, ws, env, exact, bnd, 0.01, kt::Integrator::bdf2, every);
+    r_exact += kt::step(model, ws, env, exact, bnd, 0.01, {kt::Integrator::bdf2, every});
     const double f_exact = ws.end_forces.on_end.norm();
-    for (int j = 0; j < 2; ++j) kt::step(model, ws, env, fine, bnd, 0.005, kt::Integrator::bdf2);
+    for (int j = 0; j < 2; ++j) kt::step(model, ws, env, fine, bnd, 0.005, {kt::Integrator::bdf2});
     const double f_fine = ws.end_forces.on_end.norm();
     se += (f_held - f_exact) * (f_held - f_exact);
     se_dt += (f_fine - f_exact) * (f_fine - f_exact);
@@ -237,7 +237,7 @@ TEST_CASE("an implicit step that does not converge is retried in sub-steps, neve
   SECTION("retried: several sub-steps, each converged") {
     kt::TetherWorkspaced ws(model);
     auto s = s0;
-    const auto r = kt::step(model, ws, env, s, bnd, dt, kt::Integrator::bdf2, options);
+    const auto r = kt::step(model, ws, env, s, bnd, dt, {kt::Integrator::bdf2, options});
     INFO("sub-steps " << r.substeps << ", retries " << r.retries << ", residual " << r.residual
                       << ", rejected " << r.rejected_residual);
     CHECK(r.retries >= 1);
@@ -251,7 +251,7 @@ TEST_CASE("an implicit step that does not converge is retried in sub-steps, neve
     kt::TetherWorkspaced ws(model);
     auto s = s0;
     options.max_step_halvings = 0;
-    CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, dt, kt::Integrator::bdf2, options),
+    CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, dt, {kt::Integrator::bdf2, options}),
                     kelp::numerical_error);
     CHECK(bitwise_equal(s, s0));
     CHECK_FALSE(s.has_history());
@@ -259,7 +259,7 @@ TEST_CASE("an implicit step that does not converge is retried in sub-steps, neve
   SECTION("the drivers pass the report on") {
     kt::TetherWorkspaced ws(model);
     auto s = s0;
-    const auto r = kt::advance(model, ws, env, s, bnd, 2 * dt, dt, kt::Integrator::bdf2);
+    const auto r = kt::advance(model, ws, env, s, bnd, 2 * dt, {dt, kt::Integrator::bdf2});
     CHECK(r.substeps > 2);
     CHECK(r.retries >= 1);
     CHECK(r.residual <= options.acceleration_tolerance * dt);
@@ -277,7 +277,7 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
     kt::TetherWorkspaced ws(model);
     auto s = kt::catenary_initial_state(model, env, a, b);
     for (int k = 0; k < 5; ++k)
-      kt::step(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), 10.0, kt::Integrator::bdf2);
+      kt::step(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), 10.0, {kt::Integrator::bdf2});
     CHECK(s.time == Approx(50.0));
     // Settled: at rest, on the static shape the static solve finds.
     CHECK(s.velocity.cwiseAbs().maxCoeff() < 1e-3);
@@ -291,7 +291,7 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
     const auto s0 = kt::catenary_initial_state(model, env, a, b);
     auto s = s0;
     CHECK_THROWS_WITH(
-        kt::step(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), 0.01, kt::Integrator::bdf2),
+        kt::step(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b), 0.01, {kt::Integrator::bdf2}),
         Catch::Contains("cannot be resolved") && Catch::Contains("fewer, longer segments"));
     CHECK(bitwise_equal(s, s0));
     // The same line with 20 segments steps (and a looser tolerance is the user's other way out).
@@ -301,7 +301,7 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
     kt::TetherWorkspaced ws20(model20);
     auto s20 = kt::catenary_initial_state(model20, env, a, b);
     CHECK_NOTHROW(kt::step(model20, ws20, env, s20, kt::TetherBoundaryd::fixed(a, b), 1e-5,
-                           kt::Integrator::bdf2));
+                           {kt::Integrator::bdf2}));
   }
   SECTION("a stiff float line steps to float's resolution instead of failing at step 196") {
     // 1 m of the default line in 2 segments between (0, 0, 10) and (0.5, 0, 10.5): EA/l = 2e5 N/m
@@ -321,7 +321,7 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
       auto s = kt::straight_line_state(model, a, b);
       const auto boundary = kt::TetherBoundary<S>::fixed(a, b);
       for (int k = 0; k < 3000; ++k)
-        kt::step(model, ws, water, s, boundary, 0.01, kt::Integrator::bdf2);
+        kt::step(model, ws, water, s, boundary, 0.01, {kt::Integrator::bdf2});
       return Vector3<double>(s.position.col(1).template cast<double>());
     };
     Vector3<double> node_f = Vector3<double>::Zero();
@@ -345,10 +345,11 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
     const Vector3<float> a(0, 0, 10), b(0.5f, 0, 10.5f);
     const auto s0 = kt::straight_line_state(model, a, b);
     auto s = s0;
-    CHECK_THROWS_WITH(
-        kt::step(model, ws, water, s, kt::TetherBoundaryf::fixed(a, b), 0.01, kt::Integrator::bdf2),
-        Catch::Contains("cannot be resolved") && Catch::Contains("single precision") &&
-            Catch::Contains("or double precision"));
+    CHECK_THROWS_WITH(kt::step(model, ws, water, s, kt::TetherBoundaryf::fixed(a, b), 0.01,
+                               {kt::Integrator::bdf2}),
+                      Catch::Contains("cannot be resolved") &&
+                          Catch::Contains("single precision") &&
+                          Catch::Contains("or double precision"));
     CHECK(s.position == s0.position);
     CHECK(s.time == s0.time);
   }
@@ -381,20 +382,20 @@ TEST_CASE("the integrator history lives in the state: save, step, restore, step 
     const double dt = kt::is_implicit(integ) ? 0.01 : 1e-4;
     kt::TetherWorkspaced ws(model), other(model);
     auto s = swinging(model);
-    for (int k = 0; k < 5; ++k) kt::step(model, ws, env, s, bnd, dt, integ);
+    for (int k = 0; k < 5; ++k) kt::step(model, ws, env, s, bnd, dt, {integ});
     const kt::TetherStated saved = s;
     REQUIRE(saved.has_history());
     std::vector<kt::TetherStated> first;
     for (int k = 0; k < 3; ++k) {
-      kt::step(model, ws, env, s, bnd, dt, integ);
+      kt::step(model, ws, env, s, bnd, dt, {integ});
       first.push_back(s);
     }
     // Restore, and step with a workspace that has meanwhile stepped another state.
     auto unrelated = swinging(model);
-    kt::step(model, other, env, unrelated, bnd, 2 * dt, integ);
+    kt::step(model, other, env, unrelated, bnd, 2 * dt, {integ});
     s = saved;
     for (int k = 0; k < 3; ++k) {
-      kt::step(model, other, env, s, bnd, dt, integ);
+      kt::step(model, other, env, s, bnd, dt, {integ});
       CHECK(bitwise_equal(s, first[std::size_t(k)]));
       CHECK(bitwise_equal(s.previous_position, first[std::size_t(k)].previous_position));
     }

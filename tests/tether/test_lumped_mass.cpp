@@ -92,7 +92,7 @@ TEST_CASE("bad tether parameters throw invalid_argument naming the field", "[tet
   auto s = kt::straight_line_state(model, Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
   auto b = kt::TetherBoundaryd::fixed(Vector3<double>(0, 0, 0), Vector3<double>(10, 0, 5));
   CHECK_THROWS_WITH(kt::step_rk4(model, ws, env, s, b, 0.0), Catch::Contains("dt"));
-  CHECK_THROWS_WITH(kt::step_implicit(model, ws, env, s, b, -1e-3), Catch::Contains("dt"));
+  CHECK_THROWS_WITH(kt::step_implicit_euler(model, ws, env, s, b, -1e-3), Catch::Contains("dt"));
   auto bad = b;
   bad.end.velocity.x() = nan;
   CHECK_THROWS_WITH(kt::step_symplectic_euler(model, ws, env, s, bad, 1e-4),
@@ -358,7 +358,7 @@ TEST_CASE("analytic Jacobian with seabed contact, friction and drag agrees with 
           "[tether][jacobian][seabed]") {
   // Half the nodes press into the seabed (stiffness node_kz, damping, friction) while drag acts
   // on all of them, with c_x > 0 and c_v > 0 at once. D_x leaves out the drag's dependence on
-  // the node tangents by design (see step_implicit), so the position part is differenced on
+  // the node tangents by design (see step_implicit_euler), so the position part is differenced on
   // the same line without drag (drag is an additive force term); the velocity part, where the
   // drag Jacobian is exact, on the full line. Contact nodes move only vertically: the friction
   // Jacobian (coefficient μN/v_f, N held fixed) is exact for a zero horizontal velocity, and
@@ -419,9 +419,9 @@ TEMPLATE_TEST_CASE("steps allocate nothing on the heap", "[tether][malloc]", dou
   for (auto integ : {kt::Integrator::symplectic_euler, kt::Integrator::rk2, kt::Integrator::rk4,
                      kt::Integrator::implicit_euler, kt::Integrator::bdf2}) {
     const S dt = kt::is_implicit(integ) ? S(0.01) : S(1e-5);
-    for (int k = 0; k < 3; ++k) kt::step(model, ws, env, state, boundary, dt, integ);
+    for (int k = 0; k < 3; ++k) kt::step(model, ws, env, state, boundary, dt, {integ});
   }
-  kt::advance(model, ws, env, state, boundary, S(0.02), S(0.01), kt::Integrator::bdf2);
+  kt::advance(model, ws, env, state, boundary, S(0.02), {S(0.01), kt::Integrator::bdf2});
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(kelp::all_finite(state.position));
   CHECK(state.position.col(0).isApprox(a));
@@ -452,8 +452,9 @@ TEST_CASE("a non-finite value during a step throws and leaves the state unchange
     state.velocity.col(4) = Vector3<double>(0.1, 0.2, 0.3);
     state.time = 0.6;
     const kt::TetherStated before = state;
-    CHECK_THROWS_AS(kt::step(model, ws, env, state, kt::TetherBoundaryd::fixed(a, b), 1e-4, integ),
-                    kelp::numerical_error);
+    CHECK_THROWS_AS(
+        kt::step(model, ws, env, state, kt::TetherBoundaryd::fixed(a, b), 1e-4, {integ}),
+        kelp::numerical_error);
     CHECK(state.position == before.position);
     CHECK(state.velocity == before.velocity);
     CHECK(state.time == before.time);
@@ -461,7 +462,7 @@ TEST_CASE("a non-finite value during a step throws and leaves the state unchange
     state.time = 0.4;
     const kt::TetherStated before2 = state;
     CHECK_THROWS_AS(kt::advance(model, ws, env, state, kt::TetherBoundaryd::fixed(a, b), 0.2,
-                                kt::is_implicit(integ) ? 0.01 : 1e-3, integ),
+                                {kt::is_implicit(integ) ? 0.01 : 1e-3, integ}),
                     kelp::numerical_error);
     CHECK(state.position == before2.position);
     CHECK(state.time == before2.time);
@@ -659,9 +660,9 @@ TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is
 
   SECTION("advance: more than INT_MAX sub-steps") {
     auto s = good;
-    CHECK_THROWS_AS(kt::advance(model, ws, env, s, bnd, 1e3, 1e-7, kt::Integrator::rk4),
+    CHECK_THROWS_AS(kt::advance(model, ws, env, s, bnd, 1e3, {1e-7, kt::Integrator::rk4}),
                     kelp::invalid_argument);
-    CHECK_THROWS_WITH(kt::advance(model, ws, env, s, bnd, 1e3, 1e-7, kt::Integrator::rk4),
+    CHECK_THROWS_WITH(kt::advance(model, ws, env, s, bnd, 1e3, {1e-7, kt::Integrator::rk4}),
                       Catch::Contains("max_dt"));
     CHECK(same(s, good));
   }
@@ -671,10 +672,11 @@ TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is
       INFO(field);
       for (auto integ : {kt::Integrator::implicit_euler, kt::Integrator::bdf2}) {
         auto s = good;
-        CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, 0.01, integ, o), kelp::invalid_argument);
-        CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 0.01, integ, o), Catch::Contains(field));
+        CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, 0.01, {integ, o}), kelp::invalid_argument);
+        CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 0.01, {integ, o}),
+                          Catch::Contains(field));
         CHECK(same(s, good));
-        CHECK_THROWS_AS(kt::advance(model, ws, env, s, bnd, 0.05, 0.01, integ, o),
+        CHECK_THROWS_AS(kt::advance(model, ws, env, s, bnd, 0.05, {0.01, integ, o}),
                         kelp::invalid_argument);
         CHECK(same(s, good));
       }
@@ -725,8 +727,9 @@ TEST_CASE("bad step inputs throw invalid_argument naming the field; the state is
         if (c.which == 1) s.velocity(0, 6) = std::numeric_limits<double>::infinity();
         if (c.which == 2) s.time = nan;
         const auto before = s;
-        CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, 1e-4, integ), kelp::invalid_argument);
-        CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 1e-4, integ), Catch::Contains(c.field));
+        CHECK_THROWS_AS(kt::step(model, ws, env, s, bnd, 1e-4, {integ}), kelp::invalid_argument);
+        CHECK_THROWS_WITH(kt::step(model, ws, env, s, bnd, 1e-4, {integ}),
+                          Catch::Contains(c.field));
         CHECK(same(s, before));
       }
     }

@@ -59,7 +59,7 @@ TEST_CASE("the ROV tether between an ASV and an AUV in the moderate sea steps wi
   for (int k = 0; k < 1000; ++k) {  // 10 s
     auto b = kt::TetherBoundaryd::fixed(asv, auv);
     b.start.position.z() -= env.surface_elevation(0.0, 0.0, s.time);
-    total += kt::step(model, ws, env, s, b, 0.01, kt::Integrator::bdf2);
+    total += kt::step(model, ws, env, s, b, 0.01, {kt::Integrator::bdf2});
   }
   INFO("Newton per step " << double(total.newton_iterations) / total.substeps << ", retries "
                           << total.retries);

@@ -247,8 +247,8 @@ TEST_CASE("float and double agree on the static equilibrium and a dynamic run",
   for (int k = 0; k < 100; ++k) {
     bd.end.position.x() = 10 + 0.3 * sd.time;
     bf.end.position.x() = 10.f + 0.3f * sf.time;
-    kt::step(md, wsd, envd, sd, bd, 0.01, kt::Integrator::bdf2);
-    kt::step(mf, wsf, envf, sf, bf, 0.01f, kt::Integrator::bdf2);
+    kt::step(md, wsd, envd, sd, bd, 0.01, {kt::Integrator::bdf2});
+    kt::step(mf, wsf, envf, sf, bf, 0.01f, {kt::Integrator::bdf2});
   }
   CHECK((sf.position.cast<double>() - sd.position).cwiseAbs().maxCoeff() < 5e-3);
   CHECK(double(wsf.end_forces.on_end.norm()) == Approx(wsd.end_forces.on_end.norm()).epsilon(1e-2));
@@ -278,8 +278,8 @@ TEST_CASE("a rejected pseudo step restarts from the position before it",
     inner.max_iterations = 6;
     inner.acceleration_tolerance = 0.5 * tol / model.node_mass(10);
     inner.max_step_halvings = 0;
-    REQUIRE_THROWS_AS(kt::step_implicit(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b),
-                                        options.initial_pseudo_dt, false, inner),
+    REQUIRE_THROWS_AS(kt::step_implicit_euler(model, ws, env, s, kt::TetherBoundaryd::fixed(a, b),
+                                              options.initial_pseudo_dt, inner),
                       kelp::numerical_error);
   }
   kt::TetherWorkspaced ws(model);

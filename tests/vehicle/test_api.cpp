@@ -36,11 +36,11 @@ TEST_CASE("vehicle steps take a double literal dt with a float model", "[vehicle
   const Vector6<float> zero = Vector6<float>::Zero();
   // `0.01` is a double: with `const Scalar& dt` this did not compile (Scalar deduced as both
   // float and double).
-  kv::step_rk4(model, ws, x, 0.01, zero, zero);
-  kv::step_rk4(model, ws, y, 0.01F, zero, zero, Vector3<float>::Zero());
-  kv::step_semi_implicit_euler(model, ws, z, 0.01, zero, zero);
+  kv::step_rk4(model, ws, x, {zero, zero}, 0.01);
+  kv::step_rk4(model, ws, y, {zero, zero}, 0.01F, Vector3<float>::Zero());
+  kv::step_symplectic_euler(model, ws, z, {zero, zero}, 0.01);
   kv::step_rk4_with(
-      model, ws, z, 1e-2, [&](const kv::VehicleState<float>&, float) { return zero; },
+      model, ws, z, [&](const kv::VehicleState<float>&, float) { return zero; }, 1e-2,
       Vector3<float>::Zero());
   STATIC_REQUIRE(std::is_same_v<decltype(x.nu), Vector6<float>>);
   CHECK(x.nu(0) == y.nu(0));  // the literal became the same float step
@@ -83,7 +83,7 @@ TEST_CASE("after a step the workspace holds the last evaluation's terms (documen
   // RK4: the fourth stage, at the predictor x4 = x0 + dt k3, rebuilt here stage by stage.
   kv::VehicleWorkspace<double> ws, ref;
   kv::VehicleState<double> x = x0;
-  kv::step_rk4(model, ws, x, dt, tau, zero, current);
+  kv::step_rk4(model, ws, x, {tau, zero}, dt, current);
   const auto k1 = kv::state_derivative(model, ref, x0, tau, current);
   const auto k2 =
       kv::state_derivative(model, ref, kv::detail::advance(x0, k1, 0.5 * dt), tau, current);
@@ -102,7 +102,7 @@ TEST_CASE("after a step the workspace holds the last evaluation's terms (documen
 
   // Semi-implicit Euler: the state at the start of the step.
   kv::VehicleState<double> y = x0;
-  kv::step_semi_implicit_euler(model, ws, y, dt, tau, zero, current);
+  kv::step_symplectic_euler(model, ws, y, {tau, zero}, dt, current);
   kv::forward_dynamics(model, ref, x0, tau, zero, current);
   CHECK((ws.nu_dot - ref.nu_dot).norm() == 0.0);
   CHECK((ws.damping - ref.damping).norm() == 0.0);

@@ -30,7 +30,8 @@ constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool same(const kv::VehicleState<double>& a, const kv::VehicleState<double>& b) {
-  return a.position == b.position && a.attitude.coeffs() == b.attitude.coeffs() && a.nu == b.nu;
+  return a.position == b.position && a.attitude.coeffs() == b.attitude.coeffs() && a.nu == b.nu &&
+         a.time == b.time;
 }
 
 }  // namespace
@@ -85,7 +86,7 @@ TEST_CASE("bad input: absurd vehicle parameters are refused where the model is b
     kv::VehicleWorkspace<double> ws;
     kv::VehicleState<double> x;
     x.position.z() = 5.0;  // fully submerged
-    kv::step_rk4(model, ws, x, 0.01, Vector6<double>::Zero(), Vector6<double>::Zero());
+    kv::step_rk4(model, ws, x, {Vector6<double>::Zero(), Vector6<double>::Zero()}, 0.01);
     CHECK(x.nu.allFinite());
     CHECK((x.nu(2) < 0.0) == (model.buoyancy() > model.weight()));  // rises if buoyant
   }
@@ -105,56 +106,57 @@ TEST_CASE("bad input: steps refuse NaN currents and times and mis-sized wrenches
   bad(3) = kNan;
   // A non-finite wrench is the documented numerical_error (tests/vehicle/test_dynamics.cpp), state
   // unchanged; a wrench of the wrong size is an invalid argument.
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, bad, zero), kelp::numerical_error);
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, bad), kelp::numerical_error);
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, {bad, zero}, 0.01), kelp::numerical_error);
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, {zero, bad}, 0.01), kelp::numerical_error);
   CHECK(same(x, before));
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero, Vector3<double>(kInf, 0, 0)),
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, {zero, zero}, 0.01, Vector3<double>(kInf, 0, 0)),
                     kelp::invalid_argument);
-  REQUIRE_THROWS_AS(kv::step_semi_implicit_euler(model, ws, x, 0.01, bad, zero),
+  REQUIRE_THROWS_AS(kv::step_symplectic_euler(model, ws, x, {bad, zero}, 0.01),
                     kelp::numerical_error);
   REQUIRE_THROWS_AS(
-      kv::step_semi_implicit_euler(model, ws, x, 0.01, zero, zero, Vector3<double>(kNan, 0, 0)),
+      kv::step_symplectic_euler(model, ws, x, {zero, zero}, 0.01, Vector3<double>(kNan, 0, 0)),
       kelp::invalid_argument);
-  REQUIRE_THROWS_AS(
-      kv::step_rk4_with(
-          model, ws, x, 0.01, [&](const kv::VehicleState<double>&, double) { return zero; },
-          Vector3<double>(0, kNan, 0)),
-      kelp::invalid_argument);
-  const Eigen::VectorXd short_tau = Eigen::VectorXd::Zero(5);
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, short_tau, zero), kelp::invalid_argument);
-  REQUIRE_THROWS_WITH(kv::step_rk4(model, ws, x, 0.01, short_tau, zero), Catch::Contains("tau"));
-  REQUIRE_THROWS_AS(kv::step_semi_implicit_euler(model, ws, x, 0.01, zero, short_tau),
+  REQUIRE_THROWS_AS(kv::step_rk4_with(
+                        model, ws, x, [&](const kv::VehicleState<double>&, double) { return zero; },
+                        0.01, Vector3<double>(0, kNan, 0)),
                     kelp::invalid_argument);
+  // The steps take their wrenches as VehicleInputs (two Vector6): a wrench of the wrong size
+  // cannot reach them. forward_dynamics takes any Eigen expression and checks the size.
+  const Eigen::VectorXd short_tau = Eigen::VectorXd::Zero(5);
   REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, short_tau, zero), kelp::invalid_argument);
   const Eigen::VectorXd long_current = Eigen::VectorXd::Zero(4);
   REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, zero, zero, long_current),
                     kelp::invalid_argument);
   const ke::Environment<double> env = ke::make_environment<double>(ke::presets::moderate());
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero, env, kNan),
-                    kelp::invalid_argument);
-  REQUIRE_THROWS_WITH(kv::step_rk4(model, ws, x, 0.01, zero, zero, env, kInf),
-                      Catch::Contains("t must be finite"));
+  kv::VehicleState<double> xt = x;  // the clock is the state's
+  xt.time = kNan;
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, env, xt, {zero, zero}, 0.01), kelp::invalid_argument);
+  xt.time = kInf;
+  REQUIRE_THROWS_WITH(kv::step_rk4(model, ws, env, xt, {zero, zero}, 0.01),
+                      Catch::Contains("state.time must be finite"));
   CHECK(same(x, before));
 
   // The valid neighbours step, and give the same result as before any refused call.
   kv::VehicleState<double> y = before;
-  kv::step_rk4(model, ws, x, 0.01, zero, zero);
-  kv::step_rk4(model, ws, y, 0.01, zero, zero);
+  kv::step_rk4(model, ws, x, {zero, zero}, 0.01);
+  kv::step_rk4(model, ws, y, {zero, zero}, 0.01);
   CHECK(same(x, y));
   CHECK_FALSE(same(x, before));
-  kv::step_rk4(model, ws, x, 0.01, zero, zero, env, 1e5);
+  x.time = 1e5;
+  kv::step_rk4(model, ws, env, x, {zero, zero}, 0.01);
   CHECK(x.nu.allFinite());
 
   // A huge but finite wrench is valid input: the step blows up and says so as a numerical error,
   // state unchanged (also for a surface vessel, whose wind load reads the blown-up stage states).
   const Vector6<double> huge = Vector6<double>::Constant(1e308);
   kv::VehicleState<double> z = before;
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, z, 0.01, huge, zero), kelp::numerical_error);
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, z, {huge, zero}, 0.01), kelp::numerical_error);
   CHECK(same(z, before));
   const kv::VehicleModel<double> boat(kv::blueboat<double>().parameters);
   kv::VehicleState<double> b;
+  b.time = 10.0;
   const kv::VehicleState<double> b0 = b;
-  REQUIRE_THROWS_AS(kv::step_rk4(boat, ws, b, 0.01, huge, zero, env, 10.0), kelp::numerical_error);
+  REQUIRE_THROWS_AS(kv::step_rk4(boat, ws, env, b, {huge, zero}, 0.01), kelp::numerical_error);
   CHECK(same(b, b0));
 }
 
@@ -276,11 +278,11 @@ TEST_CASE("a step keeps the attitude a unit quaternion however fast the vehicle 
         const kv::VehicleState<double> before = x;
         try {
           if (integrator == 0)
-            kv::step_rk4(model, ws, x, 1e-3, tau, zero);
+            kv::step_rk4(model, ws, x, {tau, zero}, 1e-3);
           else if (integrator == 1)
-            kv::step_semi_implicit_euler(model, ws, x, 1e-3, tau, zero);
+            kv::step_symplectic_euler(model, ws, x, {tau, zero}, 1e-3);
           else
-            kv::step_rk4(model, ws, x, 1e-3, tau, zero, env, 0.0);
+            kv::step_rk4(model, ws, env, x, {tau, zero}, 1e-3);
         } catch (const kelp::numerical_error&) {
           CHECK(same(x, before));  // refused: the state as it was
           continue;
@@ -309,5 +311,5 @@ TEST_CASE("bad input: forward_dynamics checks sizes only", "[vehicle][bad_input]
   const Vector6<double> nu_dot = kv::forward_dynamics(model, ws, x, zero, zero);  // no throw
   CHECK_FALSE(nu_dot.allFinite());
   // The step that takes the same state refuses it up front.
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, zero, zero), kelp::invalid_argument);
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, {zero, zero}, 0.01), kelp::invalid_argument);
 }

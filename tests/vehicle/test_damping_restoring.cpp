@@ -140,7 +140,7 @@ TEMPLATE_TEST_CASE("a heavy vehicle sinks, a buoyant one rises", "[vehicle][rest
     // Initial acceleration (W - B)/(m + A_33) downward (NED +z) for a heavy vehicle.
     const S expected = (model.weight() - model.buoyancy()) / (p.mass + p.added_mass(2, 2));
     CHECK(a(2) == Approx(expected).epsilon(1e-4));
-    for (int k = 0; k < 500; ++k) kv::step_rk4(model, ws, x, S(0.01), zero, zero);
+    for (int k = 0; k < 500; ++k) kv::step_rk4(model, ws, x, {zero, zero}, S(0.01));
     if (factor < 1)
       CHECK(x.position(2) > S(0.05));
     else
@@ -162,7 +162,7 @@ TEMPLATE_TEST_CASE("a pitched vehicle with r_b above r_g rights itself", "[vehic
     const Vector6<S> zero = Vector6<S>::Zero();
     const Vector6<S> a = kv::forward_dynamics(model, ws, x, zero, zero);
     CHECK(a(4) * S(theta0) < S(0));  // the pitch acceleration opposes the pitch
-    for (int k = 0; k < 3000; ++k) kv::step_rk4(model, ws, x, S(0.01), zero, zero);
+    for (int k = 0; k < 3000; ++k) kv::step_rk4(model, ws, x, {zero, zero}, S(0.01));
     const Vector3<S> e = kelp::euler_from_quaternion(x.attitude);
     // Roll has no linear damping (von Benzon 2022), so its quadratic-only decay is slow (∝ 1/t).
     CHECK(std::abs(e(0)) < S(0.02));

@@ -3,10 +3,12 @@
 // current handling, failure semantics and the absence of heap allocation.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
 #include "kelp/core/rotation.hpp"
+#include "kelp/environment/sea_state.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/kinematics.hpp"
 #include "kelp/vehicle/model.hpp"
@@ -60,7 +62,7 @@ TEMPLATE_TEST_CASE("without damping or forcing, RK4 conserves the kinetic energy
   const Vector6<S> zero = Vector6<S>::Zero();
   double worst = 0;
   for (int k = 0; k < 10000; ++k) {  // 10 s at 1 ms
-    kv::step_rk4(model, ws, x, S(0.001), zero, zero);
+    kv::step_rk4(model, ws, x, {zero, zero}, S(0.001));
     worst = std::max(worst, std::abs(energy(x) - e0) / e0);
   }
   // double: the issue's 1e-6 (RK4 error at 1 ms is ~1e-12 here); float: rounding of 1e4 steps.
@@ -93,7 +95,7 @@ TEST_CASE("without damping, kinetic + hydrostatic potential energy is conserved"
   double worst = 0;
   const Vector6<double> zero = Vector6<double>::Zero();
   for (int k = 0; k < 10000; ++k) {
-    kv::step_rk4(model, ws, x, 0.001, zero, zero);
+    kv::step_rk4(model, ws, x, {zero, zero}, 0.001);
     worst = std::max(worst, std::abs(energy(x) - e0) / scale);
   }
   CHECK(worst < 1e-6);
@@ -109,13 +111,13 @@ TEMPLATE_TEST_CASE("BlueROV2 Heavy at constant surge thrust reaches the speed wh
   tau(0) = S(40);
   // 40 = 13.7 u + 141 u² ⇒ u = 0.4862 m/s (von Benzon 2022 damping).
   const double u_ss = steady_speed(13.7, 141, 40);
-  for (int k = 0; k < 2000; ++k) kv::step_rk4(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 2000; ++k) kv::step_rk4(model, ws, x, {tau, Vector6<S>::Zero()}, S(0.01));
   CHECK(double(x.nu(0)) == Approx(u_ss).epsilon(0.01));
   CHECK(double(x.position(0)) > 0.9 * u_ss * 19);
   // The semi-implicit Euler integrator reaches the same steady state.
   kv::VehicleState<S> y;
   for (int k = 0; k < 20000; ++k)
-    kv::step_semi_implicit_euler(model, ws, y, S(0.001), tau, Vector6<S>::Zero());
+    kv::step_symplectic_euler(model, ws, y, {tau, Vector6<S>::Zero()}, S(0.001));
   CHECK(double(y.nu(0)) == Approx(u_ss).epsilon(0.01));
   CHECK(double(y.attitude.norm()) == Approx(1.0).epsilon(1e-6));
 }
@@ -134,7 +136,7 @@ TEMPLATE_TEST_CASE("BlueBoat at full thrust reaches its top speed near 3 m/s",
   const Vector6<S> tau = thrusters.wrench(f);
   CHECK(double(tau(0)) == Approx(60.8).epsilon(1e-6));
   CHECK(std::abs(double(tau(5))) < 1e-6);
-  for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, S(0.01), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, {tau, Vector6<S>::Zero()}, S(0.01));
   // Pure surge balance: 5 u + 5 u² = 60.8 ⇒ 3.023 m/s. The thrusters sit 0.10 m below the CO, so
   // the boat trims bow-up (≈ 0.03 rad) and the heave restoring force then has a surge component:
   // the simulated top speed is ≈ 2 % lower (2.966 m/s when this test was written).
@@ -157,7 +159,7 @@ TEMPLATE_TEST_CASE("a heave step settles", "[vehicle][behaviour]", double, float
   kv::VehicleState<S> x;
   Vector6<S> tau = Vector6<S>::Zero();
   tau(2) = S(50);
-  for (int k = 0; k < 2000; ++k) kv::step_rk4(boat, ws, x, S(0.005), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 2000; ++k) kv::step_rk4(boat, ws, x, {tau, Vector6<S>::Zero()}, S(0.005));
   CHECK(double(x.position(2)) == Approx(50 / (1025 * 9.80665 * 0.19)).epsilon(0.01));
   CHECK(std::abs(double(x.nu(2))) < 1e-3);
 
@@ -165,7 +167,7 @@ TEMPLATE_TEST_CASE("a heave step settles", "[vehicle][behaviour]", double, float
   const kv::VehicleModel<S> rov(neutral_rov<S>());
   kv::VehicleState<S> y;
   tau(2) = S(20);
-  for (int k = 0; k < 1000; ++k) kv::step_rk4(rov, ws, y, S(0.01), tau, Vector6<S>::Zero());
+  for (int k = 0; k < 1000; ++k) kv::step_rk4(rov, ws, y, {tau, Vector6<S>::Zero()}, S(0.01));
   CHECK(double(y.nu(2)) == Approx(steady_speed(33, 190, 20)).epsilon(0.01));
 }
 
@@ -205,7 +207,7 @@ TEST_CASE("BlueBoat heave, roll and pitch oscillate with the linear natural peri
     std::vector<double> crossings;
     double prev = coordinate();
     for (int k = 1; k < 40000 && crossings.size() < 2; ++k) {
-      kv::step_rk4(boat, ws, x, dt, Vector6<double>::Zero(), Vector6<double>::Zero());
+      kv::step_rk4(boat, ws, x, {Vector6<double>::Zero(), Vector6<double>::Zero()}, dt);
       const double now = coordinate();
       if (prev < 0 && now >= 0) crossings.push_back((k - now / (now - prev)) * dt);
       prev = now;
@@ -228,7 +230,7 @@ TEMPLATE_TEST_CASE("a passive neutrally buoyant vehicle ends up moving with a un
   x.attitude = kelp::quaternion_from_euler(S(0), S(0), S(0.7));  // yawed: the current is rotated
   const Vector3<S> current(S(0.5), S(-0.2), S(0.05));
   const Vector6<S> zero = Vector6<S>::Zero();
-  for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, S(0.01), zero, zero, current);
+  for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, {zero, zero}, S(0.01), current);
   const Vector3<S> v_ned = x.attitude * Vector3<S>(x.nu.template head<3>());
   CHECK((v_ned - current).norm() < S(2e-3));
   // The transient spin decays slowly (roll and yaw have quadratic damping only).
@@ -252,7 +254,7 @@ TEST_CASE("a body spinning while drifting with the current keeps drifting with i
   x.nu.head<3>() = x.attitude.conjugate() * current;
   x.nu(5) = 0.8;
   const Vector6<double> zero = Vector6<double>::Zero();
-  for (int k = 0; k < 5000; ++k) kv::step_rk4(model, ws, x, 0.002, zero, zero, current);
+  for (int k = 0; k < 5000; ++k) kv::step_rk4(model, ws, x, {zero, zero}, 0.002, current);
   const Vector3<double> v_ned = x.attitude * Vector3<double>(x.nu.head<3>());
   CHECK((v_ned - current).norm() < 1e-9);
   CHECK((x.position - 10.0 * current).norm() < 1e-8);
@@ -289,7 +291,40 @@ TEST_CASE("equal relative flow gives equal hydrodynamic force", "[vehicle][curre
   CHECK((ws2.nu_r - still.nu).norm() < 1e-12);
 }
 
-TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage",
+TEST_CASE("the clock is the state's: every step advances it by dt, a refused step keeps it",
+          "[vehicle][integrators]") {
+  const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
+  kv::VehicleWorkspace<double> ws;
+  const auto env =
+      kelp::environment::make_environment<double>(kelp::environment::presets::moderate());
+  kv::VehicleState<double> x;
+  x.position.z() = 5.0;
+  x.time = 2.5;
+  const kv::VehicleInputs<double> none;
+  kv::step_rk4(model, ws, x, none, 0.01);
+  CHECK(x.time == 2.5 + 0.01);
+  kv::step_symplectic_euler(model, ws, x, {Vector6<double>::Zero()}, 0.01);  // τ_ext = 0
+  CHECK(x.time == 2.5 + 0.01 + 0.01);
+  kv::step_rk4(model, ws, env, x, none, 0.02);
+  CHECK(x.time == 2.5 + 0.01 + 0.01 + 0.02);
+  kv::step_symplectic_euler(model, ws, env, x, none, 0.02);
+  CHECK(x.time == 2.5 + 0.01 + 0.01 + 0.02 + 0.02);
+  // The environment is sampled at the state's clock: in waves the same state at another time
+  // moves differently.
+  kv::VehicleState<double> a = x, b = x;
+  b.time += 3.0;
+  kv::step_rk4(model, ws, env, a, none, 0.01);
+  kv::step_rk4(model, ws, env, b, none, 0.01);
+  CHECK((a.nu - b.nu).norm() > 0.0);
+  // A step that fails leaves the clock as it was.
+  kv::VehicleInputs<double> bad;
+  bad.tau(0) = std::numeric_limits<double>::quiet_NaN();
+  const double t = x.time;
+  CHECK_THROWS_AS(kv::step_rk4(model, ws, env, x, bad, 0.01), kelp::numerical_error);
+  CHECK(x.time == t);
+}
+
+TEST_CASE("tau_ext adds to tau and a wrench callable is evaluated per RK4 stage",
           "[vehicle][integrators]") {
   const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
   kv::VehicleWorkspace<double> ws;
@@ -311,17 +346,17 @@ TEST_CASE("tau_env adds to tau and a wrench callable is evaluated per RK4 stage"
   // A callable that returns the same constant wrench reproduces step_rk4, and it is called at the
   // classical RK4 stage offsets 0, dt/2, dt/2, dt.
   kv::VehicleState<double> y = x, z = x;
-  kv::step_rk4(model, ws, y, 0.01, t1, t2);
+  kv::step_rk4(model, ws, y, {t1, t2}, 0.01);
   int calls = 0;
   double offsets[4] = {-1, -1, -1, -1};
   kv::step_rk4_with(
-      model, ws, z, 0.01,
+      model, ws, z,
       [&](const kv::VehicleState<double>&, double t) -> Vector6<double> {
         if (calls < 4) offsets[calls] = t;
         ++calls;
         return t1 + t2;
       },
-      Vector3<double>::Zero());
+      0.01, Vector3<double>::Zero());
   CHECK(calls == 4);
   CHECK(offsets[0] == 0.0);
   CHECK(offsets[1] == Approx(0.005));
@@ -358,15 +393,15 @@ TEST_CASE("a failed step throws and leaves the state unchanged", "[vehicle][inte
   const kv::VehicleState<double> before = x;
   Vector6<double> bad = Vector6<double>::Zero();
   bad(0) = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_AS(kv::step_rk4(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
+  CHECK_THROWS_AS(kv::step_rk4(model, ws, x, {bad, Vector6<double>::Zero()}, 0.01),
                   kelp::numerical_error);
-  CHECK_THROWS_AS(kv::step_semi_implicit_euler(model, ws, x, 0.01, bad, Vector6<double>::Zero()),
+  CHECK_THROWS_AS(kv::step_symplectic_euler(model, ws, x, {bad, Vector6<double>::Zero()}, 0.01),
                   kelp::numerical_error);
   CHECK(x.position == before.position);
   CHECK(x.nu == before.nu);
   CHECK(x.attitude.coeffs() == before.attitude.coeffs());
   CHECK_THROWS_WITH(
-      kv::step_rk4(model, ws, x, 0.0, Vector6<double>::Zero(), Vector6<double>::Zero()),
+      kv::step_rk4(model, ws, x, {Vector6<double>::Zero(), Vector6<double>::Zero()}, 0.0),
       Catch::Contains("dt"));
 }
 
@@ -380,17 +415,17 @@ TEMPLATE_TEST_CASE("forward dynamics and steps do not allocate", "[vehicle][mall
   kv::VehicleState<S> x;
   x.nu << S(0.3), S(0.1), S(-0.1), S(0.05), S(0.02), S(0.1);
   Eigen::Matrix<S, Eigen::Dynamic, 1> f(thrusters.size());
-  Vector6<S> tau = Vector6<S>::Zero(), tau_env = Vector6<S>::Zero();
-  tau_env(2) = S(3);
+  Vector6<S> tau = Vector6<S>::Zero(), tau_ext = Vector6<S>::Zero();
+  tau_ext(2) = S(3);
   const Vector3<S> current(S(0.2), S(0.1), S(0));
   tau(0) = S(20);
   tau(5) = S(1);
   Eigen::internal::set_is_malloc_allowed(false);
   thrusters.distribute(tau, f);
   tau = thrusters.wrench(f);
-  const Vector6<S> a = kv::forward_dynamics(model, ws, x, tau, tau_env, current);
-  kv::step_rk4(model, ws, x, S(0.01), tau, tau_env, current);
-  kv::step_semi_implicit_euler(model, ws, x, S(0.01), tau, tau_env, current);
+  const Vector6<S> a = kv::forward_dynamics(model, ws, x, tau, tau_ext, current);
+  kv::step_rk4(model, ws, x, {tau, tau_ext}, S(0.01), current);
+  kv::step_symplectic_euler(model, ws, x, {tau, tau_ext}, S(0.01), current);
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(a.allFinite());
   CHECK(x.nu.allFinite());

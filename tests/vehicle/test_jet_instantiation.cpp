@@ -88,7 +88,7 @@ TEST_CASE("Jet: an RK4 step, the T200 inverse and the allocation run with deriva
   kv::VehicleWorkspace<Jet> ws;
   kv::VehicleState<Jet> x;
   x.nu(0) = Jet(0.3, 0);  // derivative w.r.t. the initial surge speed
-  kv::step_rk4(model, ws, x, Jet(0.01), Vector6<Jet>::Zero(), Vector6<Jet>::Zero());
+  kv::step_rk4(model, ws, x, {Vector6<Jet>::Zero(), Vector6<Jet>::Zero()}, Jet(0.01));
   // Surge only decays: d u(dt) / d u(0) is a little below 1.
   CHECK(x.nu(0).v(0) < 1.0);
   CHECK(x.nu(0).v(0) > 0.9);

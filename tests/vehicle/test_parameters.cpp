@@ -183,13 +183,13 @@ TEST_CASE("steps refuse a non-unit attitude or a non-finite state, leaving it un
   kv::VehicleStated zero_q;
   zero_q.attitude.coeffs().setZero();
   const kv::VehicleStated before = zero_q;
-  CHECK_THROWS_WITH(kv::step_rk4(model, ws, zero_q, 1e-3, tau, tau), Catch::Contains("attitude"));
-  CHECK_THROWS_WITH(kv::step_semi_implicit_euler(model, ws, zero_q, 1e-3, tau, tau),
+  CHECK_THROWS_WITH(kv::step_rk4(model, ws, zero_q, {tau, tau}, 1e-3), Catch::Contains("attitude"));
+  CHECK_THROWS_WITH(kv::step_symplectic_euler(model, ws, zero_q, {tau, tau}, 1e-3),
                     Catch::Contains("attitude"));
   CHECK(zero_q.attitude.coeffs() == before.attitude.coeffs());
   kv::VehicleStated nan_nu;
   nan_nu.nu(2) = kNan;
-  CHECK_THROWS_WITH(kv::step_rk4(model, ws, nan_nu, 1e-3, tau, tau), Catch::Contains("state.nu"));
+  CHECK_THROWS_WITH(kv::step_rk4(model, ws, nan_nu, {tau, tau}, 1e-3), Catch::Contains("state.nu"));
   kv::VehicleStated ok;
-  CHECK_NOTHROW(kv::step_rk4(model, ws, ok, 1e-3, tau, tau));
+  CHECK_NOTHROW(kv::step_rk4(model, ws, ok, {tau, tau}, 1e-3));
 }

@@ -62,7 +62,7 @@ TEST_CASE("free surface: an unpowered BlueROV2 Heavy released at 5 m floats at t
   CHECK(top_eq > -0.01);                        // ... by a few millimetres (small freeboard)
   const double e0 = kv::energy(model, x);
   for (int k = 0; k < 720000; ++k) {  // 2 h
-    kv::step_rk4(model, ws, x, dt, zero, zero, env, t);
+    kv::step_rk4(model, ws, env, x, {zero, zero}, dt);
     t += dt;
     z_min = std::min(z_min, x.position(2));
     if (t_surface < 0 && x.position(2) < z_eq + 0.01) t_surface = t;
@@ -139,7 +139,7 @@ TEST_CASE("free surface: an undamped BlueROV2 bobbing through the surface conser
   const double e0 = kv::energy(model, x);
   double t = 0, zmin = 1, emax = 0;
   for (int k = 0; k < 20000; ++k) {  // 20 s at 1 ms, crossings of the surface band
-    kv::step_rk4(model, ws, x, 0.001, zero, zero, env, t);
+    kv::step_rk4(model, ws, env, x, {zero, zero}, 0.001);
     t += 0.001;
     zmin = std::min(zmin, x.position(2));
     emax = std::max(emax, std::abs(kv::energy(model, x) - e0));
@@ -160,8 +160,7 @@ TEST_CASE("free surface: an undamped BlueROV2 bobbing through the surface conser
     y.attitude = kelp::quaternion_from_euler(0.3 * std::sin(i), 0.2 * std::cos(i), 0.1 * i);
     y.nu << 0.2 * std::cos(i), 0.1, -0.5 + 0.05 * i, 0.2, -0.1 * std::sin(i), 0.3;
     const double e = kv::energy(model, y), h = 1e-5;
-    double ty = 0;
-    kv::step_rk4(model, ws, y, h, zero, zero, env, ty);
+    kv::step_rk4(model, ws, env, y, {zero, zero}, h);
     const double phi = model.submerged_fraction(y, 0.0);
     if (phi <= 0.0 || phi >= 1.0) continue;
     INFO("phi " << phi << ": dE/dt " << (kv::energy(model, y) - e) / h << " W; force of the "
@@ -237,7 +236,7 @@ TEST_CASE("free surface: a damped ROV crossing the surface never gains energy (p
   double t = 0, e = kv::energy(model, x), rise = 0, zmin = 1;
   int partial = 0;
   for (int k = 0; k < 10000; ++k) {  // 10 s at 1 ms
-    kv::step_rk4(model, ws, x, 0.001, zero, zero, env, t);
+    kv::step_rk4(model, ws, env, x, {zero, zero}, 0.001);
     t += 0.001;
     const double e1 = kv::energy(model, x);
     rise = std::max(rise, e1 - e);
@@ -274,7 +273,7 @@ TEST_CASE("waves at depth: an AUV moves with the orbital motion, e^{kz} times it
     int n = 0;
     const double dt = 0.01;
     for (int i = 0; i < 6000; ++i) {
-      kv::step_rk4(model, ws, x, dt, zero, trim, env, t);
+      kv::step_rk4(model, ws, env, x, {zero, trim}, dt);
       t += dt;
       if (t > 60.0 - 3 * period) {
         const Vector3<double> v = x.point_velocity(Vector3<double>::Zero());
@@ -320,10 +319,8 @@ TEST_CASE("current: an unpowered ASV drifts downstream at the current speed",
   kv::VehicleWorkspaced ws;
   kv::VehicleStated x;  // heading north, beam-on to the current
   const Vector6<double> zero = Vector6<double>::Zero();
-  double t = 0;
   for (int i = 0; i < 12000; ++i) {  // 120 s
-    kv::step_rk4(model, ws, x, 0.01, zero, zero, env, t);
-    t += 0.01;
+    kv::step_rk4(model, ws, env, x, {zero, zero}, 0.01);
   }
   const Vector3<double> v = x.point_velocity(Vector3<double>::Zero());
   INFO("velocity over ground " << v.transpose());
@@ -346,10 +343,8 @@ TEST_CASE("wind: an ASV drifts downwind where the wind load balances the hull's 
   kv::VehicleWorkspaced ws;
   kv::VehicleStated x;  // heading north
   const Vector6<double> zero = Vector6<double>::Zero();
-  double t = 0;
   for (int i = 0; i < 12000; ++i) {
-    kv::step_rk4(model, ws, x, 0.01, zero, zero, env, t);
-    t += 0.01;
+    kv::step_rk4(model, ws, env, x, {zero, zero}, 0.01);
   }
   // Independent steady state: ½ ρ_a (U − v)² c_y A_L = 20 v + 99.99 v², by bisection.
   const double q = 0.5 * kelp::air_density * boat.parameters.wind_coefficients.cy *
@@ -440,7 +435,7 @@ TEST_CASE("ASV heaves with a long swell", "[vehicle][environment][surface]") {
   const Vector6<double> zero = Vector6<double>::Zero();
   double t = 0, zmin = 1, zmax = -1;
   for (int i = 0; i < 6000; ++i) {
-    kv::step_rk4(model, ws, x, 0.01, zero, zero, env, t);
+    kv::step_rk4(model, ws, env, x, {zero, zero}, 0.01);
     t += 0.01;
     if (t > 40) {
       zmin = std::min(zmin, x.position(2));
@@ -468,8 +463,8 @@ TEST_CASE(
   const Vector6<double> zero = Vector6<double>::Zero();
   Eigen::internal::set_is_malloc_allowed(false);
   for (int i = 0; i < 100; ++i) {
-    kv::step_rk4(rov, ws, x, 0.01, zero, zero, env, 0.01 * i);
-    kv::step_rk4(boat, ws, y, 0.01, zero, zero, env, 0.01 * i);
+    kv::step_rk4(rov, ws, env, x, {zero, zero}, 0.01);
+    kv::step_rk4(boat, ws, env, y, {zero, zero}, 0.01);
     const kv::Surroundings<double> s = kv::surroundings(env, x, 0.01 * i);
     kv::forward_dynamics(rov, ws, x, zero, zero, s);
   }
@@ -479,7 +474,7 @@ TEST_CASE(
   for (kv::VehicleStated* s : {&x, &y}) {
     const kv::VehicleStated before = *s;
     const kv::VehicleModeld& m = (s == &x) ? rov : boat;
-    CHECK_THROWS_AS(kv::step_rk4(m, ws, *s, 0.01, huge, huge, env, 1.0), kelp::numerical_error);
+    CHECK_THROWS_AS(kv::step_rk4(m, ws, env, *s, {huge, huge}, 0.01), kelp::numerical_error);
     CHECK(std::memcmp(s->position.data(), before.position.data(), sizeof(double) * 3) == 0);
     CHECK(std::memcmp(s->attitude.coeffs().data(), before.attitude.coeffs().data(),
                       sizeof(double) * 4) == 0);
@@ -506,8 +501,9 @@ TEST_CASE("the current-vector overloads are the Surroundings forward dynamics wi
   ke::Environmentd env;
   env.set_current(c);
   kv::VehicleStated y = x, z = x;
-  kv::step_rk4(model, a, y, 0.01, tau, zero, c);
-  kv::step_rk4(model, b, z, 0.01, tau, zero, env, 123.0);
+  kv::step_rk4(model, a, y, {tau, zero}, 0.01, c);
+  z.time = 123.0;  // a uniform current is the same at every time
+  kv::step_rk4(model, b, env, z, {tau, zero}, 0.01);
   CHECK((y.nu - z.nu).norm() == 0.0);
   CHECK((y.position - z.position).norm() == 0.0);
 }

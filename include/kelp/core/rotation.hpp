@@ -3,7 +3,8 @@
 /// kinematic transformations J(η) of Fossen (2021), §2.2.
 ///
 /// Frames: world NED (x north, y east, z down); body (x forward, y starboard, z down).
-/// Quaternions are Eigen's (w, x, y, z), unit, rotating body vectors into NED: v_ned = q * v_body.
+/// Quaternions are Eigen's, unit, rotating body vectors into NED: v_ned = q * v_body; constructed
+/// as Quaternion(w, x, y, z), stored (and their rates returned) in `coeffs()` order (x, y, z, w).
 #pragma once
 
 #include <Eigen/Core>
@@ -83,15 +84,17 @@ Vector3<Scalar> euler_from_quaternion(const Quaternion<Scalar>& q) {
 }
 
 /// \brief Quaternion rate q̇ = ½ q ⊗ (0, ω) for body angular velocity ω [rad/s]
-/// (Fossen 2021, eq. 2.75), returned as (ẇ, ẋ, ẏ, ż).
+/// (Fossen 2021, eq. 2.75), returned in Eigen's `coeffs()` order (ẋ, ẏ, ż, ẇ), the order of
+/// `Quaternion::coeffs()` and of `vehicle::PoseRate::attitude_dot` (kelp's one quaternion order
+/// for rates: `q.coeffs() += h * quaternion_rate(q, omega)` is an Euler step).
 template <typename Scalar, typename Derived>
 Eigen::Matrix<Scalar, 4, 1> quaternion_rate(const Quaternion<Scalar>& q,
                                             const Eigen::MatrixBase<Derived>& omega) {
   const Scalar h(0.5);
   const Scalar w = q.w(), x = q.x(), y = q.y(), z = q.z();
   const Scalar p = omega(0), qq = omega(1), r = omega(2);
-  return Eigen::Matrix<Scalar, 4, 1>(h * (-x * p - y * qq - z * r), h * (w * p - z * qq + y * r),
-                                     h * (z * p + w * qq - x * r), h * (-y * p + x * qq + w * r));
+  return Eigen::Matrix<Scalar, 4, 1>(h * (w * p - z * qq + y * r), h * (z * p + w * qq - x * r),
+                                     h * (-y * p + x * qq + w * r), h * (-x * p - y * qq - z * r));
 }
 
 /// \brief 6×6 kinematic transformation J_Θ(η) for zyx Euler angles: η̇ = J ν with

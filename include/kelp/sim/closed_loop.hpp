@@ -157,8 +157,8 @@ class ClosedLoop {
     if (done())
       throw kelp::error("ClosedLoop::step: the run is over (" + std::to_string(steps_) +
                         " steps of the scenario's duration)");
-    inputs_.auv.control = auv_command_->wrench;
-    inputs_.asv.control = asv_command_->wrench;
+    inputs_.auv.tau = auv_command_->wrench;
+    inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
     ++k_;
     if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
@@ -188,7 +188,7 @@ class ClosedLoop {
   /// \brief Steps of the whole run, `lround(duration / dt)`.
   long total_steps() const { return steps_; }
   /// \brief Simulation time [s].
-  double time() const { return state_.time(); }
+  double time() const { return state_.time; }
 
   /// \brief The scenario being run.
   const Scenario& scenario() const { return scenario_; }
@@ -282,7 +282,7 @@ class ClosedLoop {
   // The controllers' commands at the current state, its sample, and at the log and node rates
   // the metrics and the log.
   void observe() {
-    const double t = state_.time();
+    const double t = state_.time;
     auv_command_ = &auv_.update(kelp::control::navigation_of(state_.auv), t);
     asv_command_ = &asv_.update(kelp::control::navigation_of(state_.asv), state_.auv.position, t);
     // The AUV's error: distance from the survey path (the leg it is on); the boat's: its

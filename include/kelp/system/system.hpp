@@ -5,9 +5,10 @@
 /// Model / workspace / state as in the rest of kelp: a `SystemModel` is built once (vehicle
 /// models, attachment points, tether model, the environment that is the one source of water
 /// density and gravity), a `SystemWorkspace` holds every buffer a step needs, and a `SystemState`
-/// holds everything that determines the next step (both vehicle states, the tether state with its
-/// integrator history and the clock, and the coupling's memory), so that saving and restoring a
-/// state reproduces a run bit for bit.
+/// holds everything that determines the next step (the clock, both vehicle states, the tether state
+/// with its integrator history, and the coupling's memory), so that saving and restoring a state
+/// reproduces a run bit for bit. The call is kelp's one convention, `step(model, ws, state,
+/// inputs, dt, options)` (the system model owns its environment, so none is passed).
 ///
 /// **Coupling scheme (partitioned, the tether first, impulse-consistent).** One step of length h:
 /// 1. each attachment point's motion over the step is predicted from its vehicle's state and its
@@ -164,17 +165,32 @@ class SystemModel {
 };
 
 /// \brief Everything that determines the system's next step.
+///
+/// The clock is the system's (`time`); the parts carry their own (`asv.time`, `auv.time`,
+/// `tether.time`, as when they are stepped on their own), which step() advances in lock-step
+/// with it and refuses to run when they disagree with it (a state assembled by hand from parts
+/// at other times).
 template <typename Scalar>
 struct SystemState {
-  vehicle::VehicleState<Scalar> asv;  ///< the ASV (body frame at its CO)
-  vehicle::VehicleState<Scalar> auv;  ///< the AUV
-  /// The tether, with its integrator history; its `time` is the system's clock [s].
+  /// The system's clock [s] (a double for every Scalar). After a step it is the tether's clock,
+  /// which sums its sub-steps with compensated (Kahan) summation.
+  double time = 0.0;
+  vehicle::VehicleState<Scalar> asv;  ///< the ASV (body frame at its CO); asv.time == time
+  vehicle::VehicleState<Scalar> auv;  ///< the AUV; auv.time == time
+  /// The tether, with its integrator history; tether.time == time.
   tether::TetherState<Scalar> tether;
   /// Last accelerations ν̇ of the vehicles (body axes): the predictor of the attachment motion.
   Vector6<Scalar> asv_nu_dot = Vector6<Scalar>::Zero();
   Vector6<Scalar> auv_nu_dot = Vector6<Scalar>::Zero();  ///< see asv_nu_dot
-  /// \brief The system's clock [s].
-  double time() const { return tether.time; }
+  /// \brief Sets the clock of the system and of its parts to `t` [s] (e.g. to start a run at
+  /// another time than 0).
+  void set_time(double t) {
+    time = t;
+    asv.time = t;
+    auv.time = t;
+    tether.time = t;
+    tether.time_carry = 0.0;
+  }
   /// \brief Forgets the coupling's memory (the vehicles' last accelerations, which predict the
   /// attachment motion): call it after editing the vehicle states by hand.
   void reset_coupling() {
@@ -183,20 +199,18 @@ struct SystemState {
   }
 };
 
-/// \brief What a vehicle is given for one step, body axes.
-template <typename Scalar>
-struct VehicleInput {
-  /// Control wrench τ (e.g. `ThrusterAllocation::wrench` of the thrust) [N, N m].
-  Vector6<Scalar> control = Vector6<Scalar>::Zero();
-  /// Any other external wrench [N, N m].
-  Vector6<Scalar> external = Vector6<Scalar>::Zero();
-};
-
-/// \brief The inputs of one system step.
+/// \brief The inputs of one system step: each vehicle's τ (control) and τ_ext (any other external
+/// wrench; the tether's is added by the step), body axes [N, N m].
 template <typename Scalar>
 struct SystemInputs {
-  VehicleInput<Scalar> asv;  ///< the ASV's wrenches
-  VehicleInput<Scalar> auv;  ///< the AUV's wrenches
+  vehicle::VehicleInputs<Scalar> asv;  ///< the ASV's wrenches
+  vehicle::VehicleInputs<Scalar> auv;  ///< the AUV's wrenches
+};
+
+/// \brief The options of one system step.
+struct SystemStepOptions {
+  /// Also fill `SystemReport::energy` (energy(model, state) after the step).
+  bool with_energy = false;
 };
 
 /// \brief The mechanical energy of a system [J], part by part.
@@ -218,9 +232,9 @@ SystemEnergy<Scalar> energy(const SystemModel<Scalar>& model, const SystemState<
   const auto& env = model.environment();
   SystemEnergy<Scalar> e;
   e.asv = vehicle::energy(model.asv(), state.asv,
-                          vehicle::surroundings(model.asv(), env, state.asv, state.time()));
+                          vehicle::surroundings(model.asv(), env, state.asv, state.time));
   e.auv = vehicle::energy(model.auv(), state.auv,
-                          vehicle::surroundings(model.auv(), env, state.auv, state.time()));
+                          vehicle::surroundings(model.auv(), env, state.auv, state.time));
   e.tether = tether::tether_energy(model.tether(), env, state.tether);
   return e;
 }
@@ -306,7 +320,7 @@ template <typename Scalar, typename Env>
 Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
                              vehicle::VehicleWorkspace<Scalar>& ws,
                              vehicle::VehicleState<Scalar>& x, const Env& env, double t, double dt,
-                             const VehicleInput<Scalar>& in, const Vector3<Scalar>& r,
+                             const vehicle::VehicleInputs<Scalar>& in, const Vector3<Scalar>& r,
                              const Vector3<Scalar>& f_ned) {
   const vehicle::Surroundings<Scalar> s0 = vehicle::surroundings(model, env, x, t);
   vehicle::VehicleState<Scalar> ahead = x;
@@ -317,8 +331,8 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
              [&](const vehicle::VehicleState<Scalar>& s, double c) {
                vehicle::StateDerivative<Scalar> d;
                d.pose = vehicle::pose_rate(s.attitude, s.nu);
-               const Vector6<Scalar> tau_ext = in.external + wrench_of_force(s, r, f_ned);
-               d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.control, tau_ext,
+               const Vector6<Scalar> tau_ext = in.tau_ext + wrench_of_force(s, r, f_ned);
+               d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.tau, tau_ext,
                                                     lerp(s0, s1, Scalar(c)));
                return d;
              },
@@ -346,21 +360,30 @@ struct CouplingSnapshot {
 
 /// \brief Advances the whole system by `dt` [s] (see the file's coupling scheme). No heap
 /// allocation.
-/// \param[in] with_energy also fill `SystemReport::energy` (energy(model, state) after the step).
+/// \param[in] model the system (its environment included). \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock and its parts' clocks too).
+/// \param[in] inputs the vehicles' wrenches. \param[in] dt step [s], > 0.
+/// \param[in] options what else to compute (SystemStepOptions::with_energy).
 /// \returns the tether's integration report and the forces applied to the vehicles.
 /// \throws kelp::invalid_argument for bad input (dt, non-finite inputs or vehicle states, a
-/// non-unit attitude, a workspace not built for the model); kelp::numerical_error when a part
+/// non-unit attitude, a workspace not built for the model, parts' clocks that differ from
+/// `state.time`); kelp::numerical_error when a part
 /// cannot be advanced. After any throw every part of `state` is bit-identical to
 /// what it was.
 template <typename Scalar>
 SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
                           SystemState<Scalar>& state, const SystemInputs<Scalar>& inputs, double dt,
-                          bool with_energy = false) {
+                          SystemStepOptions options = {}) {
   check_positive(dt, "dt");
-  check_all_finite(inputs.asv.control, "inputs.asv.control");
-  check_all_finite(inputs.asv.external, "inputs.asv.external");
-  check_all_finite(inputs.auv.control, "inputs.auv.control");
-  check_all_finite(inputs.auv.external, "inputs.auv.external");
+  check_all_finite(inputs.asv.tau, "inputs.asv.tau");
+  check_all_finite(inputs.asv.tau_ext, "inputs.asv.tau_ext");
+  check_all_finite(inputs.auv.tau, "inputs.auv.tau");
+  check_all_finite(inputs.auv.tau_ext, "inputs.auv.tau_ext");
+  check_finite(state.time, "state.time");
+  KELP_CHECK(state.asv.time == state.time && state.auv.time == state.time &&
+                 state.tether.time == state.time,
+             "state.asv.time, state.auv.time and state.tether.time must equal state.time (use "
+             "SystemState::set_time to set every clock)");
   KELP_CHECK(ws.tether.fits(model.tether().nodes()), "workspace was built for a different system");
   vehicle::detail::check_state(state.asv);
   vehicle::detail::check_state(state.auv);
@@ -368,7 +391,11 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   check_all_finite(state.auv_nu_dot, "state.auv_nu_dot");
   const SystemParameters<Scalar>& p = model.parameters();
   const auto& env = model.environment();
-  const double t = state.time();
+  const double t = state.time;
+  tether::AdvanceOptions<Scalar> tether_options;
+  tether_options.max_dt = p.max_tether_dt;
+  tether_options.integrator = p.tether_integrator;
+  tether_options.implicit = p.tether_options;
   // Everything a failure must restore.
   const detail::CouplingSnapshot<Scalar> before(state);
   ws.tether_backup.save(state.tether);
@@ -379,16 +406,18 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     ends.end = detail::predicted_end(state.auv, state.auv_nu_dot, p.auv_attachment);
     for (int pass = 0;; ++pass) {
       try {
-        report.tether = tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt,
-                                        p.max_tether_dt, p.tether_integrator, p.tether_options);
+        report.tether =
+            tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, tether_options);
       } catch (const kelp::numerical_error&) {
         if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
         // The failed step left the tether as it was: redo it explicitly.
         const Scalar h = tether::estimate_stable_dt(model.tether(), tether::Integrator::rk4,
                                                     env.water_density());
-        report.tether = tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt,
-                                        std::min(p.max_tether_dt, double(value_of(h))),
-                                        tether::Integrator::rk4, p.tether_options);
+        tether::AdvanceOptions<Scalar> fallback = tether_options;
+        fallback.max_dt = std::min(p.max_tether_dt, double(value_of(h)));
+        fallback.integrator = tether::Integrator::rk4;
+        report.tether =
+            tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, fallback);
         ++report.tether_fallbacks;
       }
       // The impulse the tether's integrator delivered to its ends, as a mean force.
@@ -415,7 +444,11 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     ws.tether_backup.restore(state.tether);
     throw;
   }
-  if (with_energy) report.energy = energy(model, state);
+  // The clocks in lock-step: the tether's (Kahan-summed over its sub-steps) is the system's.
+  state.time = state.tether.time;
+  state.asv.time = state.time;
+  state.auv.time = state.time;
+  if (options.with_energy) report.energy = energy(model, state);
   return report;
 }
 
@@ -454,7 +487,7 @@ SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorksp
     ::kelp::detail::throw_numerical_error(
         "system::initial_state: the tether's static shape did not converge (residual " +
         std::to_string(double(value_of(r.residual))) + " N)");
-  s.tether.time = t;
+  s.set_time(t);
   return s;
 }
 

@@ -21,15 +21,53 @@
 
 namespace kelp::tether {
 
-/// \brief One step of length `dt` [s] with the chosen integrator (dispatch).
+/// \brief How step() advances a tether: the scheme and its Newton settings.
+/// Built from its fields in order (`{Integrator::rk4}`, `{Integrator::bdf2, newton}`), each
+/// defaulted (a constructor rather than an aggregate, so that giving the leading fields only does
+/// not trip -Wmissing-field-initializers in users' builds).
+template <typename Scalar>
+struct StepOptions {
+  /// Time-stepping scheme.
+  Integrator integrator = Integrator::bdf2;
+  /// Newton settings of the implicit schemes (ignored by the explicit ones).
+  ImplicitOptions<Scalar> implicit;
+
+  /// \brief The options of the fields, in order.
+  StepOptions(Integrator integrator_ = Integrator::bdf2,  // NOLINT(google-explicit-constructor)
+              const ImplicitOptions<Scalar>& implicit_ = {})
+      : integrator(integrator_), implicit(implicit_) {}
+};
+
+/// \brief How advance() advances a tether: the longest sub-step, the scheme and its Newton
+/// settings. Built from its fields in order (`{0.01, Integrator::rk4}`), each defaulted.
+template <typename Scalar>
+struct AdvanceOptions {
+  /// Longest sub-step [s], > 0: advance() takes ⌈duration / max_dt⌉ equal sub-steps.
+  double max_dt = 0.01;
+  /// Time-stepping scheme.
+  Integrator integrator = Integrator::bdf2;
+  /// Newton settings of the implicit schemes (ignored by the explicit ones).
+  ImplicitOptions<Scalar> implicit;
+
+  /// \brief The options of the fields, in order.
+  AdvanceOptions(double max_dt_ = 0.01,  // NOLINT(google-explicit-constructor)
+                 Integrator integrator_ = Integrator::bdf2,
+                 const ImplicitOptions<Scalar>& implicit_ = {})
+      : max_dt(max_dt_), integrator(integrator_), implicit(implicit_) {}
+};
+
+/// \brief One step of length `dt` [s] with the scheme of `options` (dispatch to
+/// step_symplectic_euler, step_rk2, step_rk4, step_implicit_euler or step_bdf2, which take the
+/// same arguments): `step(model, ws, env, state, boundary, dt, options)`, kelp's calling
+/// convention (model, workspace, environment, state, inputs, dt, options).
 /// \throws as the individual steps; kelp::invalid_argument for an Integrator value outside the
 /// enumeration.
 template <typename Scalar, typename Env>
 StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                         const Env& env, TetherState<Scalar>& state,
-                        const TetherBoundary<Scalar>& boundary, double dt, Integrator integrator,
-                        const ImplicitOptions<Scalar>& options = {}) {
-  switch (integrator) {
+                        const TetherBoundary<Scalar>& boundary, double dt,
+                        const StepOptions<Scalar>& options = {}) {
+  switch (options.integrator) {
     case Integrator::symplectic_euler:
       return step_symplectic_euler(model, ws, env, state, boundary, dt);
     case Integrator::rk2:
@@ -37,16 +75,16 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
     case Integrator::rk4:
       return step_rk4(model, ws, env, state, boundary, dt);
     case Integrator::implicit_euler:
-      return step_implicit(model, ws, env, state, boundary, dt, false, options);
+      return step_implicit_euler(model, ws, env, state, boundary, dt, options.implicit);
     case Integrator::bdf2:
-      return step_implicit(model, ws, env, state, boundary, dt, true, options);
+      return step_bdf2(model, ws, env, state, boundary, dt, options.implicit);
   }
   ::kelp::detail::throw_invalid_argument("integrator is not a kelp::tether::Integrator value");
 }
 
 /// \brief Sub-stepping driver: advances `state` by `duration` [s] in n = ⌈duration/max_dt⌉ equal
-/// steps of the chosen integrator; the kinematic ends follow `boundary` (given at the current
-/// time) through the interval. `ws.end_forces` holds the forces of the last sub-step,
+/// steps of the chosen integrator (`options`); the kinematic ends follow `boundary` (given at the
+/// current time) through the interval. `ws.end_forces` holds the forces of the last sub-step,
 /// `ws.end_impulse` the impulse on the ends summed over all of them. If any
 /// sub-step fails (after its own retries, for the implicit schemes) or throws for any other reason
 /// the state is restored to its value at entry, history included, and the error rethrown. No heap
@@ -55,8 +93,9 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
 template <typename Scalar, typename Env>
 StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                            const Env& env, TetherState<Scalar>& state,
-                           const TetherBoundary<Scalar>& boundary, double duration, double max_dt,
-                           Integrator integrator, const ImplicitOptions<Scalar>& options = {}) {
+                           const TetherBoundary<Scalar>& boundary, double duration,
+                           const AdvanceOptions<Scalar>& options = {}) {
+  const double max_dt = options.max_dt;
   check_positive(duration, "duration");
   check_positive(max_dt, "max_dt");
   const double ratio = std::ceil(duration / max_dt);
@@ -64,12 +103,13 @@ StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Sca
              "max_dt too small for duration: more than INT_MAX sub-steps");
   const int n = std::max(1, static_cast<int>(ratio));
   const double h = duration / n;
+  const StepOptions<Scalar> step_options(options.integrator, options.implicit);
   ws.entry_backup.save(state);
   StepReport<Scalar> report;
   EndForces<Scalar> impulse;
   try {
     for (int k = 0; k < n; ++k) {
-      report += step(model, ws, env, state, boundary.after(Scalar(k * h)), h, integrator, options);
+      report += step(model, ws, env, state, boundary.after(Scalar(k * h)), h, step_options);
       impulse.on_start += ws.end_impulse.on_start;
       impulse.on_end += ws.end_impulse.on_end;
     }
@@ -80,5 +120,10 @@ StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Sca
   ws.end_impulse = impulse;
   return report;
 }
+
+using StepOptionsd = StepOptions<double>;        ///< StepOptions<double>
+using StepOptionsf = StepOptions<float>;         ///< StepOptions<float>
+using AdvanceOptionsd = AdvanceOptions<double>;  ///< AdvanceOptions<double>
+using AdvanceOptionsf = AdvanceOptions<float>;   ///< AdvanceOptions<float>
 
 }  // namespace kelp::tether

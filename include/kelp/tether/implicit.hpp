@@ -40,9 +40,10 @@ void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<S
   }
 }
 
-/// One attempt at an implicit step of length dt (see step_implicit): commits the new state and
-/// returns true when Newton's method converged (or options.check_convergence is false); returns
-/// false with the state untouched otherwise. Adds its work to `report`. Inputs already checked.
+/// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
+/// new state and returns true when Newton's method converged (or options.check_convergence is
+/// false); returns false with the state untouched otherwise. Adds its work to `report`. Inputs
+/// already checked.
 template <typename Scalar, typename Env>
 bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                       TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
@@ -304,11 +305,12 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
 /// the result is not finite or Newton's method does not converge.
+namespace detail {
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                                  const Env& env, TetherState<Scalar>& state,
-                                 const TetherBoundary<Scalar>& boundary, double dt,
-                                 bool bdf2 = false, const ImplicitOptions<Scalar>& options = {}) {
+                                 const TetherBoundary<Scalar>& boundary, double dt, bool bdf2,
+                                 const ImplicitOptions<Scalar>& options) {
   detail::check_step_inputs(model, ws, state, boundary, dt);
   detail::check_implicit_options(options);
   detail::check_resolvable(model, state, options);
@@ -320,15 +322,14 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
       max(options.acceleration_tolerance, detail::force_resolution(model, state));
   ws.end_impulse = EndForces<Scalar>{};
   StepReport<Scalar> report;
-  if (detail::try_implicit(model, ws, env, state, boundary, dt, bdf2, resolved, report))
-    return report;
+  if (try_implicit(model, ws, env, state, boundary, dt, bdf2, resolved, report)) return report;
   // Not converged, nothing committed: retry in halves from a backup.
   ws.retry_backup.save(state);
   bool done = false;
   if (options.max_step_halvings > 0) {
     ++report.retries;
-    done = detail::implicit_halves(model, ws, env, state, boundary, 0.0, dt, bdf2, resolved,
-                                   options.max_step_halvings - 1, report);
+    done = implicit_halves(model, ws, env, state, boundary, 0.0, dt, bdf2, resolved,
+                           options.max_step_halvings - 1, report);
   }
   if (!done) {
     ws.retry_backup.restore(state);
@@ -339,6 +340,34 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
         " m/s); the state is unchanged");
   }
   return report;
+}
+}  // namespace detail
+
+/// \brief One backward (implicit) Euler step of length `dt` [s] (Integrator::implicit_euler):
+/// the Newton scheme above with γ = 1.
+/// \param[in] model the tether. \param[in,out] ws buffers. \param[in] env the water.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] boundary the kinematic ends' motion. \param[in] dt step [s], > 0.
+/// \param[in] options Newton settings.
+/// \throws see above.
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_implicit_euler(const TetherModel<Scalar>& model,
+                                       TetherWorkspace<Scalar>& ws, const Env& env,
+                                       TetherState<Scalar>& state,
+                                       const TetherBoundary<Scalar>& boundary, double dt,
+                                       const ImplicitOptions<Scalar>& options = {}) {
+  return detail::step_implicit(model, ws, env, state, boundary, dt, false, options);
+}
+
+/// \brief One second-order BDF step of length `dt` [s] (Integrator::bdf2): the Newton scheme
+/// above with γ = 2/3 (backward Euler on the first step or after a change of dt).
+/// Parameters and throws as step_implicit_euler().
+template <typename Scalar, typename Env>
+StepReport<Scalar> step_bdf2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                             const Env& env, TetherState<Scalar>& state,
+                             const TetherBoundary<Scalar>& boundary, double dt,
+                             const ImplicitOptions<Scalar>& options = {}) {
+  return detail::step_implicit(model, ws, env, state, boundary, dt, true, options);
 }
 
 }  // namespace kelp::tether

@@ -255,7 +255,7 @@ Scalar force_resolution(const TetherModel<Scalar>& model, const TetherState<Scal
 /// (axial_force_rounding) is above a thousand times the tolerance a_min·acceleration_tolerance on
 /// the lightest node, no step can converge (e.g. a 1 cm line cut into 200 segments: EA/l = 2e9 N/m
 /// at 5 m depth rounds the force to 2e-6 N against a tolerance of 3e-10 N in double; a 1 m float
-/// line cut into 200 segments rounds it to ~30 N against 2e-5 N). Below that, step_implicit
+/// line cut into 200 segments rounds it to ~30 N against 2e-5 N). Below that, the implicit steps
 /// raises the tolerance to the resolution (force_resolution). O(1).
 /// \throws kelp::invalid_argument saying what to change.
 template <typename Scalar>

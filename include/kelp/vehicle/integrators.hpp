@@ -1,12 +1,20 @@
 /// \file
 /// \brief Fixed-step integrators for a VehicleState: classical RK4 (`step_rk4`, `step_rk4_with`)
-/// and semi-implicit (symplectic) Euler (`step_semi_implicit_euler`); kelp names every integrator
-/// step `step_<scheme>`, as the tether's. Both are allocation-free, renormalise the attitude
-/// quaternion and leave the state unchanged (throwing kelp::numerical_error) when a step produces a
-/// non-finite value or an attitude it cannot renormalise (the zero quaternion).
+/// and semi-implicit (symplectic) Euler (`step_symplectic_euler`); kelp names every integrator
+/// step `step_<scheme>`, as the tether's (one name per scheme). Both are allocation-free,
+/// renormalise the attitude quaternion and leave the state unchanged (throwing
+/// kelp::numerical_error) when a step produces a non-finite value or an attitude it cannot
+/// renormalise (the zero quaternion).
+///
+/// Calling convention (kelp's, for every layer): `step_x(model, ws, [env,] state, inputs, dt,
+/// [options])`: the constant description first (the model, then the environment, which a vehicle
+/// model does not own), then what the step writes (workspace, state), what the caller gives this
+/// step (VehicleInputs: τ and τ_ext), the step length and last the options (here the uniform
+/// current of the environment-free variants). The clock is the state's (`VehicleState::time`):
+/// a step samples the environment at it and advances it by dt on success.
 ///
 /// `dt` is a non-deduced parameter (`kelp::identity_t<Scalar>`): Scalar comes from the model and
-/// state, so `step_rk4(model, ws, x, 0.01, ...)` compiles for a float model too.
+/// state, so `step_rk4(model, ws, x, inputs, 0.01)` compiles for a float model too.
 /// After a step the workspace holds the terms of the step's last evaluation, not of the committed
 /// state (see `VehicleWorkspace`).
 ///
@@ -19,6 +27,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
@@ -42,7 +51,7 @@ struct StateDerivative {
 
 /// \brief Full state derivative: kinematics (pose_rate()) and kinetics (forward_dynamics()).
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in] state current state.
-/// \param[in] tau_total τ + τ_env [N, N m], body axes. \param[in] current_ned v_c^n [m/s], NED.
+/// \param[in] tau_total τ + τ_ext [N, N m], body axes. \param[in] current_ned v_c^n [m/s], NED.
 template <typename Scalar, typename DT, typename DC>
 StateDerivative<Scalar> state_derivative(const VehicleModel<Scalar>& model,
                                          VehicleWorkspace<Scalar>& ws,
@@ -61,6 +70,7 @@ template <typename Scalar>
 VehicleState<Scalar> advance(const VehicleState<Scalar>& x, const StateDerivative<Scalar>& d,
                              const Scalar& h) {
   VehicleState<Scalar> y;
+  y.time = x.time + double(value_of(h));  // the stage's time
   y.position = x.position + h * d.pose.position_dot;
   y.attitude.coeffs() = x.attitude.coeffs() + h * d.pose.attitude_dot;
   renormalize(y.attitude);
@@ -85,9 +95,10 @@ void commit_if_finite(VehicleState<Scalar>& state, const VehicleState<Scalar>& n
 }
 
 /// Classical RK4 over dt from `state`: `deriv(x, c)` returns the StateDerivative at the stage state
-/// x, c ∈ {0, ½, ½, 1} being the stage's fraction of the step (for stage times and wrenches).
-/// Commits a finite result (else throws numerical_error naming `who`, state unchanged) and returns
-/// the last stage's derivative. The one RK4 of the vehicle steps and of the coupled system.
+/// x (whose `time` is the stage's), c ∈ {0, ½, ½, 1} being the stage's fraction of the step.
+/// Commits a finite result at `state.time + dt` (else throws numerical_error naming `who`, state
+/// unchanged) and returns the last stage's derivative. The one RK4 of the vehicle steps and of the
+/// coupled system.
 template <typename Scalar, typename Deriv>
 StateDerivative<Scalar> rk4(VehicleState<Scalar>& state, const Scalar& dt, Deriv&& deriv,
                             const char* who) {
@@ -103,14 +114,17 @@ StateDerivative<Scalar> rk4(VehicleState<Scalar>& state, const Scalar& dt, Deriv
   k.pose.attitude_dot = k1.pose.attitude_dot + two * k2.pose.attitude_dot +
                         two * k3.pose.attitude_dot + k4.pose.attitude_dot;
   k.nu_dot = k1.nu_dot + two * k2.nu_dot + two * k3.nu_dot + k4.nu_dot;
-  commit_if_finite(state, advance(state, k, dt / Scalar(6)), who);
+  VehicleState<Scalar> next = advance(state, k, dt / Scalar(6));
+  next.time = state.time + double(value_of(dt));
+  commit_if_finite(state, next, who);
   return k4;
 }
 
-/// Checks a vehicle state: finite position, velocity and attitude, and a unit attitude (a zero or
-/// badly scaled quaternion would otherwise be silently read as some rotation by Eigen).
+/// Checks a vehicle state: finite clock, position, velocity and attitude, and a unit attitude (a
+/// zero or badly scaled quaternion would otherwise be silently read as some rotation by Eigen).
 template <typename Scalar>
 void check_state(const VehicleState<Scalar>& state) {
+  check_finite(state.time, "state.time");
   check_all_finite(state.position, "state.position");
   check_all_finite(state.nu, "state.nu");
   check_all_finite(state.attitude.coeffs(), "state.attitude");
@@ -126,14 +140,6 @@ void check_step_input(const VehicleState<Scalar>& state, identity_t<Scalar> dt) 
   check_state(state);
 }
 
-/// Checks the size of a wrench a step holds over its length: 6 entries. Its values are not
-/// checked: a non-finite wrench is reported as the step's numerical_error, state unchanged (the
-/// documented contract the vehicle tests pin down), like any other non-finite result.
-template <typename Derived>
-void check_wrench(const Eigen::MatrixBase<Derived>& w, const char* field) {
-  KELP_CHECK(w.size() == 6, std::string(field) + " must have 6 entries");
-}
-
 /// Checks a current velocity: 3 finite NED entries.
 template <typename Derived>
 void check_current(const Eigen::MatrixBase<Derived>& v) {
@@ -141,22 +147,51 @@ void check_current(const Eigen::MatrixBase<Derived>& v) {
   check_all_finite(v, "current_ned");
 }
 
+/// The semi-implicit (symplectic) Euler update from ν̇ at the start of the step (see
+/// step_symplectic_euler()); commits a finite result at `state.time + dt`.
+template <typename Scalar>
+void symplectic_euler(VehicleState<Scalar>& state, const Vector6<Scalar>& nu_dot, const Scalar& dt,
+                      const char* who) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  VehicleState<Scalar> next;
+  next.time = state.time + double(value_of(dt));
+  next.nu = state.nu + dt * nu_dot;
+  next.position =
+      state.position + dt * (state.attitude * Vector3<Scalar>(next.nu.template head<3>()));
+  const Vector3<Scalar> rot = dt * next.nu.template tail<3>();
+  const Scalar angle2 = rot.squaredNorm();
+  Quaternion<Scalar> dq;
+  if (value_of(angle2) > 1e-24) {
+    const Scalar angle = sqrt(angle2);
+    const Scalar s = sin(Scalar(0.5) * angle) / angle;
+    dq = Quaternion<Scalar>(cos(Scalar(0.5) * angle), s * rot(0), s * rot(1), s * rot(2));
+  } else {
+    const Scalar h(0.5);
+    dq = Quaternion<Scalar>(Scalar(1), h * rot(0), h * rot(1), h * rot(2));
+  }
+  next.attitude = state.attitude * dq;
+  renormalize(next.attitude);
+  commit_if_finite(state, next, who);
+}
+
 }  // namespace detail
 
 /// \brief One classical fourth-order Runge–Kutta step of length `dt` with a wrench evaluated at
-/// every stage: `wrench(stage_state, stage_time_offset)` must return τ + τ_env (Vector6, body axes,
-/// [N, N m]); stage offsets are 0, dt/2, dt/2, dt. The quaternion is renormalised at every stage
-/// and at the end.
+/// every stage: `wrench(stage_state, stage_time_offset)` must return τ + τ_ext (Vector6, body axes,
+/// [N, N m]); stage offsets are 0, dt/2, dt/2, dt (the stage state's `time` is the stage's time).
+/// The quaternion is renormalised at every stage and at the end.
 /// \param[in] model vehicle. \param[in,out] ws buffers.
-/// \param[in,out] state advanced by dt on success, unchanged on failure.
-/// \param[in] dt step [s], > 0. \param[in] wrench callable as above.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] wrench callable as above (the step's inputs). \param[in] dt step [s], > 0.
 /// \param[in] current_ned v_c^n [m/s], NED, constant over the step.
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude or
-/// a `current_ned` that is not 3 finite entries; kelp::numerical_error on a non-finite result
-/// (including a non-finite wrench returned by the callable).
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field (its time included), a
+/// non-unit attitude or a `current_ned` that is not 3 finite entries; kelp::numerical_error on a
+/// non-finite result (including a non-finite wrench returned by the callable).
 template <typename Scalar, typename WrenchFn, typename DC>
 void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                   VehicleState<Scalar>& state, identity_t<Scalar> dt, WrenchFn&& wrench,
+                   VehicleState<Scalar>& state, WrenchFn&& wrench, identity_t<Scalar> dt,
                    const Eigen::MatrixBase<DC>& current_ned) {
   detail::check_step_input(state, dt);
   detail::check_current(current_ned);
@@ -169,34 +204,41 @@ void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
       "step_rk4");
 }
 
-/// \brief One RK4 step with τ and τ_env held constant over the step (zero-order hold).
-/// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
-/// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
-/// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude, or
-/// `tau`, `tau_env` (not 6 entries) or `current_ned` (not 3 finite entries);
-/// kelp::numerical_error on a non-finite result (a NaN or Inf in tau or tau_env included).
-template <typename Scalar, typename DT, typename DE, typename DC>
+/// \brief step_rk4_with() in still water.
+template <typename Scalar, typename WrenchFn>
+void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                   VehicleState<Scalar>& state, WrenchFn&& wrench, identity_t<Scalar> dt) {
+  step_rk4_with(model, ws, state, std::forward<WrenchFn>(wrench), dt, Vector3<Scalar>::Zero());
+}
+
+/// \brief One RK4 step in a uniform current, flat calm surface, no wind, with τ and τ_ext held
+/// over the step (zero-order hold).
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] inputs τ and τ_ext [N, N m], body. \param[in] dt step [s], > 0.
+/// \param[in] current_ned v_c^n [m/s], NED.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field (its time included), a
+/// non-unit attitude or `current_ned` (not 3 finite entries); kelp::numerical_error on a
+/// non-finite result (a NaN or Inf in the inputs included).
+template <typename Scalar, typename DC>
 void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-              VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<DT>& tau,
-              const Eigen::MatrixBase<DE>& tau_env, const Eigen::MatrixBase<DC>& current_ned) {
-  detail::check_wrench(tau, "tau");
-  detail::check_wrench(tau_env, "tau_env");
-  const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_env);
+              VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
+              identity_t<Scalar> dt, const Eigen::MatrixBase<DC>& current_ned) {
+  const Vector6<Scalar> total = inputs.tau + inputs.tau_ext;
   step_rk4_with(
-      model, ws, state, dt,
+      model, ws, state,
       [&total](const VehicleState<Scalar>&, const Scalar&) -> const Vector6<Scalar>& {
         return total;
       },
-      current_ned);
+      dt, current_ned);
 }
 
-/// \brief One RK4 step without current.
-template <typename Scalar, typename DT, typename DE>
+/// \brief One RK4 step in still water (no current).
+template <typename Scalar>
 void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-              VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<DT>& tau,
-              const Eigen::MatrixBase<DE>& tau_env) {
-  step_rk4(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+              VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
+              identity_t<Scalar> dt) {
+  step_rk4(model, ws, state, inputs, dt, Vector3<Scalar>::Zero());
 }
 
 /// \brief Surroundings a vehicle model needs at state `x` and time t: the surface slope only for
@@ -241,30 +283,27 @@ Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& 
 
 /// \brief One classical RK4 step of length `dt` in an environment: the surroundings (water
 /// velocity and acceleration, free surface, wind) are sampled at each stage's state and time
-/// (t, t + dt/2, t + dt/2, t + dt) and enter forward_dynamics(…, Surroundings); τ and τ_ext are
-/// held over the step (zero-order hold). Allocation-free. The caller owns the clock (advance t by
-/// dt after a successful step) and checks once that the model's water is the environment's
-/// (check_same_water in water.hpp).
-/// \param[in] model vehicle. \param[in,out] ws buffers.
-/// \param[in,out] state advanced by dt on success, unchanged (bit for bit) on failure.
-/// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
-/// \param[in] tau_ext external wrench [N, N m], body (e.g. the tether's).
+/// (t, t + dt/2, t + dt/2, t + dt, with t = state.time) and enter forward_dynamics(…,
+/// Surroundings); τ and τ_ext are held over the step (zero-order hold). Allocation-free. The
+/// caller checks once that the model's water is the environment's (check_same_water in
+/// water.hpp).
+/// \param[in] model vehicle.
 /// \param[in] env environment (`kelp::environment::Environment` or any type with `sample(p, t)`
-/// and `surface_slope(x, y, t)`). \param[in] t time at the start of the step [s].
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude,
-/// `tau` or `tau_ext` (not 6 entries) or a non-finite `t`; kelp::numerical_error on a
-/// non-finite result (a NaN or Inf in tau or tau_ext included).
-template <typename Scalar, typename Env, typename D1, typename D2>
-void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-              VehicleState<Scalar>& state, identity_t<Scalar> dt, const Eigen::MatrixBase<D1>& tau,
-              const Eigen::MatrixBase<D2>& tau_ext, const Env& env, double t) {
+/// and `surface_slope(x, y, t)`). \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged (bit for bit) on
+/// failure. \param[in] inputs τ (control) and τ_ext (e.g. the tether's) [N, N m], body.
+/// \param[in] dt step [s], > 0.
+/// \throws kelp::invalid_argument naming `dt` or a non-finite state field (`state.time`
+/// included) or a non-unit attitude; kelp::numerical_error on a non-finite result (a NaN or Inf
+/// in the inputs included).
+template <typename Scalar, typename Env>
+void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws, const Env& env,
+              VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
+              identity_t<Scalar> dt) {
   detail::check_step_input(state, dt);
-  detail::check_wrench(tau, "tau");
-  detail::check_wrench(tau_ext, "tau_ext");
-  check_finite(t, "t");
-  const Vector6<Scalar> total = Vector6<Scalar>(tau) + Vector6<Scalar>(tau_ext);
+  const Vector6<Scalar> total = inputs.tau + inputs.tau_ext;
   const Vector6<Scalar> zero = Vector6<Scalar>::Zero();
-  const double dt_d = value_of(dt);
+  const double t = state.time, dt_d = value_of(dt);
   detail::rk4(
       state, dt,
       [&](const VehicleState<Scalar>& x, double c) {
@@ -277,56 +316,49 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
       "step_rk4");
 }
 
-/// \brief One semi-implicit (symplectic) Euler step: ν_{k+1} = ν_k + dt ν̇(x_k), then the pose is
-/// advanced with the *new* velocity: p_{k+1} = p_k + dt R(q_k) ν₁_{k+1} and
-/// q_{k+1} = q_k ⊗ exp(½ dt ν₂_{k+1}) (exact rotation for a constant rate, so the quaternion stays
-/// unit). First order; cheap and stable for stiff restoring/damping at small dt.
-/// \param[in] model vehicle. \param[in,out] ws buffers. \param[in,out] state advanced on success.
-/// \param[in] dt step [s], > 0. \param[in] tau control wrench [N, N m], body.
-/// \param[in] tau_env external wrench [N, N m], body. \param[in] current_ned v_c^n [m/s], NED.
-/// \throws kelp::invalid_argument naming `dt`, a non-finite state field, a non-unit attitude, or
-/// `tau`, `tau_env` (not 6 entries) or `current_ned` (not 3 finite entries);
-/// kelp::numerical_error on a non-finite result (a NaN or Inf in tau or tau_env included).
-template <typename Scalar, typename DT, typename DE, typename DC>
-void step_semi_implicit_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                              VehicleState<Scalar>& state, identity_t<Scalar> dt,
-                              const Eigen::MatrixBase<DT>& tau,
-                              const Eigen::MatrixBase<DE>& tau_env,
-                              const Eigen::MatrixBase<DC>& current_ned) {
-  using std::cos;
-  using std::sin;
-  using std::sqrt;
+/// \brief One semi-implicit (symplectic) Euler step in a uniform current, flat calm surface, no
+/// wind: ν_{k+1} = ν_k + dt ν̇(x_k), then the pose is advanced with the *new* velocity:
+/// p_{k+1} = p_k + dt R(q_k) ν₁_{k+1} and q_{k+1} = q_k ⊗ exp(½ dt ν₂_{k+1}) (exact rotation for a
+/// constant rate, so the quaternion stays unit). First order; cheap and stable for stiff
+/// restoring/damping at small dt. The tether's scheme of the same name (tether::Integrator::
+/// symplectic_euler) is the same update.
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] inputs τ and τ_ext [N, N m], body. \param[in] dt step [s], > 0.
+/// \param[in] current_ned v_c^n [m/s], NED.
+/// \throws kelp::invalid_argument naming `dt`, a non-finite state field (its time included), a
+/// non-unit attitude or `current_ned` (not 3 finite entries); kelp::numerical_error on a
+/// non-finite result (a NaN or Inf in the inputs included).
+template <typename Scalar, typename DC>
+void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                           VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
+                           identity_t<Scalar> dt, const Eigen::MatrixBase<DC>& current_ned) {
   detail::check_step_input(state, dt);
-  detail::check_wrench(tau, "tau");
-  detail::check_wrench(tau_env, "tau_env");
   detail::check_current(current_ned);
-  VehicleState<Scalar> next;
-  next.nu = state.nu + dt * forward_dynamics(model, ws, state, tau, tau_env, current_ned);
-  next.position =
-      state.position + dt * (state.attitude * Vector3<Scalar>(next.nu.template head<3>()));
-  const Vector3<Scalar> rot = dt * next.nu.template tail<3>();
-  const Scalar angle2 = rot.squaredNorm();
-  Quaternion<Scalar> dq;
-  if (value_of(angle2) > 1e-24) {
-    const Scalar angle = sqrt(angle2);
-    const Scalar s = sin(Scalar(0.5) * angle) / angle;
-    dq = Quaternion<Scalar>(cos(Scalar(0.5) * angle), s * rot(0), s * rot(1), s * rot(2));
-  } else {
-    const Scalar h(0.5);
-    dq = Quaternion<Scalar>(Scalar(1), h * rot(0), h * rot(1), h * rot(2));
-  }
-  next.attitude = state.attitude * dq;
-  renormalize(next.attitude);
-  detail::commit_if_finite(state, next, "step_semi_implicit_euler");
+  const Vector6<Scalar> nu_dot =
+      forward_dynamics(model, ws, state, inputs.tau, inputs.tau_ext, current_ned);
+  detail::symplectic_euler(state, nu_dot, Scalar(dt), "step_symplectic_euler");
 }
 
-/// \brief One semi-implicit Euler step without current.
-template <typename Scalar, typename DT, typename DE>
-void step_semi_implicit_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                              VehicleState<Scalar>& state, identity_t<Scalar> dt,
-                              const Eigen::MatrixBase<DT>& tau,
-                              const Eigen::MatrixBase<DE>& tau_env) {
-  step_semi_implicit_euler(model, ws, state, dt, tau, tau_env, Vector3<Scalar>::Zero());
+/// \brief One semi-implicit (symplectic) Euler step in still water (no current).
+template <typename Scalar>
+void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                           VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
+                           identity_t<Scalar> dt) {
+  step_symplectic_euler(model, ws, state, inputs, dt, Vector3<Scalar>::Zero());
+}
+
+/// \brief One semi-implicit (symplectic) Euler step in an environment: ν̇ from the surroundings
+/// sampled at the start of the step (at state.time), then the update of the current-only
+/// overload. \throws as step_rk4() in an environment.
+template <typename Scalar, typename Env>
+void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                           const Env& env, VehicleState<Scalar>& state,
+                           const VehicleInputs<Scalar>& inputs, identity_t<Scalar> dt) {
+  detail::check_step_input(state, dt);
+  const Vector6<Scalar> nu_dot = forward_dynamics(model, ws, state, inputs.tau, inputs.tau_ext,
+                                                  surroundings(model, env, state, state.time));
+  detail::symplectic_euler(state, nu_dot, Scalar(dt), "step_symplectic_euler");
 }
 
 }  // namespace kelp::vehicle

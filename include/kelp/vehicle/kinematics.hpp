@@ -36,8 +36,7 @@ PoseRate<Scalar> pose_rate(const Quaternion<Scalar>& attitude,
                            const Eigen::MatrixBase<Derived>& nu) {
   PoseRate<Scalar> out;
   out.position_dot = attitude * Vector3<Scalar>(nu.template head<3>());
-  const Eigen::Matrix<Scalar, 4, 1> wxyz = quaternion_rate(attitude, nu.template tail<3>());
-  out.attitude_dot << wxyz(1), wxyz(2), wxyz(3), wxyz(0);
+  out.attitude_dot = quaternion_rate(attitude, nu.template tail<3>());
   return out;
 }
 

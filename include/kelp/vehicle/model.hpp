@@ -323,10 +323,10 @@ class VehicleModel {
 /// After a step they hold the terms of the step's LAST EVALUATION, not of the committed state:
 /// - `step_rk4` / `step_rk4_with`: the fourth stage, evaluated at the predictor
 ///   x₄ = x_k + dt·k₃ (with the stage-4 wrench), which differs from x_{k+1} by O(dt²);
-/// - `step_semi_implicit_euler`: the state at the START of the step, x_k.
+/// - `step_symplectic_euler`: the state at the START of the step, x_k.
 ///
 /// The workspace is scratch and outputs only (nothing in it feeds the next step). To log the
-/// terms of the committed state, call `forward_dynamics(model, ws, state, tau, tau_env,
+/// terms of the committed state, call `forward_dynamics(model, ws, state, tau, tau_ext,
 /// current)` after the step: one evaluation, paid only by callers who need it (recomputing them
 /// inside every RK4 step would cost a fifth evaluation, +25 %, and for `step_rk4_with` a fifth
 /// call of the user's wrench at a time that belongs to the next step).
@@ -485,37 +485,37 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   return ws.nu_dot;
 }
 
-/// \brief Forward dynamics ν̇ = M⁻¹(τ + τ_env − C_RB(ν)ν − C_A(ν_r)ν_r − D(ν_r)ν_r − g + M_A ν̇_c)
+/// \brief Forward dynamics ν̇ = M⁻¹(τ + τ_ext − C_RB(ν)ν − C_A(ν_r)ν_r − D(ν_r)ν_r − g + M_A ν̇_c)
 /// in a uniform current, flat calm surface at z = 0, no wind (see the file comment; Fossen 2021,
 /// §10.3). Same as the Surroundings overload with water_velocity = current_ned. Allocation-free.
 ///
 /// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
 /// \param[in] state pose (NED, unit quaternion) and ν (body).
 /// \param[in] tau control wrench (thrusters) [N, N m], body axes about the CO.
-/// \param[in] tau_env other external wrench [N, N m], body axes about the CO (tether, wind,
+/// \param[in] tau_ext other external wrench [N, N m], body axes about the CO (tether, wind,
 ///   waves... added by the caller each step).
 /// \param[in] current_ned ocean current velocity v_c^n [m/s] in NED (irrotational, uniform).
 /// \return ν̇ [m/s², rad/s²], body axes.
-/// \throws kelp::invalid_argument when tau or tau_env has not 6 entries or current_ned not 3.
+/// \throws kelp::invalid_argument when tau or tau_ext has not 6 entries or current_ned not 3.
 template <typename Scalar, typename DT, typename DE, typename DC>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                                  const VehicleState<Scalar>& state,
                                  const Eigen::MatrixBase<DT>& tau,
-                                 const Eigen::MatrixBase<DE>& tau_env,
+                                 const Eigen::MatrixBase<DE>& tau_ext,
                                  const Eigen::MatrixBase<DC>& current_ned) {
   KELP_CHECK(current_ned.size() == 3, "forward_dynamics: current_ned must have 3 entries");
   Surroundings<Scalar> s;
   s.water_velocity = current_ned;
-  return forward_dynamics(model, ws, state, tau, tau_env, s);
+  return forward_dynamics(model, ws, state, tau, tau_ext, s);
 }
 
-/// \brief Forward dynamics without current: ν̇ = M⁻¹(τ + τ_env − C_RB ν − C_A ν − D ν − g).
+/// \brief Forward dynamics without current: ν̇ = M⁻¹(τ + τ_ext − C_RB ν − C_A ν − D ν − g).
 template <typename Scalar, typename DT, typename DE>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                                  const VehicleState<Scalar>& state,
                                  const Eigen::MatrixBase<DT>& tau,
-                                 const Eigen::MatrixBase<DE>& tau_env) {
-  return forward_dynamics(model, ws, state, tau, tau_env, Vector3<Scalar>::Zero());
+                                 const Eigen::MatrixBase<DE>& tau_ext) {
+  return forward_dynamics(model, ws, state, tau, tau_ext, Vector3<Scalar>::Zero());
 }
 
 /// \brief Mechanical energy [J] of a vehicle: kinetic ½ νᵀ (M_RB + φ M_A) ν (φ the submerged

@@ -14,10 +14,15 @@ template <typename Scalar>
 struct VehicleState {
   /// Position of the body-frame origin (CO) in NED [m].
   Vector3<Scalar> position = Vector3<Scalar>::Zero();
-  /// Unit quaternion rotating body vectors into NED (Eigen's w, x, y, z).
+  /// Unit quaternion rotating body vectors into NED (Eigen's: built as (w, x, y, z), stored in
+  /// `coeffs()` order x, y, z, w).
   Quaternion<Scalar> attitude = Quaternion<Scalar>::Identity();
   /// ν = (u, v, w, p, q, r): body-frame linear [m/s] and angular [rad/s] velocity.
   Vector6<Scalar> nu = Vector6<Scalar>::Zero();
+  /// Simulation time [s] of this state (a double for every Scalar: one clock, which a float
+  /// model does not round away). Every step advances it by its dt on success and samples the
+  /// environment at it.
+  double time = 0.0;
 
   /// \brief Rotation matrix body → NED.
   Matrix3<Scalar> rotation() const { return attitude.toRotationMatrix(); }
@@ -39,5 +44,28 @@ struct VehicleState {
 
 using VehicleStated = VehicleState<double>;
 using VehicleStatef = VehicleState<float>;
+
+/// \brief What the caller gives a vehicle for one step: wrenches held over the step
+/// (zero-order hold), body axes, about the CO. Built from its fields in order (`{tau}`,
+/// `{tau, tau_ext}`), each zero by default.
+/// \tparam Scalar double, float or ceres::Jet.
+template <typename Scalar>
+struct VehicleInputs {
+  /// τ: control wrench (e.g. `ThrusterAllocation::wrench` of the thrust) [N, N m].
+  Vector6<Scalar> tau = Vector6<Scalar>::Zero();
+  /// τ_ext: every other external wrench (e.g. the tether's) [N, N m].
+  Vector6<Scalar> tau_ext = Vector6<Scalar>::Zero();
+
+  /// \brief Zero wrenches.
+  VehicleInputs() = default;
+  /// \brief The wrenches τ and τ_ext [N, N m] (a constructor rather than an aggregate, so that
+  /// `{tau}` does not trip -Wmissing-field-initializers in users' builds).
+  VehicleInputs(const Vector6<Scalar>& tau_,  // NOLINT(google-explicit-constructor)
+                const Vector6<Scalar>& tau_ext_ = Vector6<Scalar>::Zero())
+      : tau(tau_), tau_ext(tau_ext_) {}
+};
+
+using VehicleInputsd = VehicleInputs<double>;
+using VehicleInputsf = VehicleInputs<float>;
 
 }  // namespace kelp::vehicle
