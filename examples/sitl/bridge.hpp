@@ -111,8 +111,10 @@ class Bridge {
                                         model.environment().gravity())),
         boat_(kv::blueboat<double>(model.environment().water_density(),
                                    model.environment().gravity())),
-        rov_thrusters_(rov_.thruster_positions, rov_.thruster_directions),
-        boat_thrusters_(boat_.thruster_positions, boat_.thruster_directions) {
+        rov_chain_(kv::ThrusterAllocationd(rov_.thruster_positions, rov_.thruster_directions),
+                   kv::t200_model, rov_.pwm),
+        boat_chain_(kv::ThrusterAllocationd(boat_.thruster_positions, boat_.thruster_directions),
+                    kv::t200_model, boat_.pwm) {
     kelp::check_positive(settings.rate, "rate");
     kelp::check_positive(settings.peer_timeout, "peer_timeout");
     auv_force_.setZero();
@@ -278,24 +280,24 @@ class Bridge {
   // BlueROV2 Heavy preset), ArduRover's skid steering ThrottleLeft on SERVO1 and ThrottleRight
   // on SERVO3 (ArduPilot Tools/autotest/default_params/rover-skid.parm). A channel without a
   // plausible pulse (0 = none, or outside 800–2200 µs) is taken as off.
-  double thrust_of(std::uint16_t pwm, const kv::PwmMappingd& m, double& command, Peer& p) {
+  double thrust_of(std::uint16_t pwm, const kv::ThrusterChaind& chain, double& command, Peer& p) {
     command = 0;
     if (pwm == 0) return 0;
     if (pwm < 800 || pwm > 2200) {
       ++p.counters.pwm_out_of_range;
       return 0;
     }
-    return kv::thrust_from_pwm(kv::t200_model, static_cast<double>(pwm), m, &command);
+    return chain.thrust_of_pwm(static_cast<double>(pwm), &command);
   }
   void set_pwm(int slot, const ServoPacket& pkt) {
     Peer& p = peers_[static_cast<std::size_t>(slot)];
     if (slot == sub) {
       for (int i = 0; i < 8; ++i)
         auv_force_(i) =
-            thrust_of(pkt.pwm[static_cast<std::size_t>(i)], rov_.pwm, auv_command_(i), p);
+            thrust_of(pkt.pwm[static_cast<std::size_t>(i)], rov_chain_, auv_command_(i), p);
     } else {
-      asv_force_(0) = thrust_of(pkt.pwm[0], boat_.pwm, asv_command_(0), p);
-      asv_force_(1) = thrust_of(pkt.pwm[2], boat_.pwm, asv_command_(1), p);
+      asv_force_(0) = thrust_of(pkt.pwm[0], boat_chain_, asv_command_(0), p);
+      asv_force_(1) = thrust_of(pkt.pwm[2], boat_chain_, asv_command_(1), p);
     }
   }
 
@@ -347,10 +349,9 @@ class Bridge {
     if (active == 0) return;
     if (settings_.start_together && steps_ == 0 && joined < 2) return;
     ks::SystemInputsd in;
-    in.auv.tau =
-        peers_[sub].active ? rov_thrusters_.wrench(auv_force_) : kelp::Vector6<double>::Zero();
+    in.auv.tau = peers_[sub].active ? rov_chain_.wrench(auv_force_) : kelp::Vector6<double>::Zero();
     in.asv.tau =
-        peers_[rover].active ? boat_thrusters_.wrench(asv_force_) : kelp::Vector6<double>::Zero();
+        peers_[rover].active ? boat_chain_.wrench(asv_force_) : kelp::Vector6<double>::Zero();
     report_ = ks::step(model_, ws_, state_, in, 1.0 / settings_.rate);
     ++steps_;
     for (int s = 0; s < 2; ++s) {
@@ -374,7 +375,7 @@ class Bridge {
   ks::presets::StartPoses<double> start_;
   BridgeSettings settings_;
   kv::VehiclePresetd rov_, boat_;
-  kv::ThrusterAllocationd rov_thrusters_, boat_thrusters_;
+  kv::ThrusterChaind rov_chain_, boat_chain_;  ///< PWM → command → thrust → wrench
   std::array<Peer, 2> peers_;
   ks::SystemReportd report_;
   std::uint64_t steps_ = 0;
