@@ -102,6 +102,15 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   }
   bool converged = false;
   Scalar res(0);
+  // Takes the iterate (ws.x1, ws.v1) with ws.end_forces: commit() turns the pre-step state into
+  // the history; the end forces' impulse over dt and the residual go to the report.
+  const auto accept = [&]() {
+    commit(state, ws.x1, ws.v1, dt, "step_implicit");
+    ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
+    ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
+    report.residual = std::max(report.residual, res);
+    ++report.substeps;
+  };
   // Evaluates F at (x, v), writes rhs = −R = γh F − M (v − v̂) on the free nodes and sets `res`
   // to the scaled max-norm max_i |R_i|/a_i.
   const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& r_max,
@@ -187,11 +196,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
         ws.end_forces.on_start += segment_block(ws, 0, Scalar(1), gh) * ws.delta.col(1);
       if (f1 == n - 1 && n >= 2)
         ws.end_forces.on_end += segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
-      commit(state, ws.x1, ws.v1, dt, "step_implicit");
-      ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
-      ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
-      report.residual = std::max(report.residual, res);
-      ++report.substeps;
+      accept();
       return true;
     }
     // Line search. R is the gradient of the step's incremental potential
@@ -234,12 +239,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     return false;
   }
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
-  // commit() turns the pre-step state into the history.
-  commit(state, ws.x1, ws.v1, dt, "step_implicit");
-  ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
-  ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
-  report.residual = std::max(report.residual, res);
-  ++report.substeps;
+  accept();
   return true;
 }
 
