@@ -371,15 +371,24 @@ TEST_CASE("Stable time step estimate refuses non-physical water and safety facto
   CHECK_FALSE(kt::is_valid(static_cast<kt::Integrator>(5)));
   for (const double rho : {nan_, -1.0})
     REQUIRE_THROWS_AS(kt::highest_axial_frequency(model, rho), kelp::invalid_argument);
-  // Vacuum (ρ = 0) is allowed and gives a finite step, shorter than in water when the line has
-  // tangential added mass (lighter axially).
+  // Vacuum (ρ = 0) is allowed and gives a finite step; tangential added mass does not lengthen
+  // it (a node in air has none).
   kt::TetherParametersd p = kelp_test::benchmark_line<double>(20);
   p.tangential_added_mass = 0.5;
   const kt::TetherModeld with_cat(p);
   const double in_water = kt::estimate_stable_dt(with_cat, kt::Integrator::rk4, 1025.0);
   const double in_vacuum = kt::estimate_stable_dt(with_cat, kt::Integrator::rk4, 0.0);
   CHECK(std::isfinite(in_water));
-  CHECK(in_vacuum < in_water);
+  CHECK(std::isfinite(in_vacuum));
+  CHECK(in_water == kt::estimate_stable_dt(model, kt::Integrator::rk4, 1025.0));
+  // A speed bound that is negative, NaN or absurd is refused; so is RK2 on an undamped line.
+  kt::StableDtOptionsd options;
+  for (const double speed : {nan_, inf_, -1.0, 1e300}) {
+    options.max_relative_speed = speed;
+    REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, kt::Integrator::rk4, options),
+                      kelp::invalid_argument);
+  }
+  REQUIRE_THROWS_AS(kt::estimate_stable_dt(model, kt::Integrator::rk2), kelp::invalid_argument);
   CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2, 1025.0)));
 }
 
