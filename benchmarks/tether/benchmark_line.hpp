@@ -12,6 +12,7 @@
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/stable_dt.hpp"
 
 namespace kelp_bench {
 
@@ -31,13 +32,20 @@ struct BenchmarkLine {
   kelp::tether::TetherStated state;
   kelp::Vector3<double> a{0, 0, 0}, b{10, 0, Heave::base_depth};
 
-  explicit BenchmarkLine(int n) : model(params(n)), ws(model) {
+  /// N segments; `damping_ratio` ζ > 0 gives the line internal damping BA = 2ζ EA/ω_max, the
+  /// damping ratio ζ at its highest axial frequency (MoorDyn's negative-BA convention).
+  explicit BenchmarkLine(int n, double damping_ratio = 0.0)
+      : model(params(n, damping_ratio)), ws(model) {
     if (!kelp::tether::static_initial_state(model, ws, env, a, b, state).converged)
       throw std::runtime_error("benchmark line: static equilibrium did not converge");
   }
-  static kelp::tether::TetherParametersd params(int n) {
+  static kelp::tether::TetherParametersd params(int n, double damping_ratio = 0.0) {
     kelp::tether::TetherParametersd p;
     p.segments = n;
+    if (damping_ratio > 0)
+      p.internal_damping =
+          2 * damping_ratio * p.axial_stiffness /
+          kelp::tether::highest_axial_frequency(kelp::tether::TetherModeld(p), 0.0);
     return p;
   }
   /// Fixed start at a, the far end heaving about b.
