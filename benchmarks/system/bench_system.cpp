@@ -1,10 +1,11 @@
 // The coupled system in issue 10's default configuration (kelp::system::presets): BlueBoat at the
 // surface, BlueROV2 Heavy 5 m down, a 10 m Fathom-class ROV tether (20 segments of 0.5 m), the
-// paper's moderate sea with the default wave components (64), wind and current; both vehicles
-// hold a constant thrust; steps of 10 ms.
+// paper's moderate or rough sea (kelp::system::presets::Sea; the scenarios paper_10m_moderate and
+// paper_10m_rough) with the default wave components (64), wind and current; both vehicles hold a
+// constant thrust; steps of 10 ms. Each benchmark's last part names the sea.
 //
 //   BM_SystemStep         one full system step; counter realtime_factor = simulated seconds per
-//                         CPU second
+//                         CPU second; newton_per_step = the tether's Newton corrections per step
 //   BM_SystemStepSplit    the same step written out with a clock around each part (the timer
 //                         costs ~50 ns a step): counters tether_us (tether advance, its water
 //                         sampling included), vehicles_us (two RK4 steps in the environment, their
@@ -28,10 +29,10 @@ using kelp::Vector3;
 namespace {
 
 struct Setup {
-  ks::presets::PaperWorld<double> world{10.0, ks::presets::Sea::moderate};
+  ks::presets::PaperWorld<double> world;
   ks::SystemInputsd inputs;
 
-  explicit Setup(int corrections = 0) {
+  explicit Setup(ks::presets::Sea sea, int corrections = 0) : world(10.0, sea) {
     if (corrections > 0) {
       auto p = world.model.parameters();
       p.coupling_corrections = corrections;
@@ -46,23 +47,25 @@ struct Setup {
   }
 };
 
-// Full steps with `corrections` corrector passes; counter realtime_factor.
-void run_steps(benchmark::State& st, int corrections) {
-  Setup s(corrections);
+// Full steps with `corrections` corrector passes; counters realtime_factor, newton_per_step.
+void run_steps(benchmark::State& st, ks::presets::Sea sea, int corrections) {
+  Setup s(sea, corrections);
+  double newton = 0;
   for (auto _ : st) {
-    s.step();
+    newton += s.step().tether.newton_iterations;
     benchmark::DoNotOptimize(s.world.state.auv.position.data());
   }
-  st.counters["realtime_factor"] =
-      benchmark::Counter(0.01 * static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
+  const double iters = static_cast<double>(st.iterations());
+  st.counters["realtime_factor"] = benchmark::Counter(0.01 * iters, benchmark::Counter::kIsRate);
+  st.counters["newton_per_step"] = newton / iters;
 }
 
-void BM_SystemStep(benchmark::State& st) { run_steps(st, 0); }
+void BM_SystemStep(benchmark::State& st, ks::presets::Sea sea) { run_steps(st, sea, 0); }
 
-void BM_SystemStepCorrected(benchmark::State& st) { run_steps(st, 1); }
+void BM_SystemStepCorrected(benchmark::State& st, ks::presets::Sea sea) { run_steps(st, sea, 1); }
 
-void BM_SystemStepSplit(benchmark::State& st) {
-  Setup s;
+void BM_SystemStepSplit(benchmark::State& st, ks::presets::Sea sea) {
+  Setup s(sea);
   auto& w = s.world;
   const auto& p = w.model.parameters();
   const auto& env = w.model.environment();
@@ -111,6 +114,12 @@ void BM_SystemStepSplit(benchmark::State& st) {
 
 }  // namespace
 
-BENCHMARK(BM_SystemStep)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SystemStepSplit)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SystemStepCorrected)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SystemStep, moderate, ks::presets::Sea::moderate)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SystemStep, rough, ks::presets::Sea::rough)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SystemStepSplit, moderate, ks::presets::Sea::moderate)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SystemStepSplit, rough, ks::presets::Sea::rough)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SystemStepCorrected, moderate, ks::presets::Sea::moderate)
+    ->Unit(benchmark::kMicrosecond);
