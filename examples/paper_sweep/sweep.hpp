@@ -361,7 +361,7 @@ inline std::string mixed_platforms_warning(const std::map<std::string, json>& re
   if (runs.size() < 2) return "";
   std::string w =
       "warning: the runs were computed on different instruction paths or C library math, so "
-      "their numbers differ in the last bits from what one machine would give (";
+      "their numbers may differ from what one machine would give (";
   bool first = true;
   for (const auto& [p, n] : runs) {
     w += (first ? "" : "; ") + p + ": " + std::to_string(n) + " run" + (n == 1 ? "" : "s");

@@ -157,7 +157,7 @@ inline void set_kernel_policy(KernelPath p) {
 
 /// \brief The process' kernel policy as requested (possibly `automatic`): the last
 /// `set_kernel_policy`, else the environment variable `KELP_KERNEL` (read at the first call that
-/// finds no policy), else `automatic`.
+/// finds no policy; empty is as unset), else `automatic`.
 /// \throws kelp::invalid_argument when KELP_KERNEL holds an unknown name or a path this CPU
 /// lacks (the message names the variable and its value; every call throws until it is fixed or
 /// `set_kernel_policy` is called).
@@ -165,7 +165,7 @@ inline KernelPath kernel_policy() {
   int v = detail::kernel_policy_slot().load(std::memory_order_relaxed);
   if (v >= 0) return static_cast<KernelPath>(v);
   KernelPath p = KernelPath::automatic;
-  if (const char* env = std::getenv(kernel_environment_variable)) {
+  if (const char* env = std::getenv(kernel_environment_variable); env && *env) {
     const std::string where = std::string(kernel_environment_variable) + "=" + env;
     try {
       p = parse_kernel_path(env);
