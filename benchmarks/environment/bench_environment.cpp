@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <limits>
+#include <string>
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/environment/sea_state.hpp"
@@ -52,12 +53,27 @@ void BM_SampleWaterDeepFloat(benchmark::State& s) {
   sample_water<float>(s, std::numeric_limits<double>::infinity());
 }
 
-// The batch query on each kernel path (kelp/core/kernel_path.hpp): range(0) = 1 portable (the
-// deterministic mode), 2 AVX2 + FMA, 3 AVX-512; 100 points, range(1) wave components, deep water.
+// Sets the kernel path of range(0): 0 portable in its SSE2 build (as on a CPU without AVX2),
+// 1 portable (the deterministic mode; the widest build without FMA the CPU has), 2 AVX2 + FMA,
+// 3 AVX-512; labels the benchmark with it.
+kelp::simd::KernelPath kernel_arg(benchmark::State& state) {
+  const int k = static_cast<int>(state.range(0));
+  kelp::simd::detail::portable_build_cap().store(k == 0 ? 0 : 2);
+  const auto path = static_cast<kelp::simd::KernelPath>(k == 0 ? 1 : k);
+  std::string label = kelp::simd::kernel_name(path);
+  if (path == kelp::simd::KernelPath::portable)
+    label += std::string(" (") +
+             kelp::simd::detail::portable_build_name(kelp::simd::detail::portable_build()) +
+             " build)";
+  state.SetLabel(label);
+  return path;
+}
+
+// The batch query on each kernel path (kernel_arg); 100 points, range(1) wave components, deep
+// water.
 void BM_SampleWaterKernel(benchmark::State& state) {
-  const auto path = static_cast<kelp::simd::KernelPath>(state.range(0));
+  const auto path = kernel_arg(state);
   const int n = 100, nc = static_cast<int>(state.range(1));
-  state.SetLabel(kelp::simd::kernel_name(path));
   if (!kelp::simd::kernel_supported(path)) {
     state.SkipWithError("this CPU lacks this kernel path");
     return;
@@ -80,8 +96,7 @@ void BM_SampleWaterKernel(benchmark::State& state) {
 
 // A single-point sample (the kernel's components-in-lanes form) on each kernel path.
 void BM_SamplePointKernel(benchmark::State& state) {
-  const auto path = static_cast<kelp::simd::KernelPath>(state.range(0));
-  state.SetLabel(kelp::simd::kernel_name(path));
+  const auto path = kernel_arg(state);
   if (!kelp::simd::kernel_supported(path)) {
     state.SkipWithError("this CPU lacks this kernel path");
     return;
@@ -152,8 +167,8 @@ void BM_SamplePointCalm(benchmark::State& state) {
 BENCHMARK(BM_SampleWaterDeep)->Args({100, 64})->Args({10, 64})->Args({100, 16});
 BENCHMARK(BM_SampleWaterFiniteDepth)->Args({100, 64});
 BENCHMARK(BM_SampleWaterDeepFloat)->Args({100, 64});
-BENCHMARK(BM_SampleWaterKernel)->Args({1, 64})->Args({2, 64})->Args({3, 64});
-BENCHMARK(BM_SamplePointKernel)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_SampleWaterKernel)->Args({0, 64})->Args({1, 64})->Args({2, 64})->Args({3, 64});
+BENCHMARK(BM_SamplePointKernel)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 BENCHMARK(BM_SampleWaterCalm);
 BENCHMARK(BM_SampleWaterCalmCurrent);
 BENCHMARK(BM_SamplePoint);

@@ -174,13 +174,54 @@ TEST_CASE("a wave field pinned to the portable path gives the same bits under ev
     CHECK((r - reference).norm() <= 1e-12 * reference.norm());
     if (p != KernelPath::portable)
       WARN("the " << simd::kernel_name(p) << " wave kernel "
-                  << (kp_same_bits(r, reference) ? "gives the portable path's bits"
-                                              : "differs from the portable path in the last bits")
+                  << (kp_same_bits(r, reference)
+                          ? "gives the portable path's bits"
+                          : "differs from the portable path in the last bits")
                   << " on this CPU (largest difference " << (r - reference).cwiseAbs().maxCoeff()
                   << ")");
   }
   if (simd::supported_kernels().size() == 1)
     WARN("only the portable path on this CPU: nothing else to compare with");
+}
+
+TEST_CASE("the portable path's builds (SSE2, AVX2 and AVX-512 without FMA) give the same bits",
+          "[environment][waves][kernel]") {
+  // The deterministic mode runs the widest build the CPU has; a CPU without AVX2 runs the SSE2
+  // one. All must agree bit for bit: batches (points in lanes) and single points (components in
+  // lanes, with the gradient and slope), deep and finite depth.
+  struct CapAfter {
+    ~CapAfter() { simd::detail::portable_build_cap().store(2); }
+  } restore;
+  for (const double depth : {std::numeric_limits<double>::infinity(), 40.0}) {
+    auto p = kp_rough_sea();
+    p.depth = depth;
+    kelp::environment::WaveFieldd w(p);
+    w.set_kernel(KernelPath::portable);
+    Eigen::MatrixXd reference;
+    Eigen::VectorXd point_reference;
+    for (int cap = 0; cap <= 2; ++cap) {
+      simd::detail::portable_build_cap().store(cap);
+      const int build = simd::detail::portable_build();
+      INFO("depth " << depth << ", portable build " << simd::detail::portable_build_name(build));
+      if (build < cap) {
+        WARN("skipped the portable build " << cap << ": this CPU (or compiler) lacks it");
+        continue;
+      }
+      const Eigen::MatrixXd r = kp_batch(w);
+      const auto k = w.kinematics(kelp::Vector3<double>(1.0, 2.0, 3.0), 13.7);
+      Eigen::VectorXd pt(17);
+      pt << k.velocity, k.acceleration,
+          Eigen::Map<const Eigen::VectorXd>(k.velocity_gradient.data(), 9), k.slope;
+      if (cap == 0) {
+        reference = r;
+        point_reference = pt;
+        CHECK(pt.norm() > 0.1);  // a point in the water: not trivially zero
+        continue;
+      }
+      CHECK(kp_same_bits(r, reference));
+      CHECK(kp_same_bits(pt, point_reference));
+    }
+  }
 }
 
 TEST_CASE("the C library's math fingerprint is stable within a process", "[core][kernel]") {

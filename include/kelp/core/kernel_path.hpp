@@ -13,8 +13,11 @@
 /// width is fixed when the program is compiled, so they give the same bits on every CPU that runs
 /// the program.
 ///
-/// `KernelPath::portable` is the baseline build, never chosen by the CPU: with it, a program gives
-/// the same bits on every CPU that runs it (the deterministic mode). It is chosen
+/// `KernelPath::portable` computes what the baseline build computes, never a fused multiply–add:
+/// with it, a program gives the same bits on every CPU that runs it (the deterministic mode). It
+/// still uses the CPU's vectors: its operations are compiled for SSE2, AVX2 without FMA and (GCC)
+/// AVX-512 with contraction off, which give the same bits, and the widest the CPU has runs. It is
+/// chosen
 ///   - for the whole process: `set_kernel_policy(KernelPath::portable)` or the environment variable
 ///     `KELP_KERNEL=portable` (read once, at the first use);
 ///   - for one wave field: `WaveField::set_kernel(KernelPath::portable)` (kelp::sim scenarios:
@@ -43,6 +46,15 @@
 /// Defined when kelp builds its AVX2 and AVX-512 kernels beside the baseline and chooses among them
 /// at run time (GCC or clang on x86-64 with a baseline below AVX2).
 #define KELP_X86_DISPATCH 1
+#endif
+
+#if defined(KELP_X86_DISPATCH) && !defined(__clang__)
+/// Defined to 1 when the portable path has an AVX-512 build without FMA (GCC: its
+/// `optimize("fp-contract=off")` attribute; clang's AVX-512 implies FMA and it has no such
+/// attribute, so there the portable path's widest build is AVX2).
+#define KELP_PORTABLE_AVX512 1
+#else
+#define KELP_PORTABLE_AVX512 0
 #endif
 
 namespace kelp::simd {
@@ -141,6 +153,41 @@ inline void check_kernel_supported(KernelPath p, const std::string& where) {
 #endif
   kelp::detail::throw_invalid_argument(where + ": kernel path \"" + kernel_name(p) +
                                        "\" cannot be used: " + why + " (available: " + have + ")");
+}
+}  // namespace detail
+
+namespace detail {
+/// The widest build of the portable path the process may use (tests and benchmarks lower it to
+/// compare the builds): 0 baseline (SSE2), 1 AVX2 without FMA, 2 AVX-512 without FMA.
+inline std::atomic<int>& portable_build_cap() {
+  static std::atomic<int> cap{2};
+  return cap;
+}
+
+/// The build the portable path takes: the widest this CPU (and compiler) has without FMA, at most
+/// `portable_build_cap()`. Every build gives the same bits (see wave_kernels.hpp).
+inline int portable_build() {
+#ifdef KELP_X86_DISPATCH
+  static const int widest = KELP_PORTABLE_AVX512 && __builtin_cpu_supports("avx512f") &&
+                                    __builtin_cpu_supports("avx512dq")
+                                ? 2
+                            : __builtin_cpu_supports("avx2") ? 1
+                                                             : 0;
+  const int cap = portable_build_cap().load(std::memory_order_relaxed);
+  return widest < cap ? widest : cap;
+#else
+  return 0;
+#endif
+}
+
+/// The name of a portable build: "sse2" (or "baseline" outside x86-64), "avx2", "avx512".
+inline const char* portable_build_name(int build) {
+#if defined(__x86_64__)
+  return build == 2 ? "avx512" : build == 1 ? "avx2" : "sse2";
+#else
+  (void)build;
+  return "baseline";
+#endif
 }
 }  // namespace detail
 

@@ -264,14 +264,49 @@ KELP_ENV_TARGET_AVX512 inline void wave_accumulate_avx512(const WaveComponentsVi
 }
 #endif
 
+#ifdef KELP_X86_DISPATCH
+// The portable path's wide builds: the baseline's operations, wider. Without FMA enabled the
+// compiler cannot contract a multiply–add, every other operation is IEEE-rounded lane by lane,
+// each point's (or lane's) sum keeps its order, and no reassociation is allowed (kelp refuses
+// -fassociative-math): the same bits as the baseline build (tested), 2–4× faster.
+/// The baseline kernel compiled for AVX2 without FMA (`target("avx2")` enables no FMA).
+__attribute__((target("avx2"))) inline void wave_accumulate_avx2_exact(const WaveComponentsView& c,
+                                                                       WaveBlock& b, int m,
+                                                                       double t, bool finite) {
+  if (finite)
+    wave_accumulate_impl<true, 8>(c, b, m, t);
+  else
+    wave_accumulate_impl<false, 8>(c, b, m, t);
+}
+#if KELP_PORTABLE_AVX512
+/// The baseline kernel compiled for AVX-512 with contraction off (GCC's AVX-512 enables FMA, so
+/// `optimize("fp-contract=off")` forbids fusing; clang has no such attribute: not built there).
+__attribute__((target("avx512f,avx512dq,avx2,prefer-vector-width=512"),
+               optimize("fp-contract=off"))) inline void
+wave_accumulate_avx512_exact(const WaveComponentsView& c, WaveBlock& b, int m, double t,
+                             bool finite) {
+  if (finite)
+    wave_accumulate_impl<true, 16>(c, b, m, t);
+  else
+    wave_accumulate_impl<false, 16>(c, b, m, t);
+}
+#endif
+#endif
+
 /// The wave kernel on instruction path `path` (a concrete one, supported by the CPU: see
-/// `simd::resolve_kernel`; `portable`, and every path in a build without run-time dispatch, is
-/// the baseline kernel).
+/// `simd::resolve_kernel`). `portable` runs the baseline kernel's operations on the widest vectors
+/// the CPU has without FMA (`simd::detail::portable_build()`), the same bits as the baseline build;
+/// in a build without run-time dispatch every path is the baseline kernel.
 inline void wave_accumulate(const WaveComponentsView& c, WaveBlock& b, int m, double t, bool finite,
                             simd::KernelPath path) {
 #ifdef KELP_X86_DISPATCH
   if (path == simd::KernelPath::avx512) return wave_accumulate_avx512(c, b, m, t, finite);
   if (path == simd::KernelPath::avx2) return wave_accumulate_avx2(c, b, m, t, finite);
+  const int build = simd::detail::portable_build();
+#if KELP_PORTABLE_AVX512
+  if (build == 2) return wave_accumulate_avx512_exact(c, b, m, t, finite);
+#endif
+  if (build >= 1) return wave_accumulate_avx2_exact(c, b, m, t, finite);
 #else
   (void)path;
 #endif
