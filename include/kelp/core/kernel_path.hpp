@@ -8,10 +8,11 @@
 /// AVX-512 builds on x86-64 with GCC or clang. The wider builds contract multiply–adds into fused
 /// multiply–adds (one rounding instead of two), so their results differ from the baseline's in the
 /// last bits (≲ 1e-15 relative per wave sum); those differences then grow through a
-/// chaotic closed loop, and a run on an AVX-512 machine does not reproduce the same run on an
-/// AVX2 machine. The tether's force kernels (kelp/core/simd.hpp) are not dispatched: their SIMD
-/// width is fixed when the program is compiled, so they give the same bits on every CPU that runs
-/// the program.
+/// chaotic closed loop, and a run on a CPU with AVX2 and FMA does not reproduce the same run on
+/// one without (the AVX2 and AVX-512 builds gave the same bits with GCC 12, but nothing obliges a
+/// compiler to contract both alike). The tether's force kernels (kelp/core/simd.hpp) are not
+/// dispatched: their SIMD width is fixed when the program is compiled, so they give the same bits
+/// on every CPU that runs the program.
 ///
 /// `KernelPath::portable` computes what the baseline build computes, never a fused multiply–add:
 /// with it, a program gives the same bits on every CPU that runs it (the deterministic mode). It
@@ -42,9 +43,12 @@
 
 #include "kelp/core/error.hpp"
 
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(__AVX2__)
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(__AVX2__) && \
+    !defined(__FMA__)
 /// Defined when kelp builds its AVX2 and AVX-512 kernels beside the baseline and chooses among them
-/// at run time (GCC or clang on x86-64 with a baseline below AVX2).
+/// at run time (GCC or clang on x86-64 with a baseline below AVX2 and without FMA). A program
+/// compiled with -mfma, -mavx2 or -march=native has one build only (its `portable` path then
+/// contracts like the rest of the program, and gives the same bits on every CPU that runs it).
 #define KELP_X86_DISPATCH 1
 #endif
 
@@ -149,7 +153,7 @@ inline void check_kernel_supported(KernelPath p, const std::string& where) {
 #else
   const char* why =
       "this build has no run-time dispatch (not GCC/clang on x86-64, or compiled "
-      "for AVX2 or above already)";
+      "with FMA or AVX2 already)";
 #endif
   kelp::detail::throw_invalid_argument(where + ": kernel path \"" + kernel_name(p) +
                                        "\" cannot be used: " + why + " (available: " + have + ")");
