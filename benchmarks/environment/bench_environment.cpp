@@ -1,8 +1,10 @@
 // Environment queries: the batch water query for a tether's nodes (the target: 100 points,
-// 64 wave components, ≤ 10 µs), single-point samples, and the calm sea's cost.
+// 64 wave components, ≤ 10 µs), single-point samples, both on each kernel path (the deterministic
+// mode's portable one and the dispatched ones), and the calm sea's cost.
 #include <benchmark/benchmark.h>
 
 #include <limits>
+#include <string>
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/environment/sea_state.hpp"
@@ -49,6 +51,67 @@ void BM_SampleWaterDeep(benchmark::State& s) {
 void BM_SampleWaterFiniteDepth(benchmark::State& s) { sample_water<double>(s, 40.0); }
 void BM_SampleWaterDeepFloat(benchmark::State& s) {
   sample_water<float>(s, std::numeric_limits<double>::infinity());
+}
+
+// Sets the kernel path of range(0): 0 portable in its SSE2 build (as on a CPU without AVX2),
+// 1 portable (the deterministic mode; the widest build without FMA the CPU has), 2 AVX2 + FMA,
+// 3 AVX-512; labels the benchmark with it.
+kelp::simd::KernelPath kernel_arg(benchmark::State& state) {
+  const int k = static_cast<int>(state.range(0));
+  kelp::simd::detail::portable_build_cap().store(k == 0 ? 0 : 2);
+  const auto path = static_cast<kelp::simd::KernelPath>(k == 0 ? 1 : k);
+  std::string label = kelp::simd::kernel_name(path);
+  if (path == kelp::simd::KernelPath::portable)
+    label += std::string(" (") +
+             kelp::simd::detail::portable_build_name(kelp::simd::detail::portable_build()) +
+             " build)";
+  state.SetLabel(label);
+  return path;
+}
+
+// The batch query on each kernel path (kernel_arg); 100 points, range(1) wave components, deep
+// water.
+void BM_SampleWaterKernel(benchmark::State& state) {
+  const auto path = kernel_arg(state);
+  const int n = 100, nc = static_cast<int>(state.range(1));
+  if (!kelp::simd::kernel_supported(path)) {
+    state.SkipWithError("this CPU lacks this kernel path");
+    return;
+  }
+  auto env = rough_sea<double>(std::numeric_limits<double>::infinity(), nc);
+  auto waves = env.waves();
+  waves.set_kernel(path);
+  env.set_waves(waves);
+  const auto pts = tether_nodes<double>(n);
+  kelp::Matrix3X<double> vel(3, n), acc(3, n);
+  double t = 0;
+  for (auto _ : state) {
+    env.sample_water(pts, t, vel, acc);
+    benchmark::DoNotOptimize(vel.data());
+    benchmark::DoNotOptimize(acc.data());
+    t += 0.01;
+  }
+  state.SetItemsProcessed(state.iterations() * n * nc);
+}
+
+// A single-point sample (the kernel's components-in-lanes form) on each kernel path.
+void BM_SamplePointKernel(benchmark::State& state) {
+  const auto path = kernel_arg(state);
+  if (!kelp::simd::kernel_supported(path)) {
+    state.SkipWithError("this CPU lacks this kernel path");
+    return;
+  }
+  auto env = rough_sea<double>(std::numeric_limits<double>::infinity(), 64);
+  auto waves = env.waves();
+  waves.set_kernel(path);
+  env.set_waves(waves);
+  kelp::Vector3<double> p(1.0, 2.0, 3.0);
+  double t = 0;
+  for (auto _ : state) {
+    auto s = env.sample(p, t);
+    benchmark::DoNotOptimize(s);
+    t += 0.01;
+  }
 }
 
 void BM_SampleWaterCalm(benchmark::State& state) {
@@ -104,6 +167,8 @@ void BM_SamplePointCalm(benchmark::State& state) {
 BENCHMARK(BM_SampleWaterDeep)->Args({100, 64})->Args({10, 64})->Args({100, 16});
 BENCHMARK(BM_SampleWaterFiniteDepth)->Args({100, 64});
 BENCHMARK(BM_SampleWaterDeepFloat)->Args({100, 64});
+BENCHMARK(BM_SampleWaterKernel)->Args({0, 64})->Args({1, 64})->Args({2, 64})->Args({3, 64});
+BENCHMARK(BM_SamplePointKernel)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 BENCHMARK(BM_SampleWaterCalm);
 BENCHMARK(BM_SampleWaterCalmCurrent);
 BENCHMARK(BM_SamplePoint);

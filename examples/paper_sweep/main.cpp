@@ -63,10 +63,17 @@ std::string plot_script() {
   return KELP_SWEEP_PLOT_SCRIPT_SOURCE;
 }
 
-// Table and figure of a complete set of results in `dir`.
+// Table and figure of a complete set of results in `dir`. When the results were computed on
+// different kernel paths or C library math (`where`: each run's source directory), a warning on
+// stderr and at the end of table.md.
 int finish(const paper_sweep::Sweep& s, const std::map<std::string, json>& results,
-           const fs::path& dir, bool plot) {
+           const fs::path& dir, bool plot, const std::map<std::string, std::string>& where = {}) {
   paper_sweep::write_table(s, results, dir);
+  const std::string warning = paper_sweep::mixed_platforms_warning(results, where);
+  if (!warning.empty()) {
+    std::fprintf(stderr, "kelp-sweep: %s\n", warning.c_str());
+    std::ofstream(dir / "table.md", std::ios::app) << "\n> **" << warning << "**\n";
+  }
   if (plot) {
     const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
     const std::string cmd = python + " '" + plot_script() + "' '" + dir.string() + "'";
@@ -88,6 +95,7 @@ struct RunOptions {
 };
 
 int run(const RunOptions& o) {
+  kelp::simd::kernel_policy();  // a bad KELP_KERNEL stops here, named, not in every run
   const paper_sweep::Sweep s =
       o.sweep_file.empty() ? paper_sweep::parse_sweep(paper_sweep::default_sweep_json().dump(),
                                                       "(embedded paper sweep)")
@@ -186,6 +194,7 @@ int merge(const std::vector<std::string>& dirs, const std::string& out_dir, bool
   fs::create_directories(out / "runs");
   write_atomically(out / "sweep.json", s.source.dump(2) + "\n");
   std::map<std::string, json> results;
+  std::map<std::string, std::string> where;  // run hash → the directory its result came from
   std::size_t missing = 0;
   for (const paper_sweep::Run& r : s.runs) {
     for (const std::string& d : dirs) {
@@ -193,6 +202,7 @@ int merge(const std::vector<std::string>& dirs, const std::string& out_dir, bool
       if (j.is_null()) continue;
       if (fs::path(d) != out) write_atomically(out / "runs" / (r.hash + ".json"), j.dump(1) + "\n");
       results[r.hash] = std::move(j);
+      where[r.hash] = d;
       break;
     }
     if (!results.count(r.hash)) ++missing;
@@ -205,7 +215,7 @@ int merge(const std::vector<std::string>& dirs, const std::string& out_dir, bool
     return 1;
   }
   std::printf("kelp-sweep merge: %zu runs from %zu directories\n", s.runs.size(), dirs.size());
-  return finish(s, results, out, plot);
+  return finish(s, results, out, plot, where);
 }
 
 }  // namespace
@@ -240,6 +250,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "kelp-sweep: invalid sweep: %s\n", e.what());
     return 3;
   } catch (const CLI::ValidationError& e) {
+    std::fprintf(stderr, "kelp-sweep: %s\n", e.what());
+    return 3;
+  } catch (const kelp::invalid_argument& e) {  // e.g. a bad KELP_KERNEL
     std::fprintf(stderr, "kelp-sweep: %s\n", e.what());
     return 3;
   } catch (const std::exception& e) {

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -204,10 +205,18 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
   const json& j = s.source;
   if (!j.is_object()) fail("/", "expected an object with base, axes and seeds");
   for (auto it = j.begin(); it != j.end(); ++it)
-    if (it.key() != "base" && it.key() != "axes" && it.key() != "seeds")
-      fail("/" + it.key(), "unknown key (allowed: axes, base, seeds)");
+    if (it.key() != "base" && it.key() != "axes" && it.key() != "seeds" &&
+        it.key() != "deterministic")
+      fail("/" + it.key(), "unknown key (allowed: axes, base, deterministic, seeds)");
   s.base = j.value("base", json::object());
   if (!s.base.is_object()) fail("/base", "expected a scenario object");
+  // "deterministic": true pins every run's wave kernel to the portable path (the same numbers on
+  // every CPU of a cluster): the base scenario's "deterministic": true.
+  if (j.contains("deterministic")) {
+    if (!j.at("deterministic").is_boolean())
+      fail("/deterministic", "expected true or false, got " + j.at("deterministic").dump());
+    if (j.at("deterministic").get<bool>()) s.base["deterministic"] = true;
+  }
   if (j.contains("axes")) {
     const json& a = j.at("axes");
     if (!a.is_array()) fail("/axes", "expected an array of {\"path\", \"values\"}");
@@ -325,6 +334,46 @@ inline std::vector<json> point_values(const Sweep& s, std::size_t point) {
     point /= s.axes[i].values.size();
   }
   return v;
+}
+
+/// What a run's numbers depend on beyond its scenario: the wave kernel's instruction path and
+/// the C library's math, as its summary records them ("unrecorded" for results written before
+/// kelp recorded them).
+inline std::string platform_of(const json& result) {
+  const json& s = result.at("summary");
+  return s.value("kernel", std::string("unrecorded")) + " kernel, math library " +
+         s.value("math_library", std::string("unrecorded"));
+}
+
+/// A warning when the results were computed on different instruction paths or C library math
+/// (e.g. shards run on different CPUs), else an empty string. `where` names each result's source
+/// (by run hash; e.g. its shard directory), or is empty.
+inline std::string mixed_platforms_warning(const std::map<std::string, json>& results,
+                                           const std::map<std::string, std::string>& where = {}) {
+  std::map<std::string, std::size_t> runs;
+  std::map<std::string, std::set<std::string>> sources;
+  for (const auto& [hash, result] : results) {
+    const std::string p = platform_of(result);
+    ++runs[p];
+    const auto it = where.find(hash);
+    if (it != where.end()) sources[p].insert(it->second);
+  }
+  if (runs.size() < 2) return "";
+  std::string w =
+      "warning: the runs were computed on different instruction paths or C library math, so "
+      "their numbers may differ from what one machine would give (";
+  bool first = true;
+  for (const auto& [p, n] : runs) {
+    w += (first ? "" : "; ") + p + ": " + std::to_string(n) + " run" + (n == 1 ? "" : "s");
+    if (!sources[p].empty()) {
+      w += " from";
+      for (const std::string& d : sources[p]) w += " " + d;
+    }
+    first = false;
+  }
+  return w +
+         "). For the same numbers on every CPU run the sweep with \"deterministic\": true "
+         "(docs/deterministic.md).";
 }
 
 /// The numbers the table summarises, from a run's summary.

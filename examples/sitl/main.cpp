@@ -245,6 +245,9 @@ int run(const Options& o) {
   summary["bind"] = o.bind;
   summary["ardusub"] = counters_json(bridge.counters(0), o.sub_port, bridge.joined(0));
   summary["ardurover"] = counters_json(bridge.counters(1), o.rover_port, bridge.joined(1));
+  // The wave kernel's instruction path and the C library's math (kelp/core/kernel_path.hpp).
+  summary["kernel"] = kelp::simd::kernel_name(model.environment().waves().active_kernel());
+  summary["math_library"] = kelp::simd::math_library_fingerprint();
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
@@ -302,6 +305,12 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", o.quiet,
                "no status lines or events on stderr (events.log still has them)");
   CLI11_PARSE(app, argc, argv);
+  try {
+    kelp::simd::kernel_policy();  // a bad KELP_KERNEL stops here, named
+  } catch (const kelp::invalid_argument& e) {
+    std::fprintf(stderr, "kelp-sitl: %s\n", e.what());
+    return 3;
+  }
   try {
     if (!file.empty()) {
       o.scenario = kelp::sim::load_scenario(file);

@@ -89,7 +89,26 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "output directory");
   app.add_flag("--quiet", o.quiet, "no progress bar");
   app.add_flag("--no-plots", o.no_plots, "do not run the plotting script");
+  std::string kernel;
+  bool deterministic = false;
+  app.add_option("--kernel", kernel,
+                 "instruction path of the wave kernel (overrides the scenario; portable: the "
+                 "same numbers on every CPU)")
+      ->check(CLI::IsMember({"auto", "portable", "avx2", "avx512"}));
+  app.add_flag("--deterministic", deterministic,
+               "the same numbers on every CPU: --kernel portable (see docs/deterministic.md)");
   CLI11_PARSE(app, argc, argv);
+  if (deterministic && !kernel.empty() && kernel != "portable") {
+    std::fprintf(stderr, "kelp-tethered-pair: --deterministic pins --kernel portable, not %s\n",
+                 kernel.c_str());
+    return 3;
+  }
+  try {
+    kelp::simd::kernel_policy();  // a bad KELP_KERNEL stops here, named
+  } catch (const kelp::invalid_argument& e) {
+    std::fprintf(stderr, "kelp-tethered-pair: %s\n", e.what());
+    return 3;
+  }
   try {
     if (!file.empty()) {
       o.scenario = kelp::sim::load_scenario(file);
@@ -97,6 +116,8 @@ int main(int argc, char** argv) {
     }
     if (duration > 0) o.scenario.duration = duration;
     if (seed >= 0) o.scenario.seed = static_cast<std::uint64_t>(seed);
+    if (!kernel.empty()) o.scenario.kernel = kernel;
+    if (deterministic) o.scenario.kernel = "portable";
     return run(o);
   } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-tethered-pair: invalid scenario: %s\n", e.what());

@@ -6,7 +6,11 @@
 - bad sweep files (unknown JSON path, empty axis, non-finite value, a value the scenario
   refuses, a bad --shard, nesting too deep, an index past an array's end, too many runs) are
   refused with exit status 3 and a message naming the path;
-- plot_sweep.py draws the figure from the table.
+- plot_sweep.py draws the figure from the table;
+- kernel paths: each run records its kernel; a bad KELP_KERNEL is refused (exit 3, named);
+  merging shards run on different kernel paths warns (stderr and table.md); a sweep with
+  "deterministic": true gives the same table and summaries, bit for bit, whatever kernel path
+  each shard's process is forced to (KELP_KERNEL), as shards on different CPUs would.
 """
 import json
 import os
@@ -24,9 +28,25 @@ def check(cond, what):
     return cond
 
 
-def run(*args):
-    p = subprocess.run(list(args), capture_output=True, text=True)
+def run(*args, env=None):
+    full_env = dict(os.environ)
+    full_env.pop("KELP_KERNEL", None)
+    full_env.update(env or {})
+    p = subprocess.run(list(args), capture_output=True, text=True, env=full_env)
     return p.returncode, p.stdout, p.stderr
+
+
+def summaries(directory):
+    """Run hash -> summary without the wall-clock fields."""
+    out = {}
+    runs = os.path.join(directory, "runs")
+    for name in sorted(os.listdir(runs)):
+        with open(os.path.join(runs, name)) as f:
+            s = json.load(f)["summary"]
+        s.pop("wall_s", None)
+        s.pop("realtime_factor", None)
+        out[name] = s
+    return out
 
 
 def read(path):
@@ -58,6 +78,7 @@ def main(program, small, work):
     merged = os.path.join(work, "merged")
     code, out, err = run(program, "merge", *shards, "--out", merged, "--no-plot")
     check(code == 0, "merge failed: %s" % err)
+    check("warning" not in err, "a merge of shards on one kernel path warned: " + err)
     check(read(os.path.join(merged, "table.csv")) == table, "merged table.csv differs")
     check(read(os.path.join(merged, "table.md")) == read(os.path.join(full, "table.md")),
           "merged table.md differs")
@@ -95,6 +116,10 @@ def main(program, small, work):
         ("too many runs",
          {"axes": [{"path": "/duration", "values": list(range(1, 11))}] * 7}, "/axes/5/values"),
         ("pointer too deep", {"axes": [{"path": "/a" * 100000, "values": [1]}]}, "/axes/0/path"),
+        ("bad deterministic", {"deterministic": "yes"}, "/deterministic"),
+        ("deterministic with a wide kernel",
+         {"deterministic": True, "base": dict(base.get("base", {}), kernel="avx2")},
+         "/deterministic"),
     ]
     for name, content, path in cases:
         f = os.path.join(work, "bad.json")
@@ -108,6 +133,8 @@ def main(program, small, work):
                          os.path.join(work, "bad"))
     check(code == 3 and "--shard" in err, "--shard 3/3 accepted")
 
+    kernel_checks(program, small, work, base)
+
     # The figure.
     plot = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plot_sweep.py")
     python = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
@@ -119,6 +146,83 @@ def main(program, small, work):
         return 1
     print("kelp-sweep: all checks passed")
     return 0
+
+
+def kernel_checks(program, small, work, base):
+    # Every run records the kernel path it took (the widest here, nothing forced).
+    for s in summaries(os.path.join(work, "full")).values():
+        check(s.get("kernel") in ("portable", "avx2", "avx512"), "a run recorded no kernel")
+        check(len(s.get("math_library", "")) == 16, "a run recorded no math library fingerprint")
+
+    # A bad KELP_KERNEL is refused once, naming the variable.
+    for bad in ("bogus", "AVX2"):
+        code, out, err = run(program, "--sweep", small, "--out", os.path.join(work, "bad"),
+                             "--no-plot", "--quiet", env={"KELP_KERNEL": bad})
+        check(code == 3 and ("KELP_KERNEL=" + bad) in err,
+              "KELP_KERNEL=%s: exit %d, %r" % (bad, code, err.strip()))
+
+    # The paths this CPU runs: a path it lacks is refused with exit 3, never run.
+    paths = ["portable"]
+    for k in ("avx2", "avx512"):
+        code, out, err = run(program, "--sweep", small, "--out", os.path.join(work, "probe-" + k),
+                             "--no-plot", "--quiet", "--shard", "0/8", env={"KELP_KERNEL": k})
+        if code == 0:
+            paths.append(k)
+        else:
+            check(code == 3 and "cannot be used" in err, "KELP_KERNEL=%s: %r" % (k, err))
+            print("skipped %s: this CPU lacks it" % k)
+    print("kernel paths on this CPU: " + ", ".join(paths))
+
+    # Shards on different kernel paths (as on different CPUs): the merge warns.
+    if len(paths) < 2:
+        print("skipped the mixed-kernel merge: this CPU runs only the portable path")
+    else:
+        mixed = []
+        for i in range(3):
+            d = os.path.join(work, "mixed-%d" % i)
+            k = paths[0] if i == 0 else paths[-1]
+            code, out, err = run(program, "--sweep", small, "--out", d, "--shard", "%d/3" % i,
+                                 "--quiet", "--jobs", "1", env={"KELP_KERNEL": k})
+            check(code == 0, "mixed shard %d failed: %s" % (i, err))
+            check(all(s["kernel"] == k for s in summaries(d).values()),
+                  "shard %d did not record kernel %s" % (i, k))
+            mixed.append(d)
+        out_dir = os.path.join(work, "mixed-merged")
+        code, out, err = run(program, "merge", *mixed, "--out", out_dir, "--no-plot")
+        print(err)
+        check(code == 0, "the mixed merge failed: " + err)
+        check("warning: the runs were computed on different instruction paths" in err,
+              "the mixed merge did not warn: " + err)
+        check(paths[0] + " kernel" in err and paths[-1] + " kernel" in err and mixed[0] in err,
+              "the warning does not name the kernels and shards: " + err)
+        md = read(os.path.join(out_dir, "table.md")).decode()
+        check("different instruction paths" in md, "the merged table.md has no warning")
+
+    # A deterministic sweep: each shard's process forced to another path, the same numbers.
+    det_file = os.path.join(work, "deterministic.json")
+    with open(det_file, "w") as fh:
+        json.dump(dict(base, deterministic=True), fh)
+    ref = os.path.join(work, "det-full")
+    code, out, err = run(program, "--sweep", det_file, "--out", ref, "--no-plot", "--quiet",
+                         env={"KELP_KERNEL": paths[-1]})
+    check(code == 0, "the deterministic sweep failed: " + err)
+    reference = summaries(ref)
+    check(all(s["kernel"] == "portable" for s in reference.values()),
+          "a deterministic run did not take the portable path")
+    shards = []
+    for i in range(3):
+        d = os.path.join(work, "det-%d" % i)
+        code, out, err = run(program, "--sweep", det_file, "--out", d, "--shard", "%d/3" % i,
+                             "--quiet", "--jobs", "1", env={"KELP_KERNEL": paths[i % len(paths)]})
+        check(code == 0, "deterministic shard %d failed: %s" % (i, err))
+        shards.append(d)
+    merged = os.path.join(work, "det-merged")
+    code, out, err = run(program, "merge", *shards, "--out", merged, "--no-plot")
+    check(code == 0 and "warning" not in err, "the deterministic merge warned or failed: " + err)
+    check(read(os.path.join(merged, "table.csv")) == read(os.path.join(ref, "table.csv")),
+          "the deterministic shards' table differs from the unsharded one")
+    check(summaries(merged) == reference,
+          "the deterministic shards' summaries differ from the unsharded ones")
 
 
 if __name__ == "__main__":

@@ -2,8 +2,9 @@
 /// \brief The CPU-specific part of the wave field (kelp/environment/waves.hpp): the batch kernel
 /// that sums the Airy components' elevation, orbital velocity and acceleration (and, for one
 /// point, the velocity gradient and surface slope) over blocks of points, written on the
-/// vectorisable math of kelp/core/fast_math.hpp, and its run-time dispatch to AVX2 + FMA or
-/// AVX-512 builds of the same code on x86-64. Internal: the public interface is `WaveField`.
+/// vectorisable math of kelp/core/fast_math.hpp, and AVX2 + FMA and AVX-512 builds of the same
+/// code on x86-64, chosen at run time (kelp/core/kernel_path.hpp: the widest the CPU runs, or the
+/// path the process or the wave field pins). Internal: the public interface is `WaveField`.
 #pragma once
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <cstdint>
 
 #include "kelp/core/fast_math.hpp"
+#include "kelp/core/kernel_path.hpp"
 
 namespace kelp {
 namespace environment {
@@ -234,8 +236,7 @@ inline void wave_accumulate_baseline(const WaveComponentsView& c, WaveBlock& b, 
     wave_accumulate_impl<false, 8>(c, b, m, t);
 }
 
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__) && !defined(__AVX2__)
-#define KELP_ENV_X86_DISPATCH 1
+#ifdef KELP_X86_DISPATCH
 /// The same kernel compiled for AVX2 + FMA (4 doubles per instruction), chosen at run time when
 /// the CPU has them. Results differ from the baseline only by FMA rounding (≲ 1e-15 relative).
 __attribute__((target("avx2,fma"))) inline void wave_accumulate_avx2(const WaveComponentsView& c,
@@ -261,24 +262,53 @@ KELP_ENV_TARGET_AVX512 inline void wave_accumulate_avx512(const WaveComponentsVi
   else
     wave_accumulate_impl<false, 16>(c, b, m, t);
 }
-
-/// The widest kernel the CPU runs (checked once): 2 = AVX-512, 1 = AVX2 + FMA, 0 = baseline.
-inline int cpu_simd_level() {
-  static const int level = (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq"))
-                               ? 2
-                           : (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) ? 1
-                                                                                               : 0;
-  return level;
-}
 #endif
 
-/// The wave kernel, dispatched to the widest instruction set available.
-inline void wave_accumulate(const WaveComponentsView& c, WaveBlock& b, int m, double t,
-                            bool finite) {
-#ifdef KELP_ENV_X86_DISPATCH
-  const int level = cpu_simd_level();
-  if (level == 2) return wave_accumulate_avx512(c, b, m, t, finite);
-  if (level == 1) return wave_accumulate_avx2(c, b, m, t, finite);
+#ifdef KELP_X86_DISPATCH
+// The portable path's wide builds: the baseline's operations, wider. Without FMA enabled the
+// compiler cannot contract a multiply–add, every other operation is IEEE-rounded lane by lane,
+// each point's (or lane's) sum keeps its order, and no reassociation is allowed (kelp refuses
+// -fassociative-math): the same bits as the baseline build (tested), 2–4× faster.
+/// The baseline kernel compiled for AVX2 without FMA (`target("avx2")` enables no FMA).
+__attribute__((target("avx2"))) inline void wave_accumulate_avx2_exact(const WaveComponentsView& c,
+                                                                       WaveBlock& b, int m,
+                                                                       double t, bool finite) {
+  if (finite)
+    wave_accumulate_impl<true, 8>(c, b, m, t);
+  else
+    wave_accumulate_impl<false, 8>(c, b, m, t);
+}
+#if KELP_PORTABLE_AVX512
+/// The baseline kernel compiled for AVX-512 with contraction off (GCC's AVX-512 enables FMA, so
+/// `optimize("fp-contract=off")` forbids fusing; clang has no such attribute: not built there).
+__attribute__((target("avx512f,avx512dq,avx2,prefer-vector-width=512"),
+               optimize("fp-contract=off"))) inline void
+wave_accumulate_avx512_exact(const WaveComponentsView& c, WaveBlock& b, int m, double t,
+                             bool finite) {
+  if (finite)
+    wave_accumulate_impl<true, 16>(c, b, m, t);
+  else
+    wave_accumulate_impl<false, 16>(c, b, m, t);
+}
+#endif
+#endif
+
+/// The wave kernel on instruction path `path` (a concrete one, supported by the CPU: see
+/// `simd::resolve_kernel`). `portable` runs the baseline kernel's operations on the widest vectors
+/// the CPU has without FMA (`simd::detail::portable_build()`), the same bits as the baseline build;
+/// in a build without run-time dispatch every path is the baseline kernel.
+inline void wave_accumulate(const WaveComponentsView& c, WaveBlock& b, int m, double t, bool finite,
+                            simd::KernelPath path) {
+#ifdef KELP_X86_DISPATCH
+  if (path == simd::KernelPath::avx512) return wave_accumulate_avx512(c, b, m, t, finite);
+  if (path == simd::KernelPath::avx2) return wave_accumulate_avx2(c, b, m, t, finite);
+  const int build = simd::detail::portable_build();
+#if KELP_PORTABLE_AVX512
+  if (build == 2) return wave_accumulate_avx512_exact(c, b, m, t, finite);
+#endif
+  if (build >= 1) return wave_accumulate_avx2_exact(c, b, m, t, finite);
+#else
+  (void)path;
 #endif
   wave_accumulate_baseline(c, b, m, t, finite);
 }

@@ -235,9 +235,27 @@ class WaveField {
   double phase(std::size_t j) const { return phase_[j]; }
   /// \brief Direction β_j [rad] (NED azimuth travelled towards) of component j.
   double direction(std::size_t j) const { return dir_[j]; }
-  /// \brief Use only the baseline-instruction-set kernel (for tests comparing the run-time
-  /// dispatched SIMD kernel with it); the default uses the widest one the CPU supports.
-  void set_force_baseline_kernel(bool on) { force_baseline_ = on; }
+  /// \brief Pins the instruction path of this field's batch kernel (kelp/core/kernel_path.hpp):
+  /// `portable` gives the same bits on every CPU (the deterministic mode); `automatic` (the
+  /// default) follows the process' policy (`simd::set_kernel_policy`, the `KELP_KERNEL`
+  /// environment variable), else the widest path the CPU runs. Copies of the field keep it.
+  /// \throws kelp::invalid_argument when the CPU (or the build) lacks `path`.
+  void set_kernel(simd::KernelPath path) {
+    if (path != simd::KernelPath::automatic) simd::resolve_kernel(path);  // checks support
+    kernel_ = path;
+  }
+  /// \brief The path set by `set_kernel` (`automatic` unless pinned).
+  simd::KernelPath kernel() const { return kernel_; }
+  /// \brief The concrete path this field's queries take now (`kernel()`, or the process' policy
+  /// or the widest path when that is `automatic`).
+  /// \throws kelp::invalid_argument for a bad `KELP_KERNEL` (see `simd::kernel_policy`).
+  simd::KernelPath active_kernel() const {
+    return kernel_ == simd::KernelPath::automatic ? simd::active_kernel() : kernel_;
+  }
+  /// \brief `set_kernel(on ? portable : automatic)` (kept for existing callers).
+  void set_force_baseline_kernel(bool on) {
+    set_kernel(on ? simd::KernelPath::portable : simd::KernelPath::automatic);
+  }
   /// \brief Variance of the discretised elevation Σ a_j²/2 [m²] (≈ Hs²/16).
   double variance() const {
     double v = 0.0;
@@ -456,10 +474,7 @@ class WaveField {
       exact_block(b, m, t);
       return;
     }
-    if (force_baseline_)
-      detail::wave_accumulate_baseline(view(), b, m, t, finite_depth_);
-    else
-      detail::wave_accumulate(view(), b, m, t, finite_depth_);
+    detail::wave_accumulate(view(), b, m, t, finite_depth_, active_kernel());
     for (int i = 0; i < m; ++i) {
       if (b.z[i] < -b.zeta[i]) {  // above the free surface: no water, no orbital motion
         b.vx[i] = b.vy[i] = b.vz[i] = b.ax[i] = b.ay[i] = b.az[i] = 0.0;
@@ -589,7 +604,7 @@ class WaveField {
 
   WaveFieldParameters params_;
   bool finite_depth_ = false;
-  bool force_baseline_ = false;
+  simd::KernelPath kernel_ = simd::KernelPath::automatic;  ///< see set_kernel
   double z_exp_limit_ = std::numeric_limits<double>::infinity();
   /// |t| [s] and |x| + |y| [m] up to which the fast kernels are accurate (see run_block).
   double time_fast_limit_ = 0.0, position_fast_limit_ = 0.0;

@@ -23,6 +23,7 @@
 
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/kernel_path.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/world.hpp"
@@ -218,7 +219,9 @@ class ClosedLoop {
 
   /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
   /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, final
-  /// energy, the scenario file and the scenario with every field as used.
+  /// energy, the wave kernel's instruction path (`kernel`: "portable", "avx2" or "avx512") and
+  /// the fingerprint of the C library's math (`math_library`), the scenario file and the scenario
+  /// with every field as used.
   nlohmann::json summary() const {
     const RunMetrics& m = metrics_;
     nlohmann::json s;
@@ -235,6 +238,10 @@ class ClosedLoop {
                    {"mean_tension_auv_n", m.auv_mean_tension()},
                    {"slack_fraction", m.slack_fraction()}};
     s["energy_j"] = kelp::system::energy(model_, state_).total();
+    // What the numbers depend on beyond the scenario: the wave kernel's instruction path and the
+    // C library's math (kelp/core/kernel_path.hpp); kelp-sweep merge compares them across runs.
+    s["kernel"] = kelp::simd::kernel_name(model_.environment().waves().active_kernel());
+    s["math_library"] = kelp::simd::math_library_fingerprint();
     s["scenario_file"] = options_.scenario_file;
     s["scenario"] = to_json(scenario_);
     return s;

@@ -95,6 +95,10 @@ struct Scenario {
   ///@{
   double log_rate = 10.0, node_rate = 1.0;
   ///@}
+  /// Instruction path of the wave kernel (kelp/core/kernel_path.hpp): "auto" (the process'
+  /// policy, i.e. `KELP_KERNEL`, else the widest the CPU runs), "portable" (the deterministic
+  /// mode: the same bits on every CPU; the file's `"deterministic": true`), "avx2" or "avx512".
+  std::string kernel = "auto";
 };
 
 /// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
@@ -237,7 +241,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   Scenario s;
   r.object(j, "",
-           {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output"});
+           {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output",
+            "kernel", "deterministic"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -332,6 +337,15 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.number(o, "/output", "log_rate", s.log_rate, 0.01, 100);
     r.number(o, "/output", "node_rate", s.node_rate, 0.001, 100);
   }
+  r.choice(j, "", "kernel", s.kernel, {"auto", "portable", "avx2", "avx512"});
+  bool deterministic = false;
+  r.boolean(j, "", "deterministic", deterministic);
+  if (deterministic) {
+    if (s.kernel != "auto" && s.kernel != "portable")
+      r.fail("/deterministic",
+             "true pins the \"portable\" kernel, but /kernel is \"" + s.kernel + "\"");
+    s.kernel = "portable";
+  }
   return s;
 }
 
@@ -345,7 +359,7 @@ inline Scenario load_scenario(const std::string& file) {
 }
 
 /// \brief The scenario as JSON, every field with its value (echoed in the run's summary; it reads
-/// back through parse_scenario to the same scenario).
+/// back through parse_scenario to the same scenario); `kernel` only when it is not "auto".
 inline nlohmann::json to_json(const Scenario& s) {
   const auto v3 = [](const kelp::Vector3<double>& v) {
     return nlohmann::json::array({v(0), v(1), v(2)});
@@ -394,6 +408,8 @@ inline nlohmann::json to_json(const Scenario& s) {
   j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
   if (!s.waypoints.empty()) j["mission"]["waypoints"] = wp;
   j["output"] = {{"log_rate", s.log_rate}, {"node_rate", s.node_rate}};
+  // Only when pinned: the default leaves the JSON (and kelp-sweep's run hashes) as they were.
+  if (s.kernel != "auto") j["kernel"] = s.kernel;
   return j;
 }
 

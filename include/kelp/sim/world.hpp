@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "kelp/core/kernel_path.hpp"
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/system/presets.hpp"
@@ -27,8 +28,9 @@ struct WorldSetup {
 
 /// \brief The system, the sea and the start poses of a scenario.
 /// \param[in] sc the scenario \param[in] file names the scenario in errors
-/// \throws scenario_error when the tether cannot span the start poses; kelp::invalid_argument
-/// from the library for parameters it refuses.
+/// \throws scenario_error when the tether cannot span the start poses or the scenario's kernel
+/// path is one this CPU lacks; kelp::invalid_argument from the library for parameters it refuses
+/// and for a bad `KELP_KERNEL` environment variable.
 inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   namespace sp = kelp::system::presets;
   namespace ke = kelp::environment;
@@ -74,7 +76,21 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     throw scenario_error(file + ": /tether/length: " + std::to_string(sc.tether_length) +
                          " m is shorter than the initial distance between its ends (" +
                          std::to_string(span) + " m)");
-  return {params, ke::make_environment<double>(sea, sea_options), start};
+  ke::Environmentd env = ke::make_environment<double>(sea, sea_options);
+  // The wave kernel's instruction path: pinned by the scenario (a path this CPU lacks is named
+  // as the file's error), else the process' policy (a bad KELP_KERNEL throws
+  // kelp::invalid_argument naming it); resolved here, before the run's first step.
+  if (sc.kernel != "auto") {
+    ke::WaveFieldd waves = env.waves();
+    try {
+      waves.set_kernel(kelp::simd::parse_kernel_path(sc.kernel));
+    } catch (const kelp::invalid_argument& e) {
+      throw scenario_error(file + ": /kernel: " + e.what());
+    }
+    env.set_waves(waves);
+  }
+  env.waves().active_kernel();
+  return {params, env, start};
 }
 
 }  // namespace sim
