@@ -21,6 +21,7 @@
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/state.hpp"
 #include "kelp/tether/stepping.hpp"
+#include "kelp/tether/whole_newton.hpp"
 
 namespace kelp::tether {
 
@@ -181,7 +182,11 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       break;
     }
     if (it >= options.max_iterations) break;
-    active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+    if (options.jacobian == JacobianKind::whole)
+      whole_newton_direction(model, ws, env, ws.x1, ws.v1, ws.v1 - ws.v0, gh, options.slack_band,
+                             options.max_active_set_passes);
+    else
+      active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
     ++report.newton_iterations;
     if (!options.check_convergence && it + 1 >= options.max_iterations) {
       // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
