@@ -204,6 +204,40 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       accept();
       return true;
     }
+    const Eigen::Index nf = f1 - f0 + 1;
+    if (options.jacobian == JacobianKind::whole) {
+      // Line search on the merit ψ(α) = Σ_i |R_i/a_i|² along δ: with the whole Jacobian δ is a
+      // descent direction of ψ (ψ'(0) = −2ψ(0)) whether or not R is a gradient (the secant
+      // search below assumes it is). Armijo test ψ(α) ≤ (1 − 2σα) ψ(0), σ = 1e-4; otherwise α
+      // from the quadratic through ψ(0), ψ'(0), ψ(α), kept in [0.1α, 0.5α] (Dennis & Schnabel,
+      // Numerical Methods for Unconstrained Optimization, §6.3.2). Damping is what stops a
+      // node that crosses a kink of the forces (the edge of the surface band, a segment at its
+      // rest length) from cycling between the two sides.
+      const auto merit = [&]() {
+        Scalar m(0);
+        for (int i = f0; i <= f1; ++i)
+          m += ws.rhs.col(i).squaredNorm() * (ws.mass_iso_inv(i) * ws.mass_iso_inv(i));
+        return m;
+      };
+      const Scalar m0 = merit();
+      Scalar alpha(1), trial_res(0);
+      for (int ls = 0;; ++ls) {
+        ws.vs.middleCols(f0, nf).noalias() =
+            ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
+        ws.xs.middleCols(f0, nf).noalias() =
+            ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
+        evaluate(ws.xs, ws.vs, trial_res, true);
+        if (ls >= options.max_backtracks) break;
+        const Scalar m = merit();
+        if (m <= (Scalar(1) - Scalar(2e-4) * alpha) * m0) break;
+        const Scalar a_q = m0 * alpha * alpha / (m - m0 + Scalar(2) * m0 * alpha);
+        alpha = std::min(std::max(a_q, Scalar(0.1) * alpha), Scalar(0.5) * alpha);
+      }
+      ws.x1.swap(ws.xs);
+      ws.v1.swap(ws.vs);
+      res = trial_res;
+      continue;
+    }
     // Line search. R is the gradient of the step's incremental potential
     // Φ(v) = ½(v − v̂)ᵀM(v − v̂) + U(x̂ + γh v) + γh·(dissipation potential), which is convex for
     // this model up to the tangent dependence of drag and added mass (elastic energy
@@ -212,7 +246,6 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     // overshoots the minimum along δ (φ'(1) > ½|φ'(0)|, e.g. across the kink of the tension at
     // l_s = l, where plain Newton can cycle between the slack and the taut branch); then secant
     // steps on φ' home in on the minimum. Each trial costs one force evaluation.
-    const Eigen::Index nf = f1 - f0 + 1;
     const auto slope = [&]() {
       return Scalar(-ws.rhs.middleCols(f0, nf).cwiseProduct(ws.delta.middleCols(f0, nf)).sum());
     };

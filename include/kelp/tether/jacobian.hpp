@@ -34,6 +34,22 @@ struct SegmentJacobian {
   Scalar tension;
 };
 
+/// m += f a bᵀ (without the temporaries of an Eigen outer-product expression).
+template <typename S>
+EIGEN_ALWAYS_INLINE void add_outer(Matrix3<S>& m, S f, const Vector3<S>& a, const Vector3<S>& b) {
+  for (int c = 0; c < 3; ++c) {
+    const S fb = f * b(c);
+    for (int r = 0; r < 3; ++r) m(r, c) += fb * a(r);
+  }
+}
+
+/// m += f (I − q qᵀ).
+template <typename S>
+EIGEN_ALWAYS_INLINE void add_projector(Matrix3<S>& m, S f, const Vector3<S>& q) {
+  add_outer(m, -f, q, q);
+  for (int k = 0; k < 3; ++k) m(k, k) += f;
+}
+
 /// The branch compute_forces takes for a segment of extension e = l_s − l [m] and stretch rate r
 /// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot).
 template <typename Scalar>
@@ -71,23 +87,22 @@ SegmentJacobian<Scalar> segment_jacobian(const TetherModel<Scalar>& model,
   if (ba_l != Scalar(0)) {
     out.tension += ba_l * r;
     grad += (ba_l * inv_ls) * (e - r * u);
-    out.c = (ba_l * u) * u.transpose();
+    add_outer(out.c, ba_l, u, u);
   }
-  out.k = u * grad.transpose();
-  const Scalar kp = out.tension * inv_ls;
-  out.k -= (kp * u) * u.transpose();
-  out.k.diagonal().array() += kp;
+  add_outer(out.k, Scalar(1), u, grad);
+  add_projector(out.k, out.tension * inv_ls, u);
   return out;
 }
 
 /// Hands every block of the Jacobian of compute_forces at (x, v), water held, to `sink`:
-/// `sink.x(i, j, A)` adds A to ∂F_i/∂x_j, `sink.v(i, j, A)` to ∂F_i/∂v_j and, when `d` is not
-/// null, `sink.m(i, j, A)` to ∂(M_i(x) d_i)/∂x_j (M_i = a_i I + b_i q_i q_iᵀ, its added mass
-/// turning with the tangent and scaled by the submerged fraction); |i − j| ≤ 2 always, several
-/// calls may add to one block. Segment branches: those compute_forces took, or `branches`
-/// (one per segment, see segment_jacobian) when not null. Preconditions: the last
-/// compute_forces of `ws` was at (x, v) (its tangents, segment lengths and directions,
-/// submerged fractions and the water it used are read). No heap allocation.
+/// `sink.x(i, j, A, c)` adds c·A to ∂F_i/∂x_j, `sink.v(i, j, A, c)` to ∂F_i/∂v_j and
+/// `sink.m(i, j, A, c)` (zero unless `d` is given) to ∂(M_i(x) d_i)/∂x_j (M_i = a_i I + b_i q_i
+/// q_iᵀ, its added mass turning with the tangent and scaled by the submerged fraction); |i − j| ≤ 2
+/// always, several calls may add to one block; `sink.xv(i, j, X, V, c)` and `sink.xvm(i, j, X, V,
+/// M, c)` add to several at once. Segment branches: those compute_forces took, or `branches` (one
+/// per segment, see segment_jacobian) when not null. Preconditions: the last compute_forces of `ws`
+/// was at (x, v) (its tangents, segment lengths and directions, submerged fractions and the water
+/// it used are read). No heap allocation.
 template <typename Scalar, typename Env, typename DX, typename DV, typename DD, typename Sink>
 void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                            const Env& env, const Eigen::MatrixBase<DX>& x,
@@ -102,21 +117,16 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
   const Scalar rho = Scalar(env.water_density()), g = Scalar(env.gravity());
   const Scalar bed = Scalar(env.seabed_depth());
   const M3 eye = M3::Identity();
+  const Scalar one(1);
 
   // Segments: +T u on node s, −T u on node s + 1.
   for (int s = 0; s < n; ++s) {
     const SegmentJacobian<Scalar> sj =
         segment_jacobian(model, ws, v, s, branches ? (*branches)(s) : Scalar(-1));
-    sink.x(s, s + 1, sj.k);
-    sink.x(s, s, -sj.k);
-    sink.x(s + 1, s + 1, -sj.k);
-    sink.x(s + 1, s, sj.k);
-    if (p.internal_damping != Scalar(0)) {
-      sink.v(s, s + 1, sj.c);
-      sink.v(s, s, -sj.c);
-      sink.v(s + 1, s + 1, -sj.c);
-      sink.v(s + 1, s, sj.c);
-    }
+    sink.xv(s, s + 1, sj.k, sj.c, one);
+    sink.xv(s, s, sj.k, sj.c, -one);
+    sink.xv(s + 1, s + 1, sj.k, sj.c, -one);
+    sink.xv(s + 1, s, sj.k, sj.c, one);
   }
 
   // Bending E = EI/l (1 − u_a·u_b) at node i between a = x_i − x_{i−1} and b = x_{i+1} − x_i:
@@ -135,15 +145,15 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
       const M3 ab = (-k / (la * lb)) * (pa * pb);
       const M3 ba = (k / (la * lb)) * (pb * pa);
       const M3 bb = (-k / (lb * lb)) * (ub * pba.transpose() + pba * ub.transpose() + cs * pb);
-      sink.x(i - 1, i - 1, -aa);
-      sink.x(i - 1, i, aa - ab);
-      sink.x(i - 1, i + 1, ab);
-      sink.x(i + 1, i - 1, -ba);
-      sink.x(i + 1, i, ba - bb);
-      sink.x(i + 1, i + 1, bb);
-      sink.x(i, i - 1, aa + ba);
-      sink.x(i, i, ab - aa + bb - ba);
-      sink.x(i, i + 1, -ab - bb);
+      sink.x(i - 1, i - 1, aa, -one);
+      sink.x(i - 1, i, M3(aa - ab), one);
+      sink.x(i - 1, i + 1, ab, one);
+      sink.x(i + 1, i - 1, ba, -one);
+      sink.x(i + 1, i, M3(ba - bb), one);
+      sink.x(i + 1, i + 1, bb, one);
+      sink.x(i, i - 1, M3(aa + ba), one);
+      sink.x(i, i, M3(ab - aa + bb - ba), one);
+      sink.x(i, i + 1, M3(ab + bb), -one);
     }
   }
 
@@ -158,7 +168,7 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     const Scalar c2 = chord.squaredNorm();
     const Scalar inv_c = c2 > Scalar(0) ? Scalar(1) / sqrt(c2) : Scalar(0);
     const V3 q = ws.tangent.col(i);
-    const M3 pq = eye - q * q.transpose();
+    // (no projector matrix: add_projector)
     const Scalar li = model.node_length(i), vol = model.node_volume(i);
     const Scalar phi = ws.submerged(i);
     const bool wet = phi > Scalar(0);
@@ -167,8 +177,10 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     const Scalar rho_vol = rho * vol;
     // ∂F_i/∂x_i collects the z-derivatives (band, seabed) and, at the ends, the chord's.
     M3 fx_i = M3::Zero();
-    // Derivatives with respect to the chord c = x_hi − x_lo.
-    M3 fc = M3::Zero();
+    // Derivatives with respect to the chord c = x_hi − x_lo: of F_i (fc), of the rate term G_i
+    // with respect to dc = v_hi − v_lo (gdc) and of M_i d_i (mc); ∂F_i/∂v_i (fvi) and
+    // ∂(M_i d_i)/∂x_i (mz).
+    M3 fc = M3::Zero(), gdc = M3::Zero(), mc = M3::Zero(), fvi = M3::Zero(), mz = M3::Zero();
     if (wet) {
       const Scalar kn0 = half_rho_d * p.normal_drag * li;
       const Scalar kt0 = half_rho_d * Scalar(kelp::pi) * p.tangential_drag * li;
@@ -180,13 +192,14 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
       const Scalar vn_abs = vn.norm();
       const Scalar cn = vn_abs > Scalar(0) ? Scalar(1) / vn_abs : Scalar(0);
       // ∂D/∂v_r = kn (|v_n| P + v_n v_nᵀ/|v_n|) + 2 kt |s| q qᵀ; v_r = u − v_i.
-      M3 dvr = (kn * vn_abs) * pq + (kn * cn * vn) * vn.transpose() +
-               (Scalar(2) * kt * abs(s) * q) * q.transpose();
+      M3 dvr = M3::Zero();
+      add_projector(dvr, kn * vn_abs, q);
+      add_outer(dvr, kn * cn, vn, vn);
+      add_outer(dvr, Scalar(2) * kt * abs(s), q, q);
       // ∂D/∂c = [kn (−s v_n v_nᵀ/|v_n| − |v_n| q v_nᵀ − |v_n| s P)
       //          + kt (2 |s| q v_nᵀ + |s| s P)] / |c|.
-      fc += inv_c *
-            ((-kn * s * cn * vn - kn * vn_abs * q + Scalar(2) * kt * abs(s) * q) * vn.transpose() +
-             (kt * abs(s) * s - kn * vn_abs * s) * pq);
+      add_outer(fc, inv_c, V3(-kn * s * cn * vn + (Scalar(2) * kt * abs(s) - kn * vn_abs) * q), vn);
+      add_projector(fc, inv_c * (kt * abs(s) * s - kn * vn_abs * s), q);
       // The fluid forces scale with φ (∂/∂z = ∂φ/∂z · force/φ); the buoyancy −φ ρ V g e_z.
       V3 dz = kn0 * vn_abs * vn + (kt0 * abs(s) * s) * q;
       dz(2) -= rho_vol * g;
@@ -194,7 +207,9 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
       // Froude–Krylov and added-mass forcing ρVφ[(1 + Can) a + (Cat − Can)(q·a) q]:
       // ∂/∂c = ρVφ (Cat − Can)[q (P a)ᵀ + (q·a) P] / |c|.
       const Scalar qa = q.dot(aw);
-      fc += (inv_c * phi * rho_vol * (cat - can)) * (q * (aw - qa * q).transpose() + qa * pq);
+      const Scalar f_fk = inv_c * phi * rho_vol * (cat - can);
+      add_outer(fc, f_fk, q, V3(aw - qa * q));
+      add_projector(fc, f_fk * qa, q);
       dz += rho_vol * ((Scalar(1) + can) * aw + (cat - can) * qa * q);
       if (mass_turns) {
         // G_i = κ [s P dc + (v_n·dc) q] on node i and w = κ s v_n on node hi (+) and lo (−),
@@ -205,34 +220,38 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
         const V3 pdc = dc - qdc * q;
         const V3 gx = s * pdc + vndc * q;  // G/κ
         // ∂G/∂v_r, ∂G/∂dc, ∂G/∂c.
-        dvr += kappa * (pdc * q.transpose() + q * pdc.transpose());
-        const M3 gdc = kappa * (s * pq + q * vn.transpose());
-        sink.v(i, hi, gdc);
-        sink.v(i, lo, -gdc);
-        fc += (kappa * inv_c) *
-              (-gx * q.transpose() + pdc * vn.transpose() - (Scalar(2) * s) * q * pdc.transpose() -
-               qdc * q * vn.transpose() + (vndc - s * qdc) * pq);
+        add_outer(dvr, kappa, pdc, q);
+        add_outer(dvr, kappa, q, pdc);
+        add_projector(gdc, kappa * s, q);
+        add_outer(gdc, kappa, q, vn);
+        const Scalar k2 = kappa * inv_c;
+        add_outer(fc, -k2, gx, q);
+        add_outer(fc, k2, V3(pdc - qdc * q), vn);
+        add_outer(fc, Scalar(-2) * s * k2, q, pdc);
+        add_projector(fc, k2 * (vndc - s * qdc), q);
         dz += kappa0 * gx;
         // w: ∂w/∂v_r = κ (v_n qᵀ + s P), ∂w/∂c = κ/|c| (v_n v_nᵀ − s v_n qᵀ − s q v_nᵀ − s² P).
-        const M3 wvr = kappa * (vn * q.transpose() + s * pq);
-        const M3 wc =
-            (kappa * inv_c) *
-            (vn * vn.transpose() - s * (vn * q.transpose() + q * vn.transpose()) - (s * s) * pq);
+        M3 wvr = M3::Zero(), wc = M3::Zero();
+        add_outer(wvr, kappa, vn, q);
+        add_projector(wvr, kappa * s, q);
+        add_outer(wc, k2, V3(vn - s * q), vn);
+        add_outer(wc, -k2 * s, vn, q);
+        add_projector(wc, -k2 * s * s, q);
         const V3 wz = (dphi * kappa0 * s) * vn;
         for (int side = 0; side < 2; ++side) {
           const int t = side == 0 ? hi : lo;
           const Scalar sg = side == 0 ? Scalar(1) : Scalar(-1);
-          sink.v(t, i, -sg * wvr);
-          sink.x(t, hi, sg * wc);
-          sink.x(t, lo, -sg * wc);
+          sink.v(t, i, wvr, -sg);
+          sink.x(t, hi, wc, sg);
+          sink.x(t, lo, wc, -sg);
           if (dphi != Scalar(0)) {
             M3 z = M3::Zero();
             z.col(2) = sg * wz;
-            sink.x(t, i, z);
+            sink.x(t, i, z, one);
           }
         }
       }
-      sink.v(i, i, -dvr);
+      fvi -= dvr;
       fx_i.col(2) += dphi * dz;
     }
     // Seabed: normal force N = (pen kb d + ż cb d ramp) l_i while positive, friction
@@ -249,8 +268,8 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
             bk * li + (ramping ? vz * bc * li / p.seabed_damping_depth : Scalar(0));
         const Scalar dn_dvz = bc * ramp * li;
         fx_i(2, 2) -= dn_dz;
-        M3 fv = M3::Zero();
-        fv(2, 2) = -dn_dvz;
+        M3& fv = fvi;
+        fv(2, 2) -= dn_dvz;
         if (p.seabed_friction > Scalar(0)) {
           const Scalar vx = v(0, i), vy = v(1, i);
           const Scalar vh2 = vx * vx + vy * vy, vf = p.friction_velocity;
@@ -277,26 +296,21 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
             fv(1, 2) -= gy * dn_dvz;
           }
         }
-        sink.v(i, i, fv);
       }
     }
-    sink.x(i, i, fx_i);
-    sink.x(i, hi, fc);
-    sink.x(i, lo, -fc);
     // Mass term M_i d_i = a d + b (q·d) q: ∂/∂c = b/|c| [q (P d)ᵀ + (q·d) P], and in the band
     // ∂/∂z = (ρ V Can d + ρ V (Cat − Can)(q·d) q)/D.
     if (d && wet) {
       const V3 di = d->col(i);
       const Scalar qd = q.dot(di), b0 = rho_vol * (cat - can);
-      const M3 mc = (phi * b0 * inv_c) * (q * (di - qd * q).transpose() + qd * pq);
-      sink.m(i, hi, mc);
-      sink.m(i, lo, -mc);
-      if (dphi != Scalar(0)) {
-        M3 z = M3::Zero();
-        z.col(2) = dphi * (rho_vol * can * di + (b0 * qd) * q);
-        sink.m(i, i, z);
-      }
+      const Scalar f_m = phi * b0 * inv_c;
+      add_outer(mc, f_m, q, V3(di - qd * q));
+      add_projector(mc, f_m * qd, q);
+      if (dphi != Scalar(0)) mz.col(2) = dphi * (rho_vol * can * di + (b0 * qd) * q);
     }
+    sink.xvm(i, i, fx_i, fvi, mz, one);
+    sink.xvm(i, hi, fc, gdc, mc, one);
+    sink.xvm(i, lo, fc, gdc, mc, -one);
   }
 }
 
@@ -327,9 +341,19 @@ struct ForceJacobian {
   Matrix3<Scalar> dMd_dx(int i, int j) const { return block(dmdx, i, j); }
 
   /// Sink of detail::force_jacobian_blocks.
-  void x(int i, int j, const Matrix3<Scalar>& a) { add(dfdx, i, j, a); }
-  void v(int i, int j, const Matrix3<Scalar>& a) { add(dfdv, i, j, a); }
-  void m(int i, int j, const Matrix3<Scalar>& a) { add(dmdx, i, j, a); }
+  void x(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dfdx, i, j, c * a); }
+  void v(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dfdv, i, j, c * a); }
+  void m(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dmdx, i, j, c * a); }
+  void xv(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av, Scalar c) {
+    x(i, j, ax, c);
+    v(i, j, av, c);
+  }
+  void xvm(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av,
+           const Matrix3<Scalar>& am, Scalar c) {
+    x(i, j, ax, c);
+    v(i, j, av, c);
+    m(i, j, am, c);
+  }
 
  private:
   static Matrix3<Scalar> block(const Eigen::Matrix<Scalar, 9, Eigen::Dynamic>& s, int i, int j) {

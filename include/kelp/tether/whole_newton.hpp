@@ -35,14 +35,29 @@ struct NewtonMatrixSink {
   Eigen::Map<Matrix3<Scalar>> at(int i, int j) {
     return Eigen::Map<Matrix3<Scalar>>(store.col(band_block_index(i, j)).data());
   }
-  void x(int i, int j, const Matrix3<Scalar>& a) {
-    if (keep(i, j)) at(i, j) -= gh2 * a;
+  using Block = Eigen::Map<Eigen::Matrix<Scalar, 9, 1>>;
+  using Input = Eigen::Map<const Eigen::Matrix<Scalar, 9, 1>>;
+  // Block (i, j) as a vector of 9 (fixed-size packets, no aliasing test).
+  EIGEN_ALWAYS_INLINE Block out(int i, int j) {
+    return Block(store.data() + 9 * band_block_index(i, j));
   }
-  void v(int i, int j, const Matrix3<Scalar>& a) {
-    if (keep(i, j)) at(i, j) -= gh * a;
+  static EIGEN_ALWAYS_INLINE Input in(const Matrix3<Scalar>& a) { return Input(a.data()); }
+  EIGEN_ALWAYS_INLINE void x(int i, int j, const Matrix3<Scalar>& a, Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh2 * c) * in(a);
   }
-  void m(int i, int j, const Matrix3<Scalar>& a) {
-    if (keep(i, j)) at(i, j) += gh * a;
+  EIGEN_ALWAYS_INLINE void v(int i, int j, const Matrix3<Scalar>& a, Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh * c) * in(a);
+  }
+  EIGEN_ALWAYS_INLINE void m(int i, int j, const Matrix3<Scalar>& a, Scalar c) {
+    if (keep(i, j)) out(i, j) += (gh * c) * in(a);
+  }
+  EIGEN_ALWAYS_INLINE void xv(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av,
+                              Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh2 * c) * in(ax) + (-gh * c) * in(av);
+  }
+  EIGEN_ALWAYS_INLINE void xvm(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av,
+                               const Matrix3<Scalar>& am, Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh2 * c) * in(ax) + (-gh * c) * in(av) + (gh * c) * in(am);
   }
 };
 
@@ -63,7 +78,7 @@ void assemble_whole_newton_matrix(const TetherModel<Scalar>& model, TetherWorksp
                                   const Eigen::MatrixBase<DV>& v, const Eigen::MatrixBase<DD>& d,
                                   Scalar gh, const VectorX<Scalar>* branches = nullptr) {
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  ws.newton_lu.setZero();
+  ws.newton_lu.middleCols(5 * Eigen::Index(f0), 5 * Eigen::Index(f1 - f0 + 1)).setZero();
   detail::NewtonMatrixSink<Scalar> sink{ws.newton_lu, f0, f1, gh, gh * gh};
   for (int i = f0; i <= f1; ++i) {
     auto mi = sink.at(i, i);
