@@ -1,6 +1,8 @@
 /// \file
 /// \brief The implicit tether steps: backward Euler and BDF2, solved by Newton's method with the
-/// analytic block-tridiagonal Jacobian (kelp/tether/block_solve.hpp), with backtracking and
+/// analytic block-tridiagonal symmetric Jacobian (kelp/tether/block_solve.hpp) or, when
+/// ImplicitOptions::jacobian says so, the whole Jacobian (kelp/tether/whole_newton.hpp), with
+/// backtracking and
 /// step halving; a step that cannot be completed throws and leaves the state as it was. End
 /// forces are those at the end of the step.
 #pragma once
@@ -327,18 +329,24 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
 /// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
 /// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
-/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
-/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
-/// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
-/// direction settles which segments are taut, slack or clamped with a primal–dual active set
-/// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
-/// when it overshoots. The initial guess extrapolates the velocity (2v_n − v_{n−1}) when the
-/// previous step had the same dt. At least one and up to `options.max_iterations` corrections,
-/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt (the tolerance raised to the arithmetic's
-/// resolution where it is below it, see ImplicitOptions::acceleration_tolerance). A step that does
-/// not converge is not committed: it is retried as two half steps, each halved again if needed, at
-/// most `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of
-/// step); if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of this J, so converging
+/// linearly rather than quadratically when they dominate (rough seas, the surface band): the
+/// tangent dependence of drag, forcing and added mass, the added-mass rate terms, the band's
+/// scaling of the fluid forces, the direction dependence of the dashpot, bending (EI). With
+/// `options.jacobian == JacobianKind::whole` Newton uses the whole Jacobian
+/// ∂R/∂v = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x (kelp/tether/jacobian.hpp, every term;
+/// block-pentadiagonal and not symmetric, block LU in O(N)) and converges quadratically. Each
+/// Newton direction settles which segments are taut, slack or clamped with a primal–dual active
+/// set (detail::active_set_direction, detail::whole_newton_direction) and is shortened by a
+/// secant line search on the slope R·δ when it overshoots (with the whole Jacobian, by an Armijo
+/// backtracking on Σ|R_i/a_i|², since R is then not treated as a gradient). The initial guess
+/// extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt. At least one
+/// and up to `options.max_iterations` corrections, until max_i |R_i|/a_i ≤ acceleration_tolerance ·
+/// dt (the tolerance raised to the arithmetic's resolution where it is below it, see
+/// ImplicitOptions::acceleration_tolerance). A step that does not converge is not committed: it is
+/// retried as two half steps, each halved again if needed, at most `options.max_step_halvings`
+/// times (BDF2 restarts with backward Euler after a change of step); if even that fails,
+/// kelp::numerical_error is thrown with the state unchanged. End forces
 /// (`ws.end_forces`) are those of the final iterate, at t + dt.
 /// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
