@@ -8,7 +8,10 @@
 //                                  (0.8 × the stability limit) for symplectic Euler, RK2 (on the
 //                                  line with internal damping ζ = 0.2), RK4; 10 ms for
 //                                  the implicit schemes (bdf2_one_newton: one unchecked Newton
-//                                  correction per step, see ImplicitOptions::check_convergence)
+//                                  correction per step, see ImplicitOptions::check_convergence;
+//                                  bdf2_whole: Newton with the whole Jacobian, JacobianKind::whole)
+//   BM_WholeNewtonAssemble/<N>     assembly of the whole Newton matrix (kelp/tether/jacobian.hpp)
+//   BM_WholeNewtonFactor/<N>       its block LU factorisation; BM_WholeNewtonSolve/<N> one solve
 // Counters: ns_per_node = time / (force evaluations × nodes) — for the implicit schemes this
 // includes the Jacobian assembly and the block-tridiagonal solves; realtime_factor = simulated
 // seconds per CPU second; evals_per_step and newton_per_step for the implicit schemes.
@@ -21,7 +24,9 @@
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
+#include "kelp/tether/jacobian.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/whole_newton.hpp"
 
 namespace kt = kelp::tether;
 using kelp::Vector3;
@@ -43,7 +48,8 @@ void BM_TetherForces(benchmark::State& st) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_implicit = false) {
+void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_implicit = false,
+                   kt::JacobianKind jacobian = kt::JacobianKind::symmetric) {
   const int n = static_cast<int>(st.range(0));
   // RK2 (explicit midpoint) is unstable on an undamped line at any step (estimate_stable_dt
   // refuses it): it runs on the line with internal damping ζ = 0.2 at its highest mode.
@@ -51,6 +57,7 @@ void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_imp
   const double dt =
       kt::is_implicit(integ) ? 0.01 : kt::estimate_stable_dt(s.model, integ, s.env.water_density());
   kt::ImplicitOptionsd options;
+  options.jacobian = jacobian;
   if (linearly_implicit) {
     options.max_iterations = 1;
     options.check_convergence = false;
@@ -89,6 +96,9 @@ BENCHMARK_CAPTURE(BM_TetherStep, implicit_euler, kt::Integrator::implicit_euler)
 BENCHMARK_CAPTURE(BM_TetherStep, bdf2, kt::Integrator::bdf2)->Apply(sizes);
 // One unchecked Newton correction per step (ImplicitOptions::check_convergence = false).
 BENCHMARK_CAPTURE(BM_TetherStep, bdf2_one_newton, kt::Integrator::bdf2, true)->Apply(sizes);
+// Exact Newton: the whole Jacobian (ImplicitOptions::jacobian = JacobianKind::whole).
+BENCHMARK_CAPTURE(BM_TetherStep, bdf2_whole, kt::Integrator::bdf2, false, kt::JacobianKind::whole)
+    ->Apply(sizes);
 
 namespace {
 
@@ -118,3 +128,74 @@ void BM_BlockSolve(benchmark::State& st) {
 }  // namespace
 
 BENCHMARK(BM_BlockSolve)->Arg(20)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kNanosecond);
+
+namespace {
+
+// The whole Newton matrix of the benchmark line after 20 BDF2 steps at 10 ms (γh = 2/3 · 10 ms):
+// assembly (BM_WholeNewtonAssemble), factorisation (BM_WholeNewtonFactor, assembly excluded by
+// restoring the assembled matrix) and one solve (BM_WholeNewtonSolve). ns_per_node = time / nodes.
+struct WholeNewtonSetup {
+  Setup s;
+  kelp::Matrix3X<double> d;
+  double gh = 2.0 / 3.0 * 0.01;
+  explicit WholeNewtonSetup(int n) : s(n) {
+    for (int k = 0; k < 20; ++k)
+      kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), 0.01,
+               {kt::Integrator::bdf2});
+    kt::compute_forces<true>(s.model, s.ws, s.env, s.state.time, s.state.position,
+                             s.state.velocity);
+    d = 0.01 * s.state.velocity;
+    for (int i = 0; i < s.model.nodes(); ++i)
+      s.ws.rhs.col(i) = Vector3<double>(std::cos(i), 1.0, std::sin(0.5 * i));
+    kt::assemble_whole_newton_matrix(s.model, s.ws, s.env, s.state.position, s.state.velocity, d,
+                                     gh);
+  }
+};
+
+void per_node(benchmark::State& st, int nodes) {
+  st.counters["ns_per_node"] =
+      benchmark::Counter(1e-9 * static_cast<double>(st.iterations()) * nodes,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_WholeNewtonAssemble(benchmark::State& st) {
+  WholeNewtonSetup w(static_cast<int>(st.range(0)));
+  for (auto _ : st) {
+    kt::assemble_whole_newton_matrix(w.s.model, w.s.ws, w.s.env, w.s.state.position,
+                                     w.s.state.velocity, w.d, w.gh);
+    benchmark::DoNotOptimize(w.s.ws.newton_lu.data());
+    benchmark::ClobberMemory();
+  }
+  per_node(st, w.s.model.nodes());
+}
+
+void BM_WholeNewtonFactor(benchmark::State& st) {
+  WholeNewtonSetup w(static_cast<int>(st.range(0)));
+  const Eigen::Matrix<double, 9, Eigen::Dynamic> assembled = w.s.ws.newton_lu;
+  for (auto _ : st) {
+    st.PauseTiming();
+    w.s.ws.newton_lu = assembled;
+    st.ResumeTiming();
+    kt::factor_whole_newton_matrix(w.s.model, w.s.ws);
+    benchmark::DoNotOptimize(w.s.ws.newton_lu.data());
+    benchmark::ClobberMemory();
+  }
+  per_node(st, w.s.model.nodes());
+}
+
+void BM_WholeNewtonSolve(benchmark::State& st) {
+  WholeNewtonSetup w(static_cast<int>(st.range(0)));
+  kt::factor_whole_newton_matrix(w.s.model, w.s.ws);
+  for (auto _ : st) {
+    kt::solve_whole_newton_matrix(w.s.model, w.s.ws, w.s.ws.rhs, w.s.ws.delta);
+    benchmark::DoNotOptimize(w.s.ws.delta.data());
+    benchmark::ClobberMemory();
+  }
+  per_node(st, w.s.model.nodes());
+}
+
+}  // namespace
+
+BENCHMARK(BM_WholeNewtonAssemble)->Arg(20)->Arg(100)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_WholeNewtonFactor)->Arg(20)->Arg(100)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_WholeNewtonSolve)->Arg(20)->Arg(100)->Unit(benchmark::kNanosecond);

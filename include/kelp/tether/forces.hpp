@@ -442,9 +442,11 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// nodes of the wet line a packet at a time (the ends and nodes in the surface band, in air or
 /// on the seabed one by one, with every branch), then the added-mass coupling of neighbours and
 /// bending. Also fills `ws.mass_iso_inv` and `ws.mass_tan_ratio`. No heap allocation.
-/// \tparam WithJacobian also fill the Jacobian ingredients (`ws.seg_*`, `ws.node_dv`,
-/// `ws.node_kz`); the Jacobian leaves out the added-mass rate terms G_i (quadratic in the
-/// velocities, small beside the mass term M/h of a step).
+/// \tparam WithJacobian also fill the ingredients of the symmetric block-tridiagonal Jacobian
+/// of the implicit steps (`ws.seg_*`, `ws.node_dv`, `ws.node_kz`), which leaves out the tangent's
+/// dependence on the positions in drag, forcing and added mass, the added-mass rate terms, the
+/// surface band's scaling of the fluid forces, the dashpot's direction and bending; the whole
+/// Jacobian, every term exact, is kelp/tether/jacobian.hpp's force_jacobian.
 /// \param[in] model the tether \param[in,out] ws workspace \param[in] env environment
 /// \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v velocities [m/s]
 /// \throws kelp::invalid_argument when `ws` was not built for `model` (TetherWorkspace::fits),

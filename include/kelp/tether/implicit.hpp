@@ -1,6 +1,8 @@
 /// \file
 /// \brief The implicit tether steps: backward Euler and BDF2, solved by Newton's method with the
-/// analytic block-tridiagonal Jacobian (kelp/tether/block_solve.hpp), with backtracking and
+/// analytic block-tridiagonal symmetric Jacobian (kelp/tether/block_solve.hpp) or, when
+/// ImplicitOptions::jacobian says so, the whole Jacobian (kelp/tether/whole_newton.hpp), with
+/// backtracking and
 /// step halving; a step that cannot be completed throws and leaves the state as it was. End
 /// forces are those at the end of the step.
 #pragma once
@@ -21,6 +23,7 @@
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/state.hpp"
 #include "kelp/tether/stepping.hpp"
+#include "kelp/tether/whole_newton.hpp"
 
 namespace kelp::tether {
 
@@ -181,7 +184,11 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       break;
     }
     if (it >= options.max_iterations) break;
-    active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+    if (options.jacobian == JacobianKind::whole)
+      whole_newton_direction(model, ws, env, ws.x1, ws.v1, ws.v1 - ws.v0, gh, options.slack_band,
+                             options.max_active_set_passes);
+    else
+      active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
     ++report.newton_iterations;
     if (!options.check_convergence && it + 1 >= options.max_iterations) {
       // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
@@ -199,6 +206,40 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       accept();
       return true;
     }
+    const Eigen::Index nf = f1 - f0 + 1;
+    if (options.jacobian == JacobianKind::whole) {
+      // Line search on the merit ψ(α) = Σ_i |R_i/a_i|² along δ: with the whole Jacobian δ is a
+      // descent direction of ψ (ψ'(0) = −2ψ(0)) whether or not R is a gradient (the secant
+      // search below assumes it is). Armijo test ψ(α) ≤ (1 − 2σα) ψ(0), σ = 1e-4; otherwise α
+      // from the quadratic through ψ(0), ψ'(0), ψ(α), kept in [0.1α, 0.5α] (Dennis & Schnabel,
+      // Numerical Methods for Unconstrained Optimization, §6.3.2). Damping is what stops a
+      // node that crosses a kink of the forces (the edge of the surface band, a segment at its
+      // rest length) from cycling between the two sides.
+      const auto merit = [&]() {
+        Scalar m(0);
+        for (int i = f0; i <= f1; ++i)
+          m += ws.rhs.col(i).squaredNorm() * (ws.mass_iso_inv(i) * ws.mass_iso_inv(i));
+        return m;
+      };
+      const Scalar m0 = merit();
+      Scalar alpha(1), trial_res(0);
+      for (int ls = 0;; ++ls) {
+        ws.vs.middleCols(f0, nf).noalias() =
+            ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
+        ws.xs.middleCols(f0, nf).noalias() =
+            ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
+        evaluate(ws.xs, ws.vs, trial_res, true);
+        if (ls >= options.max_backtracks) break;
+        const Scalar m = merit();
+        if (m <= (Scalar(1) - Scalar(2e-4) * alpha) * m0) break;
+        const Scalar a_q = m0 * alpha * alpha / (m - m0 + Scalar(2) * m0 * alpha);
+        alpha = std::min(std::max(a_q, Scalar(0.1) * alpha), Scalar(0.5) * alpha);
+      }
+      ws.x1.swap(ws.xs);
+      ws.v1.swap(ws.vs);
+      res = trial_res;
+      continue;
+    }
     // Line search. R is the gradient of the step's incremental potential
     // Φ(v) = ½(v − v̂)ᵀM(v − v̂) + U(x̂ + γh v) + γh·(dissipation potential), which is convex for
     // this model up to the tangent dependence of drag and added mass (elastic energy
@@ -207,7 +248,6 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     // overshoots the minimum along δ (φ'(1) > ½|φ'(0)|, e.g. across the kink of the tension at
     // l_s = l, where plain Newton can cycle between the slack and the taut branch); then secant
     // steps on φ' home in on the minimum. Each trial costs one force evaluation.
-    const Eigen::Index nf = f1 - f0 + 1;
     const auto slope = [&]() {
       return Scalar(-ws.rhs.middleCols(f0, nf).cwiseProduct(ws.delta.middleCols(f0, nf)).sum());
     };
@@ -289,18 +329,24 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
 /// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
 /// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
-/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
-/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
-/// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
-/// direction settles which segments are taut, slack or clamped with a primal–dual active set
-/// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
-/// when it overshoots. The initial guess extrapolates the velocity (2v_n − v_{n−1}) when the
-/// previous step had the same dt. At least one and up to `options.max_iterations` corrections,
-/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt (the tolerance raised to the arithmetic's
-/// resolution where it is below it, see ImplicitOptions::acceleration_tolerance). A step that does
-/// not converge is not committed: it is retried as two half steps, each halved again if needed, at
-/// most `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of
-/// step); if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of this J, so converging
+/// linearly rather than quadratically when they dominate (rough seas, the surface band): the
+/// tangent dependence of drag, forcing and added mass, the added-mass rate terms, the band's
+/// scaling of the fluid forces, the direction dependence of the dashpot, bending (EI). With
+/// `options.jacobian == JacobianKind::whole` Newton uses the whole Jacobian
+/// ∂R/∂v = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x (kelp/tether/jacobian.hpp, every term;
+/// block-pentadiagonal and not symmetric, block LU in O(N)) and converges quadratically. Each
+/// Newton direction settles which segments are taut, slack or clamped with a primal–dual active
+/// set (detail::active_set_direction, detail::whole_newton_direction) and is shortened by a
+/// secant line search on the slope R·δ when it overshoots (with the whole Jacobian, by an Armijo
+/// backtracking on Σ|R_i/a_i|², since R is then not treated as a gradient). The initial guess
+/// extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt. At least one
+/// and up to `options.max_iterations` corrections, until max_i |R_i|/a_i ≤ acceleration_tolerance ·
+/// dt (the tolerance raised to the arithmetic's resolution where it is below it, see
+/// ImplicitOptions::acceleration_tolerance). A step that does not converge is not committed: it is
+/// retried as two half steps, each halved again if needed, at most `options.max_step_halvings`
+/// times (BDF2 restarts with backward Euler after a change of step); if even that fails,
+/// kelp::numerical_error is thrown with the state unchanged. End forces
 /// (`ws.end_forces`) are those of the final iterate, at t + dt.
 /// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when

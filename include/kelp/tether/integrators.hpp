@@ -1,7 +1,8 @@
 /// \file
 /// \brief Time integration of the lumped-mass tether: semi-implicit (symplectic) Euler, RK2
 /// (midpoint), RK4, and implicit backward Euler / BDF2 solved by Newton's method with the
-/// analytic block-tridiagonal Jacobian (O(N) block-Thomas solve); an explicit stable-dt estimate,
+/// analytic block-tridiagonal Jacobian (O(N) block-Thomas solve) or the whole Jacobian
+/// (ImplicitOptions::jacobian, O(N) block LU); an explicit stable-dt estimate,
 /// a sub-stepping driver and a static-equilibrium solve.
 ///
 /// Kinematic ends follow the prescribed EndMotion within a step (p + vτ + ½aτ²). Explicit schemes

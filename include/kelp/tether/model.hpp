@@ -71,9 +71,9 @@ struct TetherParameters {
   bool compressive_damping = false;
   /// Bending stiffness EI [N m²] (0: a perfectly flexible line). Discrete bending energy
   /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
-  /// κ = θ/l. Enters the implicit schemes through the residual only (not the Jacobian: it would
-  /// couple nodes i−1 and i+1), so keep EI/l³ ≪ node mass / dt² there; the explicit stable-dt
-  /// estimate accounts for it.
+  /// κ = θ/l. Enters the implicit schemes' symmetric Jacobian through the residual only (it
+  /// couples nodes i−1 and i+1), so keep EI/l³ ≪ node mass / dt² there, or use
+  /// JacobianKind::whole, which has it; the explicit stable-dt estimate accounts for it.
   Scalar bending_stiffness = Scalar(0);
   /// Normal drag coefficient Cdn [-] (on the projected area d·l).
   Scalar normal_drag = Scalar(1.2);

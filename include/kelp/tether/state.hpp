@@ -204,6 +204,10 @@ struct TetherWorkspace {
   /// What the block elimination of the Newton solve keeps for its back substitution, two
   /// columns per elimination step (detail::solve_block_tridiagonal)
   Eigen::Matrix<Scalar, 17, Eigen::Dynamic> block_inv;
+  /// The whole Newton matrix (ImplicitOptions::jacobian == JacobianKind::whole) and, after
+  /// factor_whole_newton_matrix, its block LU factor: column 5i + (j − i + 2) holds the 3×3 block
+  /// (i, j), |i − j| ≤ 2, column-major (assemble_whole_newton_matrix)
+  Eigen::Matrix<Scalar, 9, Eigen::Dynamic> newton_lu;
   Matrix3X<Scalar> rhs, delta;    ///< Newton right-hand side and correction
   Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
   VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
@@ -288,6 +292,7 @@ struct TetherWorkspace {
     f(w.node_dv, 6, n);
     f(w.pass_buffer, n, 9);
     f(w.block_inv, 17, n);
+    f(w.newton_lu, 9, 5 * n);
   }
 };
 

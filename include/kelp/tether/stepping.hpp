@@ -58,9 +58,25 @@ inline bool is_implicit(Integrator i) {
   return i == Integrator::implicit_euler || i == Integrator::bdf2;
 }
 
+/// \brief Which Jacobian the implicit schemes' Newton iteration solves with.
+enum class JacobianKind {
+  /// The symmetric block-tridiagonal approximation M + γh D_v + (γh)² D_x (axial force,
+  /// geometric stiffness, drag with the tangent held, seabed), solved by twisted block-Cholesky
+  /// elimination (detail::active_set_direction): the cheapest per iteration; Newton converges
+  /// linearly where the terms it leaves out matter (rough seas, the surface band).
+  symmetric,
+  /// The whole Jacobian of the residual (kelp/tether/jacobian.hpp: the tangent's dependence of
+  /// drag and added mass, the added-mass rate terms, surface band, seabed, dashpot direction,
+  /// bending), block-pentadiagonal and not symmetric, solved by block LU
+  /// (kelp/tether/whole_newton.hpp): exact Newton, quadratic convergence.
+  whole
+};
+
 /// \brief Newton settings of the implicit schemes.
 template <typename Scalar>
 struct ImplicitOptions {
+  /// The Newton matrix (JacobianKind): symmetric approximation (default) or the whole Jacobian.
+  JacobianKind jacobian = JacobianKind::symmetric;
   /// Maximum Newton corrections per step (each: one Jacobian factorisation and solve).
   int max_iterations = 8;
   /// Newton converges when max_i |R_i| / a_i ≤ acceleration_tolerance · dt, R_i the momentum
@@ -176,6 +192,8 @@ bool history_matches(const TetherState<Scalar>& state, double dt) {
 template <typename Scalar>
 void check_implicit_options(const ImplicitOptions<Scalar>& o) {
   KELP_CHECK(o.max_iterations >= 1, "ImplicitOptions::max_iterations must be >= 1");
+  KELP_CHECK(o.jacobian == JacobianKind::symmetric || o.jacobian == JacobianKind::whole,
+             "ImplicitOptions::jacobian must be JacobianKind::symmetric or JacobianKind::whole");
   check_positive(o.acceleration_tolerance, "ImplicitOptions::acceleration_tolerance");
   check_non_negative(o.slack_band, "ImplicitOptions::slack_band");
   KELP_CHECK(o.max_active_set_passes >= 1, "ImplicitOptions::max_active_set_passes must be >= 1");

@@ -1,0 +1,246 @@
+/// \file
+/// \brief The exact-Newton path of the implicit tether steps: the whole Newton matrix
+/// J = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x over the free nodes (block-pentadiagonal, not
+/// symmetric; kelp/tether/jacobian.hpp), its block LU factorisation and solve (O(N), in the
+/// workspace), and the Newton direction with the active set of the axial-force kinks.
+/// Factorisation and solve are separate so that a factor can serve several solves.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/jacobian.hpp"
+#include "kelp/tether/model.hpp"
+#include "kelp/tether/state.hpp"
+
+namespace kelp::tether {
+
+namespace detail {
+
+/// Sink of force_jacobian_blocks that adds the blocks of the whole Newton matrix over the free
+/// nodes f0…f1 into ws.newton_lu (the kinematic ends' columns are known, their rows are not
+/// equations: both are dropped).
+template <typename Scalar>
+struct NewtonMatrixSink {
+  Eigen::Matrix<Scalar, 9, Eigen::Dynamic>& store;
+  int f0, f1;
+  Scalar gh, gh2;
+  bool keep(int i, int j) const { return i >= f0 && i <= f1 && j >= f0 && j <= f1; }
+  Eigen::Map<Matrix3<Scalar>> at(int i, int j) {
+    return Eigen::Map<Matrix3<Scalar>>(store.col(band_block_index(i, j)).data());
+  }
+  using Block = Eigen::Map<Eigen::Matrix<Scalar, 9, 1>>;
+  using Input = Eigen::Map<const Eigen::Matrix<Scalar, 9, 1>>;
+  // Block (i, j) as a vector of 9 (fixed-size packets, no aliasing test).
+  EIGEN_ALWAYS_INLINE Block out(int i, int j) {
+    return Block(store.data() + 9 * band_block_index(i, j));
+  }
+  static EIGEN_ALWAYS_INLINE Input in(const Matrix3<Scalar>& a) { return Input(a.data()); }
+  EIGEN_ALWAYS_INLINE void x(int i, int j, const Matrix3<Scalar>& a, Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh2 * c) * in(a);
+  }
+  EIGEN_ALWAYS_INLINE void v(int i, int j, const Matrix3<Scalar>& a, Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh * c) * in(a);
+  }
+  EIGEN_ALWAYS_INLINE void m(int i, int j, const Matrix3<Scalar>& a, Scalar c) {
+    if (keep(i, j)) out(i, j) += (gh * c) * in(a);
+  }
+  EIGEN_ALWAYS_INLINE void xv(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av,
+                              Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh2 * c) * in(ax) + (-gh * c) * in(av);
+  }
+  EIGEN_ALWAYS_INLINE void xvm(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av,
+                               const Matrix3<Scalar>& am, Scalar c) {
+    if (keep(i, j)) out(i, j) += (-gh2 * c) * in(ax) + (-gh * c) * in(av) + (gh * c) * in(am);
+  }
+};
+
+}  // namespace detail
+
+/// \brief Assembles the whole Newton matrix of the implicit step's residual
+/// R(v) = M(x)(v − v̂) − γh F(x̂ + γh v, v) at the iterate (x, v):
+/// J = ∂R/∂v = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x, d = v − v̂, over the free nodes, into
+/// `ws.newton_lu` (block (i, j), |i − j| ≤ 2, at column 5i + j − i + 2; other columns zero).
+///
+/// \param[in] branches when not null, the branch of every segment (TetherWorkspace::seg_branch
+/// values: 0, 1, 2) replaces the one compute_forces took (active set, whole_newton_direction).
+/// Preconditions: the last compute_forces of `ws` was at (x, v) with the water the step holds.
+/// O(N), no heap allocation.
+template <typename Scalar, typename Env, typename DX, typename DV, typename DD>
+void assemble_whole_newton_matrix(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                                  const Env& env, const Eigen::MatrixBase<DX>& x,
+                                  const Eigen::MatrixBase<DV>& v, const Eigen::MatrixBase<DD>& d,
+                                  Scalar gh, const VectorX<Scalar>* branches = nullptr) {
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  ws.newton_lu.middleCols(5 * Eigen::Index(f0), 5 * Eigen::Index(f1 - f0 + 1)).setZero();
+  detail::NewtonMatrixSink<Scalar> sink{ws.newton_lu, f0, f1, gh, gh * gh};
+  for (int i = f0; i <= f1; ++i) {
+    auto mi = sink.at(i, i);
+    const Vector3<Scalar> q = ws.tangent.col(i);
+    mi = (ws.mass_tan(i) * q) * q.transpose();
+    mi.diagonal().array() += ws.mass_iso(i);
+  }
+  detail::force_jacobian_blocks(model, ws, env, x, v, &d, branches, sink);
+}
+
+/// \brief Block LU factorisation, in place, of the block-pentadiagonal matrix in
+/// `ws.newton_lu` over the free nodes (assemble_whole_newton_matrix): A = L U with L unit block
+/// lower triangular (blocks L_{i,i−2}, L_{i,i−1} stored in place of A's) and U block upper
+/// (U_{i,i+1}, U_{i,i+2} in place; the diagonal block stored as its inverse U_ii⁻¹). O(N):
+/// about 7 products of 3×3 blocks and one 3×3 inverse per node.
+///
+/// No pivoting between blocks: each pivot block U_ii is the Schur complement of the leading
+/// nodes, inverted by cofactors. The Newton matrix is M (symmetric positive definite) plus γh,
+/// (γh)² times the force derivatives, whose dominant parts (axial stiffness, dashpot, drag's
+/// |v_r| terms, seabed) are symmetric positive semi-definite; the non-symmetric parts (the
+/// tangent's dependence of drag and added mass, the rate terms) are of the order of the drag
+/// and small beside them, so the pivots stay near those of the symmetric positive definite
+/// block-Cholesky factorisation (Golub & Van Loan, Matrix Computations, 4th ed., §4.4.1:
+/// Gaussian elimination without pivoting is stable for matrices whose symmetric part is
+/// positive definite, when the skew part is moderate). A pivot block that is not finite or
+/// numerically singular (|det U_ii| ≤ ε·‖U_ii‖³, ε of Scalar) is refused.
+/// \throws kelp::numerical_error naming the node; the implicit steps then halve the step.
+template <typename Scalar>
+void factor_whole_newton_matrix(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws) {
+  using std::abs;
+  using M3 = Matrix3<Scalar>;
+  using Map = Eigen::Map<M3>;
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  Scalar* const base = ws.newton_lu.data();
+  const auto blk = [base](int i, int j) { return Map(base + 9 * detail::band_block_index(i, j)); };
+  for (int i = f0; i <= f1; ++i) {
+    auto b2 = blk(i, i);
+    if (i - 2 >= f0) {
+      auto l0 = blk(i, i - 2);
+      const M3 l = l0 * blk(i - 2, i - 2);  // × U⁻¹ of node i − 2
+      l0 = l;
+      blk(i, i - 1).noalias() -= l * blk(i - 2, i - 1);
+      b2.noalias() -= l * blk(i - 2, i);
+    }
+    if (i - 1 >= f0) {
+      auto l1 = blk(i, i - 1);
+      const M3 l = l1 * blk(i - 1, i - 1);
+      l1 = l;
+      b2.noalias() -= l * blk(i - 1, i);
+      if (i + 1 <= f1) blk(i, i + 1).noalias() -= l * blk(i - 1, i + 1);
+    }
+    const M3 u = b2;
+    const Scalar det = u.determinant();
+    const Scalar scale = u.cwiseAbs().maxCoeff();
+    if (!(abs(det) > std::numeric_limits<Scalar>::epsilon() * scale * scale * scale) ||
+        !is_finite(det))
+      ::kelp::detail::throw_numerical_error(
+          "tether Newton step (whole Jacobian): singular or non-finite pivot block at node " +
+          std::to_string(i) + "; the state is unchanged");
+    b2 = u.inverse();
+  }
+}
+
+/// \brief Solves A δ = rhs with the factor of factor_whole_newton_matrix, over the free nodes:
+/// reads `rhs` (3×(N+1), free columns), writes the free columns of `delta` (may alias `rhs`).
+/// O(N), no heap allocation.
+template <typename Scalar, typename DR, typename DD>
+void solve_whole_newton_matrix(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
+                               const Eigen::MatrixBase<DR>& rhs, Eigen::MatrixBase<DD>& delta) {
+  using V3 = Vector3<Scalar>;
+  using CMap = Eigen::Map<const Matrix3<Scalar>>;
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  const Scalar* const base = ws.newton_lu.data();
+  const auto blk = [base](int i, int j) { return CMap(base + 9 * detail::band_block_index(i, j)); };
+  for (int i = f0; i <= f1; ++i) {
+    V3 y = rhs.col(i);
+    if (i - 2 >= f0) y.noalias() -= blk(i, i - 2) * delta.col(i - 2);
+    if (i - 1 >= f0) y.noalias() -= blk(i, i - 1) * delta.col(i - 1);
+    delta.col(i) = y;
+  }
+  for (int i = f1; i >= f0; --i) {
+    V3 y = delta.col(i);
+    if (i + 1 <= f1) y.noalias() -= blk(i, i + 1) * delta.col(i + 1);
+    if (i + 2 <= f1) y.noalias() -= blk(i, i + 2) * delta.col(i + 2);
+    delta.col(i) = blk(i, i) * y;
+  }
+}
+
+namespace detail {
+
+/// Newton direction of the implicit step with the whole Jacobian (ImplicitOptions::jacobian ==
+/// JacobianKind::whole), at the iterate (x, v) of the last compute_forces: solves J δ = −R
+/// (ws.rhs = −R) into ws.delta, J assembled and factored in ws.newton_lu. The kinks of the
+/// axial force are handled as in active_set_direction (the same primal–dual active set: each
+/// segment on the branch its predicted extension and stretch rate give, at most `max_passes`
+/// factorisations); the other kinks (surface band, seabed, friction) take the branch of the
+/// current iterate. ws.rhs is restored; ws.newton_lu keeps the last factor. No heap allocation.
+template <typename Scalar, typename Env, typename DX, typename DV, typename DD>
+void whole_newton_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                            const Env& env, const Eigen::MatrixBase<DX>& x,
+                            const Eigen::MatrixBase<DV>& v, const Eigen::MatrixBase<DD>& d,
+                            Scalar gh, Scalar band, int max_passes) {
+  const int n = model.segments();
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  const Scalar l = model.segment_length();
+  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
+  const auto rate = [&](int s) { return ws.direction.col(s).dot(v.col(s + 1) - v.col(s)); };
+  const auto true_branch = [&](int s) {
+    return segment_branch(model, ws.stretched_length(s) - l, rate(s));
+  };
+  const auto update = [&]() {
+    bool changed = false;
+    for (int s = 0; s < n; ++s) {
+      Scalar w(0);
+      const auto u = ws.direction.col(s);
+      if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
+      if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
+      const Scalar now = segment_branch(model, ws.stretched_length(s) - l + gh * w, rate(s) + w);
+      if (now != ws.seg_branch(s)) {
+        changed = true;
+        ws.seg_branch(s) = now;
+      }
+    }
+    return changed;
+  };
+  bool on_true_branch = true;
+  for (int s = 0; s < n; ++s) {
+    const Scalar bt = true_branch(s);
+    const bool banded = band > Scalar(0) && ws.stretched_length(s) >= (Scalar(1) - band) * l;
+    ws.seg_branch(s) = banded ? Scalar(2) : bt;
+    if (ws.seg_branch(s) != bt) on_true_branch = false;
+  }
+  int pass = 0;
+  if (on_true_branch) {
+    assemble_whole_newton_matrix(model, ws, env, x, v, d, gh);
+    factor_whole_newton_matrix(model, ws);
+    solve_whole_newton_matrix(model, ws, ws.rhs, ws.delta);
+    if (max_passes <= 1 || !update()) return;
+    pass = 1;
+  }
+  ws.rhs_true = ws.rhs;
+  for (;; ++pass) {
+    ws.rhs = ws.rhs_true;
+    for (int s = 0; s < n; ++s) {
+      const Scalar b = ws.seg_branch(s);
+      if (b == true_branch(s)) continue;
+      // The branch's force at the current point replaces the true one.
+      const Scalar e = ws.stretched_length(s) - l, r = rate(s);
+      const Scalar tb =
+          (b == Scalar(2) ? ea_l * e : Scalar(0)) + (b > Scalar(0) ? ba_l * r : Scalar(0));
+      const Vector3<Scalar> df = (gh * (tb - ws.tension(s))) * ws.direction.col(s);
+      ws.rhs.col(s) += df;
+      ws.rhs.col(s + 1) -= df;
+    }
+    assemble_whole_newton_matrix(model, ws, env, x, v, d, gh, &ws.seg_branch);
+    factor_whole_newton_matrix(model, ws);
+    solve_whole_newton_matrix(model, ws, ws.rhs, ws.delta);
+    if (pass + 1 >= max_passes || !update()) break;
+  }
+  ws.rhs.swap(ws.rhs_true);
+}
+
+}  // namespace detail
+
+}  // namespace kelp::tether
