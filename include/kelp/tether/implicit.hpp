@@ -40,16 +40,37 @@ void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<S
   }
 }
 
+/// True when every segment's taut/slack/clamped branch at the last force evaluation (from its
+/// length and its clamped axial force, which compute_forces fills with or without the Jacobian
+/// terms) is `branch`'s (see active_set_direction).
+template <typename Scalar>
+bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
+                  const VectorX<Scalar>& branch) {
+  const Scalar l = model.segment_length();
+  const bool clamp = !model.parameters().compressive_damping;
+  bool same = true;
+  for (int s = 0; s < model.segments(); ++s) {
+    const Scalar b = clamp && !(ws.tension(s) > Scalar(0))
+                         ? Scalar(0)
+                         : (ws.stretched_length(s) > l ? Scalar(2) : Scalar(1));
+    same = same && b == branch(s);
+  }
+  return same;
+}
+
 /// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
 /// new state and returns true when Newton's method converged (or options.check_convergence is
 /// false); returns false with the state untouched otherwise. Adds its work to `report`. Inputs
-/// already checked.
+/// already checked. With NewtonMethod::simplified, `fresh_matrices` forms the Newton matrix at
+/// every iteration (Newton's method, the matrix kept for the next steps) instead of reusing the
+/// kept one; `reused` says whether a kept matrix was reused.
 template <typename Scalar, typename Env>
 bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                       TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
-                      bool bdf2, const ImplicitOptions<Scalar>& options,
-                      StepReport<Scalar>& report) {
+                      bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report,
+                      bool fresh_matrices, bool& reused) {
   using std::abs;
+  using std::pow;
   const double t1 = state.time + dt;
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   // The history (BDF2, velocity predictor) is used only if it is this state's previous step.
@@ -102,10 +123,40 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   }
   bool converged = false;
   Scalar res(0);
+  // The Newton matrix. Exact: formed at every iteration in ws.block_inv. Simplified: the one
+  // the state keeps (TetherState::newton) while it fits this step's γh and is young enough,
+  // else one formed in this attempt (ws.newton_factor, its branches in ws.newton_branch),
+  // which commit() hands to the state.
+  const bool simplified = options.newton == NewtonMethod::simplified && options.check_convergence;
+  const bool form_always = !simplified || fresh_matrices;
+  const Scalar* matrix = nullptr;
+  const VectorX<Scalar>* matrix_branch = nullptr;
+  reused = false;
+  if (!form_always && state.newton.holds(cols) && state.newton.gh == gh &&
+      state.newton.age < options.max_matrix_age) {
+    matrix = state.newton.factor.data();
+    matrix_branch = &state.newton.branch;
+  }
+  Scalar first_residual(0);   // scaled residual after the first correction
+  bool first_reused = false;  // the first correction reused a kept matrix
   // Takes the iterate (ws.x1, ws.v1) with ws.end_forces: commit() turns the pre-step state into
   // the history; the end forces' impulse over dt and the residual go to the report.
   const auto accept = [&]() {
     commit(state, ws.x1, ws.v1, dt, "step_implicit");
+    if (!simplified) {
+      state.newton.clear();
+    } else if (matrix == ws.newton_factor.data()) {
+      state.newton.factor.swap(ws.newton_factor);
+      state.newton.branch.swap(ws.newton_branch);
+      state.newton.gh = gh;
+      state.newton.age = 1;
+    } else if (matrix) {
+      ++state.newton.age;
+    }
+    // The residual the kept matrix leaves after one correction grows with its age: once above
+    // refresh_residual · tolerance, the next step would need a second correction, which costs
+    // more than forming the matrix anew (Hairer & Wanner's κ · Tol).
+    if (first_reused && first_residual > options.refresh_residual * tolerance) state.newton.clear();
     ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
     ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
     report.residual = std::max(report.residual, res);
@@ -163,7 +214,9 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     ~WaterGuard() { w.water_frozen = false; }
   } water_guard{ws};
   ws.water_frozen = false;
-  evaluate(ws.x1, ws.v1, res, true);
+  // The Jacobian terms are needed where a matrix is formed: at the predictor unless one is kept.
+  bool jacobian_here = matrix == nullptr;
+  evaluate(ws.x1, ws.v1, res, jacobian_here);
   ws.water_frozen = !options.resample_water;
   // The trial iterates take the kinematic end nodes from here (the free ones are overwritten).
   for (int i = 0; i < cols; ++i) {
@@ -174,14 +227,50 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     ws.xs.col(i) = ws.x1.col(i);
     ws.vs.col(i) = ws.v1.col(i);
   }
+  Scalar res_before(0);  // scaled residual before the last correction
   for (int it = 0;; ++it) {
     // At least one correction: the predictor alone never makes a step.
+    if (it == 1) first_residual = res;
     if (it >= 1 && res <= tolerance) {
       converged = true;
       break;
     }
     if (it >= options.max_iterations) break;
-    active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+    // Simplified Newton: keep the matrix while the iteration contracts fast enough to reach
+    // the tolerance within the iterations left, θ = r_k / r_{k−1} < max_contraction and
+    // θ^(k_max − k) r_k / (1 − θ) ≤ tol (Hairer & Wanner §IV.8, on the scaled residual), and
+    // every segment is on the branch the matrix was formed with.
+    bool form = form_always || matrix == nullptr;
+    if (!form && it >= 1) {
+      const Scalar theta = res / res_before;
+      form =
+          !(theta < options.max_contraction) ||
+          pow(theta, Scalar(options.max_iterations - it)) * res > (Scalar(1) - theta) * tolerance;
+    }
+    if (!form) form = !branches_are(model, ws, *matrix_branch);
+    if (form) {
+      if (!jacobian_here) {
+        // The same iterate again, with the Jacobian terms (rhs and res are unchanged).
+        evaluate(ws.x1, ws.v1, res, true);
+        jacobian_here = true;
+      }
+      if (simplified) {
+        report.factorisations +=
+            active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes,
+                                 ws.newton_factor.data());
+        ws.newton_branch = ws.seg_branch;
+        matrix = ws.newton_factor.data();
+        matrix_branch = &ws.newton_branch;
+      } else {
+        report.factorisations +=
+            active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+      }
+    } else {
+      solve_factored_block_tridiagonal(model, matrix, ws.rhs, ws.delta);
+      ++report.reused_factorisations;
+      if (it == 0) first_reused = true;
+      reused = true;
+    }
     ++report.newton_iterations;
     if (!options.check_convergence && it + 1 >= options.max_iterations) {
       // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
@@ -218,10 +307,11 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       ws.vs.middleCols(f0, nf).noalias() =
           ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
       ws.xs.middleCols(f0, nf).noalias() = ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
-      // The trial carries its Jacobian terms: when another Newton iteration follows (half the
-      // steps of a line near the surface) they are needed at this point, and filling them costs
-      // less than a second evaluation there (−6 % instructions per system step).
-      evaluate(ws.xs, ws.vs, trial_res, true);
+      // Newton's method: the trial carries its Jacobian terms: when another Newton iteration
+      // follows (half the steps of a line near the surface) they are needed at this point, and
+      // filling them costs less than a second evaluation there (−6 % instructions per system
+      // step). The simplified method goes on with the matrix it has.
+      evaluate(ws.xs, ws.vs, trial_res, !simplified);
       if (ls >= options.max_backtracks || !(g0 < Scalar(0))) break;
       const Scalar g = slope();
       if (g <= Scalar(-0.5) * g0) break;
@@ -232,6 +322,8 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     }
     ws.x1.swap(ws.xs);
     ws.v1.swap(ws.vs);
+    jacobian_here = !simplified;
+    res_before = res;
     res = trial_res;
   }
   if (!converged) {
@@ -245,16 +337,27 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
 
 /// implicit_attempt, with a non-finite iterate (numerical_error) counted as not converged: a
 /// shorter step may well succeed. Nothing is committed when it returns false.
+/// With the simplified method, an attempt that reused a kept matrix and failed is made again
+/// with a fresh matrix at every iteration (Newton's method) before it counts as failed.
 template <typename Scalar, typename Env>
 bool try_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                   TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
                   bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report) {
-  try {
-    return implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report);
-  } catch (const kelp::numerical_error&) {
-    report.rejected_residual = std::numeric_limits<Scalar>::infinity();
-    return false;
+  const Scalar rejected = report.rejected_residual;
+  bool reused = false;
+  for (int fresh = 0; fresh < 2; ++fresh) {
+    try {
+      if (implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report, fresh == 1,
+                           reused)) {
+        report.rejected_residual = rejected;  // the fallback made the step: nothing rejected
+        return true;
+      }
+    } catch (const kelp::numerical_error&) {
+      report.rejected_residual = std::numeric_limits<Scalar>::infinity();
+    }
+    if (!reused) break;
   }
+  return false;
 }
 
 /// Step of length dt split into two halves, each retried in halves again up to `depth_left`
