@@ -1,8 +1,9 @@
 /// \file
-/// \brief The implicit tether steps: backward Euler and BDF2, solved by Newton's method with the
-/// analytic block-tridiagonal Jacobian (kelp/tether/block_solve.hpp), with backtracking and
-/// step halving; a step that cannot be completed throws and leaves the state as it was. End
-/// forces are those at the end of the step.
+/// \brief The implicit tether steps: backward Euler and BDF2, solved by a simplified Newton
+/// method (the factored Newton matrix kept in the state and reused across iterations and steps
+/// while it serves) or by Newton's method, with the analytic block-tridiagonal
+/// Jacobian (kelp/tether/block_solve.hpp), backtracking and step halving; a step that cannot be
+/// completed throws and leaves the state as it was. End forces are those at the end of the step.
 #pragma once
 
 #include <Eigen/Core>
@@ -142,21 +143,21 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // Takes the iterate (ws.x1, ws.v1) with ws.end_forces: commit() turns the pre-step state into
   // the history; the end forces' impulse over dt and the residual go to the report.
   const auto accept = [&]() {
-    commit(state, ws.x1, ws.v1, dt, "step_implicit");
-    if (!simplified) {
-      state.newton.clear();
-    } else if (matrix == ws.newton_factor.data()) {
+    const int age = state.newton.age;
+    commit(state, ws.x1, ws.v1, dt, "step_implicit");  // drops the kept matrix
+    if (simplified && matrix == ws.newton_factor.data()) {
       state.newton.factor.swap(ws.newton_factor);
       state.newton.branch.swap(ws.newton_branch);
       state.newton.gh = gh;
       state.newton.age = 1;
-    } else if (matrix) {
-      ++state.newton.age;
+    } else if (simplified && matrix &&
+               !(first_reused && first_residual > options.refresh_residual * tolerance)) {
+      // The residual the kept matrix leaves after one correction grows with its age: once above
+      // refresh_residual · tolerance, the next step would need a second correction, which costs
+      // more than forming the matrix anew (Hairer & Wanner's κ · Tol): then it is dropped.
+      state.newton.gh = gh;
+      state.newton.age = age + 1;
     }
-    // The residual the kept matrix leaves after one correction grows with its age: once above
-    // refresh_residual · tolerance, the next step would need a second correction, which costs
-    // more than forming the matrix anew (Hairer & Wanner's κ · Tol).
-    if (first_reused && first_residual > options.refresh_residual * tolerance) state.newton.clear();
     ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
     ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
     report.residual = std::max(report.residual, res);
@@ -397,15 +398,37 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
 /// direction settles which segments are taut, slack or clamped with a primal–dual active set
 /// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
-/// when it overshoots. The initial guess extrapolates the velocity (2v_n − v_{n−1}) when the
-/// previous step had the same dt. At least one and up to `options.max_iterations` corrections,
+/// when it overshoots.
+///
+/// The Newton matrix (ImplicitOptions::newton): NewtonMethod::exact evaluates the Jacobian and
+/// factors J at every iteration. NewtonMethod::simplified (the default) is the simplified Newton
+/// iteration of implicit Runge–Kutta codes, its matrix reused across steps (Hairer & Wanner,
+/// Solving Ordinary Differential Equations II, 2nd ed. 1996, §IV.8 "Implementation of Implicit
+/// Runge–Kutta Methods"): the factored matrix of the last step that formed one is kept in the state
+/// (TetherState::newton) and each correction is one forward and back substitution with it
+/// (detail::solve_factored_block_tridiagonal, about a fifth of a factorisation), the force
+/// evaluations skipping the Jacobian terms. It is formed anew, from the Jacobian at the current
+/// iterate, when none is kept, when γh differs from the one it was formed with (a new dt, or
+/// BDF2's backward-Euler start), when a segment's taut/slack/clamped branch at the iterate is
+/// not the one in the matrix (the kinks of the axial force change J by EA/l), when it has
+/// served `max_matrix_age` steps, when the iteration's contraction θ_k = r_k/r_{k−1} of the
+/// scaled residual reaches `max_contraction` or the residual is not expected to reach the
+/// tolerance within the corrections left (θ^(k_max−k) r_k/(1 − θ) > tol), and at the next step
+/// when a step's first correction left more than `refresh_residual` × the tolerance (the
+/// residual a kept matrix leaves grows with its age; on the benchmark line it serves two or
+/// three steps). A step that fails with a reused matrix is attempted again with a fresh matrix
+/// at every iteration (Newton's method) before it is split. Both methods stop on the same
+/// residual test, so their results agree to the tolerance. The initial guess extrapolates the
+/// velocity (2v_n − v_{n−1}) when the previous step had the same dt. At least one and up to
+/// `options.max_iterations` corrections,
 /// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt (the tolerance raised to the arithmetic's
 /// resolution where it is below it, see ImplicitOptions::acceleration_tolerance). A step that does
 /// not converge is not committed: it is retried as two half steps, each halved again if needed, at
 /// most `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of
 /// step); if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
 /// (`ws.end_forces`) are those of the final iterate, at t + dt.
-/// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
+/// \returns the work done (sub-steps, Newton iterations, factorisations and reuses, worst
+/// residual, retries).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
 /// the result is not finite or Newton's method does not converge.
 namespace detail {

@@ -63,10 +63,11 @@ enum class NewtonMethod {
   /// Newton's method: the Jacobian is evaluated and the Newton matrix factored at every
   /// iteration.
   exact,
-  /// Simplified Newton / W-method (Hairer & Wanner, Solving Ordinary Differential Equations II,
-  /// 2nd ed., Springer 1996, §IV.8): the factored Newton matrix is kept and reused across
-  /// iterations and steps while the iteration contracts well, and formed again (from a fresh
-  /// Jacobian) when the active set, γh or the contraction says it has gone stale.
+  /// Simplified Newton iteration with the matrix reused across steps (Hairer & Wanner, Solving
+  /// Ordinary Differential Equations II, 2nd ed., Springer 1996, §IV.8): the factored Newton
+  /// matrix is kept and reused across iterations and steps while the iteration contracts well,
+  /// and formed again (from a fresh Jacobian) when the active set, γh or the contraction says it
+  /// has gone stale.
   simplified
 };
 
@@ -81,19 +82,18 @@ struct ImplicitOptions {
   /// Maximum Newton corrections per step (each: one solve with the Newton matrix, factored anew
   /// for NewtonMethod::exact).
   int max_iterations = 8;
-  /// Newton's method (refactor at every iteration) or the simplified Newton / W-method that
-  /// keeps the factored Newton matrix J = M + γh D_v + (γh)² D_x in the state
-  /// (TetherState::newton) and reuses it across iterations and steps. The simplified method
-  /// forms it again when there is none, when γh changed (a new dt, or BDF2's first step), when a
-  /// segment's taut/slack/clamped branch differs from the one it was formed with, when it is
-  /// older than `max_matrix_age` steps, or when the iteration contracts by less than
-  /// `max_contraction` per correction (θ_k = r_k / r_{k−1} of the scaled residuals) or is not
-  /// expected to reach the tolerance within the iterations left (θ^(k_max − k)/(1 − θ) r_k above
-  /// it, Hairer & Wanner §IV.8). Force evaluations skip the Jacobian terms while the kept
-  /// matrix serves. A step that does not converge with a reused matrix is attempted again with
-  /// a fresh one at every iteration (Newton's method) before it is split in halves. Both methods
-  /// stop on the same residual test, so they agree to the tolerance. Ignored (exact) when
-  /// `check_convergence` is false.
+  /// Newton's method (refactor at every iteration) or the simplified Newton method that keeps the
+  /// factored Newton matrix J = M + γh D_v + (γh)² D_x in the state (TetherState::newton) and
+  /// reuses it across iterations and steps. The simplified method forms it again when there is
+  /// none, when γh changed (a new dt, or BDF2's first step), when a segment's taut/slack/clamped
+  /// branch differs from the one it was formed with, when it is older than `max_matrix_age` steps,
+  /// or when the iteration contracts by less than `max_contraction` per correction (θ_k = r_k /
+  /// r_{k−1} of the scaled residuals) or is not expected to reach the tolerance within the
+  /// iterations left (θ^(k_max − k)/(1 − θ) r_k above it, Hairer & Wanner §IV.8). Force evaluations
+  /// skip the Jacobian terms while the kept matrix serves. A step that does not converge with a
+  /// reused matrix is attempted again with a fresh one at every iteration (Newton's method) before
+  /// it is split in halves. Both methods stop on the same residual test, so they agree to the
+  /// tolerance. Ignored (exact) when `check_convergence` is false.
   NewtonMethod newton = NewtonMethod::simplified;
   /// NewtonMethod::simplified: a kept Newton matrix serves at most this many steps.
   int max_matrix_age = 64;
@@ -193,7 +193,8 @@ bool all_finite_fast(const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v) {
 }
 
 /// Commits (x, v) as the state at t + dt if finite; the state before the step becomes the
-/// state's history (BDF2, velocity predictor).
+/// state's history (BDF2, velocity predictor). The kept Newton matrix is dropped (an implicit
+/// step hands its own to the state after this).
 template <typename Scalar>
 void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v, double dt,
             const char* who) {
@@ -207,6 +208,7 @@ void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v
   state.position.swap(x);
   state.velocity.swap(v);
   state.previous_dt = dt;
+  state.newton.clear();
   // Kahan summation of the clock (TetherState::time_carry).
   const double step = dt + state.time_carry;
   const double next = state.time + step;
