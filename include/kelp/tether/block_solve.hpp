@@ -197,8 +197,11 @@ void back_substitute_block_tridiagonal(const TetherModel<Scalar>& model, const S
 /// at the middle node m, whose block (both neighbours eliminated) gives δ_m; the back
 /// substitution δ_i = z_i + P_i A δ_k (k the neighbour towards m) then runs outward both ways.
 /// Each D' is inverted by invert_block as P = g N with a single division g = 1/(…), so that
-/// A P A = g L, L = u eᵀ + e uᵀ + β² N, e = ½ α² (u·N u) u + α β N u, and N rhs' are formed
-/// while the division runs: the dependency chain per step is D' → g → A − g L → next D'.
+/// A P A = g L, L = u eᵀ + e uᵀ + β² N, e = ½ α² (u·N u) u + α β N u, is formed while the
+/// division runs: the dependency chain per step is D' → g → A − g L → next D'. The right-hand
+/// side goes on as A z = C rhs' (C = A P) and the back substitution is δ_i = z_i + Cᵀ δ_k: one
+/// 3×3 product per step on each of their dependency chains, so that a solve with a kept factor
+/// (solve_factored_block_tridiagonal) costs about a fifth of the factorisation.
 ///
 /// Pivot floor: in exact arithmetic every LDLᵀ pivot of every D' is at least λ_min(J) ≥ c_m ·
 /// min_node_mass (J − c_m M is positive semi-definite); a computed pivot below half that bound
@@ -301,7 +304,7 @@ void factor_solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWork
                     base.zx + a_s.zx + cpl.zx, base.yy + a_s.yy + cpl.yy,
                     base.zy + a_s.zy + cpl.zy, base.zz + a_s.zz + cpl.zz};
     // P = D'⁻¹ = g N. Alongside the division: N u, L = u eᵀ + e uᵀ + β² N with
-    // e = ½ α² (u·N u) u + α β N u (A P A = g L), v = N r', u·v; then only products with g.
+    // e = ½ α² (u·N u) u + α β N u (A P A = g L); then only products with g.
     Sym3<V> nm;
     V g;
     invert_block(d, floor, nm, g);

@@ -67,7 +67,8 @@ struct KeptNewtonMatrix {
 
 /// \brief Everything that determines the tether's next step: positions and velocities of all
 /// N + 1 nodes (NED), the clock, and the integrator history (BDF2's previous step, also the
-/// implicit schemes' velocity predictor).
+/// implicit schemes' velocity predictor, and the Newton matrix the simplified Newton method
+/// keeps).
 ///
 /// Saving a copy of a state and restoring it later reproduces the following steps bit for bit;
 /// the workspace holds scratch only. The clock is a double for every Scalar, so a float tether
