@@ -44,16 +44,22 @@ void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<S
 /// True when every segment's taut/slack/clamped branch at the last force evaluation (from its
 /// length and its clamped axial force, which compute_forces fills with or without the Jacobian
 /// terms) is `branch`'s (see active_set_direction).
+/// Segments at least (1 − band)·l long count as taut, as active_set_direction starts them.
 template <typename Scalar>
 bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
-                  const VectorX<Scalar>& branch) {
+                  const VectorX<Scalar>& branch, Scalar band) {
   const Scalar l = model.segment_length();
+  const Scalar taut_from = band > Scalar(0) ? (Scalar(1) - band) * l : l;
   const bool clamp = !model.parameters().compressive_damping;
   bool same = true;
   for (int s = 0; s < model.segments(); ++s) {
-    const Scalar b = clamp && !(ws.tension(s) > Scalar(0))
-                         ? Scalar(0)
-                         : (ws.stretched_length(s) > l ? Scalar(2) : Scalar(1));
+    const Scalar ls = ws.stretched_length(s);
+    const bool taut = band > Scalar(0) ? ls >= taut_from : ls > l;
+    const Scalar b = taut && band > Scalar(0)
+                         ? Scalar(2)
+                         : (clamp && !(ws.tension(s) > Scalar(0))
+                                ? Scalar(0)
+                                : (ls > l ? Scalar(2) : Scalar(1)));
     same = same && b == branch(s);
   }
   return same;
@@ -248,7 +254,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
           !(theta < options.max_contraction) ||
           pow(theta, Scalar(options.max_iterations - it)) * res > (Scalar(1) - theta) * tolerance;
     }
-    if (!form) form = !branches_are(model, ws, *matrix_branch);
+    if (!form) form = !branches_are(model, ws, *matrix_branch, options.slack_band);
     if (form) {
       if (!jacobian_here) {
         // The same iterate again, with the Jacobian terms (rhs and res are unchanged).
