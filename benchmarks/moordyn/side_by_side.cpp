@@ -15,8 +15,9 @@
 //
 // Per N and round r (r = 0..R-1), in this order: MoorDyn RK4 (one MoorDyn_Step per dtM),
 // MoorDyn RK4 (one MoorDyn_Step per ~10 ms coupling interval, K internal dtM steps), kelp RK4
-// at dt, kelp bare compute_forces (without and with the Jacobian terms), kelp BDF2 at 10 ms (Newton
-// to tolerance, then one unchecked correction per step). Each measurement runs >= min_time of wall
+// at dt, kelp bare compute_forces (without and with the Jacobian terms), kelp BDF2 at 10 ms (to
+// tolerance with the default simplified Newton / W-method, to tolerance with Newton's method,
+// then one unchecked correction per step). Each measurement runs >= min_time of wall
 // clock (steady_clock); thread CPU time is recorded as well.
 #include <fcntl.h>
 #include <moordyn/MoorDyn2.h>
@@ -82,10 +83,17 @@ Timing run_for(double min_time, long batch, F&& body) {
 // The benchmark line in kelp, with a step at the current time.
 struct Kelp : kelp_bench::BenchmarkLine {
   using BenchmarkLine::BenchmarkLine;
-  void step(double dt, kt::Integrator integ, const kt::ImplicitOptionsd& o = {}) {
-    kt::step(model, ws, env, state, boundary(state.time), dt, {integ, o});
+  kt::StepReportd step(double dt, kt::Integrator integ, const kt::ImplicitOptionsd& o = {}) {
+    return kt::step(model, ws, env, state, boundary(state.time), dt, {integ, o});
   }
 };
+
+// BDF2 with Newton's method: the matrix formed at every iteration (kt::NewtonMethod::exact).
+kt::ImplicitOptionsd exact_newton() {
+  kt::ImplicitOptionsd o;
+  o.newton = kt::NewtonMethod::exact;
+  return o;
+}
 
 // BDF2 with one unchecked Newton correction per step (linearly implicit; see
 // kt::ImplicitOptions::check_convergence).
@@ -247,12 +255,14 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     k.state.velocity.col(i) = m.node_vel_ned(i);
   }
   k.state.clear_history();
-  Kelp kb(n), k1(n);
-  kb.state.position = k1.state.position = k.state.position;
-  kb.state.velocity = k1.state.velocity = k.state.velocity;
+  Kelp kb(n), k1(n), kx(n);
+  kb.state.position = k1.state.position = kx.state.position = k.state.position;
+  kb.state.velocity = k1.state.velocity = kx.state.velocity = k.state.velocity;
   kb.state.clear_history();
   k1.state.clear_history();
-  double se1 = 0;
+  kx.state.clear_history();
+  double se1 = 0, sex = 0, sbx = 0;
+  kt::StepReportd rb, rx;
   const long K = std::lround(0.01 / dt);
   const long steps = std::lround(T / (K * dt)) * K;
   const int seg = n - 2;
@@ -266,11 +276,14 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     for (int i = 0; i <= n; ++i)
       dmax_run = std::max(dmax_run, (m.node_ned(i) - k.state.position.col(i)).norm());
     if (s % K == 0) {
-      kb.step(K * dt, kt::Integrator::bdf2);
+      rb += kb.step(K * dt, kt::Integrator::bdf2);
+      rx += kx.step(K * dt, kt::Integrator::bdf2, exact_newton());
       k1.step(K * dt, kt::Integrator::bdf2, one_newton());
-      const double tb = ten(kp(kb), seg), t1 = ten(kp(k1), seg);
+      const double tb = ten(kp(kb), seg), t1 = ten(kp(k1), seg), tx = ten(kp(kx), seg);
       se2 += (tm - tb) * (tm - tb);
       se1 += (tm - t1) * (tm - t1);
+      sex += (tm - tx) * (tm - tx);
+      sbx += (tx - tb) * (tx - tb);
       sref2 += tm * tm;
     }
   }
@@ -287,6 +300,22 @@ void agreement(int n, double dt, const std::string& dir, double T) {
       "  N=%3d kelp BDF2 at %.3f ms vs MoorDyn RK4 at dt, sampled every %ld steps: RMS "
       "segment-%d force difference %.2e of RMS force\n",
       n, K * dt * 1e3, K, seg, std::sqrt(se2 / sref2));
+  std::printf(
+      "  N=%3d kelp BDF2 Newton's method (exact) at %.3f ms vs MoorDyn RK4 at dt: RMS segment-%d "
+      "force difference %.2e of RMS force; simplified vs exact %.2e\n",
+      n, K * dt * 1e3, seg, std::sqrt(sex / sref2), std::sqrt(sbx / sref2));
+  const auto per_step = [](const kt::StepReportd& r) {
+    const double st = r.substeps;
+    char b[160];
+    std::snprintf(b, sizeof b,
+                  "%.3f Newton corrections, %.3f force evaluations, %.3f factorisations, %.3f "
+                  "reuses per step",
+                  r.newton_iterations / st, r.force_evaluations / st, r.factorisations / st,
+                  r.reused_factorisations / st);
+    return std::string(b);
+  };
+  std::printf("  N=%3d kelp BDF2 simplified: %s\n", n, per_step(rb).c_str());
+  std::printf("  N=%3d kelp BDF2 exact:      %s\n", n, per_step(rx).c_str());
   std::printf(
       "  N=%3d kelp BDF2 one Newton correction at %.3f ms vs MoorDyn RK4 at dt: RMS segment-%d "
       "force difference %.2e of RMS force\n",
@@ -388,7 +417,7 @@ int main(int argc, char** argv) {
   struct Sum {
     int n;
     double dt, dt_kelp;
-    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf21, krk4own;
+    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf2x, kbdf21, krk4own;
   };
   std::vector<Sum> sums;
   for (int n : sizes) {
@@ -400,8 +429,8 @@ int main(int argc, char** argv) {
     S.dt = dt;
     Md md(n, dt, dir);
     Md mdc(n, dt, dir);
-    Kelp krk(n), kf(n), kbd(n), kbd1(n), kown(n);
-    const kt::ImplicitOptionsd once = one_newton();
+    Kelp krk(n), kf(n), kbd(n), kbdx(n), kbd1(n), kown(n);
+    const kt::ImplicitOptionsd once = one_newton(), exact = exact_newton();
     S.dt_kelp = kt::estimate_stable_dt(kown.model, kt::Integrator::rk4, kown.env.water_density());
     const double nodes = n + 1;
     auto record = [&](const char* name, Row& row, int r, const Timing& t, double evals_per_iter,
@@ -444,6 +473,13 @@ int main(int argc, char** argv) {
                    .force_evaluations;
       });
       record("kelp_bdf2_10ms", S.kbdf2, r, t, double(evb) / t.iters, 0.01, 0.01);
+      evb = 0;
+      t = run_for(min_time, 16, [&] {
+        evb += kt::step(kbdx.model, kbdx.ws, kbdx.env, kbdx.state, kbdx.boundary(kbdx.state.time),
+                        0.01, {kt::Integrator::bdf2, exact})
+                   .force_evaluations;
+      });
+      record("kelp_bdf2_exact_10ms", S.kbdf2x, r, t, double(evb) / t.iters, 0.01, 0.01);
       t = run_for(min_time, 16, [&] { kbd1.step(0.01, kt::Integrator::bdf2, once); });
       record("kelp_bdf2_one_newton_10ms", S.kbdf21, r, t, 1, 0.01, 0.01);
       t = run_for(min_time, 64, [&] { kown.step(S.dt_kelp, kt::Integrator::rk4); });
@@ -481,6 +517,8 @@ int main(int argc, char** argv) {
     std::printf("  kelp compute_forces<true>   ns/node      %s\n", ns(S.kforcej).c_str());
     std::printf("  kelp BDF2 10 ms             ns/node/eval %s  RTF %s\n", ns(S.kbdf2).c_str(),
                 rtf(S.kbdf2).c_str());
+    std::printf("  kelp BDF2 exact Newton 10 ms ns/node/eval %s  RTF %s\n", ns(S.kbdf2x).c_str(),
+                rtf(S.kbdf2x).c_str());
     std::printf("  kelp BDF2 one Newton 10 ms  ns/node/eval %s  RTF %s\n", ns(S.kbdf21).c_str(),
                 rtf(S.kbdf21).c_str());
     std::printf("  kelp RK4 (own dt)           ns/node/eval %s  RTF %s\n", ns(S.krk4own).c_str(),

@@ -6,15 +6,19 @@
 //   BM_TetherForces/<N>            one force evaluation (no Jacobian)
 //   BM_TetherStep/<integrator>/<N> one full step at the integrator's dt: estimate_stable_dt
 //                                  (0.8 × the stability limit) for symplectic Euler, RK2 (on the
-//                                  line with internal damping ζ = 0.2), RK4; 10 ms for
-//                                  the implicit schemes (bdf2_one_newton: one unchecked Newton
-//                                  correction per step, see ImplicitOptions::check_convergence;
-//                                  bdf2_whole: Newton with the whole Jacobian, JacobianKind::whole)
+//                                  line with internal damping ζ = 0.2), RK4; 10 ms for the
+//                                  implicit schemes (bdf2: the default simplified Newton /
+//                                  W-method with the adaptive Jacobian; bdf2_exact: Newton's
+//                                  method, the symmetric matrix formed at every iteration;
+//                                  bdf2_whole: Newton with the whole Jacobian, JacobianKind::whole;
+//                                  bdf2_one_newton: one unchecked Newton correction per step, see
+//                                  ImplicitOptions::check_convergence)
 //   BM_WholeNewtonAssemble/<N>     assembly of the whole Newton matrix (kelp/tether/jacobian.hpp)
 //   BM_WholeNewtonFactor/<N>       its block LU factorisation; BM_WholeNewtonSolve/<N> one solve
 // Counters: ns_per_node = time / (force evaluations × nodes) — for the implicit schemes this
 // includes the Jacobian assembly and the block-tridiagonal solves; realtime_factor = simulated
-// seconds per CPU second; evals_per_step and newton_per_step for the implicit schemes.
+// seconds per CPU second; evals_per_step, newton_per_step and factor_per_step (Newton matrices
+// factored) for the implicit schemes.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -49,7 +53,8 @@ void BM_TetherForces(benchmark::State& st) {
 }
 
 void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_implicit = false,
-                   kt::JacobianKind jacobian = kt::JacobianKind::symmetric) {
+                   kt::NewtonMethod newton_method = kt::NewtonMethod::simplified,
+                   kt::JacobianKind jacobian = kt::JacobianKind::adaptive) {
   const int n = static_cast<int>(st.range(0));
   // RK2 (explicit midpoint) is unstable on an undamped line at any step (estimate_stable_dt
   // refuses it): it runs on the line with internal damping ζ = 0.2 at its highest mode.
@@ -57,17 +62,19 @@ void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_imp
   const double dt =
       kt::is_implicit(integ) ? 0.01 : kt::estimate_stable_dt(s.model, integ, s.env.water_density());
   kt::ImplicitOptionsd options;
+  options.newton = newton_method;
   options.jacobian = jacobian;
   if (linearly_implicit) {
     options.max_iterations = 1;
     options.check_convergence = false;
   }
-  double evals = 0, newton = 0;
+  double evals = 0, newton = 0, factorisations = 0;
   for (auto _ : st) {
     const kt::StepReportd r =
         kt::step(s.model, s.ws, s.env, s.state, s.boundary(s.state.time), dt, {integ, options});
     evals += r.force_evaluations;
     newton += r.newton_iterations;
+    factorisations += r.factorisations;
     benchmark::DoNotOptimize(s.state.position.data());
   }
   const double iters = static_cast<double>(st.iterations());
@@ -78,6 +85,7 @@ void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_imp
   if (kt::is_implicit(integ)) {
     st.counters["evals_per_step"] = evals / iters;
     st.counters["newton_per_step"] = newton / iters;
+    st.counters["factor_per_step"] = factorisations / iters;
   }
 }
 
@@ -94,10 +102,14 @@ BENCHMARK_CAPTURE(BM_TetherStep, rk2, kt::Integrator::rk2)->Apply(sizes);
 BENCHMARK_CAPTURE(BM_TetherStep, rk4, kt::Integrator::rk4)->Apply(sizes);
 BENCHMARK_CAPTURE(BM_TetherStep, implicit_euler, kt::Integrator::implicit_euler)->Apply(sizes);
 BENCHMARK_CAPTURE(BM_TetherStep, bdf2, kt::Integrator::bdf2)->Apply(sizes);
+// Newton's method with the matrix formed at every iteration (ImplicitOptions::newton = exact).
+BENCHMARK_CAPTURE(BM_TetherStep, bdf2_exact, kt::Integrator::bdf2, false, kt::NewtonMethod::exact)
+    ->Apply(sizes);
 // One unchecked Newton correction per step (ImplicitOptions::check_convergence = false).
 BENCHMARK_CAPTURE(BM_TetherStep, bdf2_one_newton, kt::Integrator::bdf2, true)->Apply(sizes);
 // Exact Newton: the whole Jacobian (ImplicitOptions::jacobian = JacobianKind::whole).
-BENCHMARK_CAPTURE(BM_TetherStep, bdf2_whole, kt::Integrator::bdf2, false, kt::JacobianKind::whole)
+BENCHMARK_CAPTURE(BM_TetherStep, bdf2_whole, kt::Integrator::bdf2, false, kt::NewtonMethod::exact,
+                  kt::JacobianKind::whole)
     ->Apply(sizes);
 
 namespace {
@@ -105,7 +117,10 @@ namespace {
 // BM_BlockSolve/<N>: one block-tridiagonal Newton solve (kt::detail::solve_block_tridiagonal) on
 // the benchmark line's Jacobian after 20 BDF2 steps at 10 ms (c_m = 1, c_v = γh, c_x = (γh)²,
 // γ = 2/3). ns_per_node = time / free nodes.
-void BM_BlockSolve(benchmark::State& st) {
+// BM_BlockSolveKept/<N>: the same system solved with the factor kept by a first solve
+// (kt::detail::solve_factored_block_tridiagonal: forward elimination and back substitution only,
+// what the simplified Newton method does while its matrix serves).
+void BM_BlockSolve(benchmark::State& st, bool kept) {
   const int n = static_cast<int>(st.range(0));
   Setup s(n);
   const double dt = 0.01, gh = 2.0 / 3.0 * dt;
@@ -114,8 +129,14 @@ void BM_BlockSolve(benchmark::State& st) {
   kt::compute_forces<true>(s.model, s.ws, s.env, s.state.time, s.state.position, s.state.velocity);
   for (int i = 0; i < s.model.nodes(); ++i)
     s.ws.rhs.col(i) = Vector3<double>(std::cos(i), 1.0, std::sin(0.5 * i));
+  kt::detail::factor_solve_block_tridiagonal(s.model, s.ws, 1.0, gh, gh * gh,
+                                             s.ws.newton_factor.data(), true);
   for (auto _ : st) {
-    kt::detail::solve_block_tridiagonal(s.model, s.ws, 1.0, gh, gh * gh);
+    if (kept)
+      kt::detail::solve_factored_block_tridiagonal(s.model, s.ws.newton_factor.data(), s.ws.rhs,
+                                                   s.ws.delta);
+    else
+      kt::detail::solve_block_tridiagonal(s.model, s.ws, 1.0, gh, gh * gh);
     benchmark::DoNotOptimize(s.ws.delta.data());
     benchmark::ClobberMemory();
   }
@@ -126,8 +147,6 @@ void BM_BlockSolve(benchmark::State& st) {
 }
 
 }  // namespace
-
-BENCHMARK(BM_BlockSolve)->Arg(20)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kNanosecond);
 
 namespace {
 
@@ -199,3 +218,15 @@ void BM_WholeNewtonSolve(benchmark::State& st) {
 BENCHMARK(BM_WholeNewtonAssemble)->Arg(20)->Arg(100)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_WholeNewtonFactor)->Arg(20)->Arg(100)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_WholeNewtonSolve)->Arg(20)->Arg(100)->Unit(benchmark::kNanosecond);
+BENCHMARK_CAPTURE(BM_BlockSolve, factor, false)
+    ->Arg(20)
+    ->Arg(50)
+    ->Arg(100)
+    ->Arg(200)
+    ->Unit(benchmark::kNanosecond);
+BENCHMARK_CAPTURE(BM_BlockSolve, kept, true)
+    ->Arg(20)
+    ->Arg(50)
+    ->Arg(100)
+    ->Arg(200)
+    ->Unit(benchmark::kNanosecond);

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -129,6 +130,59 @@ void invert_block(const Sym3<T>& d, S floor, Sym3<T>& nm, T& g) {
   }
 }
 
+/// Per elimination step, the block elimination keeps 15 lane pairs: P = D'⁻¹ (symmetric: xx, yx,
+/// zx, yy, zy, zz) and C = A P (row by row); the meeting node's P takes 6 scalars after the last
+/// step.
+inline constexpr int kKeptStepSize = 30;
+static_assert(kKeptStepSize == kNewtonFactorStepSize, "newton_factor_size (state.hpp) is stale");
+
+/// Back substitution of the twisted elimination (factor_solve_block_tridiagonal), outward from
+/// the meeting node m whose δ_m is in `delta`, the elimination steps in reverse:
+/// δ_i = P_i (rhs'_i + A δ_k) = z_i + Cᵀ δ_k (C = A P_i, A symmetric), z_i = P_i rhs'_i held in
+/// δ's column i by the forward elimination, k the neighbour towards m, A = α u uᵀ + β I the
+/// segment between them. Step −1 (node f0 in both lanes) copies lane 0.
+template <typename Scalar, typename V>
+void back_substitute_block_tridiagonal(const TetherModel<Scalar>& model, const Scalar* kept,
+                                       Matrix3X<Scalar>& delta) {
+  using S = Scalar;
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
+  const bool extra = m - f0 > pairs;
+  const auto kept_pair = [](const S* in) {
+    if constexpr (std::is_trivially_copyable_v<V>) {
+      V x;
+      std::memcpy(&x, in, sizeof(V));
+      return x;
+    } else {
+      return V{in[0], in[1]};
+    }
+  };
+  const S y0 = delta(0, m), y1 = delta(1, m), y2 = delta(2, m);
+  V d0{y0, y0}, d1{y1, y1}, d2{y2, y2};
+  for (int k = pairs - 1; k >= (extra ? -1 : 0); --k) {
+    const int i0 = m - pairs + k, i1 = k < 0 ? f0 : f1 - k;
+    if (k < 0) {
+      d0 = V{d0[0], d0[0]};
+      d1 = V{d1[0], d1[0]};
+      d2 = V{d2[0], d2[0]};
+    }
+    const S* const in = kept + kKeptStepSize * (k + (extra ? 1 : 0));
+    const auto q = [&](int j) { return kept_pair(in + 2 * j); };
+    const V z0{delta(0, i0), delta(0, i1)}, z1{delta(1, i0), delta(1, i1)},
+        z2{delta(2, i0), delta(2, i1)};
+    const V e0 = d0, e1 = d1, e2 = d2;
+    d0 = z0 + (q(6) * e0 + q(9) * e1 + q(12) * e2);
+    d1 = z1 + (q(7) * e0 + q(10) * e1 + q(13) * e2);
+    d2 = z2 + (q(8) * e0 + q(11) * e1 + q(14) * e2);
+    delta(0, i0) = d0[0];
+    delta(0, i1) = d0[1];
+    delta(1, i0) = d1[0];
+    delta(1, i1) = d1[1];
+    delta(2, i0) = d2[0];
+    delta(2, i1) = d2[1];
+  }
+}
+
 /// Solves J δ = rhs over the free nodes f0…f1, J = c_m M + c_v (−∂F/∂v) + c_x (−∂F/∂x), block
 /// tridiagonal and symmetric positive definite. The off-diagonal block of segment s is −A_s with
 /// A_s = α_s u uᵀ + β_s I (α = c_v BA/l + c_x k_uu, β = c_x k_perp); the diagonal block of node
@@ -143,8 +197,11 @@ void invert_block(const Sym3<T>& d, S floor, Sym3<T>& nm, T& g) {
 /// at the middle node m, whose block (both neighbours eliminated) gives δ_m; the back
 /// substitution δ_i = z_i + P_i A δ_k (k the neighbour towards m) then runs outward both ways.
 /// Each D' is inverted by invert_block as P = g N with a single division g = 1/(…), so that
-/// A P A = g L, L = u eᵀ + e uᵀ + β² N, e = ½ α² (u·N u) u + α β N u, and N rhs' are formed
-/// while the division runs: the dependency chain per step is D' → g → A − g L → next D'.
+/// A P A = g L, L = u eᵀ + e uᵀ + β² N, e = ½ α² (u·N u) u + α β N u, is formed while the
+/// division runs: the dependency chain per step is D' → g → A − g L → next D'. The right-hand
+/// side goes on as A z = C rhs' (C = A P) and the back substitution is δ_i = z_i + Cᵀ δ_k: one
+/// 3×3 product per step on each of their dependency chains, so that a solve with a kept factor
+/// (solve_factored_block_tridiagonal) costs about a fifth of the factorisation.
 ///
 /// Pivot floor: in exact arithmetic every LDLᵀ pivot of every D' is at least λ_min(J) ≥ c_m ·
 /// min_node_mass (J − c_m M is positive semi-definite); a computed pivot below half that bound
@@ -157,12 +214,15 @@ void invert_block(const Sym3<T>& d, S floor, Sym3<T>& nm, T& g) {
 /// is not checked: it gives a non-finite δ.
 ///
 /// Reads the Jacobian ingredients of the last compute_forces<true> and ws.rhs; writes the free
-/// columns of ws.delta (the kinematic end columns are left as they are) and uses ws.block_inv
-/// as scratch for the back substitution (per step, both lanes: N rhs', N, g, g β, α g N u, u).
-/// O(N), no heap allocation. `V` is the lane pair (a template parameter for the tests).
+/// columns of ws.delta (the kinematic end columns are left as they are) and keeps the factor in
+/// `kept` (newton_factor_size(nodes) scalars; the meeting node's block only when `keep_meeting`:
+/// without it kKeptStepSize · (nodes / 2) suffice), so that solve_factored_block_tridiagonal can
+/// solve for further right-hand sides with it. O(N), no heap allocation. `V` is the lane
+/// pair (a template parameter for the tests).
 template <typename Scalar, typename V = typename LanePair<Scalar>::type>
-void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
-                             Scalar c_m, Scalar c_v, Scalar c_x) {
+void factor_solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                                    Scalar c_m, Scalar c_v, Scalar c_x, Scalar* kept,
+                                    bool keep_meeting) {
   using S = Scalar;
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
@@ -173,27 +233,12 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
   // first in both lanes.
   const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
   const bool extra = m - f0 > pairs;
-  // Each elimination step keeps kStepVectors lane pairs for the back substitution in
-  // ws.block_inv, two columns per step (there are at most (N + 1) / 2 steps), both lanes of a
-  // pair side by side.
-  constexpr int kStepVectors = 17, kStepSize = 2 * kStepVectors;
-  static_assert(kStepSize <= 2 * std::decay_t<decltype(ws.block_inv)>::RowsAtCompileTime);
-  KELP_ASSERT(ws.block_inv.cols() == model.nodes());
   const auto keep = [](S* out, const V& x) {
     if constexpr (std::is_trivially_copyable_v<V>) {
       std::memcpy(out, &x, sizeof(V));
     } else {
       out[0] = x[0];
       out[1] = x[1];
-    }
-  };
-  const auto kept = [](const S* in) {
-    if constexpr (std::is_trivially_copyable_v<V>) {
-      V x;
-      std::memcpy(&x, in, sizeof(V));
-      return x;
-    } else {
-      return V{in[0], in[1]};
     }
   };
 
@@ -259,7 +304,7 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
                     base.zx + a_s.zx + cpl.zx, base.yy + a_s.yy + cpl.yy,
                     base.zy + a_s.zy + cpl.zy, base.zz + a_s.zz + cpl.zz};
     // P = D'⁻¹ = g N. Alongside the division: N u, L = u eᵀ + e uᵀ + β² N with
-    // e = ½ α² (u·N u) u + α β N u (A P A = g L), v = N r', A v; then only products with g.
+    // e = ½ α² (u·N u) u + α β N u (A P A = g L); then only products with g.
     Sym3<V> nm;
     V g;
     invert_block(d, floor, nm, g);
@@ -272,38 +317,42 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
     const Sym3<V> l{lxx + lxx + bb * nm.xx,         uy * ex + ey * ux + bb * nm.yx,
                     uz * ex + ez * ux + bb * nm.zx, lyy + lyy + bb * nm.yy,
                     uz * ey + ez * uy + bb * nm.zy, lzz + lzz + bb * nm.zz};
-    const V v0 = nm.xx * r0 + nm.yx * r1 + nm.zx * r2;
-    const V v1 = nm.yx * r0 + nm.yy * r1 + nm.zy * r2;
-    const V v2 = nm.zx * r0 + nm.zy * r1 + nm.zz * r2;
-    const V uv = al * (ux * v0 + uy * v1 + uz * v2);
-    const V av0 = uv * ux + be * v0, av1 = uv * uy + be * v1, av2 = uv * uz + be * v2;
-    // Coupling to the chain's next node: A − A P A = A − g L, A z = g A v.
+    // P = g N, C = A P = α u (P u)ᵀ + β P; the chain's rhs goes on as A z = C rhs' and the back
+    // substitution is δ_i = z_i + Cᵀ δ_k (z = P rhs'): one 3×3 product per step on each
+    // dependency chain (the form solve_factored_block_tridiagonal repeats).
+    const Sym3<V> p{g * nm.xx, g * nm.yx, g * nm.zx, g * nm.yy, g * nm.zy, g * nm.zz};
+    const V px = g * nx, py = g * ny, pz = g * nz;
+    const V ax = al * ux, ay = al * uy, az = al * uz;
+    const V c00 = ax * px + be * p.xx, c01 = ax * py + be * p.yx, c02 = ax * pz + be * p.zx;
+    const V c10 = ay * px + be * p.yx, c11 = ay * py + be * p.yy, c12 = ay * pz + be * p.zy;
+    const V c20 = az * px + be * p.zx, c21 = az * py + be * p.zy, c22 = az * pz + be * p.zz;
     cpl = {a_s.xx - g * l.xx, a_s.yx - g * l.yx, a_s.zx - g * l.zx,
            a_s.yy - g * l.yy, a_s.zy - g * l.zy, a_s.zz - g * l.zz};
-    cr0 = g * av0;
-    cr1 = g * av1;
-    cr2 = g * av2;
-    // Kept for the back substitution, step by step (both lanes side by side).
+    put(ws.delta, 0, i0, i1, p.xx * r0 + p.yx * r1 + p.zx * r2);
+    put(ws.delta, 1, i0, i1, p.yx * r0 + p.yy * r1 + p.zy * r2);
+    put(ws.delta, 2, i0, i1, p.zx * r0 + p.zy * r1 + p.zz * r2);
+    cr0 = c00 * r0 + c01 * r1 + c02 * r2;
+    cr1 = c10 * r0 + c11 * r1 + c12 * r2;
+    cr2 = c20 * r0 + c21 * r1 + c22 * r2;
+    // z goes to δ's columns until the back substitution; P and C to `kept`, step by step (both
+    // lanes side by side).
     {
-      const V ag = al * g;
-      S* const out = ws.block_inv.data() + kStepSize * (k + (extra ? 1 : 0));
-      keep(out, v0);
-      keep(out + 2, v1);
-      keep(out + 4, v2);
-      keep(out + 6, nm.xx);
-      keep(out + 8, nm.yx);
-      keep(out + 10, nm.zx);
-      keep(out + 12, nm.yy);
-      keep(out + 14, nm.zy);
-      keep(out + 16, nm.zz);
-      keep(out + 18, g);
-      keep(out + 20, g * be);
-      keep(out + 22, ag * nx);
-      keep(out + 24, ag * ny);
-      keep(out + 26, ag * nz);
-      keep(out + 28, ux);
-      keep(out + 30, uy);
-      keep(out + 32, uz);
+      S* const out = kept + kKeptStepSize * (k + (extra ? 1 : 0));
+      keep(out, p.xx);
+      keep(out + 2, p.yx);
+      keep(out + 4, p.zx);
+      keep(out + 6, p.yy);
+      keep(out + 8, p.zy);
+      keep(out + 10, p.zz);
+      keep(out + 12, c00);
+      keep(out + 14, c01);
+      keep(out + 16, c02);
+      keep(out + 18, c10);
+      keep(out + 20, c11);
+      keep(out + 22, c12);
+      keep(out + 24, c20);
+      keep(out + 26, c21);
+      keep(out + 28, c22);
     }
     if (k < 0) {
       // Lane 1 starts the bottom chain.
@@ -316,7 +365,6 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
   }
   // Meeting node: δ_m = D'⁻¹_m rhs'_m, with the couplings to both eliminated neighbours (r
   // holds rhs_m plus lane 0's).
-  S y0, y1, y2;
   {
     Sym3<S> pm;
     S g;
@@ -325,36 +373,83 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
                          base.zy[0] + cpl.zy[0] + cpl.zy[1], base.zz[0] + cpl.zz[0] + cpl.zz[1]},
                  floor, pm, g);
     const S s0 = r0[0] + cr0[1], s1 = r1[0] + cr1[1], s2 = r2[0] + cr2[1];
-    y0 = g * (pm.xx * s0 + pm.yx * s1 + pm.zx * s2);
-    y1 = g * (pm.yx * s0 + pm.yy * s1 + pm.zy * s2);
-    y2 = g * (pm.zx * s0 + pm.zy * s1 + pm.zz * s2);
-    ws.delta(0, m) = y0;
-    ws.delta(1, m) = y1;
-    ws.delta(2, m) = y2;
+    const S p[6] = {g * pm.xx, g * pm.yx, g * pm.zx, g * pm.yy, g * pm.zy, g * pm.zz};
+    ws.delta(0, m) = p[0] * s0 + p[1] * s1 + p[2] * s2;
+    ws.delta(1, m) = p[1] * s0 + p[3] * s1 + p[4] * s2;
+    ws.delta(2, m) = p[2] * s0 + p[4] * s1 + p[5] * s2;
+    if (keep_meeting) std::copy(p, p + 6, kept + kKeptStepSize * (pairs + (extra ? 1 : 0)));
   }
-  // Back substitution outward from m, the elimination steps in reverse:
-  // δ_i = P_i (rhs'_i + A δ_k) = g (v + α N u (u·δ_k) + N (β δ_k)), k the neighbour towards m,
-  // A = α u uᵀ + β I the segment between them. Step −1 (node f0 in both lanes) copies lane 0.
-  V d0{y0, y0}, d1{y1, y1}, d2{y2, y2};
-  for (int k = pairs - 1; k >= (extra ? -1 : 0); --k) {
-    const int i0 = m - pairs + k, i1 = k < 0 ? f0 : f1 - k;
-    if (k < 0) {
-      d0 = V{d0[0], d0[0]};
-      d1 = V{d1[0], d1[0]};
-      d2 = V{d2[0], d2[0]};
+  back_substitute_block_tridiagonal<Scalar, V>(model, kept, ws.delta);
+}
+
+/// Solves J δ = rhs with the factor that factor_solve_block_tridiagonal kept in `kept` (with
+/// keep_meeting): forward elimination of rhs (into the free columns of δ) and back
+/// substitution, the same arithmetic as the factorisation's own solve, so that the same rhs
+/// gives the same δ bit for bit. Reads only `kept` and `rhs`; O(N), no heap allocation.
+template <typename Scalar, typename V = typename LanePair<Scalar>::type>
+void solve_factored_block_tridiagonal(const TetherModel<Scalar>& model, const Scalar* kept,
+                                      const Matrix3X<Scalar>& rhs, Matrix3X<Scalar>& delta) {
+  using S = Scalar;
+  const int f0 = model.first_free_node(), f1 = model.last_free_node();
+  if (f1 < f0) return;
+  const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
+  const bool extra = m - f0 > pairs;
+  const auto kept_pair = [](const S* in) {
+    if constexpr (std::is_trivially_copyable_v<V>) {
+      V x;
+      std::memcpy(&x, in, sizeof(V));
+      return x;
+    } else {
+      return V{in[0], in[1]};
     }
-    const S* const in = ws.block_inv.data() + kStepSize * (k + (extra ? 1 : 0));
-    const auto q = [&](int j) { return kept(in + 2 * j); };
-    const V ud = q(14) * d0 + q(15) * d1 + q(16) * d2;
-    const V gb = q(10), t0 = gb * d0, t1 = gb * d1, t2 = gb * d2;
-    const V n00 = q(3), n10 = q(4), n20 = q(5), n11 = q(6), n21 = q(7), n22 = q(8), g = q(9);
-    d0 = (g * q(0) + q(11) * ud) + (n00 * t0 + n10 * t1 + n20 * t2);
-    d1 = (g * q(1) + q(12) * ud) + (n10 * t0 + n11 * t1 + n21 * t2);
-    d2 = (g * q(2) + q(13) * ud) + (n20 * t0 + n21 * t1 + n22 * t2);
-    put(ws.delta, 0, i0, i1, d0);
-    put(ws.delta, 1, i0, i1, d1);
-    put(ws.delta, 2, i0, i1, d2);
+  };
+  const auto lanes_row = [](const auto& a, int row, int i0, int i1) {
+    return V{a(row, i0), a(row, i1)};
+  };
+  const auto put = [](auto& a, int row, int i0, int i1, const V& x) {
+    a(row, i0) = x[0];
+    a(row, i1) = x[1];
+  };
+  V cr0{S(0), S(0)}, cr1{S(0), S(0)}, cr2{S(0), S(0)};
+  V r0, r1, r2;
+  for (int k = extra ? -1 : 0;; ++k) {
+    const int i0 = m - pairs + k, i1 = k < 0 ? f0 : f1 - k;
+    r0 = lanes_row(rhs, 0, i0, i1) + cr0;
+    r1 = lanes_row(rhs, 1, i0, i1) + cr1;
+    r2 = lanes_row(rhs, 2, i0, i1) + cr2;
+    if (k == pairs) break;
+    const S* const in = kept + kKeptStepSize * (k + (extra ? 1 : 0));
+    const auto q = [&](int j) { return kept_pair(in + 2 * j); };
+    const V p00 = q(0), p10 = q(1), p20 = q(2), p11 = q(3), p21 = q(4), p22 = q(5);
+    put(delta, 0, i0, i1, p00 * r0 + p10 * r1 + p20 * r2);
+    put(delta, 1, i0, i1, p10 * r0 + p11 * r1 + p21 * r2);
+    put(delta, 2, i0, i1, p20 * r0 + p21 * r1 + p22 * r2);
+    cr0 = q(6) * r0 + q(7) * r1 + q(8) * r2;
+    cr1 = q(9) * r0 + q(10) * r1 + q(11) * r2;
+    cr2 = q(12) * r0 + q(13) * r1 + q(14) * r2;
+    if (k < 0) {
+      cr0 = V{cr0[0], S(0)};
+      cr1 = V{cr1[0], S(0)};
+      cr2 = V{cr2[0], S(0)};
+    }
   }
+  {
+    const S* const pm = kept + kKeptStepSize * (pairs + (extra ? 1 : 0));
+    const S s0 = r0[0] + cr0[1], s1 = r1[0] + cr1[1], s2 = r2[0] + cr2[1];
+    delta(0, m) = pm[0] * s0 + pm[1] * s1 + pm[2] * s2;
+    delta(1, m) = pm[1] * s0 + pm[3] * s1 + pm[4] * s2;
+    delta(2, m) = pm[2] * s0 + pm[4] * s1 + pm[5] * s2;
+  }
+  back_substitute_block_tridiagonal<Scalar, V>(model, kept, delta);
+}
+
+/// solve_block_tridiagonal's elimination with its factor kept in ws.block_inv (as scratch: the
+/// meeting node's block is not kept): solves J δ = rhs, see factor_solve_block_tridiagonal.
+template <typename Scalar, typename V = typename LanePair<Scalar>::type>
+void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                             Scalar c_m, Scalar c_v, Scalar c_x) {
+  KELP_ASSERT(ws.block_inv.size() >= kKeptStepSize * (model.nodes() / 2));
+  factor_solve_block_tridiagonal<Scalar, V>(model, ws, c_m, c_v, c_x, ws.block_inv.data(), false);
 }
 
 /// Newton direction with a primal–dual active set for the kinks of the axial force (semismooth
@@ -368,9 +463,15 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
 /// and stretch rate until they repeat (at most `max_passes` solves). Reads ws.rhs (= −R) and the
 /// Jacobian terms of compute_forces<true>; writes ws.delta; ws.rhs and the Jacobian terms are
 /// restored.
+///
+/// Each pass factors the Newton matrix (factor_solve_block_tridiagonal): into `kept` with the
+/// meeting node's block when given (newton_factor_size(nodes) scalars, the last pass's factor
+/// then serves solve_factored_block_tridiagonal, its branches being those left in
+/// ws.seg_branch), else into ws.block_inv as scratch. Returns the number of passes
+/// (factorisations).
 template <typename Scalar>
-void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
-                          Scalar band, int max_passes) {
+int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
+                         Scalar band, int max_passes, Scalar* kept = nullptr) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   const Scalar l = model.segment_length();
@@ -401,6 +502,12 @@ void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scal
     }
     return changed;
   };
+  const auto solve = [&]() {
+    if (kept)
+      factor_solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh, kept, true);
+    else
+      solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+  };
   bool on_true_branch = true;
   for (int s = 0; s < n; ++s) {
     const Scalar bt = true_branch(s);
@@ -411,8 +518,8 @@ void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scal
   int pass = 0;
   if (on_true_branch) {
     // Common case: plain Newton; done unless the prediction crosses a kink.
-    solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
-    if (max_passes <= 1 || !update()) return;
+    solve();
+    if (max_passes <= 1 || !update()) return 1;
     pass = 1;
   }
   ws.rhs_true = ws.rhs;
@@ -435,12 +542,13 @@ void active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scal
       ws.seg_k_uu(s) = (b == Scalar(2) ? ea_l : Scalar(0)) - ws.seg_k_perp(s);
       ws.seg_c_uu(s) = b > Scalar(0) ? ba_l : Scalar(0);
     }
-    solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+    solve();
     if (pass + 1 >= max_passes || !update()) break;
   }
   ws.seg_k_uu = ws.seg_true_k_uu;
   ws.seg_c_uu = ws.seg_true_c_uu;
   ws.rhs.swap(ws.rhs_true);
+  return pass + 1;
 }
 
 }  // namespace detail

@@ -1,10 +1,9 @@
 /// \file
-/// \brief The implicit tether steps: backward Euler and BDF2, solved by Newton's method with the
-/// analytic block-tridiagonal symmetric Jacobian (kelp/tether/block_solve.hpp) or, when
-/// ImplicitOptions::jacobian says so, the whole Jacobian (kelp/tether/whole_newton.hpp), with
-/// backtracking and
-/// step halving; a step that cannot be completed throws and leaves the state as it was. End
-/// forces are those at the end of the step.
+/// \brief The implicit tether steps: backward Euler and BDF2, solved by a simplified Newton
+/// method (the factored Newton matrix kept in the state and reused across iterations and steps
+/// while it serves) or by Newton's method, with the analytic block-tridiagonal
+/// Jacobian (kelp/tether/block_solve.hpp), backtracking and step halving; a step that cannot be
+/// completed throws and leaves the state as it was. End forces are those at the end of the step.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,16 +42,44 @@ void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<S
   }
 }
 
+/// True when every segment's taut/slack/clamped branch at the last force evaluation (from its
+/// length and its clamped axial force, which compute_forces fills with or without the Jacobian
+/// terms) is `branch`'s (see active_set_direction).
+/// Segments at least (1 − band)·l long count as taut, as active_set_direction starts them.
+template <typename Scalar>
+bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
+                  const VectorX<Scalar>& branch, Scalar band) {
+  const Scalar l = model.segment_length();
+  const Scalar taut_from = band > Scalar(0) ? (Scalar(1) - band) * l : l;
+  const bool clamp = !model.parameters().compressive_damping;
+  bool same = true;
+  for (int s = 0; s < model.segments(); ++s) {
+    const Scalar ls = ws.stretched_length(s);
+    const bool taut = band > Scalar(0) ? ls >= taut_from : ls > l;
+    const Scalar b = taut && band > Scalar(0) ? Scalar(2)
+                                              : (clamp && !(ws.tension(s) > Scalar(0))
+                                                     ? Scalar(0)
+                                                     : (ls > l ? Scalar(2) : Scalar(1)));
+    same = same && b == branch(s);
+  }
+  return same;
+}
+
 /// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
 /// new state and returns true when Newton's method converged (or options.check_convergence is
 /// false); returns false with the state untouched otherwise. Adds its work to `report`. Inputs
-/// already checked.
+/// already checked. With NewtonMethod::simplified, `fresh_matrices` forms the Newton matrix at
+/// every iteration (Newton's method, the matrix kept for the next steps) instead of reusing the
+/// kept one; `reused` says whether a kept matrix was reused. With `whole`, every iteration
+/// forms and factors the whole Jacobian (kelp/tether/whole_newton.hpp: exact Newton) and the
+/// line search works on the residual's norm.
 template <typename Scalar, typename Env>
 bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                       TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
-                      bool bdf2, const ImplicitOptions<Scalar>& options,
-                      StepReport<Scalar>& report) {
+                      bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report,
+                      bool fresh_matrices, bool whole, bool& reused) {
   using std::abs;
+  using std::pow;
   const double t1 = state.time + dt;
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   // The history (BDF2, velocity predictor) is used only if it is this state's previous step.
@@ -105,10 +132,40 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   }
   bool converged = false;
   Scalar res(0);
+  // The Newton matrix. Exact: formed at every iteration in ws.block_inv. Simplified: the one
+  // the state keeps (TetherState::newton) while it fits this step's γh and is young enough,
+  // else one formed in this attempt (ws.newton_factor, its branches in ws.newton_branch),
+  // which commit() hands to the state.
+  const bool simplified = options.newton == NewtonMethod::simplified && options.check_convergence;
+  const bool form_always = !simplified || fresh_matrices || whole;
+  const Scalar* matrix = nullptr;
+  const VectorX<Scalar>* matrix_branch = nullptr;
+  reused = false;
+  if (!form_always && state.newton.holds(cols) && state.newton.gh == gh &&
+      state.newton.age < options.max_matrix_age) {
+    matrix = state.newton.factor.data();
+    matrix_branch = &state.newton.branch;
+  }
+  Scalar first_residual(0);   // scaled residual after the first correction
+  bool first_reused = false;  // the first correction reused a kept matrix
   // Takes the iterate (ws.x1, ws.v1) with ws.end_forces: commit() turns the pre-step state into
   // the history; the end forces' impulse over dt and the residual go to the report.
   const auto accept = [&]() {
-    commit(state, ws.x1, ws.v1, dt, "step_implicit");
+    const int age = state.newton.age;
+    commit(state, ws.x1, ws.v1, dt, "step_implicit");  // drops the kept matrix
+    if (simplified && matrix == ws.newton_factor.data()) {
+      state.newton.factor.swap(ws.newton_factor);
+      state.newton.branch.swap(ws.newton_branch);
+      state.newton.gh = gh;
+      state.newton.age = 1;
+    } else if (simplified && matrix &&
+               !(first_reused && first_residual > options.refresh_residual * tolerance)) {
+      // The residual the kept matrix leaves after one correction grows with its age: once above
+      // refresh_residual · tolerance, the next step would need a second correction, which costs
+      // more than forming the matrix anew (Hairer & Wanner's κ · Tol): then it is dropped.
+      state.newton.gh = gh;
+      state.newton.age = age + 1;
+    }
     ws.end_impulse.on_start += Scalar(dt) * ws.end_forces.on_start;
     ws.end_impulse.on_end += Scalar(dt) * ws.end_forces.on_end;
     report.residual = std::max(report.residual, res);
@@ -166,7 +223,9 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     ~WaterGuard() { w.water_frozen = false; }
   } water_guard{ws};
   ws.water_frozen = false;
-  evaluate(ws.x1, ws.v1, res, true);
+  // The Jacobian terms are needed where a matrix is formed: at the predictor unless one is kept.
+  bool jacobian_here = matrix == nullptr;
+  evaluate(ws.x1, ws.v1, res, jacobian_here);
   ws.water_frozen = !options.resample_water;
   // The trial iterates take the kinematic end nodes from here (the free ones are overwritten).
   for (int i = 0; i < cols; ++i) {
@@ -177,18 +236,54 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     ws.xs.col(i) = ws.x1.col(i);
     ws.vs.col(i) = ws.v1.col(i);
   }
+  Scalar res_before(0);  // scaled residual before the last correction
   for (int it = 0;; ++it) {
     // At least one correction: the predictor alone never makes a step.
+    if (it == 1) first_residual = res;
     if (it >= 1 && res <= tolerance) {
       converged = true;
       break;
     }
     if (it >= options.max_iterations) break;
-    if (options.jacobian == JacobianKind::whole)
-      whole_newton_direction(model, ws, env, ws.x1, ws.v1, ws.v1 - ws.v0, gh, options.slack_band,
-                             options.max_active_set_passes);
-    else
-      active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+    // Simplified Newton: keep the matrix while the iteration contracts fast enough to reach
+    // the tolerance within the iterations left, θ = r_k / r_{k−1} < max_contraction and
+    // θ^(k_max − k) r_k / (1 − θ) ≤ tol (Hairer & Wanner §IV.8, on the scaled residual), and
+    // every segment is on the branch the matrix was formed with.
+    bool form = form_always || matrix == nullptr;
+    if (!form && it >= 1) {
+      const Scalar theta = res / res_before;
+      form =
+          !(theta < options.max_contraction) ||
+          pow(theta, Scalar(options.max_iterations - it)) * res > (Scalar(1) - theta) * tolerance;
+    }
+    if (!form) form = !branches_are(model, ws, *matrix_branch, options.slack_band);
+    if (form) {
+      if (!jacobian_here) {
+        // The same iterate again, with the Jacobian terms (rhs and res are unchanged).
+        evaluate(ws.x1, ws.v1, res, true);
+        jacobian_here = true;
+      }
+      if (whole) {
+        report.factorisations +=
+            whole_newton_direction(model, ws, env, ws.x1, ws.v1, ws.v1 - ws.v0, gh,
+                                   options.slack_band, options.max_active_set_passes);
+      } else if (simplified) {
+        report.factorisations +=
+            active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes,
+                                 ws.newton_factor.data());
+        ws.newton_branch = ws.seg_branch;
+        matrix = ws.newton_factor.data();
+        matrix_branch = &ws.newton_branch;
+      } else {
+        report.factorisations +=
+            active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes);
+      }
+    } else {
+      solve_factored_block_tridiagonal(model, matrix, ws.rhs, ws.delta);
+      ++report.reused_factorisations;
+      if (it == 0) first_reused = true;
+      reused = true;
+    }
     ++report.newton_iterations;
     if (!options.check_convergence && it + 1 >= options.max_iterations) {
       // Take the last correction unchecked; extrapolate the end forces with the Jacobian of the
@@ -207,7 +302,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       return true;
     }
     const Eigen::Index nf = f1 - f0 + 1;
-    if (options.jacobian == JacobianKind::whole) {
+    if (whole) {
       // Line search on the merit ψ(α) = Σ_i |R_i/a_i|² along δ: with the whole Jacobian δ is a
       // descent direction of ψ (ψ'(0) = −2ψ(0)) whether or not R is a gradient (the secant
       // search below assumes it is). Armijo test ψ(α) ≤ (1 − 2σα) ψ(0), σ = 1e-4; otherwise α
@@ -237,6 +332,8 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       }
       ws.x1.swap(ws.xs);
       ws.v1.swap(ws.vs);
+      jacobian_here = true;
+      res_before = res;
       res = trial_res;
       continue;
     }
@@ -258,10 +355,11 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       ws.vs.middleCols(f0, nf).noalias() =
           ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
       ws.xs.middleCols(f0, nf).noalias() = ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
-      // The trial carries its Jacobian terms: when another Newton iteration follows (half the
-      // steps of a line near the surface) they are needed at this point, and filling them costs
-      // less than a second evaluation there (−6 % instructions per system step).
-      evaluate(ws.xs, ws.vs, trial_res, true);
+      // Newton's method: the trial carries its Jacobian terms: when another Newton iteration
+      // follows (half the steps of a line near the surface) they are needed at this point, and
+      // filling them costs less than a second evaluation there (−6 % instructions per system
+      // step). The simplified method goes on with the matrix it has.
+      evaluate(ws.xs, ws.vs, trial_res, !simplified);
       if (ls >= options.max_backtracks || !(g0 < Scalar(0))) break;
       const Scalar g = slope();
       if (g <= Scalar(-0.5) * g0) break;
@@ -272,6 +370,8 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     }
     ws.x1.swap(ws.xs);
     ws.v1.swap(ws.vs);
+    jacobian_here = !simplified;
+    res_before = res;
     res = trial_res;
   }
   if (!converged) {
@@ -285,16 +385,34 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
 
 /// implicit_attempt, with a non-finite iterate (numerical_error) counted as not converged: a
 /// shorter step may well succeed. Nothing is committed when it returns false.
+/// With the simplified method, an attempt that reused a kept matrix and failed is made again
+/// with a fresh matrix at every iteration (Newton's method) before it counts as failed.
 template <typename Scalar, typename Env>
 bool try_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                   TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
                   bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report) {
-  try {
-    return implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report);
-  } catch (const kelp::numerical_error&) {
-    report.rejected_residual = std::numeric_limits<Scalar>::infinity();
-    return false;
+  const Scalar rejected = report.rejected_residual;
+  // Attempts: 0 as the options say (reusing a kept matrix), 1 with fresh matrices when attempt 0
+  // reused one, 2 with the whole Jacobian (JacobianKind::adaptive) when the symmetric matrix
+  // did not converge.
+  const bool always_whole = options.jacobian == JacobianKind::whole;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const bool whole = always_whole || attempt == 2;
+    if (attempt == 2) ++report.whole_jacobian_attempts;
+    bool reused = false;
+    try {
+      if (implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report, attempt >= 1,
+                           whole, reused)) {
+        report.rejected_residual = rejected;  // the fallback made the step: nothing rejected
+        return true;
+      }
+    } catch (const kelp::numerical_error&) {
+      report.rejected_residual = std::numeric_limits<Scalar>::infinity();
+    }
+    if (whole || (attempt == 1 && options.jacobian != JacobianKind::adaptive)) break;
+    if (attempt == 0 && !reused) attempt = options.jacobian == JacobianKind::adaptive ? 1 : 2;
   }
+  return false;
 }
 
 /// Step of length dt split into two halves, each retried in halves again up to `depth_left`
@@ -329,26 +447,42 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
 /// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
 /// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
-/// in O(N) by block-Thomas elimination (no dense N×N). Left out of this J, so converging
-/// linearly rather than quadratically when they dominate (rough seas, the surface band): the
-/// tangent dependence of drag, forcing and added mass, the added-mass rate terms, the band's
-/// scaling of the fluid forces, the direction dependence of the dashpot, bending (EI). With
-/// `options.jacobian == JacobianKind::whole` Newton uses the whole Jacobian
-/// ∂R/∂v = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x (kelp/tether/jacobian.hpp, every term;
-/// block-pentadiagonal and not symmetric, block LU in O(N)) and converges quadratically. Each
-/// Newton direction settles which segments are taut, slack or clamped with a primal–dual active
-/// set (detail::active_set_direction, detail::whole_newton_direction) and is shortened by a
-/// secant line search on the slope R·δ when it overshoots (with the whole Jacobian, by an Armijo
-/// backtracking on Σ|R_i/a_i|², since R is then not treated as a gradient). The initial guess
-/// extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt. At least one
-/// and up to `options.max_iterations` corrections, until max_i |R_i|/a_i ≤ acceleration_tolerance ·
-/// dt (the tolerance raised to the arithmetic's resolution where it is below it, see
-/// ImplicitOptions::acceleration_tolerance). A step that does not converge is not committed: it is
-/// retried as two half steps, each halved again if needed, at most `options.max_step_halvings`
-/// times (BDF2 restarts with backward Euler after a change of step); if even that fails,
-/// kelp::numerical_error is thrown with the state unchanged. End forces
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
+/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
+/// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
+/// direction settles which segments are taut, slack or clamped with a primal–dual active set
+/// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
+/// when it overshoots.
+///
+/// The Newton matrix (ImplicitOptions::newton): NewtonMethod::exact evaluates the Jacobian and
+/// factors J at every iteration. NewtonMethod::simplified (the default) is the simplified Newton
+/// iteration of implicit Runge–Kutta codes, its matrix reused across steps (Hairer & Wanner,
+/// Solving Ordinary Differential Equations II, 2nd ed. 1996, §IV.8 "Implementation of Implicit
+/// Runge–Kutta Methods"): the factored matrix of the last step that formed one is kept in the state
+/// (TetherState::newton) and each correction is one forward and back substitution with it
+/// (detail::solve_factored_block_tridiagonal, about a fifth of a factorisation), the force
+/// evaluations skipping the Jacobian terms. It is formed anew, from the Jacobian at the current
+/// iterate, when none is kept, when γh differs from the one it was formed with (a new dt, or
+/// BDF2's backward-Euler start), when a segment's taut/slack/clamped branch at the iterate is
+/// not the one in the matrix (the kinks of the axial force change J by EA/l), when it has
+/// served `max_matrix_age` steps, when the iteration's contraction θ_k = r_k/r_{k−1} of the
+/// scaled residual reaches `max_contraction` or the residual is not expected to reach the
+/// tolerance within the corrections left (θ^(k_max−k) r_k/(1 − θ) > tol), and at the next step
+/// when a step's first correction left more than `refresh_residual` × the tolerance (the
+/// residual a kept matrix leaves grows with its age; on the benchmark line it serves two or
+/// three steps). A step that fails with a reused matrix is attempted again with a fresh matrix
+/// at every iteration (Newton's method) before it is split. Both methods stop on the same
+/// residual test, so their results agree to the tolerance. The initial guess extrapolates the
+/// velocity (2v_n − v_{n−1}) when the previous step had the same dt. At least one and up to
+/// `options.max_iterations` corrections,
+/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt (the tolerance raised to the arithmetic's
+/// resolution where it is below it, see ImplicitOptions::acceleration_tolerance). A step that does
+/// not converge is not committed: it is retried as two half steps, each halved again if needed, at
+/// most `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of
+/// step); if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
 /// (`ws.end_forces`) are those of the final iterate, at t + dt.
-/// \returns the work done (sub-steps, Newton iterations, worst residual, retries).
+/// \returns the work done (sub-steps, Newton iterations, factorisations and reuses, worst
+/// residual, retries).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
 /// the result is not finite or Newton's method does not converge.
 namespace detail {

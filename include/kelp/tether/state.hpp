@@ -17,9 +17,58 @@
 
 namespace kelp::tether {
 
+namespace detail {
+/// Scalars kept per step of the implicit steps' block elimination (see
+/// detail::factor_solve_block_tridiagonal).
+inline constexpr int kNewtonFactorStepSize = 30;
+/// Scalars of a kept Newton factorisation of a tether of `nodes` nodes: at most nodes / 2
+/// elimination steps and the meeting node's block.
+inline Eigen::Index newton_factor_size(int nodes) {
+  return Eigen::Index(kNewtonFactorStepSize) * (nodes / 2) + 8;
+}
+}  // namespace detail
+
+/// \brief The Newton matrix an implicit step kept for the next ones (the simplified Newton /
+/// W-method of ImplicitOptions::newton): the block factorisation of J = M + γh D_v + (γh)² D_x
+/// at the point where it was last formed, the taut/slack/clamped branch of every segment it was
+/// formed with, its γh, and how many steps have used it.
+///
+/// It lives in the state because it determines the next step's iterates: saving and restoring a
+/// state restores it too, so a run is reproduced bit for bit. A state built from a model has it
+/// sized and empty (`gh` = 0: the next implicit step forms a new one).
+template <typename Scalar>
+struct KeptNewtonMatrix {
+  /// Factorisation (detail::factor_solve_block_tridiagonal's layout).
+  VectorX<Scalar> factor;
+  /// Branch of each segment in the factored matrix: 0 no axial force, 1 dashpot, 2 taut.
+  VectorX<Scalar> branch;
+  /// γh [s] the matrix was formed with; 0 when none is kept.
+  Scalar gh = Scalar(0);
+  /// Steps committed with this factorisation since it was formed.
+  int age = 0;
+
+  /// \brief True when a factorisation is kept and sized for `nodes` nodes.
+  bool holds(int nodes) const {
+    return gh > Scalar(0) && factor.size() == detail::newton_factor_size(nodes) &&
+           branch.size() == nodes - 1;
+  }
+  /// \brief Forgets the kept factorisation (the buffers stay allocated).
+  void clear() {
+    gh = Scalar(0);
+    age = 0;
+  }
+  /// \brief Sizes the buffers for `nodes` nodes, nothing kept.
+  void resize(int nodes) {
+    factor.setZero(detail::newton_factor_size(nodes));
+    branch.setZero(nodes - 1);
+    clear();
+  }
+};
+
 /// \brief Everything that determines the tether's next step: positions and velocities of all
 /// N + 1 nodes (NED), the clock, and the integrator history (BDF2's previous step, also the
-/// implicit schemes' velocity predictor).
+/// implicit schemes' velocity predictor, and the Newton matrix the simplified Newton method
+/// keeps).
 ///
 /// Saving a copy of a state and restoring it later reproduces the following steps bit for bit;
 /// the workspace holds scratch only. The clock is a double for every Scalar, so a float tether
@@ -45,6 +94,8 @@ struct TetherState {
   /// Length of the step that led from the previous positions to `position` [s]; 0 when there
   /// is no history (a new state, or one whose positions were set by hand: call clear_history()).
   double previous_dt = 0.0;
+  /// The implicit steps' kept Newton matrix (see KeptNewtonMatrix; ImplicitOptions::newton).
+  KeptNewtonMatrix<Scalar> newton;
 
   TetherState() = default;
   /// \brief Zero state sized for `model`, no history.
@@ -52,13 +103,19 @@ struct TetherState {
       : position(Matrix3X<Scalar>::Zero(3, model.nodes())),
         velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
         previous_position(Matrix3X<Scalar>::Zero(3, model.nodes())),
-        previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {}
+        previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {
+    newton.resize(model.nodes());
+  }
 
   /// \brief True when the state carries the previous step (BDF2 history).
   bool has_history() const { return previous_dt > 0.0; }
   /// \brief Forgets the integrator history: the next implicit step starts with backward Euler.
-  /// Call it after editing `position` or `velocity` by hand.
-  void clear_history() { previous_dt = 0.0; }
+  /// Call it after editing `position` or `velocity` by hand. The kept Newton matrix is dropped
+  /// too.
+  void clear_history() {
+    previous_dt = 0.0;
+    newton.clear();
+  }
 };
 
 /// \brief Motion of a kinematic end point over a step, NED.
@@ -131,6 +188,7 @@ template <typename Scalar>
 struct StateBackup {
   Matrix3X<Scalar> position, velocity, previous_position, previous_velocity;
   double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
+  KeptNewtonMatrix<Scalar> newton;
 
   /// \brief Sizes the buffers for `nodes` nodes.
   /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1].
@@ -138,8 +196,9 @@ struct StateBackup {
     detail::check_node_count(nodes, "StateBackup::resize");
     for (Matrix3X<Scalar>* m : {&position, &velocity, &previous_position, &previous_velocity})
       m->setZero(3, nodes);
+    newton.resize(nodes);
   }
-  /// \brief Copies `s` (history included).
+  /// \brief Copies `s` (history and kept Newton matrix included).
   void save(const TetherState<Scalar>& s) {
     position = s.position;
     velocity = s.velocity;
@@ -148,6 +207,10 @@ struct StateBackup {
     time = s.time;
     time_carry = s.time_carry;
     previous_dt = s.previous_dt;
+    newton.factor = s.newton.factor;
+    newton.branch = s.newton.branch;
+    newton.gh = s.newton.gh;
+    newton.age = s.newton.age;
   }
   /// \brief Puts the saved state back into `s`.
   void restore(TetherState<Scalar>& s) const {
@@ -158,6 +221,10 @@ struct StateBackup {
     s.time = time;
     s.time_carry = time_carry;
     s.previous_dt = previous_dt;
+    s.newton.factor = newton.factor;
+    s.newton.branch = newton.branch;
+    s.newton.gh = newton.gh;
+    s.newton.age = newton.age;
   }
 };
 
@@ -208,6 +275,9 @@ struct TetherWorkspace {
   /// factor_whole_newton_matrix, its block LU factor: column 5i + (j − i + 2) holds the 3×3 block
   /// (i, j), |i − j| ≤ 2, column-major (assemble_whole_newton_matrix)
   Eigen::Matrix<Scalar, 9, Eigen::Dynamic> newton_lu;
+  /// A Newton factorisation formed in the current step (ImplicitOptions::newton = simplified),
+  /// swapped into TetherState::newton when the step is committed, and its segment branches
+  VectorX<Scalar> newton_factor, newton_branch;
   Matrix3X<Scalar> rhs, delta;    ///< Newton right-hand side and correction
   Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
   VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
@@ -293,6 +363,8 @@ struct TetherWorkspace {
     f(w.pass_buffer, n, 9);
     f(w.block_inv, 17, n);
     f(w.newton_lu, 9, 5 * n);
+    f(w.newton_factor, detail::newton_factor_size(nodes), 1);
+    f(w.newton_branch, s, 1);
   }
 };
 

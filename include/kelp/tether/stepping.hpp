@@ -62,23 +62,77 @@ inline bool is_implicit(Integrator i) {
 enum class JacobianKind {
   /// The symmetric block-tridiagonal approximation M + γh D_v + (γh)² D_x (axial force,
   /// geometric stiffness, drag with the tangent held, seabed), solved by twisted block-Cholesky
-  /// elimination (detail::active_set_direction): the cheapest per iteration; Newton converges
-  /// linearly where the terms it leaves out matter (rough seas, the surface band).
+  /// elimination (detail::active_set_direction): the cheapest per iteration, and the matrix the
+  /// simplified Newton method keeps; Newton converges linearly where the terms it leaves out
+  /// matter (rough seas, the surface band).
   symmetric,
   /// The whole Jacobian of the residual (kelp/tether/jacobian.hpp: the tangent's dependence of
   /// drag and added mass, the added-mass rate terms, surface band, seabed, dashpot direction,
   /// bending), block-pentadiagonal and not symmetric, solved by block LU
-  /// (kelp/tether/whole_newton.hpp): exact Newton, quadratic convergence.
-  whole
+  /// (kelp/tether/whole_newton.hpp) and formed at every iteration: exact Newton, quadratic
+  /// convergence, about twice the cost of a symmetric iteration.
+  whole,
+  /// The symmetric matrix (kept and reused by the simplified method), and the whole Jacobian
+  /// for a step that did not converge with a fresh symmetric matrix, before the step is split.
+  adaptive
 };
+
+/// \brief Name of a Jacobian kind ("symmetric", "whole", "adaptive").
+inline const char* jacobian_kind_name(JacobianKind k) {
+  return k == JacobianKind::symmetric ? "symmetric"
+                                      : (k == JacobianKind::whole ? "whole" : "adaptive");
+}
+
+/// \brief How the implicit schemes solve their nonlinear equations.
+enum class NewtonMethod {
+  /// Newton's method: the Jacobian is evaluated and the Newton matrix factored at every
+  /// iteration.
+  exact,
+  /// Simplified Newton iteration with the matrix reused across steps (Hairer & Wanner, Solving
+  /// Ordinary Differential Equations II, 2nd ed., Springer 1996, §IV.8): the factored Newton
+  /// matrix is kept and reused across iterations and steps while the iteration contracts well,
+  /// and formed again (from a fresh Jacobian) when the active set, γh or the contraction says it
+  /// has gone stale.
+  simplified
+};
+
+/// \brief Name of a Newton method ("exact", "simplified").
+inline const char* newton_method_name(NewtonMethod m) {
+  return m == NewtonMethod::exact ? "exact" : "simplified";
+}
 
 /// \brief Newton settings of the implicit schemes.
 template <typename Scalar>
 struct ImplicitOptions {
-  /// The Newton matrix (JacobianKind): symmetric approximation (default) or the whole Jacobian.
-  JacobianKind jacobian = JacobianKind::symmetric;
-  /// Maximum Newton corrections per step (each: one Jacobian factorisation and solve).
+  /// Maximum Newton corrections per step (each: one solve with the Newton matrix, factored anew
+  /// for NewtonMethod::exact).
   int max_iterations = 8;
+  /// The Newton matrix (JacobianKind): the symmetric approximation, reused by the simplified
+  /// method, with the whole Jacobian for the steps it cannot converge (adaptive, the default);
+  /// always symmetric; or always the whole Jacobian (exact Newton, no reuse).
+  JacobianKind jacobian = JacobianKind::adaptive;
+  /// Newton's method (refactor at every iteration) or the simplified Newton method that keeps the
+  /// factored Newton matrix J = M + γh D_v + (γh)² D_x in the state (TetherState::newton) and
+  /// reuses it across iterations and steps. The simplified method forms it again when there is
+  /// none, when γh changed (a new dt, or BDF2's first step), when a segment's taut/slack/clamped
+  /// branch differs from the one it was formed with, when it is older than `max_matrix_age` steps,
+  /// or when the iteration contracts by less than `max_contraction` per correction (θ_k = r_k /
+  /// r_{k−1} of the scaled residuals) or is not expected to reach the tolerance within the
+  /// iterations left (θ^(k_max − k)/(1 − θ) r_k above it, Hairer & Wanner §IV.8). Force evaluations
+  /// skip the Jacobian terms while the kept matrix serves. A step that does not converge with a
+  /// reused matrix is attempted again with a fresh one at every iteration (Newton's method) before
+  /// it is split in halves. Both methods stop on the same residual test, so they agree to the
+  /// tolerance. Ignored (exact) when `check_convergence` is false.
+  NewtonMethod newton = NewtonMethod::simplified;
+  /// NewtonMethod::simplified: a kept Newton matrix serves at most this many steps.
+  int max_matrix_age = 64;
+  /// NewtonMethod::simplified: largest accepted contraction θ of the residual per correction
+  /// with a kept matrix (0 < θ < 1); a slower iteration forms the matrix again.
+  Scalar max_contraction = Scalar(0.5);
+  /// NewtonMethod::simplified: a kept matrix whose first correction of a step leaves a scaled
+  /// residual above this fraction of the tolerance is formed anew at the next step (the residual
+  /// it leaves grows with its age, and a second correction costs more than a new matrix).
+  Scalar refresh_residual = Scalar(0.5);
   /// Newton converges when max_i |R_i| / a_i ≤ acceleration_tolerance · dt, R_i the momentum
   /// residual of node i and a_i its isotropic mass: an error ΔF in the node force shows up as
   /// γ dt ΔF / a_i, so this bounds the node forces' error per unit mass [m/s²] whatever the step,
@@ -139,6 +193,14 @@ struct StepReport {
   int retries = 0;
   /// Worst final residual of the attempts that did not converge and were split [m/s].
   Scalar rejected_residual = Scalar(0);
+  /// Newton matrices factored (block eliminations, one per active-set pass; failed attempts
+  /// included; 0 for explicit schemes).
+  int factorisations = 0;
+  /// Newton corrections that reused a kept factorisation (NewtonMethod::simplified).
+  int reused_factorisations = 0;
+  /// Step attempts made with the whole Jacobian after the symmetric matrix did not converge
+  /// (JacobianKind::adaptive).
+  int whole_jacobian_attempts = 0;
 
   /// \brief Adds another step's report: counts add up, the residual is the worst.
   StepReport& operator+=(const StepReport& o) {
@@ -148,6 +210,9 @@ struct StepReport {
     residual = std::max(residual, o.residual);
     retries += o.retries;
     rejected_residual = std::max(rejected_residual, o.rejected_residual);
+    factorisations += o.factorisations;
+    reused_factorisations += o.reused_factorisations;
+    whole_jacobian_attempts += o.whole_jacobian_attempts;
     return *this;
   }
 };
@@ -161,7 +226,8 @@ bool all_finite_fast(const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v) {
 }
 
 /// Commits (x, v) as the state at t + dt if finite; the state before the step becomes the
-/// state's history (BDF2, velocity predictor).
+/// state's history (BDF2, velocity predictor). The kept Newton matrix is dropped (an implicit
+/// step hands its own to the state after this).
 template <typename Scalar>
 void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v, double dt,
             const char* who) {
@@ -175,6 +241,7 @@ void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v
   state.position.swap(x);
   state.velocity.swap(v);
   state.previous_dt = dt;
+  state.newton.clear();
   // Kahan summation of the clock (TetherState::time_carry).
   const double step = dt + state.time_carry;
   const double next = state.time + step;
@@ -192,14 +259,21 @@ bool history_matches(const TetherState<Scalar>& state, double dt) {
 template <typename Scalar>
 void check_implicit_options(const ImplicitOptions<Scalar>& o) {
   KELP_CHECK(o.max_iterations >= 1, "ImplicitOptions::max_iterations must be >= 1");
-  KELP_CHECK(o.jacobian == JacobianKind::symmetric || o.jacobian == JacobianKind::whole,
-             "ImplicitOptions::jacobian must be JacobianKind::symmetric or JacobianKind::whole");
+  KELP_CHECK(o.jacobian == JacobianKind::symmetric || o.jacobian == JacobianKind::whole ||
+                 o.jacobian == JacobianKind::adaptive,
+             "ImplicitOptions::jacobian must be JacobianKind::symmetric, whole or adaptive");
   check_positive(o.acceleration_tolerance, "ImplicitOptions::acceleration_tolerance");
   check_non_negative(o.slack_band, "ImplicitOptions::slack_band");
   KELP_CHECK(o.max_active_set_passes >= 1, "ImplicitOptions::max_active_set_passes must be >= 1");
   KELP_CHECK(o.max_backtracks >= 0, "ImplicitOptions::max_backtracks must be >= 0");
   KELP_CHECK(o.max_step_halvings >= 0 && o.max_step_halvings <= 30,
              "ImplicitOptions::max_step_halvings must be in [0, 30]");
+  KELP_CHECK(o.newton == NewtonMethod::exact || o.newton == NewtonMethod::simplified,
+             "ImplicitOptions::newton must be NewtonMethod::exact or NewtonMethod::simplified");
+  KELP_CHECK(o.max_matrix_age >= 1, "ImplicitOptions::max_matrix_age must be >= 1");
+  KELP_CHECK(o.max_contraction > Scalar(0) && o.max_contraction < Scalar(1),
+             "ImplicitOptions::max_contraction must be in (0, 1)");
+  check_non_negative(o.refresh_residual, "ImplicitOptions::refresh_residual");
 }
 
 /// Checks a step's inputs, then gives a state whose history buffers do not fit the model (a
@@ -235,6 +309,9 @@ void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<S
     state.previous_velocity.setZero(3, model.nodes());
     state.previous_dt = 0.0;
   }
+  if (state.newton.factor.size() != newton_factor_size(model.nodes()) ||
+      state.newton.branch.size() != model.segments())
+    state.newton.resize(model.nodes());
 }
 
 /// `x` in %g format, for error messages.

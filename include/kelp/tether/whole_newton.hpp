@@ -176,11 +176,12 @@ namespace detail {
 /// segment on the branch its predicted extension and stretch rate give, at most `max_passes`
 /// factorisations); the other kinks (surface band, seabed, friction) take the branch of the
 /// current iterate. ws.rhs is restored; ws.newton_lu keeps the last factor. No heap allocation.
+/// \returns the number of factorisations (active-set passes).
 template <typename Scalar, typename Env, typename DX, typename DV, typename DD>
-void whole_newton_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
-                            const Env& env, const Eigen::MatrixBase<DX>& x,
-                            const Eigen::MatrixBase<DV>& v, const Eigen::MatrixBase<DD>& d,
-                            Scalar gh, Scalar band, int max_passes) {
+int whole_newton_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                           const Env& env, const Eigen::MatrixBase<DX>& x,
+                           const Eigen::MatrixBase<DV>& v, const Eigen::MatrixBase<DD>& d,
+                           Scalar gh, Scalar band, int max_passes) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   const Scalar l = model.segment_length();
@@ -216,7 +217,7 @@ void whole_newton_direction(const TetherModel<Scalar>& model, TetherWorkspace<Sc
     assemble_whole_newton_matrix(model, ws, env, x, v, d, gh);
     factor_whole_newton_matrix(model, ws);
     solve_whole_newton_matrix(model, ws, ws.rhs, ws.delta);
-    if (max_passes <= 1 || !update()) return;
+    if (max_passes <= 1 || !update()) return 1;
     pass = 1;
   }
   ws.rhs_true = ws.rhs;
@@ -239,6 +240,7 @@ void whole_newton_direction(const TetherModel<Scalar>& model, TetherWorkspace<Sc
     if (pass + 1 >= max_passes || !update()) break;
   }
   ws.rhs.swap(ws.rhs_true);
+  return pass + 1;
 }
 
 }  // namespace detail
