@@ -23,6 +23,7 @@
 #include "bridge.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/solver_report.hpp"
 #include "kelp/sim/world.hpp"
 
 namespace fs = std::filesystem;
@@ -245,6 +246,8 @@ int run(const Options& o) {
   summary["bind"] = o.bind;
   summary["ardusub"] = counters_json(bridge.counters(0), o.sub_port, bridge.joined(0));
   summary["ardurover"] = counters_json(bridge.counters(1), o.rover_port, bridge.joined(1));
+  summary["tether_solver"] =
+      kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters());
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';

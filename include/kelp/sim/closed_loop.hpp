@@ -25,8 +25,10 @@
 #include "kelp/core/error.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/solver_report.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/system/presets.hpp"
+#include "kelp/system/solver_stats.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/thrusters.hpp"
@@ -160,6 +162,7 @@ class ClosedLoop {
     inputs_.auv.tau = auv_command_->wrench;
     inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
+    solver_stats_ += report_;
     ++k_;
     if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
     observe();
@@ -215,10 +218,13 @@ class ClosedLoop {
   const LogRow& sample() const { return sample_; }
   /// \brief The statistics so far.
   const RunMetrics& metrics() const { return metrics_; }
+  /// \brief How hard the tether's solver has worked so far (every step's report summed).
+  const kelp::system::SolverStatsd& solver_stats() const { return solver_stats_; }
 
   /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
-  /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, final
-  /// energy, the scenario file and the scenario with every field as used.
+  /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, the
+  /// tether solver's work (`tether_solver`, see solver_summary()), final energy, the scenario
+  /// file and the scenario with every field as used.
   nlohmann::json summary() const {
     const RunMetrics& m = metrics_;
     nlohmann::json s;
@@ -234,6 +240,7 @@ class ClosedLoop {
     s["tether"] = {{"max_tension_n", m.max_tension},
                    {"mean_tension_auv_n", m.auv_mean_tension()},
                    {"slack_fraction", m.slack_fraction()}};
+    s["tether_solver"] = solver_summary(solver_stats_, model_.parameters());
     s["energy_j"] = kelp::system::energy(model_, state_).total();
     s["scenario_file"] = options_.scenario_file;
     s["scenario"] = to_json(scenario_);
@@ -345,6 +352,7 @@ class ClosedLoop {
   const kelp::control::AsvCommand* asv_command_ = nullptr;
   LogRow sample_;
   RunMetrics metrics_;
+  kelp::system::SolverStatsd solver_stats_;
 };
 
 /// \brief Options of simulate().
