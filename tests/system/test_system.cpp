@@ -276,10 +276,14 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
   CHECK(threw);
 }
 
-TEST_CASE("the explicit fallback is an opt-in: off in SystemParameters and paper_system",
+TEST_CASE("no crutches in the defaults: no explicit fallback, the library's Newton budget",
           "[system][errors][solver_stats]") {
   CHECK_FALSE(ks::SystemParametersd{}.explicit_fallback);
   CHECK_FALSE(ks::presets::paper_system(10.0).explicit_fallback);
+  // No crutch either: the paper's system takes the library's Newton budget (it raised it to 16).
+  for (const auto kind : {ks::presets::TetherKind::rov_tether, ks::presets::TetherKind::bead_chain})
+    CHECK(ks::presets::paper_system(15.0, kind).tether_options.max_iterations ==
+          kt::ImplicitOptionsd{}.max_iterations);
 }
 
 TEST_CASE("SolverStats sums the system steps' reports: a known step count, one forced fallback",
