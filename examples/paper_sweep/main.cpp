@@ -74,6 +74,23 @@ int finish(const paper_sweep::Sweep& s, const std::map<std::string, json>& resul
     std::fprintf(stderr, "kelp-sweep: %s\n", warning.c_str());
     std::ofstream(dir / "table.md", std::ios::app) << "\n> **" << warning << "**\n";
   }
+  // The tether solver over the whole sweep: its mean work, its worst run and any fallback.
+  double newton = 0, newton_max = 0, retried = 0, fallbacks = 0;
+  std::string worst;
+  for (const auto& [hash, result] : results) {
+    const paper_sweep::Metrics m = paper_sweep::metrics_of(result.at("summary"));
+    newton += m.newton_mean / static_cast<double>(results.size());
+    if (worst.empty() || m.newton_max > newton_max) {
+      newton_max = m.newton_max;
+      worst = "run " + std::to_string(result.value("index", 0)) + " (" + hash + ")";
+    }
+    retried += m.retried;
+    fallbacks += m.fallbacks;
+  }
+  std::printf(
+      "kelp-sweep: tether solver: %.3g Newton iterations per step on average, at most %.0f in "
+      "one step (%s); %.0f retried steps, %.0f explicit fallbacks\n",
+      newton, newton_max, worst.c_str(), retried, fallbacks);
   if (plot) {
     const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
     const std::string cmd = python + " '" + plot_script() + "' '" + dir.string() + "'";

@@ -379,6 +379,10 @@ inline std::string mixed_platforms_warning(const std::map<std::string, json>& re
 /// The numbers the table summarises, from a run's summary.
 struct Metrics {
   double auv = 0, asv = 0, combined = 0, max_tension = 0, slack = 0;
+  /// The tether solver's work (summary's `tether_solver`; NaN in a result written before it
+  /// was reported): mean and most Newton iterations per step, retried steps, explicit
+  /// fallbacks.
+  double newton_mean = NAN, newton_max = NAN, retried = NAN, fallbacks = NAN;
 };
 inline Metrics metrics_of(const json& summary) {
   Metrics m;
@@ -387,11 +391,21 @@ inline Metrics metrics_of(const json& summary) {
   m.combined = std::sqrt(0.5 * (m.auv * m.auv + m.asv * m.asv));
   m.max_tension = summary.at("tether").at("max_tension_n").get<double>();
   m.slack = summary.at("tether").at("slack_fraction").get<double>();
+  if (summary.contains("tether_solver")) {
+    const json& t = summary.at("tether_solver");
+    m.newton_mean = t.at("newton_iterations_per_step_mean").get<double>();
+    m.newton_max = t.at("newton_iterations_per_step_max").get<double>();
+    m.retried = t.at("retried_steps").get<double>();
+    m.fallbacks = t.at("explicit_fallbacks").get<double>();
+  }
   return m;
 }
 
 /// Writes table.csv and table.md: per grid point, mean and sample standard deviation over the
-/// seeds. `results` maps run hashes to their stored result ({"summary": ...}).
+/// seeds, and the tether solver's work in the grid point's worst run (the most Newton
+/// iterations in one step, retried steps and explicit fallbacks, each the largest over the
+/// seeds) beside the mean Newton iterations per step over all its runs. `results` maps run
+/// hashes to their stored result ({"summary": ...}).
 inline void write_table(const Sweep& s, const std::map<std::string, json>& results,
                         const std::filesystem::path& dir) {
   std::ofstream csv(dir / "table.csv"), md(dir / "table.md");
@@ -400,12 +414,13 @@ inline void write_table(const Sweep& s, const std::map<std::string, json>& resul
   for (const Axis& a : s.axes) csv << a.path << ',';
   csv << "seeds";
   for (const char* n : names) csv << ',' << n << "_mean," << n << "_sd";
-  csv << '\n';
+  csv << ",newton_iterations_per_step_mean,worst_newton_iterations_per_step_max,"
+         "worst_retried_steps,worst_explicit_fallbacks\n";
   md << '|';
   for (const Axis& a : s.axes) md << ' ' << a.path << " |";
   md << " seeds | AUV RMS error [m] | ASV RMS error [m] | combined [m] | max tension [N] | slack "
-        "fraction |\n|";
-  for (std::size_t i = 0; i < s.axes.size() + 6; ++i) md << "---|";
+        "fraction | Newton it./step: mean (worst max) | worst run: retried / fallbacks |\n|";
+  for (std::size_t i = 0; i < s.axes.size() + 8; ++i) md << "---|";
   md << '\n';
   char b[64];
   for (std::size_t point = 0; point < s.points; ++point) {
@@ -437,6 +452,22 @@ inline void write_table(const Sweep& s, const std::map<std::string, json>& resul
       std::snprintf(b, sizeof b, " %.3g ± %.2g |", mean, sd);
       md << b;
     }
+    // The solver: the mean over the runs, the worst run's maxima (NaN propagates: a result
+    // without the solver's figures shows as nan).
+    double newton_mean = 0, newton_max = 0, retried = 0, fallbacks = 0;
+    for (const Metrics& m : ms) {
+      newton_mean += m.newton_mean / static_cast<double>(ms.size());
+      newton_max = std::isnan(m.newton_max) ? m.newton_max : std::max(newton_max, m.newton_max);
+      retried = std::isnan(m.retried) ? m.retried : std::max(retried, m.retried);
+      fallbacks = std::isnan(m.fallbacks) ? m.fallbacks : std::max(fallbacks, m.fallbacks);
+    }
+    char line[1200];  // %.0f of a double takes up to 309 digits
+    std::snprintf(line, sizeof line, ",%.9g,%.9g,%.9g,%.9g", newton_mean, newton_max, retried,
+                  fallbacks);
+    csv << line;
+    std::snprintf(line, sizeof line, " %.3g (%.0f) | %.0f / %.0f |", newton_mean, newton_max,
+                  retried, fallbacks);
+    md << line;
     csv << '\n';
     md << '\n';
   }

@@ -36,6 +36,7 @@
 #include <string>
 
 #include "kelp/system/presets.hpp"
+#include "kelp/system/solver_stats.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/thrusters.hpp"
@@ -215,6 +216,8 @@ class Bridge {
   const ks::SystemModeld& model() const { return model_; }
   const ks::SystemStated& state() const { return state_; }
   const ks::SystemReportd& last_report() const { return report_; }
+  /// How hard the tether's solver has worked over every physics step so far.
+  const ks::SolverStatsd& solver_stats() const { return solver_stats_; }
   const PeerCounters& counters(int slot) const {
     return peers_[static_cast<std::size_t>(slot)].counters;
   }
@@ -353,6 +356,7 @@ class Bridge {
     in.asv.tau =
         peers_[rover].active ? boat_chain_.wrench(asv_force_) : kelp::Vector6<double>::Zero();
     report_ = ks::step(model_, ws_, state_, in, 1.0 / settings_.rate);
+    solver_stats_ += report_;
     ++steps_;
     for (int s = 0; s < 2; ++s) {
       Peer& p = peers_[static_cast<std::size_t>(s)];
@@ -378,6 +382,7 @@ class Bridge {
   kv::ThrusterChaind rov_chain_, boat_chain_;  ///< PWM → command → thrust → wrench
   std::array<Peer, 2> peers_;
   ks::SystemReportd report_;
+  ks::SolverStatsd solver_stats_;
   std::uint64_t steps_ = 0;
   Eigen::Matrix<double, 8, 1> auv_force_, auv_command_;
   Eigen::Vector2d asv_force_, asv_command_;

@@ -23,6 +23,7 @@
 #include "bridge.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/solver_report.hpp"
 #include "kelp/sim/world.hpp"
 
 namespace fs = std::filesystem;
@@ -248,6 +249,8 @@ int run(const Options& o) {
   // The wave kernel's instruction path and the C library's math (kelp/core/kernel_path.hpp).
   summary["kernel"] = kelp::simd::kernel_name(model.environment().waves().active_kernel());
   summary["math_library"] = kelp::simd::math_library_fingerprint();
+  summary["tether_solver"] =
+      kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters());
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';

@@ -26,3 +26,20 @@ foreach(f timeseries.csv nodes.csv)
     message(FATAL_ERROR "the same seed gave different ${f}")
   endif()
 endforeach()
+# summary.json reports the tether solver's work: one report per 10 ms step of the 20 s run, every
+# step committed by Newton's method (at least one correction each), no explicit fallback (off by
+# default) and the worst residual within the tolerance.
+file(READ "${OUT}/a/summary.json" summary)
+string(JSON solver GET "${summary}" tether_solver)
+message(STATUS "tether_solver: ${solver}")
+string(JSON steps GET "${solver}" steps)
+string(JSON newton GET "${solver}" newton_iterations)
+string(JSON fallbacks GET "${solver}" explicit_fallbacks)
+string(JSON enabled GET "${solver}" explicit_fallback)
+string(JSON worst GET "${solver}" worst_residual_m_s)
+string(JSON tolerance GET "${solver}" residual_tolerance_m_s)
+if(NOT steps EQUAL 2000 OR newton LESS 2000 OR NOT fallbacks EQUAL 0 OR enabled
+   OR worst GREATER tolerance)
+  message(FATAL_ERROR "summary.json: tether_solver is not that of 2000 converged implicit steps "
+                      "without fallback: ${solver}")
+endif()

@@ -67,6 +67,14 @@ int run(const Options& o) {
       "%.2f m, boat %.2f m from the AUV RMS, peak tension %.1f N; outputs in %s (timeseries.csv, "
       "nodes.csv, summary.json%s)\n",
       duration, wall, duration / wall, auv_rms, asv_rms, t_max, o.out.c_str(), plots.c_str());
+  const nlohmann::json& ts = summary["tether_solver"];
+  std::printf(
+      "kelp-tethered-pair: tether solver (%s): %.2f Newton iterations per step on average, at "
+      "most %d in one step; %ld retried steps, %ld explicit fallbacks\n",
+      ts["integrator"].get<std::string>().c_str(),
+      ts["newton_iterations_per_step_mean"].get<double>(),
+      ts["newton_iterations_per_step_max"].get<int>(), ts["retried_steps"].get<long>(),
+      ts["explicit_fallbacks"].get<long>());
   return 0;
 }
 

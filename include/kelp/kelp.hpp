@@ -14,6 +14,7 @@
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/environment/wave_loads.hpp"
 #include "kelp/system/presets.hpp"
+#include "kelp/system/solver_stats.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/system/tether_attachment.hpp"
 #include "kelp/tether/catenary.hpp"

@@ -9,4 +9,5 @@
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/solver_report.hpp"
 #include "kelp/sim/world.hpp"

@@ -1,6 +1,7 @@
 // kelp::sim: the closed loop stepped by hand gives simulate()'s run bit for bit, it samples and
 // logs at the scenario's rates, it refuses to step past its end and bad scenarios with errors
 // derived from kelp::error, and a step allocates nothing.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -105,6 +106,57 @@ TEST_CASE("the closed loop refuses a step past its end and counts its steps", "[
   CHECK_THROWS_AS(loop.step(), kelp::error);
   CHECK(loop.time() == t);
   CHECK_THROWS_AS(loop.run_for(-1.0), kelp::invalid_argument);
+}
+
+TEST_CASE("the closed loop counts the tether solver's work of every step and reports it",
+          "[sim][solver_stats]") {
+  ks::Scenario sc = short_calm_run();
+  sc.duration = 0.5;
+  ks::ClosedLoop loop(sc);
+  // Every step's report, summed here by hand beside the loop's own statistics.
+  long newton = 0, substeps = 0, evaluations = 0;
+  int most = 0;
+  while (!loop.done()) {
+    const kelp::system::SystemReportd& r = loop.step();
+    newton += r.tether.newton_iterations;
+    substeps += r.tether.substeps;
+    evaluations += r.tether.force_evaluations;
+    most = std::max(most, r.tether.newton_iterations);
+  }
+  const kelp::system::SolverStatsd& st = loop.solver_stats();
+  CHECK(st.steps == 50);
+  CHECK(st.tether_steps == substeps);
+  CHECK(st.tether_steps >= 50);  // 10 ms steps of at most 10 ms tether steps
+  CHECK(st.newton_iterations == newton);
+  CHECK(st.newton_iterations >= st.tether_steps);  // BDF2 makes at least one correction a step
+  CHECK(st.max_step_newton_iterations == most);
+  CHECK(st.force_evaluations == evaluations);
+  CHECK(st.explicit_fallbacks == 0);
+  CHECK(st.mean_step_newton_iterations() == Approx(newton / 50.0));
+  const nlohmann::json j = loop.summary()["tether_solver"];
+  INFO(j.dump());
+  CHECK(j["steps"] == 50);
+  CHECK(j["integrator"] == "bdf2");
+  CHECK(j["newton_iterations"] == newton);
+  CHECK(j["newton_iterations_per_step_max"] == most);
+  CHECK(j["explicit_fallbacks"] == 0);
+  CHECK(j["explicit_fallback"] == false);
+  CHECK(j["worst_residual_m_s"].get<double>() <= j["residual_tolerance_m_s"].get<double>());
+}
+
+TEST_CASE("a scenario's tether.explicit_fallback is off unless set, and reaches the system",
+          "[sim][solver_stats]") {
+  CHECK_FALSE(ks::Scenario{}.explicit_fallback);
+  CHECK_FALSE(ks::world_setup(ks::Scenario{}, "default").parameters.explicit_fallback);
+  const ks::Scenario on =
+      ks::parse_scenario(R"({"tether": {"explicit_fallback": true}})", "on.json");
+  CHECK(on.explicit_fallback);
+  CHECK(ks::world_setup(on, "on.json").parameters.explicit_fallback);
+  // The summary's echo reads back to the same setting.
+  CHECK(ks::parse_scenario(ks::to_json(on).dump(), "echo").explicit_fallback);
+  CHECK_FALSE(ks::parse_scenario(ks::to_json(ks::Scenario{}).dump(), "echo").explicit_fallback);
+  CHECK_THROWS_WITH(ks::parse_scenario(R"({"tether": {"explicit_fallback": 1}})", "bad.json"),
+                    Catch::Contains("/tether/explicit_fallback"));
 }
 
 TEST_CASE("bad scenarios throw scenario_error, a kelp::invalid_argument naming the path", "[sim]") {

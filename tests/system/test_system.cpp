@@ -10,6 +10,7 @@
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/system/presets.hpp"
+#include "kelp/system/solver_stats.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/tether/catenary.hpp"
 #include "kelp/tether/initial_state.hpp"
@@ -217,8 +218,15 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
   auto p = w.params;
   p.tether_options.max_step_halvings = 0;
   p.tether_options.max_iterations = 1;
+  p.explicit_fallback = true;  // opt-in
   const ks::SystemModeld strict(p, w.env);
-  const ks::SystemModeld normal(w.params, w.env);
+  // The library's Newton settings. This snatch load is harsher than any paper run: with the
+  // tether Jacobian's drag and added-mass tangent terms left out, Newton stalls at one step
+  // (t = 1.37 s, residual 5.5 m/s even at dt/64), so this run keeps the safety net too (as it
+  // had when it was on by default) and counts it.
+  auto q = w.params;
+  q.explicit_fallback = true;
+  const ks::SystemModeld normal(q, w.env);
   auto r = w.params;
   r.tether_integrator = kt::Integrator::rk4;
   r.max_tether_dt =
@@ -234,8 +242,9 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
   // 1.5 s: over 3 s this snatch-loaded pair diverges chaotically (input changes of 1e-9 N turn
   // a passing run into a vehicle tumbling until an RK4 tether step overflows, for every build
   // of the tether step tried), so the comparison is made before that.
+  int normal_fallbacks = 0;
   for (int k = 0; k < 150; ++k) {
-    ks::step(normal, ws, a, in, 0.01);
+    normal_fallbacks += ks::step(normal, ws, a, in, 0.01).tether_fallbacks;
     fallbacks += ks::step(strict, ws, b, in, 0.01).tether_fallbacks;
     ks::step(reference, ws, c, in, 0.01);
   }
@@ -245,7 +254,8 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
                      (x.tether.position - c.tether.position).colwise().norm().maxCoeff()});
   };
   INFO(fallbacks << " of 150 steps redone; after 1.5 s, largest distance from the RK4 run: "
-                 << gap(b) << " m with the fallback, " << gap(a) << " m converged BDF2");
+                 << gap(b) << " m with the fallback, " << gap(a) << " m converged BDF2 ("
+                 << normal_fallbacks << " steps redone)");
   CHECK(fallbacks > 100);
   // Measured 6.7 mm (converged BDF2: 5.5 mm); over input perturbations of 1e-9 to 1 N the
   // fallback run stays 6–21 mm from the RK4 run, converged BDF2 6–17 mm.
@@ -264,6 +274,88 @@ TEST_CASE("a tether step Newton cannot converge is redone explicitly, close to a
     }
   }
   CHECK(threw);
+}
+
+TEST_CASE("no crutches in the defaults: no explicit fallback, the library's Newton budget",
+          "[system][errors][solver_stats]") {
+  CHECK_FALSE(ks::SystemParametersd{}.explicit_fallback);
+  CHECK_FALSE(ks::presets::paper_system(10.0).explicit_fallback);
+  // No crutch either: the paper's system takes the library's Newton budget (it raised it to 16).
+  for (const auto kind : {ks::presets::TetherKind::rov_tether, ks::presets::TetherKind::bead_chain})
+    CHECK(ks::presets::paper_system(15.0, kind).tether_options.max_iterations ==
+          kt::ImplicitOptionsd{}.max_iterations);
+}
+
+TEST_CASE("SolverStats sums the system steps' reports: a known step count, one forced fallback",
+          "[system][solver_stats]") {
+  World w;
+  // 25 ms system steps of at most 10 ms tether steps: ⌈2.5⌉ = 3 tether steps each.
+  w.params.max_tether_dt = 0.01;
+  const ks::SystemModeld model(w.params, w.env);
+  ks::SystemWorkspaced ws(model);
+  auto s = initial_state(model, ws);
+  ks::SystemInputsd in;  // no thrust: the line settles from its static shape
+  ks::SolverStatsd stats;
+  long newton = 0;
+  int most = 0;
+  for (int k = 0; k < 40; ++k) {
+    const ks::SystemReportd r = ks::step(model, ws, s, in, 0.025);
+    stats += r;
+    newton += r.tether.newton_iterations;
+    most = std::max(most, r.tether.newton_iterations);
+  }
+  INFO("mean Newton iterations per step " << stats.mean_step_newton_iterations() << ", per tether "
+                                          << "step " << stats.mean_tether_step_newton_iterations()
+                                          << ", at most " << stats.max_step_newton_iterations);
+  CHECK(stats.steps == 40);
+  REQUIRE(stats.retried_steps == 0);  // else the halves would count too
+  CHECK(stats.tether_steps == 120);
+  CHECK(stats.newton_iterations == newton);
+  CHECK(stats.newton_iterations >= 120);  // at least one correction per tether step
+  CHECK(stats.max_step_newton_iterations == most);
+  CHECK(stats.mean_step_newton_iterations() == Approx(newton / 40.0));
+  CHECK(stats.mean_tether_step_newton_iterations() == Approx(newton / 120.0));
+  CHECK(stats.explicit_fallbacks == 0);
+  CHECK(stats.worst_residual > 0);
+  CHECK(stats.worst_residual <= w.params.tether_options.acceleration_tolerance * (0.025 / 3));
+  CHECK(stats.force_evaluations >= stats.newton_iterations);
+
+  // One Newton correction and no halving, with the safety net on: step until the first step
+  // whose Newton iteration fails (most do, see the test above); it is redone with RK4 in
+  // ⌈dt / h_stable⌉ sub-steps and counted once.
+  auto p = w.params;
+  p.tether_options.max_step_halvings = 0;
+  p.tether_options.max_iterations = 1;
+  p.explicit_fallback = true;
+  const ks::SystemModeld strict(p, w.env);
+  const double h_stable =
+      kt::estimate_stable_dt(strict.tether(), kt::Integrator::rk4, w.env.water_density());
+  const long rk4_substeps = static_cast<long>(std::ceil(0.01 / std::min(0.01, h_stable)));
+  auto b = initial_state(strict, ws);
+  in.asv.tau << 40, 0, 0, 0, 0, 0;
+  in.auv.tau << -20, 0, 10, 0, 0, 0;
+  ks::SolverStatsd strict_stats;
+  ks::SystemReportd last;
+  for (int k = 0; k < 150 && strict_stats.explicit_fallbacks == 0; ++k) {
+    last = ks::step(strict, ws, b, in, 0.01);
+    strict_stats += last;
+  }
+  INFO("first fallback at step " << strict_stats.steps << " of 10 ms; RK4 sub-steps "
+                                 << last.tether.substeps << " (expected " << rk4_substeps << ")");
+  REQUIRE(last.tether_fallbacks == 1);
+  CHECK(strict_stats.explicit_fallbacks == 1);
+  CHECK(last.tether.substeps == rk4_substeps);
+  CHECK(last.tether.newton_iterations == 0);  // RK4; the failed attempt reports nothing
+  CHECK(strict_stats.tether_steps == (strict_stats.steps - 1) + rk4_substeps);
+  CHECK(strict_stats.newton_iterations == strict_stats.steps - 1);  // one per implicit step
+
+  // Statistics of two runs add up.
+  ks::SolverStatsd both = stats;
+  both += strict_stats;
+  CHECK(both.steps == stats.steps + strict_stats.steps);
+  CHECK(both.explicit_fallbacks == 1);
+  CHECK(both.max_step_newton_iterations == stats.max_step_newton_iterations);
+  CHECK(both.worst_residual == std::max(stats.worst_residual, strict_stats.worst_residual));
 }
 
 TEST_CASE("a system step allocates nothing", "[system][malloc]") {

@@ -26,8 +26,10 @@
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/solver_report.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/system/presets.hpp"
+#include "kelp/system/solver_stats.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/thrusters.hpp"
@@ -161,6 +163,7 @@ class ClosedLoop {
     inputs_.auv.tau = auv_command_->wrench;
     inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
+    solver_stats_ += report_;
     ++k_;
     if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
     observe();
@@ -216,12 +219,15 @@ class ClosedLoop {
   const LogRow& sample() const { return sample_; }
   /// \brief The statistics so far.
   const RunMetrics& metrics() const { return metrics_; }
+  /// \brief How hard the tether's solver has worked so far (every step's report summed).
+  const kelp::system::SolverStatsd& solver_stats() const { return solver_stats_; }
 
   /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
-  /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, final
-  /// energy, the wave kernel's instruction path (`kernel`: "portable", "avx2" or "avx512") and
-  /// the fingerprint of the C library's math (`math_library`), the scenario file and the scenario
-  /// with every field as used.
+  /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, the
+  /// tether solver's work (`tether_solver`, see solver_summary()), final energy, the wave
+  /// kernel's instruction path (`kernel`: "portable", "avx2" or "avx512") and the fingerprint of
+  /// the C library's math (`math_library`), the scenario file and the scenario with every field
+  /// as used.
   nlohmann::json summary() const {
     const RunMetrics& m = metrics_;
     nlohmann::json s;
@@ -237,6 +243,7 @@ class ClosedLoop {
     s["tether"] = {{"max_tension_n", m.max_tension},
                    {"mean_tension_auv_n", m.auv_mean_tension()},
                    {"slack_fraction", m.slack_fraction()}};
+    s["tether_solver"] = solver_summary(solver_stats_, model_.parameters());
     s["energy_j"] = kelp::system::energy(model_, state_).total();
     // What the numbers depend on beyond the scenario: the wave kernel's instruction path and the
     // C library's math (kelp/core/kernel_path.hpp); kelp-sweep merge compares them across runs.
@@ -352,6 +359,7 @@ class ClosedLoop {
   const kelp::control::AsvCommand* asv_command_ = nullptr;
   LogRow sample_;
   RunMetrics metrics_;
+  kelp::system::SolverStatsd solver_stats_;
 };
 
 /// \brief Options of simulate().

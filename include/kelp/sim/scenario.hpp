@@ -69,6 +69,10 @@ struct Scenario {
   double diameter = 0, mass_per_length = 0, axial_stiffness = 0, internal_damping = -1;
   double normal_drag = -1, tangential_drag = -1;
   ///@}
+  /// Redo a tether step whose implicit solve fails with RK4 instead of stopping the run
+  /// (system::SystemParameters::explicit_fallback; counted in the summary's
+  /// `tether_solver.explicit_fallbacks`). Off by default: a run stops with an error instead.
+  bool explicit_fallback = false;
   /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
   /// empty: the paper's start, 5 m down astern of the boat).
   ///@{
@@ -272,7 +276,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     const auto& t = j.at("tether");
     r.object(t, "/tether",
              {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
-              "internal_damping", "normal_drag", "tangential_drag"});
+              "internal_damping", "normal_drag", "tangential_drag", "explicit_fallback"});
     r.number(t, "/tether", "diameter", s.diameter, 1e-4, 0.5);
     r.number(t, "/tether", "mass_per_length", s.mass_per_length, 1e-4, 100);
     r.number(t, "/tether", "axial_stiffness", s.axial_stiffness, 1, 1e10);
@@ -282,6 +286,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.number(t, "/tether", "length", s.tether_length, 0.5, 1000);
     r.choice(t, "/tether", "kind", s.tether_kind, {"rov_tether", "bead_chain"});
     r.number(t, "/tether", "segment_length", s.segment_length, 0.05, 10);
+    r.boolean(t, "/tether", "explicit_fallback", s.explicit_fallback);
   }
   if (j.contains("vehicles")) {
     const auto& v = j.at("vehicles");
@@ -387,6 +392,7 @@ inline nlohmann::json to_json(const Scenario& s) {
   opt("internal_damping", s.internal_damping, -1);
   opt("normal_drag", s.normal_drag, -1);
   opt("tangential_drag", s.tangential_drag, -1);
+  j["tether"]["explicit_fallback"] = s.explicit_fallback;
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;

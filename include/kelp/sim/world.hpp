@@ -46,6 +46,7 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
   if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
   if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
+  params.explicit_fallback = sc.explicit_fallback;
   params.asv_attachment = sc.asv_attachment;
   params.auv_attachment = sc.auv_attachment;
   ke::SeaStateOptions sea_options;

@@ -75,10 +75,9 @@ Vector3<Scalar> bluerov2_attachment() {
 
 /// \brief The paper's system: BlueBoat (ASV), BlueROV2 Heavy (AUV) and a tether of
 /// `tether_length` [m] (the paper evaluates 5, 10 and 15 m), in seawater; BDF2 tether steps of at
-/// most 10 ms, with up to 16 Newton iterations before a step is halved (the tether's default is
-/// 8): when a vehicle tumbles at the surface in the rough sea the drag terms left out of the
-/// Jacobian make Newton converge linearly, and halving does not speed that up (the 15 m line in
-/// the rough sea, seed 5, needed 10 at t = 142 s and failed with 8 even at dt/64).
+/// most 10 ms with the library's Newton settings (tether::ImplicitOptions' defaults) and no
+/// explicit fallback (SystemParameters' default): a step Newton's method cannot converge, even
+/// split in halves, throws with the state unchanged.
 /// \throws kelp::invalid_argument for a non-positive length.
 template <typename Scalar>
 SystemParameters<Scalar> paper_system(Scalar tether_length = Scalar(10),
@@ -89,7 +88,6 @@ SystemParameters<Scalar> paper_system(Scalar tether_length = Scalar(10),
   p.auv = vehicle::bluerov2_heavy<Scalar>().parameters;
   p.asv_attachment = blueboat_attachment<Scalar>();
   p.auv_attachment = bluerov2_attachment<Scalar>();
-  p.tether_options.max_iterations = 16;
   switch (kind) {
     case TetherKind::rov_tether:
       p.tether = tether::presets::rov_tether(tether_length, Scalar(0.5));

@@ -90,13 +90,14 @@ struct SystemParameters {
   /// fastest; each pass costs about one more step and makes the exchange of work between the
   /// vehicles and the tether more exact (see the file's comment).
   int coupling_corrections = 0;
-  /// When an implicit tether step fails (Newton's method does not converge even in the
-  /// sub-steps `tether_options.max_step_halvings` allows), redo that step with RK4 in sub-steps
-  /// of the line's stable explicit step (tether::estimate_stable_dt) instead of throwing; counted
-  /// in SystemReport::tether_fallbacks. Such steps are rare (a vehicle tumbling at the surface in
-  /// a rough sea can fold the line so that Newton stalls) and cost about dt / h_stable × 4 force
-  /// evaluations. false: throw kelp::numerical_error as the tether step does.
-  bool explicit_fallback = true;
+  /// An opt-in safety net: when an implicit tether step fails (Newton's method does not
+  /// converge even in the sub-steps `tether_options.max_step_halvings` allows), redo that step
+  /// with RK4 in sub-steps of the line's stable explicit step (tether::estimate_stable_dt)
+  /// instead of throwing; counted in SystemReport::tether_fallbacks (and SolverStats). Such a
+  /// step costs about dt / h_stable × 4 force evaluations, and its numbers are RK4's, not the
+  /// chosen scheme's. false (the default): throw kelp::numerical_error with the state unchanged,
+  /// as the tether step does, so that a run's results never silently depend on it.
+  bool explicit_fallback = false;
 };
 
 /// \brief Checks system parameters (the parts' own checks, kinematic tether ends, attachment
@@ -242,7 +243,9 @@ SystemEnergy<Scalar> energy(const SystemModel<Scalar>& model, const SystemState<
 /// \brief What one system step did.
 template <typename Scalar>
 struct SystemReport {
-  /// The tether integration: sub-steps, Newton iterations, worst residual, retries.
+  /// The tether integration: sub-steps, Newton iterations, worst residual, retries, summed over
+  /// the step's coupling passes (SystemParameters::coupling_corrections) and its explicit
+  /// fallback, if any.
   tether::StepReport<Scalar> tether;
   /// Tether force on each vehicle over the step, NED [N]: the impulse the tether's integrator
   /// delivered to that end divided by dt (for BDF2, the end force at t + h).
@@ -406,7 +409,7 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     ends.end = detail::predicted_end(state.auv, state.auv_nu_dot, p.auv_attachment);
     for (int pass = 0;; ++pass) {
       try {
-        report.tether =
+        report.tether +=
             tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, tether_options);
       } catch (const kelp::numerical_error&) {
         if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
@@ -416,7 +419,7 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
         tether::AdvanceOptions<Scalar> fallback = tether_options;
         fallback.max_dt = std::min(p.max_tether_dt, double(value_of(h)));
         fallback.integrator = tether::Integrator::rk4;
-        report.tether =
+        report.tether +=
             tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, fallback);
         ++report.tether_fallbacks;
       }

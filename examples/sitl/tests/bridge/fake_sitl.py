@@ -328,6 +328,13 @@ def main(program, outdir):
     check(r["timeouts"] == 1 and s["timeouts"] == 0, "time-out counters")
     check(abs(summary["physics_s"] - t[0]) < 1e-6, "physics time %.6f, expected %.6f"
           % (summary["physics_s"], t[0]))
+    # The tether solver's work: one report per physics step, every step converged implicitly.
+    ts = summary.get("tether_solver", {})
+    print("tether solver:", json.dumps(ts))
+    check(ts.get("steps") == summary["steps"] and ts.get("explicit_fallbacks") == 0
+          and ts.get("newton_iterations", 0) >= ts.get("tether_steps", 1) > 0
+          and ts.get("worst_residual_m_s", 1) <= ts.get("residual_tolerance_m_s", 0),
+          "tether_solver in summary.json: %r" % ts)
     with open(os.path.join(log, "events.log")) as f:
         events = f.read()
     for what in ("ArduSub joined", "ArduRover joined", "ArduSub restarted",
