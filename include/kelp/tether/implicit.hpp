@@ -77,7 +77,7 @@ template <typename Scalar, typename Env>
 bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                       TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
                       bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report,
-                      bool fresh_matrices, bool whole, bool& reused) {
+                      bool fresh_matrices, bool whole_from_start, bool& reused) {
   using std::abs;
   using std::pow;
   const double t1 = state.time + dt;
@@ -137,7 +137,12 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // else one formed in this attempt (ws.newton_factor, its branches in ws.newton_branch),
   // which commit() hands to the state.
   const bool simplified = options.newton == NewtonMethod::simplified && options.check_convergence;
+  bool whole = whole_from_start;
   const bool form_always = !simplified || fresh_matrices || whole;
+  // JacobianKind::adaptive: the correction before came from a symmetric matrix formed at that
+  // iterate (not a kept one).
+  const bool adaptive = options.jacobian == JacobianKind::adaptive;
+  bool fresh_symmetric = false;
   const Scalar* matrix = nullptr;
   const VectorX<Scalar>* matrix_branch = nullptr;
   reused = false;
@@ -249,14 +254,23 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     // the tolerance within the iterations left, θ = r_k / r_{k−1} < max_contraction and
     // θ^(k_max − k) r_k / (1 − θ) ≤ tol (Hairer & Wanner §IV.8, on the scaled residual), and
     // every segment is on the branch the matrix was formed with.
-    bool form = form_always || matrix == nullptr;
-    if (!form && it >= 1) {
-      const Scalar theta = res / res_before;
+    bool form = form_always || matrix == nullptr || whole;
+    const Scalar theta = it >= 1 ? res / res_before : Scalar(0);
+    if (!form && it >= 1)
       form =
           !(theta < options.max_contraction) ||
           pow(theta, Scalar(options.max_iterations - it)) * res > (Scalar(1) - theta) * tolerance;
-    }
     if (!form) form = !branches_are(model, ws, *matrix_branch, options.slack_band);
+    // Adaptive: when even a symmetric matrix formed at the last iterate contracted by less than
+    // max_contraction, the terms it leaves out matter here (a node crossing the surface band, a
+    // line whipped by the waves): the rest of the attempt uses the whole Jacobian, with which
+    // Newton converges quadratically.
+    if (adaptive && !whole && fresh_symmetric && !(theta < options.max_contraction)) {
+      whole = true;
+      form = true;
+      ++report.whole_jacobian_attempts;
+    }
+    fresh_symmetric = form && !whole;
     if (form) {
       if (!jacobian_here) {
         // The same iterate again, with the Jacobian terms (rhs and res are unchanged).

@@ -73,7 +73,9 @@ enum class JacobianKind {
   /// convergence, about twice the cost of a symmetric iteration.
   whole,
   /// The symmetric matrix (kept and reused by the simplified method), and the whole Jacobian
-  /// for a step that did not converge with a fresh symmetric matrix, before the step is split.
+  /// for the rest of an attempt where a symmetric matrix formed at the iterate contracts the
+  /// residual by less than ImplicitOptions::max_contraction, and for a step that did not
+  /// converge with fresh symmetric matrices, before the step is split.
   adaptive
 };
 
@@ -198,8 +200,9 @@ struct StepReport {
   int factorisations = 0;
   /// Newton corrections that reused a kept factorisation (NewtonMethod::simplified).
   int reused_factorisations = 0;
-  /// Step attempts made with the whole Jacobian after the symmetric matrix did not converge
-  /// (JacobianKind::adaptive).
+  /// Step attempts that turned to the whole Jacobian (JacobianKind::adaptive): within the
+  /// attempt, when a symmetric matrix formed at the iterate contracted the residual by less than
+  /// `max_contraction`, or after the symmetric attempts did not converge.
   int whole_jacobian_attempts = 0;
 
   /// \brief Adds another step's report: counts add up, the residual is the worst.
