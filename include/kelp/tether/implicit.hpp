@@ -72,12 +72,14 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
 /// every iteration (Newton's method, the matrix kept for the next steps) instead of reusing the
 /// kept one; `reused` says whether a kept matrix was reused. With `whole`, every iteration
 /// forms and factors the whole Jacobian (kelp/tether/whole_newton.hpp: exact Newton) and the
-/// line search works on the residual's norm.
+/// line search works on the residual's norm. With `may_switch`, the attempt turns to the whole
+/// Jacobian once a symmetric matrix formed at the iterate contracts the residual by less than
+/// options.max_contraction (JacobianKind::adaptive).
 template <typename Scalar, typename Env>
 bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                       TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
                       bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report,
-                      bool fresh_matrices, bool whole_from_start, bool& reused) {
+                      bool fresh_matrices, bool whole_from_start, bool may_switch, bool& reused) {
   using std::abs;
   using std::pow;
   const double t1 = state.time + dt;
@@ -141,8 +143,11 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   const bool form_always = !simplified || fresh_matrices || whole;
   // JacobianKind::adaptive: the correction before came from a symmetric matrix formed at that
   // iterate (not a kept one).
-  const bool adaptive = options.jacobian == JacobianKind::adaptive;
   bool fresh_symmetric = false;
+  // A whole matrix the block LU refused (a numerically singular pivot block, e.g. (γh)² EA/l
+  // dwarfing the mass at a very long step, where the symmetric elimination floors its pivots):
+  // the attempt goes on with symmetric matrices.
+  bool whole_refused = false;
   const Scalar* matrix = nullptr;
   const VectorX<Scalar>* matrix_branch = nullptr;
   reused = false;
@@ -265,7 +270,8 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     // max_contraction, the terms it leaves out matter here (a node crossing the surface band, a
     // line whipped by the waves): the rest of the attempt uses the whole Jacobian, with which
     // Newton converges quadratically.
-    if (adaptive && !whole && fresh_symmetric && !(theta < options.max_contraction)) {
+    if (may_switch && !whole && !whole_refused && fresh_symmetric &&
+        !(theta < options.max_contraction)) {
       whole = true;
       form = true;
       ++report.whole_jacobian_attempts;
@@ -278,9 +284,21 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
         jacobian_here = true;
       }
       if (whole) {
-        report.factorisations +=
-            whole_newton_direction(model, ws, env, ws.x1, ws.v1, ws.v1 - ws.v0, gh,
-                                   options.slack_band, options.max_active_set_passes);
+        try {
+          report.factorisations +=
+              whole_newton_direction(model, ws, env, ws.x1, ws.v1, ws.v1 - ws.v0, gh,
+                                     options.slack_band, options.max_active_set_passes);
+        } catch (const kelp::numerical_error&) {
+          if (whole_from_start) throw;
+          // Refused after the switch: the same iterate again (the active-set passes may have
+          // left ws.rhs modified), then the symmetric matrix.
+          whole = false;
+          whole_refused = true;
+          evaluate(ws.x1, ws.v1, res, true);
+        }
+      }
+      if (whole) {
+        // The direction is in ws.delta.
       } else if (simplified) {
         report.factorisations +=
             active_set_direction(model, ws, gh, options.slack_band, options.max_active_set_passes,
@@ -406,17 +424,20 @@ bool try_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                   TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary, double dt,
                   bool bdf2, const ImplicitOptions<Scalar>& options, StepReport<Scalar>& report) {
   const Scalar rejected = report.rejected_residual;
-  // Attempts: 0 as the options say (reusing a kept matrix), 1 with fresh matrices when attempt 0
-  // reused one, 2 with the whole Jacobian (JacobianKind::adaptive) when the symmetric matrix
-  // did not converge.
+  // Attempts: 0 as the options say (reusing a kept matrix; JacobianKind::adaptive: turning to
+  // the whole Jacobian where the symmetric matrix contracts slowly); 1 with fresh symmetric
+  // matrices at every iteration (Newton's method as before the whole Jacobian) when attempt 0
+  // reused a matrix or could switch; 2 with the whole Jacobian from the start
+  // (JacobianKind::adaptive) when those did not converge.
   const bool always_whole = options.jacobian == JacobianKind::whole;
+  const bool adaptive = options.jacobian == JacobianKind::adaptive;
   for (int attempt = 0; attempt < 3; ++attempt) {
     const bool whole = always_whole || attempt == 2;
     if (attempt == 2) ++report.whole_jacobian_attempts;
     bool reused = false;
     try {
       if (implicit_attempt(model, ws, env, state, boundary, dt, bdf2, options, report, attempt >= 1,
-                           whole, reused)) {
+                           whole, adaptive && attempt == 0, reused)) {
         report.rejected_residual = rejected;  // the fallback made the step: nothing rejected
         return true;
       }
@@ -424,7 +445,7 @@ bool try_implicit(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
       report.rejected_residual = std::numeric_limits<Scalar>::infinity();
     }
     if (whole || (attempt == 1 && options.jacobian != JacobianKind::adaptive)) break;
-    if (attempt == 0 && !reused) attempt = options.jacobian == JacobianKind::adaptive ? 1 : 2;
+    if (attempt == 0 && !reused && !adaptive) attempt = 2;
   }
   return false;
 }
