@@ -68,6 +68,8 @@ struct Scenario {
   ///@{
   double diameter = 0, mass_per_length = 0, axial_stiffness = 0, internal_damping = -1;
   double normal_drag = -1, tangential_drag = -1;
+  /// The line model, "kelp" (default) or "moordyn" (MoorDyn v2's: kelp::tether::LineModel).
+  std::string line_model = "kelp";
   ///@}
   /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
   /// empty: the paper's start, 5 m down astern of the boat).
@@ -267,7 +269,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     const auto& t = j.at("tether");
     r.object(t, "/tether",
              {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
-              "internal_damping", "normal_drag", "tangential_drag"});
+              "internal_damping", "normal_drag", "tangential_drag", "line_model"});
     r.number(t, "/tether", "diameter", s.diameter, 1e-4, 0.5);
     r.number(t, "/tether", "mass_per_length", s.mass_per_length, 1e-4, 100);
     r.number(t, "/tether", "axial_stiffness", s.axial_stiffness, 1, 1e10);
@@ -277,6 +279,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.number(t, "/tether", "length", s.tether_length, 0.5, 1000);
     r.choice(t, "/tether", "kind", s.tether_kind, {"rov_tether", "bead_chain"});
     r.number(t, "/tether", "segment_length", s.segment_length, 0.05, 10);
+    r.choice(t, "/tether", "line_model", s.line_model, {"kelp", "moordyn"});
   }
   if (j.contains("vehicles")) {
     const auto& v = j.at("vehicles");
@@ -373,6 +376,7 @@ inline nlohmann::json to_json(const Scenario& s) {
   opt("internal_damping", s.internal_damping, -1);
   opt("normal_drag", s.normal_drag, -1);
   opt("tangential_drag", s.tangential_drag, -1);
+  if (s.line_model != "kelp") j["tether"]["line_model"] = s.line_model;
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;

@@ -44,6 +44,10 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
   if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
   if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
+  if (sc.line_model != "kelp" && sc.line_model != "moordyn")
+    throw scenario_error(file + ": /tether/line_model: expected \"kelp\" or \"moordyn\", got \"" +
+                         sc.line_model + "\"");
+  if (sc.line_model == "moordyn") tp.line_model = kelp::tether::LineModel::moordyn;
   params.asv_attachment = sc.asv_attachment;
   params.auv_attachment = sc.auv_attachment;
   ke::SeaStateOptions sea_options;
