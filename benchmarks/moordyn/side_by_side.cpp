@@ -2,7 +2,14 @@
 // https://github.com/FloatingArrayDesign/MoorDyn) in one process, through MoorDyn's C API.
 // Built only against a MoorDyn installation the user provides (benchmarks/moordyn/CMakeLists.txt).
 // Usage: kelp-moordyn-side-by-side [--sizes 20,50,100,200] [--rounds 5] [--min-time 0.3]
-//        [--check-time 5] [--no-check|--no-timing]
+//        [--check-time 5] [--no-check|--no-timing|--no-validation] [--dir /tmp/moordyn-bench]
+//        [--write-reference tests/tether/moordyn_reference.hpp]
+//
+// First the validation cases of tests/tether/moordyn_cases.hpp (surge, snap loads, static shape
+// in a current): kelp's default line, the same with compressive_damping, and
+// TetherParameters::line_model = LineModel::moordyn against MoorDyn (benchmarks/results/tether.md,
+// "kelp's line and MoorDyn's"); --write-reference stores MoorDyn's results for
+// tests/tether/test_moordyn_reference.cpp.
 //
 // The benchmark line of kelp (benchmarks/tether/bench_tether.cpp): 20 m, d 8 mm, 0.07 kg/m,
 // EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1, Cat 0, no internal damping, no bending, ends 10 m apart
@@ -85,6 +92,13 @@ struct Kelp : kelp_bench::BenchmarkLine {
   using BenchmarkLine::BenchmarkLine;
   void step(double dt, kt::Integrator integ, const kt::ImplicitOptionsd& o = {}) {
     kt::step(model, ws, env, state, boundary(state.time), dt, {integ, o});
+  }
+  // A step with the far end moving as MoorDyn moves a coupled point: linearly within the step,
+  // at the velocity of its start (no acceleration).
+  void step_linear_end(double dt, kt::Integrator integ) {
+    kt::TetherBoundaryd linear = boundary(state.time);
+    linear.end.acceleration.setZero();
+    kt::step(model, ws, env, state, linear, dt, {integ});
   }
 };
 
@@ -248,11 +262,13 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     k.state.velocity.col(i) = m.node_vel_ned(i);
   }
   k.state.clear_history();
-  Kelp kb(n), k1(n);
-  kb.state.position = k1.state.position = k.state.position;
-  kb.state.velocity = k1.state.velocity = k.state.velocity;
+  Kelp kb(n), k1(n), km(n, kt::LineModel::moordyn);
+  kb.state.position = k1.state.position = km.state.position = k.state.position;
+  kb.state.velocity = k1.state.velocity = km.state.velocity = k.state.velocity;
   kb.state.clear_history();
   k1.state.clear_history();
+  km.state.clear_history();
+  double sem = 0, dmax_m = 0;
   double se1 = 0;
   const long K = std::lround(0.01 / dt);
   const long steps = std::lround(T / (K * dt)) * K;
@@ -266,6 +282,11 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     sref += tm * tm;
     for (int i = 0; i <= n; ++i)
       dmax_run = std::max(dmax_run, (m.node_ned(i) - k.state.position.col(i)).norm());
+    km.step_linear_end(dt, kt::Integrator::rk4);
+    const double tkm = ten(kp(km), seg);
+    sem += (tm - tkm) * (tm - tkm);
+    for (int i = 0; i <= n; ++i)
+      dmax_m = std::max(dmax_m, (m.node_ned(i) - km.state.position.col(i)).norm());
     if (s % K == 0) {
       kb.step(K * dt, kt::Integrator::bdf2);
       k1.step(K * dt, kt::Integrator::bdf2, one_newton());
@@ -282,6 +303,10 @@ void agreement(int n, double dt, const std::string& dir, double T) {
       "  N=%3d RK4 vs RK4 over %.2f s: RMS segment-%d force difference %.2e of RMS force; "
       "largest node distance %.2e m; clocks kelp %.9f MoorDyn %.9f\n",
       n, k.state.time, seg, std::sqrt(se / sref), dmax_run, k.state.time, m.t);
+  std::printf(
+      "  N=%3d RK4 vs RK4, kelp with LineModel::moordyn and MoorDyn's end motion (linear within "
+      "a step): RMS segment-%d force difference %.2e of RMS force; largest node distance %.2e m\n",
+      n, seg, std::sqrt(sem / sref), dmax_m);
   std::snprintf(what, sizeof what, "BDF2 %.2fms t=%.2fs", K * dt * 1e3, kb.state.time);
   compare(what, kb, seg);
   std::printf(

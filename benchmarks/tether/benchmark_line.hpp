@@ -31,13 +31,16 @@ struct BenchmarkLine {
   kelp::tether::TetherStated state;
   kelp::Vector3<double> a{0, 0, 0}, b{10, 0, Heave::base_depth};
 
-  explicit BenchmarkLine(int n) : model(params(n)), ws(model) {
+  explicit BenchmarkLine(int n, kelp::tether::LineModel line_model = kelp::tether::LineModel::kelp)
+      : model(params(n, line_model)), ws(model) {
     if (!kelp::tether::static_initial_state(model, ws, env, a, b, state).converged)
       throw std::runtime_error("benchmark line: static equilibrium did not converge");
   }
-  static kelp::tether::TetherParametersd params(int n) {
+  static kelp::tether::TetherParametersd params(
+      int n, kelp::tether::LineModel line_model = kelp::tether::LineModel::kelp) {
     kelp::tether::TetherParametersd p;
     p.segments = n;
+    p.line_model = line_model;
     return p;
   }
   /// Fixed start at a, the far end heaving about b.
