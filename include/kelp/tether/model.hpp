@@ -32,12 +32,11 @@ enum class EndMode {
 /// forcing, seabed spring–damper); they differ in three places (docs/equations.md, section 4;
 /// benchmarks/results/tether.md, "kelp's line and MoorDyn's" for the measured effect):
 ///
-/// | | `kelp` (default) | `moordyn` |
-/// |---|---|---|
-/// | added-mass rate terms (Cat ≠ Can) | yes: the model is passive | none, as MoorDyn v2 |
-/// | internal dashpot BA·ε̇ | the axial force is clamped at 0 (a cable never pushes) | acts in
-/// compression too | | seabed damping at touchdown | ramps up over `seabed_damping_depth` | at once
-/// (a force step) |
+/// - added-mass rate terms (Cat ≠ Can): `kelp` has them (the model is passive), `moordyn` not;
+/// - internal dashpot BA·ε̇: `kelp` clamps the axial force at 0 (a cable never pushes),
+///   `moordyn` lets it act in compression too;
+/// - seabed damping at touchdown: `kelp` ramps it in over `seabed_damping_depth`, `moordyn`
+///   switches it on at first contact (a force step).
 enum class LineModel {
   /// kelp's passive line: the added-mass rate terms (Lagrange's equations with the
   /// tangent-dependent added mass; see compute_forces), an axial force that never pushes (unless
@@ -95,7 +94,9 @@ struct TetherParameters {
   /// axial force is max(0, EA·max(0, ε) + BA·ε̇).
   bool compressive_damping = false;
   /// The line model: kelp's passive line (default) or MoorDyn v2's (see LineModel; `moordyn`
-  /// implies compressive_damping and a zero seabed_damping_depth).
+  /// implies compressive_damping and a zero seabed_damping_depth). One field rather than a preset
+  /// that sets several: it travels with the parameters (copies, scenario files), it cannot be
+  /// half applied, and it reads as what it is when a line is printed or compared.
   LineModel line_model = LineModel::kelp;
   /// Bending stiffness EI [N m²] (0: a perfectly flexible line). Discrete bending energy
   /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
