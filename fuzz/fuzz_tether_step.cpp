@@ -46,6 +46,7 @@ void run(const std::uint8_t* data, std::size_t size) {
   p.end_mode = (flags & 2) ? kt::EndMode::free : kt::EndMode::kinematic;
   p.compressive_damping = (flags & 4) != 0;
   const bool catenary_start = (flags & 8) == 0;
+  if (flags & 16) p.line_model = kt::LineModel::moordyn;
   for (double* v :
        {&p.length, &p.diameter, &p.mass_per_length, &p.axial_stiffness, &p.internal_damping,
         &p.bending_stiffness, &p.normal_drag, &p.tangential_drag, &p.normal_added_mass,

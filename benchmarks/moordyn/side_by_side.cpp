@@ -2,7 +2,14 @@
 // https://github.com/FloatingArrayDesign/MoorDyn) in one process, through MoorDyn's C API.
 // Built only against a MoorDyn installation the user provides (benchmarks/moordyn/CMakeLists.txt).
 // Usage: kelp-moordyn-side-by-side [--sizes 20,50,100,200] [--rounds 5] [--min-time 0.3]
-//        [--check-time 5] [--no-check|--no-timing]
+//        [--check-time 5] [--no-check|--no-timing|--no-validation] [--dir /tmp/moordyn-bench]
+//        [--write-reference tests/tether/moordyn_reference.hpp]
+//
+// First the validation cases of tests/tether/moordyn_cases.hpp (surge, snap loads, static shape
+// in a current): kelp's default line, the same with compressive_damping, and
+// TetherParameters::line_model = LineModel::moordyn against MoorDyn (benchmarks/results/tether.md,
+// "kelp's line and MoorDyn's"); --write-reference stores MoorDyn's results for
+// tests/tether/test_moordyn_reference.cpp.
 //
 // The benchmark line of kelp (benchmarks/tether/bench_tether.cpp): 20 m, d 8 mm, 0.07 kg/m,
 // EA 1e5 N, Cdn 1.2, Cdt 0.008, Can 1, Cat 0, no internal damping, no bending, ends 10 m apart
@@ -35,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "../../tests/tether/moordyn_cases.hpp"
 #include "../tether/benchmark_line.hpp"
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/initial_state.hpp"
@@ -85,6 +93,13 @@ struct Kelp : kelp_bench::BenchmarkLine {
   using BenchmarkLine::BenchmarkLine;
   kt::StepReportd step(double dt, kt::Integrator integ, const kt::ImplicitOptionsd& o = {}) {
     return kt::step(model, ws, env, state, boundary(state.time), dt, {integ, o});
+  }
+  // A step with the far end moving as MoorDyn moves a coupled point: linearly within the step,
+  // at the velocity of its start (no acceleration).
+  void step_linear_end(double dt, kt::Integrator integ) {
+    kt::TetherBoundaryd linear = boundary(state.time);
+    linear.end.acceleration.setZero();
+    kt::step(model, ws, env, state, linear, dt, {integ});
   }
 };
 
@@ -255,13 +270,13 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     k.state.velocity.col(i) = m.node_vel_ned(i);
   }
   k.state.clear_history();
-  Kelp kb(n), k1(n), kx(n);
-  kb.state.position = k1.state.position = kx.state.position = k.state.position;
-  kb.state.velocity = k1.state.velocity = kx.state.velocity = k.state.velocity;
-  kb.state.clear_history();
-  k1.state.clear_history();
-  kx.state.clear_history();
-  double se1 = 0, sex = 0, sbx = 0;
+  Kelp kb(n), k1(n), kx(n), km(n, 0.0, kt::LineModel::moordyn);
+  for (Kelp* kk : {&kb, &k1, &kx, &km}) {
+    kk->state.position = k.state.position;
+    kk->state.velocity = k.state.velocity;
+    kk->state.clear_history();
+  }
+  double se1 = 0, sex = 0, sbx = 0, sem = 0, dmax_m = 0;
   kt::StepReportd rb, rx;
   const long K = std::lround(0.01 / dt);
   const long steps = std::lround(T / (K * dt)) * K;
@@ -275,6 +290,11 @@ void agreement(int n, double dt, const std::string& dir, double T) {
     sref += tm * tm;
     for (int i = 0; i <= n; ++i)
       dmax_run = std::max(dmax_run, (m.node_ned(i) - k.state.position.col(i)).norm());
+    km.step_linear_end(dt, kt::Integrator::rk4);
+    const double tkm = ten(kp(km), seg);
+    sem += (tm - tkm) * (tm - tkm);
+    for (int i = 0; i <= n; ++i)
+      dmax_m = std::max(dmax_m, (m.node_ned(i) - km.state.position.col(i)).norm());
     if (s % K == 0) {
       rb += kb.step(K * dt, kt::Integrator::bdf2);
       rx += kx.step(K * dt, kt::Integrator::bdf2, exact_newton());
@@ -294,6 +314,10 @@ void agreement(int n, double dt, const std::string& dir, double T) {
       "  N=%3d RK4 vs RK4 over %.2f s: RMS segment-%d force difference %.2e of RMS force; "
       "largest node distance %.2e m; clocks kelp %.9f MoorDyn %.9f\n",
       n, k.state.time, seg, std::sqrt(se / sref), dmax_run, k.state.time, m.t);
+  std::printf(
+      "  N=%3d RK4 vs RK4, kelp with LineModel::moordyn and MoorDyn's end motion (linear within "
+      "a step): RMS segment-%d force difference %.2e of RMS force; largest node distance %.2e m\n",
+      n, seg, std::sqrt(sem / sref), dmax_m);
   std::snprintf(what, sizeof what, "BDF2 %.2fms t=%.2fs", K * dt * 1e3, kb.state.time);
   compare(what, kb, seg);
   std::printf(
@@ -359,14 +383,234 @@ void agreement(int n, double dt, const std::string& dir, double T) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// The validation cases of tests/tether/moordyn_cases.hpp: MoorDyn's run of a case and the table
+// of kelp's two line models against it; `--write-reference` stores MoorDyn's results for the
+// tests (tests/tether/moordyn_reference.hpp).
+namespace mc = moordyn_cases;
+
+// MoorDyn's run of a case: its initial nodes (NED), and either its samples (a dynamic case) or
+// its nodes after 300 s with the ends held (the static case in a current: MoorDyn's stationary
+// solver leaves the line metres short of its equilibrium in this current, and 300 s of dynamics
+// settle it to 1e-12 m per 20 s).
+struct MdRun {
+  kelp::Matrix3X<double> x0, x_end;
+  mc::Series series;
+};
+
+MdRun run_moordyn(const mc::Case& c, const std::string& dir) {
+  const int n = c.segments;
+  const std::string sub = dir + "/" + c.name;
+  std::system(("mkdir -p " + sub).c_str());
+  const std::string path = sub + "/line.txt";
+  const double dt = c.dt();
+  {
+    std::ofstream o(path);
+    char num[256];
+    o << "--------------------- MoorDyn Input File ------------------------------------\n"
+         "kelp validation case "
+      << c.name
+      << "\n"
+         "----------------------- LINE TYPES ------------------------------------------\n"
+         "TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    "
+         "CaAx\n"
+         "(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     "
+         "(-)\n";
+    std::snprintf(num, sizeof num,
+                  "tether     0.008   0.07       1.0e5      %.17g   0.0   1.2    "
+                  "1.0    0.008   0.0\n",
+                  c.internal_damping);
+    o << num
+      << "---------------------- POINT PROPERTIES --------------------------------\n"
+         "ID    Type      X       Y       Z       Mass   Volume  CdA    Ca\n"
+         "(#)   (-)       (m)     (m)     (m)     (kg)   (mˆ3)   (m^2)  (-)\n";
+    std::snprintf(num, sizeof num, "1     Fixed     %.17g %.17g %.17g 0 0 0 0\n", c.start[0],
+                  c.start[1], -c.start[2]);
+    o << num;
+    std::snprintf(num, sizeof num, "2     Coupled   %.17g %.17g %.17g 0 0 0 0\n", c.end[0],
+                  c.end[1], -c.end[2]);
+    o << num
+      << "---------------------- LINES ----------------------------------------\n"
+         "ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs\n"
+         "(#)   (name)     (#)      (#)       (m)       (-)     (-)\n"
+         "1     tether     1        2         20.0      "
+      << n << "      -\n"
+      << "---------------------- OPTIONS -----------------------------------------\n"
+         "0             writeLog\n"
+         "RK4           tScheme\n";
+    std::snprintf(num, sizeof num, "%.17g  dtM\n", dt);
+    o << num
+      << "1025.0        WtrDnsty\n"
+         "9.80665       g\n"
+         "1000.0        WtrDpth\n"
+         "3.0e6         kBot\n"
+         "3.0e5         cBot\n"
+         "0.5 dtIC\n300.0 TmaxIC\n1e-9 threshIC\n1.0 CdScaleIC\n"
+      << (c.current != 0 ? "1             Currents\n" : "")
+      << "1             disableOutput\n"
+         "1             disableOutTime\n"
+         "------------------------- need this line --------------------------------------\n";
+  }
+  if (c.current != 0) {
+    // A uniform current (MoorDyn's steady current profile: Currents = 1).
+    std::ofstream o(sub + "/current_profile.txt");
+    o << "--------------------- MoorDyn steady currents File ------------------------------\n"
+         "uniform current\n"
+         "z (m), ux (m/s), uy (m/s), uz (m/s)\n";
+    o << "-1000.0 " << c.current << " 0 0\n0.0 " << c.current << " 0 0\n";
+  }
+  std::fflush(stdout);
+  const int saved = dup(1), devnull = open("/dev/null", O_WRONLY);
+  dup2(devnull, 1);
+  MoorDyn sys = MoorDyn_Create(path.c_str());
+  if (!sys) throw std::runtime_error("MoorDyn_Create failed");
+  MoorDyn_SetVerbosity(sys, 0);
+  double x[3] = {c.end_x(0), c.end[1], -c.end[2]}, xd[3] = {c.end_vx(0), 0, 0}, f[3];
+  if (MoorDyn_Init(sys, x, xd) != MOORDYN_SUCCESS) throw std::runtime_error("MoorDyn_Init failed");
+  std::fflush(stdout);
+  dup2(saved, 1);
+  close(saved);
+  close(devnull);
+  MoorDynLine line = MoorDyn_GetLine(sys, 1);
+  auto nodes = [&] {
+    kelp::Matrix3X<double> m(3, n + 1);
+    for (int i = 0; i <= n; ++i) {
+      double p[3];
+      MoorDyn_GetLineNodePos(line, i, p);
+      m.col(i) = kelp::Vector3<double>(p[0], p[1], -p[2]);
+    }
+    return m;
+  };
+  auto velocities = [&] {
+    kelp::Matrix3X<double> m(3, n + 1);
+    for (int i = 0; i <= n; ++i) {
+      double p[3];
+      MoorDyn_GetLineNodeVel(line, i, p);
+      m.col(i) = kelp::Vector3<double>(p[0], p[1], -p[2]);
+    }
+    return m;
+  };
+  MdRun r;
+  r.x0 = nodes();
+  double t = 0;
+  const long steps = c.duration > 0 ? c.steps() : std::lround(300.0 / dt);
+  kelp::tether::TetherStated st;
+  for (long k = 1; k <= steps; ++k) {
+    x[0] = c.end_x(t);
+    xd[0] = c.end_vx(t);
+    double h = dt;
+    if (MoorDyn_Step(sys, x, xd, f, &t, &h) != MOORDYN_SUCCESS)
+      throw std::runtime_error("MoorDyn_Step failed");
+    if (c.duration > 0 && k % c.sample_every == 0) {
+      st.position = nodes();
+      st.velocity = velocities();
+      st.time = t;
+      mc::sample(c, st, true, r.series);
+    }
+  }
+  r.x_end = nodes();
+  MoorDyn_Close(sys);
+  return r;
+}
+
+// kelp's static shape of the current case (its own solver) for a line model.
+kelp::Matrix3X<double> kelp_static(const mc::Case& c, kt::LineModel lm) {
+  const kt::TetherModeld model(mc::parameters(c, lm));
+  kt::TetherWorkspaced ws(model);
+  const auto env = mc::environment(c);
+  kt::TetherStated st(model);
+  kt::StaticOptionsd o;
+  o.force_tolerance = 1e-8;  // N (the default is 1e-7 of the weight in air: 1.4e-6 N)
+  o.max_iterations = 5000;   // the line in a current takes ~2000 pseudo steps to 1e-8 N
+  const auto res =
+      kt::static_initial_state(model, ws, env, Vector3<double>(c.start[0], c.start[1], c.start[2]),
+                               Vector3<double>(c.end[0], c.end[1], c.end[2]), st, o);
+  if (!res.converged)
+    throw std::runtime_error("kelp static solve did not converge: residual " +
+                             std::to_string(res.residual) + " N");
+  return st.position;
+}
+
+void print_matrix(std::ofstream& o, const char* name, const kelp::Matrix3X<double>& m) {
+  o << "inline constexpr double " << name << "[][3] = {\n";
+  char b[128];
+  for (int i = 0; i < m.cols(); ++i) {
+    std::snprintf(b, sizeof b, "    {%.17g, %.17g, %.17g},\n", m(0, i), m(1, i), m(2, i));
+    o << b;
+  }
+  o << "};\n";
+}
+
+void print_series(std::ofstream& o, const char* name, const mc::Series& s) {
+  o << "// Every sample_every steps: end-segment axial force [N], mid node x, z (NED) [m]\n";
+  o << "inline constexpr double " << name << "[][3] = {\n";
+  char b[160];
+  for (size_t i = 0; i < s.t.size(); ++i) {
+    std::snprintf(b, sizeof b, "    {%.12g, %.12g, %.12g},\n", s.tension[i], s.mid_x[i],
+                  s.mid_z[i]);
+    o << b;
+  }
+  o << "};\n";
+}
+
+// Runs the cases in MoorDyn and in kelp (both line models), prints the table, and writes
+// MoorDyn's results to `reference` when it is not empty.
+void validation(const std::string& dir, const std::string& reference) {
+  std::printf("== validation cases (tests/tether/moordyn_cases.hpp) vs MoorDyn v2 RK4 ==\n");
+  std::printf(
+      "case, kelp line model, end-segment force RMS diff / RMS, largest mid-node distance [m]\n");
+  const MdRun surge = run_moordyn(mc::surge, dir), snap = run_moordyn(mc::snap, dir),
+              cur = run_moordyn(mc::current, dir);
+  for (const auto* cp : {&mc::surge, &mc::snap}) {
+    const MdRun& m = cp == &mc::surge ? surge : snap;
+    // kelp's default line, the same with MoorDyn's dashpot only, and LineModel::moordyn.
+    for (int variant = 0; variant < 3; ++variant) {
+      kt::TetherParametersd p =
+          mc::parameters(*cp, variant == 2 ? kt::LineModel::moordyn : kt::LineModel::kelp);
+      p.compressive_damping = variant == 1;
+      const mc::Series k = mc::run_kelp(*cp, p, m.x0);
+      const char* names[] = {"kelp", "kelp + compressive_damping", "moordyn"};
+      std::printf("%s, %s, %.3e, %.3e\n", cp->name, names[variant],
+                  mc::relative_rms(k.tension, m.series.tension),
+                  mc::max_distance(k.mid_x, k.mid_z, m.series.mid_x, m.series.mid_z));
+    }
+  }
+  for (kt::LineModel lm : {kt::LineModel::kelp, kt::LineModel::moordyn}) {
+    const kelp::Matrix3X<double> xs = kelp_static(mc::current, lm);
+    std::printf(
+        "current (static), %s, largest node distance %.3e m, mid node %.3e m\n",
+        lm == kt::LineModel::kelp ? "kelp" : "moordyn",
+        (xs - cur.x_end).colwise().norm().maxCoeff(),
+        (xs.col(mc::current.segments / 2) - cur.x_end.col(mc::current.segments / 2)).norm());
+  }
+  if (reference.empty()) return;
+  std::ofstream o(reference);
+  o << "// MoorDyn v2.7.1's results for the validation cases of tests/tether/moordyn_cases.hpp,\n"
+       "// written by kelp-moordyn-side-by-side --write-reference (benchmarks/moordyn/). Do not\n"
+       "// edit: regenerate. MoorDyn: https://github.com/FloatingArrayDesign/MoorDyn "
+       "(BSD-3-Clause).\n"
+       "// clang-format off\n"
+       "#pragma once\n\nnamespace moordyn_reference {\n\n";
+  o << "// Initial nodes (MoorDyn's stationary solution, NED [m]).\n";
+  print_matrix(o, "surge_x0", surge.x0);
+  print_series(o, "surge_series", surge.series);
+  print_matrix(o, "snap_x0", snap.x0);
+  print_series(o, "snap_series", snap.series);
+  o << "// The line in the current: MoorDyn's nodes after its stationary solution and 300 s of\n"
+       "// dynamics with the ends held (settled to 1e-12 m; NED [m]).\n";
+  print_matrix(o, "current_nodes", cur.x_end);
+  o << "\n}  // namespace moordyn_reference\n// clang-format on\n";
+  std::printf("wrote %s\n", reference.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<int> sizes = {20, 50, 100, 200};
   int rounds = 5;
   double min_time = 0.2, check_T = 5.0;
-  bool check = true, timing = true;
-  std::string dir = "/tmp/moordyn-bench";
+  bool check = true, timing = true, validate = true;
+  std::string dir = "/tmp/moordyn-bench", reference;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--rounds")
@@ -379,6 +623,10 @@ int main(int argc, char** argv) {
       check = false;
     else if (a == "--no-timing")
       timing = false;
+    else if (a == "--no-validation")
+      validate = false;
+    else if (a == "--write-reference")
+      reference = argv[++i];
     else if (a == "--sizes") {
       sizes.clear();
       std::string s = argv[++i];
@@ -401,6 +649,7 @@ int main(int argc, char** argv) {
     return std::floor(dt_cfl / q) * q;
   };
 
+  if (validate) validation(dir, reference);
   if (check) {
     std::printf("== agreement check (%.0f s of heave, common dt) ==\n", check_T);
     for (int n : sizes) agreement(n, common_dt(n), dir, check_T);

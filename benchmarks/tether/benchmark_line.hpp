@@ -33,15 +33,20 @@ struct BenchmarkLine {
   kelp::Vector3<double> a{0, 0, 0}, b{10, 0, Heave::base_depth};
 
   /// N segments; `damping_ratio` ζ > 0 gives the line internal damping BA = 2ζ EA/ω_max, the
-  /// damping ratio ζ at its highest axial frequency (MoorDyn's negative-BA convention).
-  explicit BenchmarkLine(int n, double damping_ratio = 0.0)
-      : model(params(n, damping_ratio)), ws(model) {
+  /// damping ratio ζ at its highest axial frequency (MoorDyn's negative-BA convention);
+  /// `line_model` kelp's line or MoorDyn's (kelp::tether::LineModel).
+  explicit BenchmarkLine(int n, double damping_ratio = 0.0,
+                         kelp::tether::LineModel line_model = kelp::tether::LineModel::kelp)
+      : model(params(n, damping_ratio, line_model)), ws(model) {
     if (!kelp::tether::static_initial_state(model, ws, env, a, b, state).converged)
       throw std::runtime_error("benchmark line: static equilibrium did not converge");
   }
-  static kelp::tether::TetherParametersd params(int n, double damping_ratio = 0.0) {
+  static kelp::tether::TetherParametersd params(
+      int n, double damping_ratio = 0.0,
+      kelp::tether::LineModel line_model = kelp::tether::LineModel::kelp) {
     kelp::tether::TetherParametersd p;
     p.segments = n;
+    p.line_model = line_model;
     if (damping_ratio > 0)
       p.internal_damping =
           2 * damping_ratio * p.axial_stiffness /

@@ -1,6 +1,7 @@
 // kelp::sim: the closed loop stepped by hand gives simulate()'s run bit for bit, it samples and
 // logs at the scenario's rates, it refuses to step past its end and bad scenarios with errors
-// derived from kelp::error, and a step allocates nothing.
+// derived from kelp::error, the tether's line model travels from the file to the tether, and a
+// step allocates nothing.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -172,6 +173,34 @@ TEST_CASE("bad scenarios throw scenario_error, a kelp::invalid_argument naming t
   ks::Scenario sc = short_calm_run();
   sc.auv_start = {30.0, 0.0, 5.0};  // some 30 m from the boat, on a 10 m tether
   CHECK_THROWS_AS(ks::ClosedLoop(sc), ks::scenario_error);
+}
+
+TEST_CASE("the tether's line_model: parsed, written back, passed to the tether, checked", "[sim]") {
+  // Default: kelp's line, and to_json leaves the key out.
+  const ks::Scenario plain = ks::parse_scenario(R"({"tether": {"length": 10}})", "a.json");
+  CHECK(plain.line_model == "kelp");
+  CHECK_FALSE(ks::to_json(plain).at("tether").contains("line_model"));
+  CHECK(ks::world_setup(plain, "a.json").parameters.tether.line_model ==
+        kelp::tether::LineModel::kelp);
+  // "moordyn": parsed, round-tripped through to_json, and reaching the tether's parameters.
+  const ks::Scenario md =
+      ks::parse_scenario(R"({"tether": {"length": 10, "line_model": "moordyn"}})", "b.json");
+  CHECK(md.line_model == "moordyn");
+  CHECK(ks::parse_scenario(ks::to_json(md).dump(), "c.json").line_model == "moordyn");
+  CHECK(ks::world_setup(md, "b.json").parameters.tether.line_model ==
+        kelp::tether::LineModel::moordyn);
+  // Anything else is refused with the path, in the file and in a Scenario built by hand.
+  try {
+    (void)ks::parse_scenario(R"({"tether": {"line_model": "MoorDyn"}})", "d.json");
+    FAIL("line_model \"MoorDyn\" was accepted");
+  } catch (const ks::scenario_error& e) {
+    CHECK(std::string(e.what()).rfind("d.json: /tether/line_model: ", 0) == 0);
+  }
+  CHECK_THROWS_AS(ks::parse_scenario(R"({"tether": {"line_model": 1}})", "e.json"),
+                  ks::scenario_error);
+  ks::Scenario bad = plain;
+  bad.line_model = "orcaflex";
+  CHECK_THROWS_AS(ks::world_setup(bad, "f.json"), ks::scenario_error);
 }
 
 TEST_CASE("a closed-loop step allocates nothing", "[sim][malloc]") {

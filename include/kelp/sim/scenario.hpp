@@ -68,6 +68,8 @@ struct Scenario {
   ///@{
   double diameter = 0, mass_per_length = 0, axial_stiffness = 0, internal_damping = -1;
   double normal_drag = -1, tangential_drag = -1;
+  /// The line model, "kelp" (default) or "moordyn" (MoorDyn v2's: kelp::tether::LineModel).
+  std::string line_model = "kelp";
   ///@}
   /// Redo a tether step whose implicit solve fails with RK4 instead of stopping the run
   /// (system::SystemParameters::explicit_fallback; counted in the summary's
@@ -274,9 +276,10 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   if (j.contains("tether")) {
     const auto& t = j.at("tether");
-    r.object(t, "/tether",
-             {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
-              "internal_damping", "normal_drag", "tangential_drag", "explicit_fallback"});
+    r.object(
+        t, "/tether",
+        {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
+         "internal_damping", "normal_drag", "tangential_drag", "explicit_fallback", "line_model"});
     r.number(t, "/tether", "diameter", s.diameter, 1e-4, 0.5);
     r.number(t, "/tether", "mass_per_length", s.mass_per_length, 1e-4, 100);
     r.number(t, "/tether", "axial_stiffness", s.axial_stiffness, 1, 1e10);
@@ -287,6 +290,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.choice(t, "/tether", "kind", s.tether_kind, {"rov_tether", "bead_chain"});
     r.number(t, "/tether", "segment_length", s.segment_length, 0.05, 10);
     r.boolean(t, "/tether", "explicit_fallback", s.explicit_fallback);
+    r.choice(t, "/tether", "line_model", s.line_model, {"kelp", "moordyn"});
   }
   if (j.contains("vehicles")) {
     const auto& v = j.at("vehicles");
@@ -393,6 +397,7 @@ inline nlohmann::json to_json(const Scenario& s) {
   opt("normal_drag", s.normal_drag, -1);
   opt("tangential_drag", s.tangential_drag, -1);
   j["tether"]["explicit_fallback"] = s.explicit_fallback;
+  if (s.line_model != "kelp") j["tether"]["line_model"] = s.line_model;
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;

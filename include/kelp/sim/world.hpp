@@ -47,6 +47,10 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
   if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
   params.explicit_fallback = sc.explicit_fallback;
+  if (sc.line_model != "kelp" && sc.line_model != "moordyn")
+    throw scenario_error(file + ": /tether/line_model: expected \"kelp\" or \"moordyn\", got \"" +
+                         sc.line_model + "\"");
+  if (sc.line_model == "moordyn") tp.line_model = kelp::tether::LineModel::moordyn;
   params.asv_attachment = sc.asv_attachment;
   params.auv_attachment = sc.auv_attachment;
   ke::SeaStateOptions sea_options;

@@ -367,8 +367,9 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   c.clamp = !p.compressive_damping;
   c.damping = c.ba != Scalar(0);
   c.bending = p.bending_stiffness > Scalar(0);
-  // Added-mass rate terms (see above); none when Cat = Can (b = 0).
-  c.mass_turns = c.cat != c.can;
+  // Added-mass rate terms (see compute_forces); none when Cat = Can (b = 0) and none in
+  // MoorDyn's line model (TetherModel::added_mass_rate_terms).
+  c.mass_turns = model.added_mass_rate_terms();
 
   // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
   // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
@@ -423,7 +424,7 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// \f]
 /// - axial: T_s = max(0, EA·max(0, ε_s) + BA ε̇_s): the elastic part acts only when l_s > l, the
 ///   dashpot at any length, and the sum is clamped at zero so that a segment never pushes
-///   (`compressive_damping` drops the clamp, as MoorDyn does);
+///   (`compressive_damping` or LineModel::moordyn drops the clamp, as MoorDyn does);
 /// - drag (Morison, on v_r = u_water − v_i): ½ρ d l_i Cdn |v_rn| v_rn + ½ρ π d l_i Cdt |v_rt| v_rt;
 /// - fluid inertia: ρ V_i [(1 + Can)(I − q qᵀ) + (1 + Cat) q qᵀ] a_water;
 /// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force from a
@@ -432,7 +433,10 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 ///   turns with the tangent, Lagrange's equations add G_i = −b_i[(q̇_i·v_r) q_i + (q_i·v_r) q̇_i]
 ///   on node i and ±b_i (q_i·v_r)(I − q_i q_iᵀ) v_r/|c_i| on the two nodes of its chord c_i
 ///   (∂T/∂x). Without them the line gains energy whenever Cat ≠ Can; with them the model is
-///   passive (Lamb 1932, Hydrodynamics §137: fluid kinetic energy in Lagrange's equations);
+///   passive (Lamb 1932, Hydrodynamics §137: fluid kinetic energy in Lagrange's equations). In a
+///   steady axial flow along a curved line they are the fluid's "centrifugal" force of
+///   slender-body theory (Lighthill 1960; Païdoussis 1966). LineModel::moordyn leaves them out,
+///   as MoorDyn v2 does;
 /// - seabed (z_i > h): upward (z_i − h) kb d l_i + ż_i cb d l_i (≥ 0), and saturated-viscous
 ///   friction −μ_f N v_h / max(|v_h|, v_f);
 /// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,

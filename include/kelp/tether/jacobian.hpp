@@ -161,7 +161,7 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
   const Scalar half_rho_d = Scalar(0.5) * rho * p.diameter;
   const Scalar inv_diam = Scalar(1) / p.diameter;
   const Scalar can = p.normal_added_mass, cat = p.tangential_added_mass;
-  const bool mass_turns = cat != can;
+  const bool mass_turns = model.added_mass_rate_terms();  // as compute_forces
   for (int i = 0; i <= n; ++i) {
     const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
     const V3 chord = x.col(hi) - x.col(lo);

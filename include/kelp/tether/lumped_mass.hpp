@@ -10,6 +10,7 @@
 /// in MoorDyn v2 (source/Line.cpp); the code is kelp's own. Two deliberate differences from
 /// MoorDyn: the added mass enters through the kinetic energy (its rate of change included, so the
 /// line is passive), and the axial force never pushes (see TetherParameters::compressive_damping).
+/// `TetherParameters::line_model = LineModel::moordyn` selects MoorDyn's line model instead.
 ///
 /// Frames and units: world NED (z down, mean sea surface at z = 0, free surface at z = −ζ), SI.
 /// Environments are duck-typed (`Env`): anything with `water_density()`, `gravity()`,

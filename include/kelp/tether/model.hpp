@@ -25,6 +25,30 @@ enum class EndMode {
   free
 };
 
+/// \brief Which lumped-mass line model the force evaluation follows.
+///
+/// Both share the formulation of Hall & Goupee (2015) as MoorDyn v2 implements it (tangents,
+/// Morison drag split, added mass in the node mass matrices, weight, buoyancy, Froude–Krylov
+/// forcing, seabed spring–damper); they differ in three places (docs/equations.md, section 4;
+/// benchmarks/results/tether.md, "kelp's line and MoorDyn's" for the measured effect):
+///
+/// - added-mass rate terms (Cat ≠ Can): `kelp` has them (the model is passive), `moordyn` not;
+/// - internal dashpot BA·ε̇: `kelp` clamps the axial force at 0 (a cable never pushes),
+///   `moordyn` lets it act in compression too;
+/// - seabed damping at touchdown: `kelp` ramps it in over `seabed_damping_depth`, `moordyn`
+///   switches it on at first contact (a force step).
+enum class LineModel {
+  /// kelp's passive line: the added-mass rate terms (Lagrange's equations with the
+  /// tangent-dependent added mass; see compute_forces), an axial force that never pushes (unless
+  /// `compressive_damping`), the seabed damping ramped in over `seabed_damping_depth`.
+  kelp,
+  /// MoorDyn v2's line model (source/Line.cpp of MoorDyn v2.7.1): no added-mass rate terms, the
+  /// internal dashpot acting in compression as well (`compressive_damping` is implied), the seabed
+  /// damping switched on at first contact (`seabed_damping_depth` is ignored, as if 0). For users
+  /// porting MoorDyn models and for validation against MoorDyn.
+  moordyn
+};
+
 /// \brief Upper bounds of TetherParameters (validate() refuses values above them). Far above any
 /// real tether (a 1 km, 150 mm steel mooring chain has 450 kg/m and EA 2e9 N), they keep every
 /// force computed from the parameters finite.
@@ -69,6 +93,11 @@ struct TetherParameters {
   /// clamped): use it to reproduce MoorDyn. Default false: a cable cannot push, so the total
   /// axial force is max(0, EA·max(0, ε) + BA·ε̇).
   bool compressive_damping = false;
+  /// The line model: kelp's passive line (default) or MoorDyn v2's (see LineModel; `moordyn`
+  /// implies compressive_damping and a zero seabed_damping_depth). One field rather than a preset
+  /// that sets several: it travels with the parameters (copies, scenario files), it cannot be
+  /// half applied, and it reads as what it is when a line is printed or compared.
+  LineModel line_model = LineModel::kelp;
   /// Bending stiffness EI [N m²] (0: a perfectly flexible line). Discrete bending energy
   /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
   /// κ = θ/l. Enters the implicit schemes' symmetric Jacobian through the residual only (it
@@ -113,7 +142,7 @@ struct TetherParameters {
 /// \throws kelp::invalid_argument naming the offending field: segments in [1, 100000]; length,
 /// diameter, mass_per_length, axial_stiffness, friction_velocity finite and > 0; the rest finite
 /// and ≥ 0; every magnitude at most its bound in kelp::tether::limits; segments at least 1 µm
-/// long; end modes EndMode values.
+/// long; end modes EndMode values; line_model a LineModel value.
 template <typename Scalar>
 void validate(const TetherParameters<Scalar>& p) {
   // Each magnitude finite and of the right sign, then below a generous physical bound (far above
@@ -151,6 +180,8 @@ void validate(const TetherParameters<Scalar>& p) {
              "start_mode must be EndMode::kinematic or EndMode::free");
   KELP_CHECK(p.end_mode == EndMode::kinematic || p.end_mode == EndMode::free,
              "end_mode must be EndMode::kinematic or EndMode::free");
+  KELP_CHECK(p.line_model == LineModel::kelp || p.line_model == LineModel::moordyn,
+             "line_model must be LineModel::kelp or LineModel::moordyn");
 }
 
 /// \brief Validated tether parameters with the per-step constants precomputed.
@@ -164,6 +195,13 @@ class TetherModel {
   /// \throws kelp::invalid_argument naming the offending field.
   explicit TetherModel(const TetherParameters<Scalar>& p) : p_(p) {
     validate(p);
+    // MoorDyn's line model implies its dashpot and its touchdown (see LineModel): resolved here
+    // once, so that every reader of parameters() (forces, Jacobian, stable step) sees them.
+    if (p.line_model == LineModel::moordyn) {
+      p_.compressive_damping = true;
+      p_.seabed_damping_depth = Scalar(0);
+    }
+    rate_terms_ = p.line_model == LineModel::kelp && p.tangential_added_mass != p.normal_added_mass;
     const int n = p.segments;
     const Scalar N = Scalar(n);
     l_ = p.length / N;
@@ -187,8 +225,13 @@ class TetherModel {
     last_free_ = p.end_mode == EndMode::kinematic ? n - 1 : n;
   }
 
-  /// \brief The parameters the model was built from.
+  /// \brief The parameters the model was built from, as the model uses them: with
+  /// LineModel::moordyn, `compressive_damping` is true and `seabed_damping_depth` 0.
   const TetherParameters<Scalar>& parameters() const { return p_; }
+  /// \brief True when the forces carry the added-mass rate terms (see compute_forces): kelp's line
+  /// model with Cat ≠ Can. False for LineModel::moordyn and whenever Cat = Can (the added mass is
+  /// then isotropic and does not turn with the tangent).
+  bool added_mass_rate_terms() const { return rate_terms_; }
   /// \brief Number of segments N.
   int segments() const { return p_.segments; }
   /// \brief Number of nodes N + 1.
@@ -227,6 +270,7 @@ class TetherModel {
   Scalar l_, inv_l_, ea_over_l_, ba_over_l_, area_, min_node_mass_;
   VectorX<Scalar> node_mass_, node_volume_, node_length_;
   int first_free_ = 1, last_free_ = 0;
+  bool rate_terms_ = false;
 };
 
 /// \brief Double-precision aliases.
