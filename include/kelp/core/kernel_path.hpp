@@ -98,8 +98,8 @@ inline KernelPath parse_kernel_path(const std::string& name) {
   for (KernelPath p :
        {KernelPath::automatic, KernelPath::portable, KernelPath::avx2, KernelPath::avx512})
     if (name == kernel_name(p)) return p;
-  detail::throw_invalid_argument("kernel path \"" + name +
-                                 "\" is not one of \"auto\", \"portable\", \"avx2\", \"avx512\"");
+  ::kelp::detail::throw_invalid_argument(
+      "kernel path \"" + name + "\" is not one of \"auto\", \"portable\", \"avx2\", \"avx512\"");
 }
 
 /// \brief True when this program on this CPU can take path `p` (`automatic` and `portable`
