@@ -151,8 +151,8 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   const Scalar* matrix = nullptr;
   const VectorX<Scalar>* matrix_branch = nullptr;
   reused = false;
-  if (!form_always && state.newton.holds(cols) && state.newton.gh == gh &&
-      state.newton.age < options.max_matrix_age) {
+  if (!form_always && state.newton.pause == 0 && state.newton.holds(cols) &&
+      state.newton.gh == gh && state.newton.age < options.max_matrix_age) {
     matrix = state.newton.factor.data();
     matrix_branch = &state.newton.branch;
   }
@@ -162,7 +162,22 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // the history; the end forces' impulse over dt and the residual go to the report.
   const auto accept = [&]() {
     const int age = state.newton.age;
+    int pause = std::max(state.newton.pause - 1, 0), backoff = state.newton.backoff;
+    using std::max;
+    if (first_reused && first_residual > max(options.refresh_residual, Scalar(1)) * tolerance) {
+      // The kept matrix could not make this step in one correction: form a new one at the
+      // predictor for the next 1, 3, 7, … 31 steps before trying one again (a second
+      // correction with a kept matrix costs about as much as forming a new one).
+      backoff = std::min(2 * backoff + 1, 31);
+      pause = backoff;
+    } else if (first_reused) {
+      backoff = 0;
+    }
     commit(state, ws.x1, ws.v1, dt, "step_implicit");  // drops the kept matrix
+    if (simplified) {
+      state.newton.pause = pause;
+      state.newton.backoff = backoff;
+    }
     if (simplified && matrix == ws.newton_factor.data()) {
       state.newton.factor.swap(ws.newton_factor);
       state.newton.branch.swap(ws.newton_branch);
@@ -505,16 +520,17 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// tolerance within the corrections left (θ^(k_max−k) r_k/(1 − θ) > tol), and at the next step
 /// when a step's first correction left more than `refresh_residual` × the tolerance (the
 /// residual a kept matrix leaves grows with its age; on the benchmark line it serves two or
-/// three steps). A step that fails with a reused matrix is attempted again with a fresh matrix
-/// at every iteration (Newton's method) before it is split. Both methods stop on the same
-/// residual test, so their results agree to the tolerance. The initial guess extrapolates the
-/// velocity (2v_n − v_{n−1}) when the previous step had the same dt. At least one and up to
-/// `options.max_iterations` corrections,
-/// until max_i |R_i|/a_i ≤ acceleration_tolerance · dt (the tolerance raised to the arithmetic's
-/// resolution where it is below it, see ImplicitOptions::acceleration_tolerance). A step that does
-/// not converge is not committed: it is retried as two half steps, each halved again if needed, at
-/// most `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of
-/// step); if even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
+/// three steps); after a step that the kept matrix could not make in one correction, the next
+/// 1, 3, 7, … 31 steps form their own (a fast-moving line). A step that fails with a reused matrix
+/// is attempted again with a fresh matrix at every iteration (Newton's method) before it is split.
+/// Both methods stop on the same residual test, so their results agree to the tolerance. The
+/// initial guess extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt.
+/// At least one and up to `options.max_iterations` corrections, until max_i |R_i|/a_i ≤
+/// acceleration_tolerance · dt (the tolerance raised to the arithmetic's resolution where it is
+/// below it, see ImplicitOptions::acceleration_tolerance). A step that does not converge is not
+/// committed: it is retried as two half steps, each halved again if needed, at most
+/// `options.max_step_halvings` times (BDF2 restarts with backward Euler after a change of step); if
+/// even that fails, kelp::numerical_error is thrown with the state unchanged. End forces
 /// (`ws.end_forces`) are those of the final iterate, at t + dt.
 /// \returns the work done (sub-steps, Newton iterations, factorisations and reuses, worst
 /// residual, retries).

@@ -46,16 +46,24 @@ struct KeptNewtonMatrix {
   Scalar gh = Scalar(0);
   /// Steps committed with this factorisation since it was formed.
   int age = 0;
+  /// Steps that form their own matrix instead of trying a kept one: after a step whose first
+  /// correction with a kept matrix missed the tolerance, 1, 3, 7, … up to 31 while that repeats
+  /// (a line moving too fast for a matrix to serve the next step).
+  int pause = 0;
+  /// The last pause (0 after a kept matrix served a step with one correction).
+  int backoff = 0;
 
   /// \brief True when a factorisation is kept and sized for `nodes` nodes.
   bool holds(int nodes) const {
     return gh > Scalar(0) && factor.size() == detail::newton_factor_size(nodes) &&
            branch.size() == nodes - 1;
   }
-  /// \brief Forgets the kept factorisation (the buffers stay allocated).
+  /// \brief Forgets the kept factorisation and its history (the buffers stay allocated).
   void clear() {
     gh = Scalar(0);
     age = 0;
+    pause = 0;
+    backoff = 0;
   }
   /// \brief Sizes the buffers for `nodes` nodes, nothing kept.
   void resize(int nodes) {
@@ -211,6 +219,8 @@ struct StateBackup {
     newton.branch = s.newton.branch;
     newton.gh = s.newton.gh;
     newton.age = s.newton.age;
+    newton.pause = s.newton.pause;
+    newton.backoff = s.newton.backoff;
   }
   /// \brief Puts the saved state back into `s`.
   void restore(TetherState<Scalar>& s) const {
@@ -225,6 +235,8 @@ struct StateBackup {
     s.newton.branch = newton.branch;
     s.newton.gh = newton.gh;
     s.newton.age = newton.age;
+    s.newton.pause = newton.pause;
+    s.newton.backoff = newton.backoff;
   }
 };
 

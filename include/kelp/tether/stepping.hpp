@@ -133,7 +133,10 @@ struct ImplicitOptions {
   Scalar max_contraction = Scalar(0.5);
   /// NewtonMethod::simplified: a kept matrix whose first correction of a step leaves a scaled
   /// residual above this fraction of the tolerance is formed anew at the next step (the residual
-  /// it leaves grows with its age, and a second correction costs more than a new matrix).
+  /// it leaves grows with its age, and a second correction costs more than a new matrix). Above
+  /// max(1, refresh_residual) × the tolerance (the kept matrix missed it), the following 1, 3, 7,
+  /// … 31 steps form their own matrix before a kept one is tried again (TetherState::newton's
+  /// pause: a line moving too fast for a matrix to serve the next step).
   Scalar refresh_residual = Scalar(0.5);
   /// Newton converges when max_i |R_i| / a_i ≤ acceleration_tolerance · dt, R_i the momentum
   /// residual of node i and a_i its isotropic mass: an error ΔF in the node force shows up as
