@@ -1,8 +1,9 @@
 /// \file
 /// \brief The implicit tether steps: backward Euler and BDF2, solved by a simplified Newton
 /// method (the factored Newton matrix kept in the state and reused across iterations and steps
-/// while it serves) or by Newton's method, with the analytic block-tridiagonal
-/// Jacobian (kelp/tether/block_solve.hpp), backtracking and step halving; a step that cannot be
+/// while it serves) or by Newton's method, with the analytic block-tridiagonal symmetric
+/// Jacobian (kelp/tether/block_solve.hpp) and, where it does not serve, the whole Jacobian
+/// (kelp/tether/whole_newton.hpp), backtracking and step halving; a step that cannot be
 /// completed throws and leaves the state as it was. End forces are those at the end of the step.
 #pragma once
 
@@ -497,12 +498,20 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// (D_v = −∂F/∂v: internal damping exactly, drag linearised, seabed damping and friction;
 /// D_x = −∂F/∂x: axial plus geometric stiffness exactly, seabed stiffness; M, with its added
 /// mass, at the current iterate) is block tridiagonal, symmetric positive definite, and solved
-/// in O(N) by block-Thomas elimination (no dense N×N). Left out of J, so converging linearly
-/// rather than quadratically when they dominate: the tangent dependence of drag and added mass,
-/// the added-mass rate terms, the direction dependence of the dashpot, bending (EI). Each Newton
-/// direction settles which segments are taut, slack or clamped with a primal–dual active set
-/// (detail::active_set_direction) and is shortened by a secant line search on the slope R·δ
-/// when it overshoots.
+/// in O(N) by block-Thomas elimination (no dense N×N). Left out of this J, so converging
+/// linearly rather than quadratically when they dominate (rough seas, the surface band): the
+/// tangent dependence of drag, forcing and added mass, the added-mass rate terms, the band's
+/// scaling of the fluid forces, the direction dependence of the dashpot, bending (EI). The whole
+/// Jacobian ∂R/∂v = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x (kelp/tether/jacobian.hpp, every
+/// term; block-pentadiagonal, not symmetric, block LU in O(N), kelp/tether/whole_newton.hpp)
+/// makes Newton converge quadratically at about twice the cost per iteration
+/// (ImplicitOptions::jacobian: `whole` at every iteration; `adaptive`, the default, where a
+/// symmetric matrix formed at the iterate contracts the residual by less than max_contraction,
+/// and for a step the symmetric attempts cannot converge). Each Newton direction settles which
+/// segments are taut, slack or clamped with a primal–dual active set
+/// (detail::active_set_direction, detail::whole_newton_direction) and is shortened by a secant
+/// line search on the slope R·δ when it overshoots (with the whole Jacobian, by an Armijo
+/// backtracking on Σ|R_i/a_i|², R then not being a gradient).
 ///
 /// The Newton matrix (ImplicitOptions::newton): NewtonMethod::exact evaluates the Jacobian and
 /// factors J at every iteration. NewtonMethod::simplified (the default) is the simplified Newton
