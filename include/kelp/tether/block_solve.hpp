@@ -452,39 +452,39 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
   factor_solve_block_tridiagonal<Scalar, V>(model, ws, c_m, c_v, c_x, ws.block_inv.data(), false);
 }
 
-/// Newton direction with a primal–dual active set for the kinks of the axial force (semismooth
-/// Newton on T = max(0, EA·max(0, ε) + BA·ε̇), or without the outer max when
-/// compressive_damping). Over a Newton correction δ (velocities; positions move by γh δ) a
+/// The branch compute_forces takes for a segment of extension e = l_s − l [m] and stretch rate r
+/// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot).
+template <typename Scalar>
+Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r) {
+  const bool elastic = e > Scalar(0);
+  const Scalar force = (elastic ? model.axial_spring() * e : Scalar(0)) + model.axial_damper() * r;
+  if (!model.parameters().compressive_damping && !(force > Scalar(0))) return Scalar(0);
+  return elastic ? Scalar(2) : Scalar(1);
+}
+
+/// Primal–dual active set for the kinks of the axial force (semismooth Newton on
+/// T = max(0, EA·max(0, ε) + BA·ε̇), or without the outer max when compressive_damping), shared
+/// by both Newton matrices. Over a Newton correction δ (velocities; positions move by γh δ) a
 /// segment's force is a monotone piecewise-linear function of w = u·(δ_{s+1} − δ_s) with three
 /// branches: 2 elastic and dashpot (taut), 1 dashpot only (slack), 0 no force (clamped). In the
-/// linear model each segment sits on one branch, extended linearly beyond its kink (negative
-/// values allowed inside the linear model). The branches start from those at the current point
-/// (segments with l_s ≥ (1 − band)·l start taut) and are updated from the predicted extension
-/// and stretch rate until they repeat (at most `max_passes` solves). Reads ws.rhs (= −R) and the
-/// Jacobian terms of compute_forces<true>; writes ws.delta; ws.rhs and the Jacobian terms are
-/// restored.
-///
-/// Each pass factors the Newton matrix (factor_solve_block_tridiagonal): into `kept` with the
-/// meeting node's block when given (newton_factor_size(nodes) scalars, the last pass's factor
-/// then serves solve_factored_block_tridiagonal, its branches being those left in
-/// ws.seg_branch), else into ws.block_inv as scratch. Returns the number of passes
-/// (factorisations).
-template <typename Scalar>
-int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
-                         Scalar band, int max_passes, Scalar* kept = nullptr) {
+/// linear model each segment sits on one branch (ws.seg_branch), extended linearly beyond its
+/// kink (negative values allowed inside the linear model). The branches start from those at the
+/// current point (segments with l_s ≥ (1 − band)·l start taut) and are updated from the predicted
+/// extension and stretch rate until they repeat (at most `max_passes` passes). In each pass the
+/// force of a segment off its true branch is replaced in ws.rhs by its branch's, and
+/// `solve(on_true_branches)` forms the Newton matrix with the slopes of the branches in
+/// ws.seg_branch (only the true ones when `on_true_branches`) and solves it for ws.rhs into
+/// ws.delta. Reads ws.rhs (= −R) and the segment terms of compute_forces<true>; ws.rhs is
+/// restored. Returns the number of passes (factorisations).
+template <typename Scalar, typename Solve>
+int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
+                       Scalar band, int max_passes, Solve&& solve) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   const Scalar l = model.segment_length();
   const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
-  const bool clamp = !model.parameters().compressive_damping;
-  // Branch of a segment with extension e = l_s − l [m] and stretch rate r [m/s].
-  const auto branch_of = [&](Scalar e, Scalar r) {
-    const bool elastic = e > Scalar(0);
-    if (clamp && !((elastic ? ea_l * e : Scalar(0)) + ba_l * r > Scalar(0))) return Scalar(0);
-    return elastic ? Scalar(2) : Scalar(1);
-  };
   const auto true_branch = [&](int s) {
-    return branch_of(ws.stretched_length(s) - l, ws.seg_rate(s));
+    return segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s));
   };
   // Updates the branches from the extension and rate predicted by ws.delta; true if any changed.
   const auto update = [&]() {
@@ -494,19 +494,14 @@ int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scala
       const auto u = ws.direction.col(s);
       if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
       if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
-      const Scalar now = branch_of(ws.stretched_length(s) - l + gh * w, ws.seg_rate(s) + w);
+      const Scalar now =
+          segment_branch(model, ws.stretched_length(s) - l + gh * w, ws.seg_rate(s) + w);
       if (now != ws.seg_branch(s)) {
         changed = true;
         ws.seg_branch(s) = now;
       }
     }
     return changed;
-  };
-  const auto solve = [&]() {
-    if (kept)
-      factor_solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh, kept, true);
-    else
-      solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
   };
   bool on_true_branch = true;
   for (int s = 0; s < n; ++s) {
@@ -518,37 +513,76 @@ int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scala
   int pass = 0;
   if (on_true_branch) {
     // Common case: plain Newton; done unless the prediction crosses a kink.
-    solve();
+    solve(true);
     if (max_passes <= 1 || !update()) return 1;
     pass = 1;
   }
   ws.rhs_true = ws.rhs;
-  ws.seg_true_k_uu = ws.seg_k_uu;
-  ws.seg_true_c_uu = ws.seg_c_uu;
   for (;; ++pass) {
     ws.rhs = ws.rhs_true;
     for (int s = 0; s < n; ++s) {
-      ws.seg_k_uu(s) = ws.seg_true_k_uu(s);
-      ws.seg_c_uu(s) = ws.seg_true_c_uu(s);
       const Scalar b = ws.seg_branch(s);
       if (b == true_branch(s)) continue;
-      // The branch's force at the current point replaces the true one, its slopes the true ones.
+      // The branch's force at the current point replaces the true one.
       const Scalar e = ws.stretched_length(s) - l, r = ws.seg_rate(s);
       const Scalar tb =
           (b == Scalar(2) ? ea_l * e : Scalar(0)) + (b > Scalar(0) ? ba_l * r : Scalar(0));
       const Vector3<Scalar> df = (gh * (tb - ws.tension(s))) * ws.direction.col(s);
       ws.rhs.col(s) += df;
       ws.rhs.col(s + 1) -= df;
-      ws.seg_k_uu(s) = (b == Scalar(2) ? ea_l : Scalar(0)) - ws.seg_k_perp(s);
-      ws.seg_c_uu(s) = b > Scalar(0) ? ba_l : Scalar(0);
     }
-    solve();
+    solve(false);
     if (pass + 1 >= max_passes || !update()) break;
   }
-  ws.seg_k_uu = ws.seg_true_k_uu;
-  ws.seg_c_uu = ws.seg_true_c_uu;
   ws.rhs.swap(ws.rhs_true);
   return pass + 1;
+}
+
+/// Newton direction with the symmetric block-tridiagonal matrix and the active set of
+/// segment_active_set: the slopes of a segment off its true branch are its branch's. Reads
+/// ws.rhs (= −R) and the Jacobian terms of compute_forces<true>; writes ws.delta; ws.rhs and the
+/// Jacobian terms are restored.
+///
+/// Each pass factors the Newton matrix (factor_solve_block_tridiagonal): into `kept` with the
+/// meeting node's block when given (newton_factor_size(nodes) scalars, the last pass's factor
+/// then serves solve_factored_block_tridiagonal, its branches being those left in
+/// ws.seg_branch), else into ws.block_inv as scratch. Returns the number of passes
+/// (factorisations).
+template <typename Scalar>
+int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
+                         Scalar band, int max_passes, Scalar* kept = nullptr) {
+  const int n = model.segments();
+  const Scalar l = model.segment_length();
+  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
+  bool saved = false;
+  const int passes = segment_active_set(model, ws, gh, band, max_passes, [&](bool on_true) {
+    if (!on_true) {
+      if (!saved) {
+        ws.seg_true_k_uu = ws.seg_k_uu;
+        ws.seg_true_c_uu = ws.seg_c_uu;
+        saved = true;
+      }
+      for (int s = 0; s < n; ++s) {
+        const Scalar b = ws.seg_branch(s);
+        if (b == segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s))) {
+          ws.seg_k_uu(s) = ws.seg_true_k_uu(s);
+          ws.seg_c_uu(s) = ws.seg_true_c_uu(s);
+        } else {
+          ws.seg_k_uu(s) = (b == Scalar(2) ? ea_l : Scalar(0)) - ws.seg_k_perp(s);
+          ws.seg_c_uu(s) = b > Scalar(0) ? ba_l : Scalar(0);
+        }
+      }
+    }
+    if (kept)
+      factor_solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh, kept, true);
+    else
+      solve_block_tridiagonal(model, ws, Scalar(1), gh, gh * gh);
+  });
+  if (saved) {
+    ws.seg_k_uu = ws.seg_true_k_uu;
+    ws.seg_c_uu = ws.seg_true_c_uu;
+  }
+  return passes;
 }
 
 }  // namespace detail

@@ -15,6 +15,7 @@
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/tether/block_solve.hpp"
 #include "kelp/tether/forces.hpp"
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/state.hpp"
@@ -48,16 +49,6 @@ template <typename S>
 EIGEN_ALWAYS_INLINE void add_projector(Matrix3<S>& m, S f, const Vector3<S>& q) {
   add_outer(m, -f, q, q);
   for (int k = 0; k < 3; ++k) m(k, k) += f;
-}
-
-/// The branch compute_forces takes for a segment of extension e = l_s − l [m] and stretch rate r
-/// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot).
-template <typename Scalar>
-Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r) {
-  const bool elastic = e > Scalar(0);
-  const Scalar force = (elastic ? model.axial_spring() * e : Scalar(0)) + model.axial_damper() * r;
-  if (!model.parameters().compressive_damping && !(force > Scalar(0))) return Scalar(0);
-  return elastic ? Scalar(2) : Scalar(1);
 }
 
 /// SegmentJacobian of segment s on branch `b` (a negative b: the branch compute_forces took)

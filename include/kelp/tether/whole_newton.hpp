@@ -172,7 +172,7 @@ namespace detail {
 /// Newton direction of the implicit step with the whole Jacobian (ImplicitOptions::jacobian ==
 /// JacobianKind::whole), at the iterate (x, v) of the last compute_forces: solves J δ = −R
 /// (ws.rhs = −R) into ws.delta, J assembled and factored in ws.newton_lu. The kinks of the
-/// axial force are handled as in active_set_direction (the same primal–dual active set: each
+/// axial force are handled by segment_active_set (the primal–dual active set: each
 /// segment on the branch its predicted extension and stretch rate give, at most `max_passes`
 /// factorisations); the other kinks (surface band, seabed, friction) take the branch of the
 /// current iterate. ws.rhs is restored; ws.newton_lu keeps the last factor. No heap allocation.
@@ -182,65 +182,11 @@ int whole_newton_direction(const TetherModel<Scalar>& model, TetherWorkspace<Sca
                            const Env& env, const Eigen::MatrixBase<DX>& x,
                            const Eigen::MatrixBase<DV>& v, const Eigen::MatrixBase<DD>& d,
                            Scalar gh, Scalar band, int max_passes) {
-  const int n = model.segments();
-  const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  const Scalar l = model.segment_length();
-  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
-  const auto rate = [&](int s) { return ws.direction.col(s).dot(v.col(s + 1) - v.col(s)); };
-  const auto true_branch = [&](int s) {
-    return segment_branch(model, ws.stretched_length(s) - l, rate(s));
-  };
-  const auto update = [&]() {
-    bool changed = false;
-    for (int s = 0; s < n; ++s) {
-      Scalar w(0);
-      const auto u = ws.direction.col(s);
-      if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
-      if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
-      const Scalar now = segment_branch(model, ws.stretched_length(s) - l + gh * w, rate(s) + w);
-      if (now != ws.seg_branch(s)) {
-        changed = true;
-        ws.seg_branch(s) = now;
-      }
-    }
-    return changed;
-  };
-  bool on_true_branch = true;
-  for (int s = 0; s < n; ++s) {
-    const Scalar bt = true_branch(s);
-    const bool banded = band > Scalar(0) && ws.stretched_length(s) >= (Scalar(1) - band) * l;
-    ws.seg_branch(s) = banded ? Scalar(2) : bt;
-    if (ws.seg_branch(s) != bt) on_true_branch = false;
-  }
-  int pass = 0;
-  if (on_true_branch) {
-    assemble_whole_newton_matrix(model, ws, env, x, v, d, gh);
+  return segment_active_set(model, ws, gh, band, max_passes, [&](bool on_true) {
+    assemble_whole_newton_matrix(model, ws, env, x, v, d, gh, on_true ? nullptr : &ws.seg_branch);
     factor_whole_newton_matrix(model, ws);
     solve_whole_newton_matrix(model, ws, ws.rhs, ws.delta);
-    if (max_passes <= 1 || !update()) return 1;
-    pass = 1;
-  }
-  ws.rhs_true = ws.rhs;
-  for (;; ++pass) {
-    ws.rhs = ws.rhs_true;
-    for (int s = 0; s < n; ++s) {
-      const Scalar b = ws.seg_branch(s);
-      if (b == true_branch(s)) continue;
-      // The branch's force at the current point replaces the true one.
-      const Scalar e = ws.stretched_length(s) - l, r = rate(s);
-      const Scalar tb =
-          (b == Scalar(2) ? ea_l * e : Scalar(0)) + (b > Scalar(0) ? ba_l * r : Scalar(0));
-      const Vector3<Scalar> df = (gh * (tb - ws.tension(s))) * ws.direction.col(s);
-      ws.rhs.col(s) += df;
-      ws.rhs.col(s + 1) -= df;
-    }
-    assemble_whole_newton_matrix(model, ws, env, x, v, d, gh, &ws.seg_branch);
-    factor_whole_newton_matrix(model, ws);
-    solve_whole_newton_matrix(model, ws, ws.rhs, ws.delta);
-    if (pass + 1 >= max_passes || !update()) break;
-  }
-  ws.rhs.swap(ws.rhs_true);
-  return pass + 1;
+  });
 }
 
 }  // namespace detail
