@@ -130,6 +130,29 @@ void invert_block(const Sym3<T>& d, S floor, Sym3<T>& nm, T& g) {
   }
 }
 
+/// A lane pair V read from two consecutive scalars (the layout of the kept factors).
+template <typename V, typename S>
+V load_lane_pair(const S* in) {
+  if constexpr (std::is_trivially_copyable_v<V>) {
+    V x;
+    std::memcpy(&x, in, sizeof(V));
+    return x;
+  } else {
+    return V{in[0], in[1]};
+  }
+}
+
+/// A lane pair V written to two consecutive scalars.
+template <typename V, typename S>
+void store_lane_pair(S* out, const V& x) {
+  if constexpr (std::is_trivially_copyable_v<V>) {
+    std::memcpy(out, &x, sizeof(V));
+  } else {
+    out[0] = x[0];
+    out[1] = x[1];
+  }
+}
+
 /// Per elimination step, the block elimination keeps 15 lane pairs: P = D'⁻¹ (symmetric: xx, yx,
 /// zx, yy, zy, zz) and C = A P (row by row); the meeting node's P takes 6 scalars after the last
 /// step.
@@ -148,15 +171,7 @@ void back_substitute_block_tridiagonal(const TetherModel<Scalar>& model, const S
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
   const bool extra = m - f0 > pairs;
-  const auto kept_pair = [](const S* in) {
-    if constexpr (std::is_trivially_copyable_v<V>) {
-      V x;
-      std::memcpy(&x, in, sizeof(V));
-      return x;
-    } else {
-      return V{in[0], in[1]};
-    }
-  };
+  const auto kept_pair = [](const S* in) { return load_lane_pair<V>(in); };
   const S y0 = delta(0, m), y1 = delta(1, m), y2 = delta(2, m);
   V d0{y0, y0}, d1{y1, y1}, d2{y2, y2};
   for (int k = pairs - 1; k >= (extra ? -1 : 0); --k) {
@@ -233,14 +248,7 @@ void factor_solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWork
   // first in both lanes.
   const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
   const bool extra = m - f0 > pairs;
-  const auto keep = [](S* out, const V& x) {
-    if constexpr (std::is_trivially_copyable_v<V>) {
-      std::memcpy(out, &x, sizeof(V));
-    } else {
-      out[0] = x[0];
-      out[1] = x[1];
-    }
-  };
+  const auto keep = [](S* out, const V& x) { store_lane_pair(out, x); };
 
   const auto lanes = [](const auto& v, int i0, int i1) { return V{v(i0), v(i1)}; };
   const auto lanes_row = [](const auto& a, int row, int i0, int i1) {
@@ -394,15 +402,7 @@ void solve_factored_block_tridiagonal(const TetherModel<Scalar>& model, const Sc
   if (f1 < f0) return;
   const int m = f0 + (f1 - f0 + 1) / 2, pairs = f1 - m;
   const bool extra = m - f0 > pairs;
-  const auto kept_pair = [](const S* in) {
-    if constexpr (std::is_trivially_copyable_v<V>) {
-      V x;
-      std::memcpy(&x, in, sizeof(V));
-      return x;
-    } else {
-      return V{in[0], in[1]};
-    }
-  };
+  const auto kept_pair = [](const S* in) { return load_lane_pair<V>(in); };
   const auto lanes_row = [](const auto& a, int row, int i0, int i1) {
     return V{a(row, i0), a(row, i1)};
   };
