@@ -52,13 +52,21 @@ void reference_compute_forces(const kt::TetherModel<Scalar>& model, kt::TetherWo
   // handle); the sum is clamped at zero (a cable cannot push) unless compressive_damping. The
   // clamp is a kink like the one of the elastic force at l_s = l; the implicit schemes' active
   // set handles both (kt::detail::active_set_direction). Returns T_s u_s.
+  // kelp's line fades the dashpot out on a segment shorter than l_f = l/10 (0: no fade):
+  // σ(l_s) BA·ε̇ with the smoothstep σ = ρ²(3 − 2ρ), ρ = l_s/l_f (TetherModel::dashpot_fade);
+  // its slope σ' BA/l ε̇ joins the axial stiffness where it is positive.
   const bool clamp = !p.compressive_damping;
+  const Scalar lf = model.dashpot_fade_length();
   const auto segment = [&](int s) -> V3 {
     const V3 d = x.col(s + 1) - x.col(s);
     const Scalar ls2 = d.squaredNorm();
     const Scalar ls = sqrt(ls2);
     ws.stretched_length(s) = ls;
-    Scalar tension(0), k_axial(0), c_axial(ba_l);
+    const bool fading = lf > Scalar(0) && ls < lf;
+    const Scalar rf = fading ? ls / lf : Scalar(1);
+    const Scalar sigma = rf * rf * (Scalar(3) - Scalar(2) * rf);
+    const Scalar sigma_slope = fading ? Scalar(6) * rf * (Scalar(1) - rf) / lf : Scalar(0);
+    Scalar tension(0), k_axial(0), c_axial(ba_l * sigma);
     V3 u = V3::Zero();
     if (ls > Scalar(0)) {
       const Scalar inv_ls = Scalar(1) / ls;
@@ -70,7 +78,8 @@ void reference_compute_forces(const kt::TetherModel<Scalar>& model, kt::TetherWo
       if (ba != Scalar(0)) {
         const Scalar rate = u.dot(v.col(s + 1) - v.col(s));
         if constexpr (WithJacobian) ws.seg_rate(s) = rate;
-        tension += ba * rate * inv_l;
+        tension += ba * rate * inv_l * sigma;
+        if (sigma_slope * ba_l * rate > Scalar(0)) k_axial += sigma_slope * ba_l * rate;
         if (clamp && !(tension > Scalar(0))) {
           tension = Scalar(0);
           k_axial = c_axial = Scalar(0);

@@ -12,6 +12,7 @@
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/presets.hpp"
 #include "tether_test_support.hpp"
 
 namespace kt = kelp::tether;
@@ -417,4 +418,49 @@ TEST_CASE("the clock is a double for every Scalar: 24 h of 10 ms steps end at 86
   const long steps = 8640000;
   for (long k = 0; k < steps; ++k) kt::step_symplectic_euler(model, ws, env, s, bnd, 0.01);
   CHECK(std::abs(s.time - 86400.0) <= 1e-9 * 86400.0);
+}
+
+TEST_CASE("a kinematic end running through a slack line's first node: the implicit steps converge",
+          "[tether][implicit][dashpot]") {
+  // The paper's tether (Fathom-class, BA = 100 N s, 0.5 m segments), slack, in deep still
+  // water: the start end moves straight through the first free node, which sits a millimetre or
+  // two ahead of it (on its path, or 10 µm off it). The clamped dashpot pulls along the
+  // segment's direction, which turns over as the end passes the node: without the fade of the
+  // dashpot on a segment folded below a tenth of its length (TetherModel::dashpot_fade), a
+  // backward-Euler step across the passage has no solution (the node can neither be passed, the
+  // damping then stopping the end's approach, nor be stopped, there being no damping before it
+  // is passed), and Newton's method failed at every sub-step down to dt/64 (numerical_error) in
+  // both cases. The system met this in a rough sea, the boat's attachment point running through
+  // the first node of a slack tether.
+  kelp_test::TestWater<double> env;
+  env.surface_z = -100.0;  // deep
+  const kt::TetherModeld model(kt::presets::rov_tether(1.5, 0.5));
+  REQUIRE(model.segments() == 3);
+  REQUIRE(model.dashpot_fade_length() == Approx(0.05));
+  struct Case {
+    double ahead, off, speed, turn;  // m, m, m/s, rad (of the second segment)
+  };
+  for (const Case& c : {Case{2e-3, 0.0, 1.0, 0.0}, Case{1e-3, 1e-5, 0.3, 1.5}}) {
+    kt::TetherStated s(model);
+    s.position.col(1) = Vector3<double>(c.ahead, c.off, 0);
+    s.position.col(2) = Vector3<double>(0.2 * std::cos(c.turn), 0.2 * std::sin(c.turn), 0.1);
+    s.position.col(3) = Vector3<double>(0.3, 0, 0.2);
+    kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(s.position.col(0), s.position.col(3));
+    bnd.start.velocity = Vector3<double>(c.speed, 0, 0);
+    kt::TetherWorkspaced ws(model);
+    const double dt = 0.01;
+    kt::ImplicitOptionsd options;
+    double residual = 0;
+    for (int k = 0; k < 20; ++k) {
+      INFO("node " << 1000 * c.ahead << " mm ahead, " << 1000 * c.off << " mm off, end at "
+                   << c.speed << " m/s; step " << k << " at t = " << s.time << " s");
+      kt::StepReportd r;
+      REQUIRE_NOTHROW(r = kt::step_bdf2(model, ws, env, s, bnd, dt, options));
+      residual = std::max(residual, r.residual);
+      bnd.start = bnd.start.after(dt);
+    }
+    CHECK(residual <= options.acceleration_tolerance * dt);
+    CHECK(kelp::all_finite(s.position));
+    CHECK(kelp::all_finite(s.velocity));
+  }
 }

@@ -3,9 +3,9 @@
 // states that cover every branch: wet interior nodes, ends (kinematic and free), the surface
 // band, nodes in air, seabed contact (spring, ramped damper, friction sliding and sticking,
 // with and without the frozen normal force), taut, slack and clamped segments with a dashpot,
-// compressive damping, bending, Cat ≠ Can (added-mass rate terms). Also: the check can fail (the
-// symmetric approximation the implicit steps used so far is rejected), and the whole Newton
-// matrix's factor/solve against a dense solve.
+// a segment folded below the dashpot's fade length, compressive damping, bending, Cat ≠ Can
+// (added-mass rate terms). Also: the check can fail (the symmetric approximation the implicit steps
+// used so far is rejected), and the whole Newton matrix's factor/solve against a dense solve.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -33,6 +33,9 @@ using Mat = Eigen::MatrixXd;
 
 struct Config {
   bool free_start = false, free_end = false, compressive = false, frozen_friction = false;
+  // Segment 5 folded to 0.5 … 0.9 of the dashpot's fade length (TetherModel::dashpot_fade),
+  // stretching (its dashpot pulling).
+  bool fold = false;
   double bending = 0.5, cat = 0.3, damping = 20.0;
 };
 
@@ -86,7 +89,9 @@ struct Scene {
       if (i > 0) {
         Vector3<double> dir(1.0, 0.4 * u(rng), 0.4 * u(rng) + 0.35);
         dir.normalize();
-        p += (l * (1.0 + 0.15 * u(rng))) * dir;
+        double length = l * (1.0 + 0.15 * u(rng));
+        if (c.fold && i == 6) length = model.dashpot_fade_length() * (0.5 + 0.4 * std::abs(u(rng)));
+        p += length * dir;
       }
       x.col(i) = p;
       for (int k = 0; k < 3; ++k) {
@@ -96,6 +101,10 @@ struct Scene {
         ws.water_acceleration(k, i) = 0.8 * u(rng);
       }
       ws.surface_elevation(i) = 0.02 * u(rng);
+    }
+    if (c.fold) {
+      const Vector3<double> dir = (x.col(6) - x.col(5)).normalized();
+      v.col(6) += (0.3 + 0.2 * std::abs(u(rng)) - dir.dot(v.col(6) - v.col(5))) * dir;
     }
     // Surface: node 0 in air, nodes 1 and 2 in the band (well inside it), node 3 deeper.
     const double zeta0 = ws.surface_elevation(0);
@@ -280,6 +289,11 @@ TEST_CASE("whole Jacobian: every block matches central differences of compute_fo
     c.damping = 0.0;
     configs.push_back({"no bending, Cat = Can, no dashpot", c});
   }
+  {
+    Config c;
+    c.fold = true;
+    configs.push_back({"a segment folded below the dashpot's fade length", c});
+  }
   for (const auto& [name, c] : configs)
     for (unsigned seed = 1; seed <= 6; ++seed) {
       INFO(name);
@@ -291,9 +305,11 @@ TEST_CASE("whole Jacobian: the states of the check cover every branch", "[tether
   // The scenes above must reach each branch the Jacobian distinguishes, or the check proves
   // nothing about it.
   int air = 0, band = 0, bed = 0, ramp = 0, sliding = 0, sticking = 0, taut = 0, slack = 0,
-      clamped = 0;
-  for (unsigned seed = 1; seed <= 6; ++seed) {
-    Scene sc(Config{}, seed);
+      clamped = 0, faded = 0;
+  Config folded;
+  folded.fold = true;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    Scene sc(seed <= 6 ? Config{} : folded, seed);
     Matrix3X<double> f, md;
     sc.forces(sc.x, sc.v, f, md);
     const auto& p = sc.model.parameters();
@@ -310,6 +326,7 @@ TEST_CASE("whole Jacobian: the states of the check cover every branch", "[tether
       const double r = sc.ws.direction.col(s).dot(sc.v.col(s + 1) - sc.v.col(s));
       const double b = kt::detail::segment_branch(
           sc.model, sc.ws.stretched_length(s) - sc.model.segment_length(), r);
+      faded += b == 1.0 && sc.ws.stretched_length(s) < sc.model.dashpot_fade_length();
       taut += b == 2.0;
       slack += b == 1.0;
       clamped += b == 0.0;
@@ -324,6 +341,7 @@ TEST_CASE("whole Jacobian: the states of the check cover every branch", "[tether
   CHECK(taut > 0);
   CHECK(slack > 0);
   CHECK(clamped > 0);
+  CHECK(faded >= 6);
 }
 
 TEST_CASE("whole Jacobian: the check rejects the symmetric approximation", "[tether][jacobian]") {

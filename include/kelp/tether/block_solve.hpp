@@ -526,7 +526,8 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
       // The branch's force at the current point replaces the true one.
       const Scalar e = ws.stretched_length(s) - l, r = ws.seg_rate(s);
       const Scalar tb =
-          (b == Scalar(2) ? ea_l * e : Scalar(0)) + (b > Scalar(0) ? ba_l * r : Scalar(0));
+          (b == Scalar(2) ? ea_l * e : Scalar(0)) +
+          (b > Scalar(0) ? ba_l * model.dashpot_fade(ws.stretched_length(s)).value * r : Scalar(0));
       const Vector3<Scalar> df = (gh * (tb - ws.tension(s))) * ws.direction.col(s);
       ws.rhs.col(s) += df;
       ws.rhs.col(s + 1) -= df;
@@ -569,7 +570,10 @@ int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scala
           ws.seg_c_uu(s) = ws.seg_true_c_uu(s);
         } else {
           ws.seg_k_uu(s) = (b == Scalar(2) ? ea_l : Scalar(0)) - ws.seg_k_perp(s);
-          ws.seg_c_uu(s) = b > Scalar(0) ? ba_l : Scalar(0);
+          // (Off its true branch a segment has no fade slope in k: a clamped one has r ≤ 0, a
+          // banded one is longer than the fade length.)
+          ws.seg_c_uu(s) =
+              b > Scalar(0) ? ba_l * model.dashpot_fade(ws.stretched_length(s)).value : Scalar(0);
         }
       }
     }

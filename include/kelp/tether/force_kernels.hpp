@@ -44,9 +44,11 @@ struct ForcePass {
   const TetherParameters<Scalar>* p;
   int n;
   Scalar rho, g, bed, l, l2, inv_l, ea_l, ba_l, ea, ba, can, cat, inv_d, bed_k, bed_c;
+  /// 1/l_f of the dashpot's fade (TetherModel::dashpot_fade), used when `fade`.
+  Scalar inv_fade;
   /// Half the cable diameter [m]: a node at least this deep under the surface is wholly wet.
   Scalar half_d;
-  bool clamp, damping, still, bending, mass_turns;
+  bool clamp, damping, fade, still, bending, mass_turns;
   NodeConstants<Scalar> kinds[3];
   const Scalar* x;
   Eigen::Index xs;
@@ -70,13 +72,15 @@ enum PassColumn : int { kSegmentForce = 0, kNodeForce = 3, kMassRate = 6 };
 template <typename Scalar, bool Wide>
 struct PackedConstants {
   using P = simd::Pack<Scalar, Wide>;
-  P zero, one, two, l, l2, inv_l, ea, ea_l, ba, ba_l, bed, half_d, wet_weight, kn, kt, rho_vol,
-      one_plus_can, cat_minus_can, mass_iso_wet, mass_tan_wet, mass_iso_inv, mass_tan_ratio;
+  P zero, one, two, three, l, l2, inv_l, ea, ea_l, ba, ba_l, inv_fade, bed, half_d, wet_weight, kn,
+      kt, rho_vol, one_plus_can, cat_minus_can, mass_iso_wet, mass_tan_wet, mass_iso_inv,
+      mass_tan_ratio;
   explicit PackedConstants(const ForcePass<Scalar>& c) {
     const NodeConstants<Scalar>& nc = c.kinds[1];
     zero = P::all(Scalar(0));
     one = P::all(Scalar(1));
     two = P::all(Scalar(2));
+    three = P::all(Scalar(3));
     l = P::all(c.l);
     l2 = P::all(c.l2);
     inv_l = P::all(c.inv_l);
@@ -84,6 +88,7 @@ struct PackedConstants {
     ea_l = P::all(c.ea_l);
     ba = P::all(c.ba);
     ba_l = P::all(c.ba_l);
+    inv_fade = P::all(c.inv_fade);
     bed = P::all(c.bed);
     half_d = P::all(c.half_d);
     wet_weight = P::all(nc.wet_weight);
@@ -128,7 +133,20 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
     const P e1 = P::gather(b + c.vs + 1, c.vs) - P::gather(b + 1, c.vs);
     const P e2 = P::gather(b + c.vs + 2, c.vs) - P::gather(b + 2, c.vs);
     rate = (u0 * e0 + u1 * e1) + u2 * e2;
-    tension += (pc.ba * rate) * pc.inv_l;
+    P damping = (pc.ba * rate) * pc.inv_l;
+    if (c.fade) {
+      // kelp's line: the dashpot fades out below l_f (TetherModel::dashpot_fade), σ = ρ²(3 − 2ρ)
+      // with ρ = min(l_s/l_f, 1); σ = 1 exactly above l_f. Its slope σ' BA/l ε̇ joins the axial
+      // stiffness where it is positive (the symmetric matrix stays positive semi-definite).
+      const P r0 = ls * pc.inv_fade;
+      const P r = simd::select(simd::greater(r0, pc.one), pc.one, r0);
+      const P sigma = (r * r) * (pc.three - pc.two * r);
+      const P k_fade = ((pc.two * pc.three) * r * (pc.one - r) * pc.inv_fade) * (pc.ba_l * rate);
+      damping = damping * sigma;
+      c_axial = c_axial * sigma;
+      k_axial = k_axial + simd::select(simd::greater(k_fade, zero), k_fade, zero);
+    }
+    tension += damping;
     if (c.clamp) {
       // A zero-length segment keeps its dashpot slope (its force is zero either way).
       const auto keep = simd::greater(tension, zero);

@@ -366,6 +366,8 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   c.bed_c = p.seabed_damping * p.diameter;
   c.clamp = !p.compressive_damping;
   c.damping = c.ba != Scalar(0);
+  c.fade = model.dashpot_fade_length() > Scalar(0);
+  c.inv_fade = model.inverse_dashpot_fade_length();
   c.bending = p.bending_stiffness > Scalar(0);
   // Added-mass rate terms (see compute_forces); none when Cat = Can (b = 0) and none in
   // MoorDyn's line model (TetherModel::added_mass_rate_terms).

@@ -26,9 +26,10 @@ namespace detail {
 
 /// Segment s's axial force T u and its derivatives on `branch` b (0 no force, 1 dashpot only,
 /// 2 elastic plus dashpot, see active_set_direction): T_b = [b = 2] EA/l (l_s − l) + [b ≥ 1]
-/// BA/l r with r = u·e the stretch rate (e = v_{s+1} − v_s), so with d = x_{s+1} − x_s and
-/// P = I − u uᵀ: ∂T_b/∂d = [b = 2] EA/l u + [b ≥ 1] BA/l P e / l_s (the dashpot turns with the
-/// segment), K = ∂(T_b u)/∂d = u ∂T_b/∂dᵀ + T_b P / l_s and C = ∂(T_b u)/∂e = [b ≥ 1] BA/l u uᵀ.
+/// σ BA/l r with r = u·e the stretch rate (e = v_{s+1} − v_s) and σ(l_s) the dashpot's fade
+/// (TetherModel::dashpot_fade), so with d = x_{s+1} − x_s and P = I − u uᵀ: ∂T_b/∂d = [b = 2]
+/// EA/l u + [b ≥ 1] BA/l (σ P e / l_s + σ' r u) (the dashpot turns with the segment),
+/// K = ∂(T_b u)/∂d = u ∂T_b/∂dᵀ + T_b P / l_s and C = ∂(T_b u)/∂e = [b ≥ 1] σ BA/l u uᵀ.
 template <typename Scalar>
 struct SegmentJacobian {
   Matrix3<Scalar> k, c;
@@ -76,9 +77,12 @@ SegmentJacobian<Scalar> segment_jacobian(const TetherModel<Scalar>& model,
     grad = ea_l * u;
   }
   if (ba_l != Scalar(0)) {
-    out.tension += ba_l * r;
-    grad += (ba_l * inv_ls) * (e - r * u);
-    add_outer(out.c, ba_l, u, u);
+    // The dashpot σ(l_s) BA/l r (TetherModel::dashpot_fade): ∂/∂d = BA/l (σ' r u + σ P e/l_s).
+    const typename TetherModel<Scalar>::Fade fade = model.dashpot_fade(ls);
+    const Scalar bs = ba_l * fade.value;
+    out.tension += bs * r;
+    grad += (bs * inv_ls) * (e - r * u) + (ba_l * fade.slope * r) * u;
+    add_outer(out.c, bs, u, u);
   }
   add_outer(out.k, Scalar(1), u, grad);
   add_projector(out.k, out.tension * inv_ls, u);

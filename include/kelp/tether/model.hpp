@@ -208,6 +208,8 @@ class TetherModel {
     inv_l_ = Scalar(1) / l_;
     ea_over_l_ = p.axial_stiffness / l_;
     ba_over_l_ = p.internal_damping / l_;
+    fade_length_ = p.line_model == LineModel::kelp ? kDashpotFadeFraction * l_ : Scalar(0);
+    inv_fade_length_ = fade_length_ > Scalar(0) ? Scalar(1) / fade_length_ : Scalar(0);
     area_ = Scalar(kelp::pi) * p.diameter * p.diameter / Scalar(4);
     node_mass_.resize(n + 1);
     node_volume_.resize(n + 1);
@@ -244,6 +246,40 @@ class TetherModel {
   Scalar axial_spring() const { return ea_over_l_; }
   /// \brief BA/l [N s/m]: the axial damper constant of one segment.
   Scalar axial_damper() const { return ba_over_l_; }
+  /// \brief Fraction of the rest length l below which kelp's line model fades its dashpot out:
+  /// see dashpot_fade().
+  static constexpr double kDashpotFadeFraction = 0.1;
+  /// \brief Segment length l_f [m] below which the dashpot fades out (l/10 in kelp's line
+  /// model; 0, no fade, in LineModel::moordyn): see dashpot_fade().
+  Scalar dashpot_fade_length() const { return fade_length_; }
+  /// \brief The dashpot's factor σ(l_s) and its slope dσ/dl_s [1/m] for a segment of length
+  /// l_s [m]: the damping tension is σ(l_s) BA·ε̇. σ = ρ²(3 − 2ρ), ρ = l_s/l_f, below l_f
+  /// (a smoothstep: σ(0) = 0, σ(l_f) = 1, zero slope at both), 1 above it and without a fade.
+  ///
+  /// Why: the dashpot pulls along the segment's direction u = (x_{s+1} − x_s)/l_s, which is
+  /// undefined at l_s = 0, and its force (BA/l)(u·e) u (e = v_{s+1} − v_s) jumps when two nodes
+  /// pass through each other. Clamped at zero (a cable never pushes) it resists only their
+  /// separation, so two coinciding nodes stick, and an implicit step in which they would pass
+  /// through each other has no solution at all (in one dimension: the nodes cannot cross
+  /// without being stopped by the damping, nor be stopped before crossing without it); Newton's
+  /// method then fails at any sub-step (issue 24: the boat's attachment point running through
+  /// the first node of a slack line in a rough sea). With the fade the damping force near
+  /// l_s = 0 is (BA/l)(3/l_f²)(d·e) d (d = x_{s+1} − x_s), smooth. Physically a segment folded to
+  /// a tenth of its rest length is a heap of slack cable whose chord rate is no strain rate of
+  /// its material (the dashpot models the material's damping of a stretching cable); the fade
+  /// changes nothing while every segment is longer than l/10 (MoorDyn's validation cases, a
+  /// line in tension).
+  struct Fade {
+    Scalar value, slope;
+  };
+  Fade dashpot_fade(Scalar ls) const {
+    if (!(ls < fade_length_)) return {Scalar(1), Scalar(0)};
+    const Scalar r = ls * inv_fade_length_;
+    return {r * r * (Scalar(3) - Scalar(2) * r),
+            Scalar(6) * r * (Scalar(1) - r) * inv_fade_length_};
+  }
+  /// \brief 1/l_f [1/m] (0 without a fade).
+  Scalar inverse_dashpot_fade_length() const { return inv_fade_length_; }
   /// \brief Cross-section area A = π d²/4 [m²].
   Scalar area() const { return area_; }
   /// \brief Structural mass of node i [kg] (μ times its share of length, plus the point mass of a
@@ -268,6 +304,7 @@ class TetherModel {
  private:
   TetherParameters<Scalar> p_;
   Scalar l_, inv_l_, ea_over_l_, ba_over_l_, area_, min_node_mass_;
+  Scalar fade_length_, inv_fade_length_;
   VectorX<Scalar> node_mass_, node_volume_, node_length_;
   int first_free_ = 1, last_free_ = 0;
   bool rate_terms_ = false;
