@@ -424,9 +424,10 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// (`ws.mass_iso`, `ws.mass_tan`), plus tensions, tangents and seabed forces. Per node i:
 /// \f[ F_i = T_i u_i − T_{i−1} u_{i−1} + (m_i − ρ V_i) g e_z + F^{drag}_i + F^{FK}_i + F^{bed}_i
 /// \f]
-/// - axial: T_s = max(0, EA·max(0, ε_s) + BA ε̇_s): the elastic part acts only when l_s > l, the
-///   dashpot at any length, and the sum is clamped at zero so that a segment never pushes
-///   (`compressive_damping` or LineModel::moordyn drops the clamp, as MoorDyn does);
+/// - axial: T_s = max(0, EA·max(0, ε_s) + σ(l_s) BA ε̇_s): the elastic part acts only when
+///   l_s > l, the dashpot at any length (faded out by σ on a segment folded below l/10 in kelp's
+///   line, TetherModel::dashpot_fade), and the sum is clamped at zero so that a segment never
+///   pushes (`compressive_damping` or LineModel::moordyn drops the clamp, as MoorDyn does);
 /// - drag (Morison, on v_r = u_water − v_i): ½ρ d l_i Cdn |v_rn| v_rn + ½ρ π d l_i Cdt |v_rt| v_rt;
 /// - fluid inertia: ρ V_i [(1 + Can)(I − q qᵀ) + (1 + Cat) q qᵀ] a_water;
 /// - added mass ρ V_i [Can (I − q qᵀ) + Cat q qᵀ] in the mass matrix (never as a force from a

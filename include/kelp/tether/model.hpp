@@ -29,18 +29,23 @@ enum class EndMode {
 ///
 /// Both share the formulation of Hall & Goupee (2015) as MoorDyn v2 implements it (tangents,
 /// Morison drag split, added mass in the node mass matrices, weight, buoyancy, Froude–Krylov
-/// forcing, seabed spring–damper); they differ in three places (docs/equations.md, section 4;
-/// benchmarks/results/tether.md, "kelp's line and MoorDyn's" for the measured effect):
+/// forcing, seabed spring–damper); they differ in four places (docs/equations.md, section 4;
+/// benchmarks/results/tether.md, "kelp's line and MoorDyn's" for the measured effect of the
+/// first three):
 ///
 /// - added-mass rate terms (Cat ≠ Can): `kelp` has them (the model is passive), `moordyn` not;
 /// - internal dashpot BA·ε̇: `kelp` clamps the axial force at 0 (a cable never pushes),
 ///   `moordyn` lets it act in compression too;
 /// - seabed damping at touchdown: `kelp` ramps it in over `seabed_damping_depth`, `moordyn`
-///   switches it on at first contact (a force step).
+///   switches it on at first contact (a force step);
+/// - the dashpot of a segment folded below a tenth of its rest length: `kelp` fades it out
+///   (TetherModel::dashpot_fade: its direction is undefined at zero length), `moordyn` keeps it;
+///   nothing differs while every segment is longer than that.
 enum class LineModel {
   /// kelp's passive line: the added-mass rate terms (Lagrange's equations with the
   /// tangent-dependent added mass; see compute_forces), an axial force that never pushes (unless
-  /// `compressive_damping`), the seabed damping ramped in over `seabed_damping_depth`.
+  /// `compressive_damping`), the seabed damping ramped in over `seabed_damping_depth`, the
+  /// dashpot faded out on a segment folded below l/10 (TetherModel::dashpot_fade).
   kelp,
   /// MoorDyn v2's line model (source/Line.cpp of MoorDyn v2.7.1): no added-mass rate terms, the
   /// internal dashpot acting in compression as well (`compressive_damping` is implied), the seabed
