@@ -467,3 +467,35 @@ TEST_CASE("chain: the supply voltage scales every thrust and the inverse uses it
   CHECK(old.thrust_of_command(0, -1.0) == Approx(-30.4));
   CHECK(old.max_positive_thrust(0) == kv::von_benzon_t200_max_thrust);
 }
+
+TEST_CASE("chain: the datasheet is read at the ESC's pulse width, whatever the PWM mapping",
+          "[vehicle][t200][thrusters]") {
+  // The BlueBoat's outputs span 1000–2000 µs; the Basic ESC is full at 1100 / 1900 µs. The same
+  // pulse width gives the same thrust as on the ROV's 1100–1900 µs mapping, and anything beyond
+  // 1900 µs is full thrust.
+  const auto boat = kv::blueboat<double>();
+  const auto rov = kv::bluerov2_heavy<double>();
+  const kv::ThrusterChaind b(
+      kv::ThrusterAllocationd(boat.thruster_positions, boat.thruster_directions), kv::t200_model,
+      boat.pwm, boat.thruster_facing);
+  const kv::ThrusterChaind r(
+      kv::ThrusterAllocationd(rov.thruster_positions, rov.thruster_directions), kv::t200_model,
+      rov.pwm, rov.thruster_facing);
+  for (double pwm = 1100; pwm <= 1900; pwm += 20)
+    CHECK(b.thrust_of_pwm(0, pwm) == Approx(r.thrust_of_pwm(0, pwm)).margin(1e-12));
+  CHECK(b.thrust_of_pwm(0, 2000) == Approx(kv::t200_max_thrust(16.0)));
+  CHECK(b.thrust_of_pwm(1, 1000) == Approx(-kv::t200_max_reverse_thrust(16.0)));
+  // The inverse answers in the chain's own command: 0.8 (1900 µs) already gives full thrust.
+  Eigen::Vector2d want(30, 100), cmd, got;
+  b.commands_for(want, cmd, got);
+  CHECK(got(0) == Approx(30));
+  CHECK(kv::pwm_from_command(cmd(0), boat.pwm) ==
+        Approx(kv::pwm_from_command(kv::t200_command(30.0, 16.0), rov.pwm)));
+  CHECK(cmd(1) == Approx(0.8));
+  CHECK(got(1) == Approx(kv::t200_max_thrust(16.0)));
+  // A polynomial model keeps the chain's command as it is (its u is the normalised command).
+  const kv::ThrusterChaind p(
+      kv::ThrusterAllocationd(boat.thruster_positions, boat.thruster_directions),
+      kv::von_benzon_t200_model, boat.pwm);
+  CHECK(p.thrust_of_pwm(0, 1900) == Approx(kv::thrust(kv::von_benzon_t200_model, 0.8)));
+}

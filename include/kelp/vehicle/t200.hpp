@@ -57,6 +57,9 @@ inline constexpr double t200_nominal_voltage = 16.0;
 inline constexpr double t200_data_min_voltage = 10.0;
 /// \brief Highest supported voltage [V] (the data's and the T200's rated maximum).
 inline constexpr double t200_max_voltage = 20.0;
+/// \brief Half-range of the ESC's pulse width [µs]: the data's command u = (pwm − 1500 µs)/400 µs
+/// (Blue Robotics Basic ESC: 1100–1900 µs, full reverse to full forward).
+inline constexpr double t200_esc_half_range_us = 400.0;
 /// \brief One kilogram-force [N] (the data's thrust unit; standard gravity).
 inline constexpr double t200_kgf = 9.80665;
 

@@ -424,6 +424,11 @@ class ThrusterChain {
                    "thruster_facing entries must be +1 or -1");
       facing_ = facing;
     }
+    if (model.curve == ThrusterCurve::t200_datasheet) {
+      // The datasheet's command is the ESC's: u = (pwm − 1500 µs)/400 µs, full at 1100 / 1900.
+      esc_up_ = value_of(pwm_.max_us - pwm_.neutral_us) / t200_esc_half_range_us;
+      esc_down_ = value_of(pwm_.neutral_us - pwm_.min_us) / t200_esc_half_range_us;
+    }
     set_voltage(voltage);
   }
 
@@ -466,11 +471,13 @@ class ThrusterChain {
   Scalar command_from_pwm(const Scalar& pwm_us) const {
     return vehicle::command_from_pwm(pwm_us, pwm_);
   }
-  /// \brief Thrust [N] of thruster i along d_i for a normalised command:
-  /// facing · thrust(facing · u, V).
+  /// \brief Thrust [N] of thruster i along d_i for a normalised command u (of this chain's PWM
+  /// mapping): facing · thrust(facing · u_esc, V). For the datasheet curve u_esc is the ESC's
+  /// command, u scaled to the ESC's 1100–1900 µs and clamped (e.g. the BlueBoat's 1000–2000 µs
+  /// mapping: u_esc = 1.25 u, full thrust from 1900 µs on); for a polynomial u_esc = u.
   Scalar thrust_of_command(Eigen::Index i, const Scalar& u) const {
     const Scalar s(facing_(i));
-    return s * thrust(model_, Scalar(s * u), Scalar(voltage_));
+    return s * thrust(model_, Scalar(s * esc_command(u)), Scalar(voltage_));
   }
   /// \brief Thrust [N] of thruster i along d_i for a pulse width [µs].
   /// \param[out] command the normalised command, if not null.
@@ -479,11 +486,16 @@ class ThrusterChain {
     if (command != nullptr) *command = u;
     return thrust_of_command(i, u);
   }
-  /// \brief Command of thruster i for a desired thrust [N] along d_i: facing ·
-  /// command_for_thrust(facing · force, V) (saturates at the largest thrust that way).
+  /// \brief Command of thruster i for a desired thrust [N] along d_i: the inverse of
+  /// thrust_of_command(), facing · command_for_thrust(facing · force, V) taken back from the
+  /// ESC's command to the chain's (saturates at the largest thrust that way, |u| ≤ 1).
   Scalar command_for(Eigen::Index i, const Scalar& force) const {
     const Scalar s(facing_(i));
-    return s * command_for_thrust(model_, Scalar(s * force), Scalar(voltage_));
+    const Scalar ue = s * command_for_thrust(model_, Scalar(s * force), Scalar(voltage_));
+    Scalar u = value_of(ue) > 0.0 ? Scalar(ue / Scalar(esc_up_)) : Scalar(ue / Scalar(esc_down_));
+    if (value_of(u) > 1.0) u = Scalar(1);
+    if (value_of(u) < -1.0) u = Scalar(-1);
+    return u;
   }
 
   /// \brief For desired per-thruster forces [N]: the commands and the thrust they deliver
@@ -534,7 +546,17 @@ class ThrusterChain {
   ThrusterAllocation<Scalar> allocation_;
   ThrusterModel model_;
   PwmMapping<Scalar> pwm_;
+  /// The ESC's command of the chain's: u_esc = u · esc_up_ (u > 0) or u · esc_down_, clamped.
+  Scalar esc_command(const Scalar& u) const {
+    check_finite(u, "thruster command u");
+    Scalar ue = value_of(u) > 0.0 ? Scalar(u * Scalar(esc_up_)) : Scalar(u * Scalar(esc_down_));
+    if (value_of(ue) > 1.0) ue = Scalar(1);
+    if (value_of(ue) < -1.0) ue = Scalar(-1);
+    return ue;
+  }
+
   Eigen::VectorXd facing_;
+  double esc_up_ = 1.0, esc_down_ = 1.0;
   double voltage_ = t200_nominal_voltage;
   double max_forward_ = 0.0, max_reverse_ = 0.0;
 };
