@@ -151,9 +151,11 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   ≈ 0.2 m hulls and deck box), L_oa = 1.2 m (assumed from the product dimensions); constant
 ///   coefficients c_x = 0.6, c_y = 0.8 (assumed, mid-range of Fossen 2021 §10.1.1's values for
 ///   small craft), c_n = 0 (fore-aft symmetric profile assumed: no wind yaw moment).
-/// Resulting behaviour (checked by tests/vehicle): top speed 2.97 m/s at full command (the
-/// thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against the pure surge
-/// balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch 0.68 s.
+/// Resulting behaviour (checked by tests/vehicle): top speed 2.97 m/s with von Benzon's 30.4 N per
+/// thruster (the thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against
+/// the pure surge balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch
+/// 0.68 s. With the T200 datasheet (2 × 51.6 N at 16 V) the same damping gives ≈ 4.1 m/s, above
+/// the Blue Robotics figure: the assumed surge damping was chosen for the old curve.
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
 /// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
 /// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (the displaced volume is m/ρ).
