@@ -270,6 +270,7 @@ class ClosedLoop {
   }
   static kelp::control::AuvControllerSettings auv_settings(const Scenario& sc) {
     kelp::control::AuvControllerSettings s;
+    s.thruster_facing = kelp::vehicle::bluerov2_heavy<double>().thruster_facing;
     s.compensate = sc.compensation;
     s.period = 1.0 / sc.auv_rate;
     set_gains(s.surge, sc.auv_surge);
@@ -280,6 +281,7 @@ class ClosedLoop {
   }
   static kelp::control::AsvControllerSettings asv_settings(const Scenario& sc) {
     kelp::control::AsvControllerSettings s;
+    s.thruster_facing = kelp::vehicle::blueboat<double>().thruster_facing;
     s.compensate = sc.compensation;
     s.period = 1.0 / sc.asv_rate;
     s.thrust_clip = sc.asv_thrust_clip;
