@@ -79,8 +79,7 @@ TEST_CASE("IMU white noise: σ = density · √rate on every axis", "[nav][imu]"
   }
 }
 
-TEST_CASE("IMU bias random walk: the variance of its change grows as walk² · time",
-          "[nav][imu]") {
+TEST_CASE("IMU bias random walk: the variance of its change grows as walk² · time", "[nav][imu]") {
   kn::ImuParameters p;
   p.gyro_noise_density = 0;
   p.accel_noise_density = 0;
@@ -134,8 +133,7 @@ TEST_CASE("depth and compass: σ and bias as given", "[nav][depth][compass]") {
   CHECK(c.sd() == Approx(cp.noise).epsilon(0.1));
 }
 
-TEST_CASE("DVL: bottom lock within its altitude range, else water track or no fix",
-          "[nav][dvl]") {
+TEST_CASE("DVL: bottom lock within its altitude range, else water track or no fix", "[nav][dvl]") {
   kn::DvlParameters p;
   kn::Dvl dvl(p, 5, 3);
   CHECK(dvl.mode_at(0.01) == kn::DvlMode::water);
@@ -169,7 +167,7 @@ TEST_CASE("DVL: bottom lock within its altitude range, else water track or no fi
   REQUIRE(b.sample(x, env, 0.0, s));
   CHECK(s.mode == kn::DvlMode::water);
   const V3 expected = V3(1.0, 0.2, 0.0) - x.attitude.conjugate() * V3(0.0, 0.5, 0.0);
-  CHECK(s.velocity.isApprox(expected));  // relative to the water
+  CHECK(s.velocity.isApprox(expected));                   // relative to the water
   CHECK_FALSE(b.sample(x, env, 1.0 / p.bottom_rate, s));  // water track pings at 2 Hz
   CHECK(b.sample(x, env, 1.0 / p.water_rate, s));
 }
@@ -227,9 +225,10 @@ TEST_CASE("GPS: white noise σ, Gauss–Markov σ and correlation time, vertical
   CHECK(c == Approx(std::exp(-1.0)).epsilon(0.1));
 }
 
-TEST_CASE("USBL: noise grows with slant range, fixes are lost at the dropout rate and arrive "
-          "after the latency",
-          "[nav][usbl]") {
+TEST_CASE(
+    "USBL: noise grows with slant range, fixes are lost at the dropout rate and arrive "
+    "after the latency",
+    "[nav][usbl]") {
   kn::UsblParameters p;
   p.dropout = 0;
   p.latency = 0;

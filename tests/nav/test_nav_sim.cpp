@@ -87,8 +87,8 @@ TEST_CASE("closed loop on sensors: the estimates converge and stay bounded in th
     if (loop.time() > 30) {
       const auto* n = loop.navigation();
       late_auv = std::max(late_auv, (n->auv().position - loop.state().auv.position).norm());
-      late_asv = std::max(
-          late_asv, (n->asv().position - loop.state().asv.position).head<2>().norm());
+      late_asv =
+          std::max(late_asv, (n->asv().position - loop.state().asv.position).head<2>().norm());
     }
   }
   const nlohmann::json s = loop.summary()["navigation"];
@@ -97,12 +97,13 @@ TEST_CASE("closed loop on sensors: the estimates converge and stay bounded in th
   CHECK(s["dvl_pings"]["water"].get<long>() > 100);
   CHECK(s["dvl_pings"]["bottom"].get<long>() == 0);
   CHECK(s["usbl"]["pings"].get<long>() == 60);
-  CHECK(s["auv_rms_position_error_m"].get<double>() < 1.0);
-  CHECK(s["asv_rms_horizontal_error_m"].get<double>() < 1.0);
+  // Measured (seed 1): ROV 0.38 m RMS, boat 0.26 m RMS horizontally; the bounds leave 2x.
+  CHECK(s["auv_rms_position_error_m"].get<double>() < 0.75);
+  CHECK(s["asv_rms_horizontal_error_m"].get<double>() < 0.6);
   CHECK(s["auv_rms_heading_error_deg"].get<double>() < 1.0);
   CHECK(s["auv_rms_velocity_error_m_s"].get<double>() < 0.5);
-  CHECK(late_auv < 2.0);
-  CHECK(late_asv < 2.0);
+  CHECK(late_auv < 1.5);
+  CHECK(late_asv < 1.5);
 }
 
 TEST_CASE("closed loop on sensors: the same seed gives the same run, another seed another",

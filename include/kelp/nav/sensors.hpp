@@ -96,8 +96,11 @@ class SensorSchedule {
   }
   /// \brief The sampling period [s].
   double period() const { return period_; }
-  /// \brief Changes the period [s] from the next sample on.
-  void set_period(double p) { period_ = p; }
+  /// \brief Schedules the next sample one period `p` [s] after `t` [s] (and keeps that period).
+  void reschedule(double t, double p) {
+    period_ = p;
+    next_ = t + p;
+  }
 
  private:
   double period_ = 1.0, next_ = 0.0;
@@ -303,7 +306,7 @@ class Dvl {
     }
     out = measure(x, mode, water, t);
     out.altitude = altitude;
-    schedule_.set_period(1.0 / (mode == DvlMode::bottom ? p_.bottom_rate : p_.water_rate));
+    schedule_.reschedule(t, 1.0 / (mode == DvlMode::bottom ? p_.bottom_rate : p_.water_rate));
     return true;
   }
   /// \brief One fix in `mode` given the water's NED velocity below [m/s], regardless of the
