@@ -11,17 +11,18 @@
 /// - **IMU**: the TDK InvenSense ICM-20602 of Blue Robotics' Navigator flight controller (the
 ///   BlueROV2's and the BlueBoat's autopilot board). ICM-20602 data sheet (DS-000176): gyroscope
 ///   rate noise spectral density 0.004 °/s/√Hz, accelerometer noise 100 µg/√Hz. The data sheet
-///   gives no bias random walk; the defaults are the example MEMS values of Kalibr's IMU noise
-///   model documentation (ethz-asl/kalibr wiki, "IMU Noise Model": gyroscope 1.9393e-5 rad/s²/√Hz,
-///   accelerometer 3.0e-3 m/s³/√Hz). Rate 100 Hz: kelp's closed loop steps at 10 ms.
+///   gives no bias random walk; the defaults are those of the ADIS16448 of the EuRoC MAV datasets
+///   (Burri et al., IJRR 35(10), 2016; their sensor.yaml, the example Kalibr's IMU noise model is
+///   used with: gyroscope 1.9393e-5 rad/s²/√Hz, accelerometer 3.0e-3 m/s³/√Hz), a conservative
+///   stand-in for a consumer part. Rate 100 Hz: kelp's closed loop steps at 10 ms.
 ///   The accelerometer measures the specific force f = (ν̇₁ + ω × ν₁) − Rᵀ (0, 0, g) in body
 ///   axes (the CO's acceleration minus gravity), so it needs the vehicle's last ν̇.
 /// - **Depth**: Blue Robotics Bar30 (TE MS5837-30BA). Bar30 technical details
 ///   (bluerobotics/bar30-pressure-sensor): 0.2 mbar resolution, i.e. 2 mm of water, taken as the
 ///   noise σ; absolute accuracy ±50 mbar (0.5 m) over 0–6 bar, which the autopilot's zeroing at
-///   the surface removes (a constant `bias`, 0 by default). Rate 20 Hz: two conversions at the
-///   highest oversampling take about 2 × 18 ms (MS5837-30BA data sheet). It reads the CO's depth
-///   (no wave pressure, no lever arm).
+///   the surface removes (a constant `bias`, 0 by default). Rate 20 Hz: a read (pressure and
+///   temperature conversions at the highest oversampling) takes up to 40 ms (Blue Robotics'
+///   MS5837 library). It reads the CO's depth (no wave pressure, no lever arm).
 /// - **DVL**: Water Linked DVL A50. Bottom lock from 0.05 to 50 m altitude (Water Linked's A50
 ///   page: "0.05 – 50 meter range", ping rate 4–26 Hz altitude dependent; range-mode table: 5–6 Hz
 ///   between 1.5 and 14 m, the default 5 Hz). Velocity noise σ = 0.001 m/s + 1 % of the speed:
