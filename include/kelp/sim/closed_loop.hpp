@@ -24,6 +24,7 @@
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
+#include "kelp/nav/pair.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
@@ -145,6 +146,9 @@ class ClosedLoop {
     }
     auv_.follow(waypoints_);
     asv_.follow_auv();
+    if (sc.navigation.mode == "sensors")
+      navigation_ = std::make_unique<kelp::nav::PairNavigation>(sc.navigation.sensors,
+                                                                sc.navigation.seed, model_, state_);
     observe();
   }
 
@@ -221,6 +225,36 @@ class ClosedLoop {
   const RunMetrics& metrics() const { return metrics_; }
   /// \brief How hard the tether's solver has worked so far (every step's report summed).
   const kelp::system::SolverStatsd& solver_stats() const { return solver_stats_; }
+  /// \brief The sensors and filters when the scenario's navigation mode is "sensors", else null.
+  const kelp::nav::PairNavigation* navigation() const { return navigation_.get(); }
+
+  /// \brief The summary's `navigation` object: the mode, and with sensors the seed, the RMS
+  /// errors of each vehicle's estimate over every step after t = 0 (position, 3-D and horizontal
+  /// [m], heading [deg], body velocity [m/s]), the USBL's pings, losses and fixes used and the
+  /// DVL's pings by mode.
+  nlohmann::json navigation_summary() const {
+    nlohmann::json n = {{"mode", scenario_.navigation.mode}};
+    if (!navigation_) return n;
+    const kelp::nav::PairNavigation& v = *navigation_;
+    const double deg = 180.0 / kelp::pi;
+    n["seed"] = scenario_.navigation.seed;
+    n["auv_rms_position_error_m"] = v.auv_errors().rms_position();
+    n["auv_rms_horizontal_error_m"] = v.auv_errors().rms_horizontal();
+    n["auv_max_position_error_m"] = v.auv_errors().max_position;
+    n["auv_rms_heading_error_deg"] = v.auv_errors().rms_heading() * deg;
+    n["auv_rms_velocity_error_m_s"] = v.auv_errors().rms_velocity();
+    n["asv_rms_position_error_m"] = v.asv_errors().rms_position();
+    n["asv_rms_horizontal_error_m"] = v.asv_errors().rms_horizontal();
+    n["asv_max_position_error_m"] = v.asv_errors().max_position;
+    n["asv_rms_heading_error_deg"] = v.asv_errors().rms_heading() * deg;
+    n["asv_rms_velocity_error_m_s"] = v.asv_errors().rms_velocity();
+    n["usbl"] = {
+        {"pings", v.usbl_pings()}, {"dropouts", v.usbl_dropouts()}, {"fixes_used", v.usbl_fixes()}};
+    n["dvl_pings"] = {{"bottom", v.dvl_pings(kelp::nav::DvlMode::bottom)},
+                      {"water", v.dvl_pings(kelp::nav::DvlMode::water)},
+                      {"none", v.dvl_pings(kelp::nav::DvlMode::none)}};
+    return n;
+  }
 
   /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
   /// time (simulate() adds it) and the program's version: errors, tensions, slack fraction, the
@@ -249,6 +283,7 @@ class ClosedLoop {
     // C library's math (kelp/core/kernel_path.hpp); kelp-sweep merge compares them across runs.
     s["kernel"] = kelp::simd::kernel_name(model_.environment().waves().active_kernel());
     s["math_library"] = kelp::simd::math_library_fingerprint();
+    s["navigation"] = navigation_summary();
     s["scenario_file"] = options_.scenario_file;
     s["scenario"] = to_json(scenario_);
     return s;
@@ -299,8 +334,16 @@ class ClosedLoop {
   // the metrics and the log.
   void observe() {
     const double t = state_.time;
-    auv_command_ = &auv_.update(kelp::control::navigation_of(state_.auv), t);
-    asv_command_ = &asv_.update(kelp::control::navigation_of(state_.asv), state_.auv.position, t);
+    // What the controllers see: the true state, or the sensors' estimates (the boat takes the
+    // ROV's position from the ROV's estimate, which it receives over the tether).
+    if (navigation_) {
+      navigation_->update(model_, state_);
+      auv_command_ = &auv_.update(navigation_->auv(), t);
+      asv_command_ = &asv_.update(navigation_->asv(), navigation_->auv().position, t);
+    } else {
+      auv_command_ = &auv_.update(kelp::control::navigation_of(state_.auv), t);
+      asv_command_ = &asv_.update(kelp::control::navigation_of(state_.asv), state_.auv.position, t);
+    }
     // The AUV's error: distance from the survey path (the leg it is on); the boat's: its
     // horizontal distance from the AUV.
     const std::size_t leg = std::min(auv_.next_waypoint(), waypoints_.size() - 1);
@@ -362,6 +405,8 @@ class ClosedLoop {
   LogRow sample_;
   RunMetrics metrics_;
   kelp::system::SolverStatsd solver_stats_;
+  // Navigation from sensors ("sensors" mode); null: the controllers see the true state.
+  std::unique_ptr<kelp::nav::PairNavigation> navigation_;
 };
 
 /// \brief Options of simulate().

@@ -24,6 +24,7 @@
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/nav/pair.hpp"
 
 namespace kelp {
 namespace sim {
@@ -43,6 +44,14 @@ struct Gains {
   double kp;  ///< proportional gain
   double ki;  ///< integral gain
   double kd;  ///< derivative gain
+};
+
+/// \brief What the controllers navigate by (the scenario's `navigation` object): the true state
+/// ("perfect", the default) or the estimates of kelp::nav's sensors and filters ("sensors").
+struct NavigationSettings {
+  std::string mode = "perfect";    ///< "perfect" or "sensors"
+  std::uint64_t seed = 1;          ///< seed of the sensors' noise
+  kelp::nav::PairSensors sensors;  ///< every sensor's parameters (defaults: kelp/nav/sensors.hpp)
 };
 
 /// \brief One run of the tethered pair, as a scenario file describes it (every field has the
@@ -105,6 +114,8 @@ struct Scenario {
   /// policy, i.e. `KELP_KERNEL`, else the widest the CPU runs), "portable" (the deterministic
   /// mode: the same bits on every CPU; the file's `"deterministic": true`), "avx2" or "avx512".
   std::string kernel = "auto";
+  /// Navigation: perfect or from sensors (read by detail::parse_navigation()).
+  NavigationSettings navigation;
 };
 
 /// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
@@ -229,6 +240,135 @@ class Reader {
 
 }  // namespace detail
 
+namespace detail {
+
+/// Reads the scenario's `navigation` object (schema in examples/tethered_pair/README.md): the
+/// mode, the seed and every sensor's parameters, each checked against its range.
+inline void parse_navigation(const nlohmann::json& j, const Reader& r, NavigationSettings& out) {
+  const std::string p = "/navigation";
+  r.object(j, p, {"mode", "seed", "imu", "depth", "dvl", "compass", "gps", "usbl"});
+  r.choice(j, p, "mode", out.mode, {"perfect", "sensors"});
+  r.integer(j, p, "seed", out.seed, 0, 1e18);
+  kelp::nav::PairSensors& s = out.sensors;
+  // Rates up to the closed loop's 100 steps per second: a sensor samples at most once a step.
+  if (j.contains("imu")) {
+    const auto& o = j.at("imu");
+    const std::string q = p + "/imu";
+    r.object(o, q,
+             {"rate", "gyro_noise_density", "gyro_bias_walk", "gyro_bias_initial",
+              "accel_noise_density", "accel_bias_walk", "accel_bias_initial"});
+    r.number(o, q, "rate", s.imu.rate, 1, 100);
+    r.number(o, q, "gyro_noise_density", s.imu.gyro_noise_density, 0, 0.1);
+    r.number(o, q, "gyro_bias_walk", s.imu.gyro_bias_walk, 0, 0.1);
+    r.number(o, q, "gyro_bias_initial", s.imu.gyro_bias_initial, 0, 0.5);
+    r.number(o, q, "accel_noise_density", s.imu.accel_noise_density, 0, 1);
+    r.number(o, q, "accel_bias_walk", s.imu.accel_bias_walk, 0, 1);
+    r.number(o, q, "accel_bias_initial", s.imu.accel_bias_initial, 0, 2);
+  }
+  if (j.contains("depth")) {
+    const auto& o = j.at("depth");
+    const std::string q = p + "/depth";
+    r.object(o, q, {"rate", "noise", "bias"});
+    r.number(o, q, "rate", s.depth.rate, 0.01, 100);
+    r.number(o, q, "noise", s.depth.noise, 0, 10);
+    r.number(o, q, "bias", s.depth.bias, -100, 100);
+  }
+  if (j.contains("dvl")) {
+    const auto& o = j.at("dvl");
+    const std::string q = p + "/dvl";
+    r.object(o, q,
+             {"bottom_rate", "water_rate", "min_altitude", "max_altitude", "noise_floor",
+              "noise_fraction", "water_track", "water_noise", "water_track_distance"});
+    r.number(o, q, "bottom_rate", s.dvl.bottom_rate, 0.01, 100);
+    r.number(o, q, "water_rate", s.dvl.water_rate, 0.01, 100);
+    r.number(o, q, "min_altitude", s.dvl.min_altitude, 0, 1000);
+    r.number(o, q, "max_altitude", s.dvl.max_altitude, 0, 1e4);
+    if (s.dvl.max_altitude <= s.dvl.min_altitude)
+      r.fail(q + "/max_altitude", "expected more than /navigation/dvl/min_altitude (" +
+                                      std::to_string(s.dvl.min_altitude) + ")");
+    r.number(o, q, "noise_floor", s.dvl.noise_floor, 0, 10);
+    r.number(o, q, "noise_fraction", s.dvl.noise_fraction, 0, 1);
+    r.boolean(o, q, "water_track", s.dvl.water_track);
+    r.number(o, q, "water_noise", s.dvl.water_noise, 0, 10);
+    r.number(o, q, "water_track_distance", s.dvl.water_track_distance, 0, 100);
+  }
+  if (j.contains("compass")) {
+    const auto& o = j.at("compass");
+    const std::string q = p + "/compass";
+    r.object(o, q, {"rate", "noise", "bias"});
+    r.number(o, q, "rate", s.compass.rate, 0.01, 100);
+    r.number(o, q, "noise", s.compass.noise, 0, 1);
+    r.number(o, q, "bias", s.compass.bias, -3.15, 3.15);
+  }
+  if (j.contains("gps")) {
+    const auto& o = j.at("gps");
+    const std::string q = p + "/gps";
+    r.object(o, q, {"rate", "noise", "bias_sigma", "bias_time", "vertical_factor"});
+    r.number(o, q, "rate", s.gps.rate, 0.01, 100);
+    r.number(o, q, "noise", s.gps.noise, 0, 100);
+    r.number(o, q, "bias_sigma", s.gps.bias_sigma, 0, 100);
+    r.number(o, q, "bias_time", s.gps.bias_time, 0.01, 1e6);
+    r.number(o, q, "vertical_factor", s.gps.vertical_factor, 0, 10);
+  }
+  if (j.contains("usbl")) {
+    const auto& o = j.at("usbl");
+    const std::string q = p + "/usbl";
+    r.object(o, q, {"rate", "noise_floor", "noise_fraction", "latency", "dropout", "max_range"});
+    r.number(o, q, "rate", s.usbl.rate, 0.01, 100);
+    r.number(o, q, "noise_floor", s.usbl.noise_floor, 0, 100);
+    r.number(o, q, "noise_fraction", s.usbl.noise_fraction, 0, 1);
+    r.number(o, q, "latency", s.usbl.latency, 0, 10);
+    if (s.usbl.latency * s.usbl.rate >= kelp::nav::usbl_queue_capacity - 2)
+      r.fail(q, "latency × rate must be < " + std::to_string(kelp::nav::usbl_queue_capacity - 2) +
+                    " (fixes in flight)");
+    r.number(o, q, "dropout", s.usbl.dropout, 0, 0.99);
+    r.number(o, q, "max_range", s.usbl.max_range, 0.1, 1e4);
+  }
+}
+
+/// The `navigation` object of a scenario, every field with its value.
+inline nlohmann::json navigation_json(const NavigationSettings& n) {
+  const kelp::nav::PairSensors& s = n.sensors;
+  return {
+      {"mode", n.mode},
+      {"seed", n.seed},
+      {"imu",
+       {{"rate", s.imu.rate},
+        {"gyro_noise_density", s.imu.gyro_noise_density},
+        {"gyro_bias_walk", s.imu.gyro_bias_walk},
+        {"gyro_bias_initial", s.imu.gyro_bias_initial},
+        {"accel_noise_density", s.imu.accel_noise_density},
+        {"accel_bias_walk", s.imu.accel_bias_walk},
+        {"accel_bias_initial", s.imu.accel_bias_initial}}},
+      {"depth", {{"rate", s.depth.rate}, {"noise", s.depth.noise}, {"bias", s.depth.bias}}},
+      {"dvl",
+       {{"bottom_rate", s.dvl.bottom_rate},
+        {"water_rate", s.dvl.water_rate},
+        {"min_altitude", s.dvl.min_altitude},
+        {"max_altitude", s.dvl.max_altitude},
+        {"noise_floor", s.dvl.noise_floor},
+        {"noise_fraction", s.dvl.noise_fraction},
+        {"water_track", s.dvl.water_track},
+        {"water_noise", s.dvl.water_noise},
+        {"water_track_distance", s.dvl.water_track_distance}}},
+      {"compass", {{"rate", s.compass.rate}, {"noise", s.compass.noise}, {"bias", s.compass.bias}}},
+      {"gps",
+       {{"rate", s.gps.rate},
+        {"noise", s.gps.noise},
+        {"bias_sigma", s.gps.bias_sigma},
+        {"bias_time", s.gps.bias_time},
+        {"vertical_factor", s.gps.vertical_factor}}},
+      {"usbl",
+       {{"rate", s.usbl.rate},
+        {"noise_floor", s.usbl.noise_floor},
+        {"noise_fraction", s.usbl.noise_fraction},
+        {"latency", s.usbl.latency},
+        {"dropout", s.usbl.dropout},
+        {"max_range", s.usbl.max_range}}}};
+}
+
+}  // namespace detail
+
 /// \brief Reads and validates a scenario from JSON text.
 /// \param[in] text the JSON text \param[in] file names the scenario in error messages
 /// \throws scenario_error naming the file, the JSON path and what was expected.
@@ -248,7 +388,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   Scenario s;
   r.object(j, "",
            {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output",
-            "kernel", "deterministic"});
+            "kernel", "deterministic", "navigation"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -346,6 +486,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.number(o, "/output", "log_rate", s.log_rate, 0.01, 100);
     r.number(o, "/output", "node_rate", s.node_rate, 0.001, 100);
   }
+  if (j.contains("navigation")) detail::parse_navigation(j.at("navigation"), r, s.navigation);
   r.choice(j, "", "kernel", s.kernel, {"auto", "portable", "avx2", "avx512"});
   bool deterministic = false;
   r.boolean(j, "", "deterministic", deterministic);
@@ -421,6 +562,9 @@ inline nlohmann::json to_json(const Scenario& s) {
   j["output"] = {{"log_rate", s.log_rate}, {"node_rate", s.node_rate}};
   // Only when pinned: the default leaves the JSON (and kelp-sweep's run hashes) as they were.
   if (s.kernel != "auto") j["kernel"] = s.kernel;
+  // Navigation: likewise only when it differs from the default (perfect navigation).
+  const nlohmann::json nav = detail::navigation_json(s.navigation);
+  if (nav != detail::navigation_json(NavigationSettings{})) j["navigation"] = nav;
   return j;
 }
 
