@@ -86,7 +86,7 @@ TEST_CASE("AUV controller: depth, heading and position hold in calm water", "[co
   CHECK(worst_z < 0.05);
   CHECK(worst_xy < 0.05);
   CHECK(worst_psi < 0.02);
-  CHECK(peak_command <= kv::t200_peak_command + 1e-12);
+  CHECK(peak_command <= kv::von_benzon_t200_peak_command + 1e-12);
 }
 
 TEST_CASE("AUV controller: a 10 m square of waypoints at 5 m depth", "[control][auv]") {

@@ -97,21 +97,22 @@ TEMPLATE_TEST_CASE("T200 curve, its peak and its inverse", "[vehicle][thrusters]
   CHECK(double(kv::t200_thrust(S(-0.6))) == Approx(-double(kv::t200_thrust(S(0.6)))));
   CHECK(kv::t200_thrust(S(2)) == kv::t200_thrust(S(1)));  // clamped
   // The published constants: slope zero at the peak, peak value = max thrust.
-  CHECK(std::abs(kv::t200_thrust_slope(kv::t200_peak_command)) < 1e-3);  // measured 8e-5
-  CHECK(kv::t200_thrust(kv::t200_peak_command) == Approx(kv::t200_max_thrust).epsilon(1e-5));
+  CHECK(std::abs(kv::t200_thrust_slope(kv::von_benzon_t200_peak_command)) < 1e-3);  // measured 8e-5
+  CHECK(kv::t200_thrust(kv::von_benzon_t200_peak_command) ==
+        Approx(kv::von_benzon_t200_max_thrust).epsilon(1e-5));
   // Monotone on [0, u_peak].
   for (int i = 1; i <= 100; ++i) {
-    const double u = kv::t200_peak_command * i / 100.0;
+    const double u = kv::von_benzon_t200_peak_command * i / 100.0;
     CHECK(kv::t200_thrust_slope(u) > 0);
   }
   const double tol = std::is_same<S, float>::value ? 1e-3 : 1e-9;
   for (double f = -30.0; f <= 30.0; f += 0.75) {
     const S u = kv::t200_command(S(f));
     CHECK(double(kv::t200_thrust(u)) == Approx(f).margin(tol * 30));
-    CHECK(std::abs(double(u)) <= kv::t200_peak_command + 1e-6);
+    CHECK(std::abs(double(u)) <= kv::von_benzon_t200_peak_command + 1e-6);
   }
-  CHECK(double(kv::t200_command(S(100))) == Approx(kv::t200_peak_command));
-  CHECK(double(kv::t200_command(S(-100))) == Approx(-kv::t200_peak_command));
+  CHECK(double(kv::t200_command(S(100))) == Approx(kv::von_benzon_t200_peak_command));
+  CHECK(double(kv::t200_command(S(-100))) == Approx(-kv::von_benzon_t200_peak_command));
 }
 
 TEMPLATE_TEST_CASE("PWM <-> command mapping with deadband", "[vehicle][thrusters]", double, float) {
@@ -173,10 +174,10 @@ TEMPLATE_TEST_CASE(
   for (int i = 0; i < 8; ++i) {
     CHECK(cmd(i) == kv::t200_command(want(i)));
     CHECK(got(i) == kv::t200_thrust(cmd(i)));
-    if (std::abs(double(want(i))) < kv::t200_max_thrust)
+    if (std::abs(double(want(i))) < kv::von_benzon_t200_max_thrust)
       CHECK(double(got(i)) == Approx(double(want(i))).margin(1e-3));
     else
-      CHECK(std::abs(double(got(i))) == Approx(kv::t200_max_thrust).epsilon(1e-5));
+      CHECK(std::abs(double(got(i))) == Approx(kv::von_benzon_t200_max_thrust).epsilon(1e-5));
   }
   // One curve, written once: the slope is the derivative of the thrust (central differences).
   for (double x = -0.95; x <= 0.95; x += 0.05) {

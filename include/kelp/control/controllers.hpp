@@ -125,14 +125,14 @@ class DisturbanceObserver {
 /// level. Defaults tuned for the BlueROV2 Heavy preset (surge mass with added mass ≈ 20 kg, heave
 /// ≈ 32 kg): natural frequencies ≈ 1.4 rad/s, about critically damped.
 struct AuvControllerSettings {
-  PidGains surge{40.0, 4.0, 56.0, 80.0, 10.0};   ///< x error → X [N]
-  PidGains sway{40.0, 4.0, 56.0, 80.0, 10.0};    ///< y error → Y [N]
-  PidGains heave{60.0, 8.0, 88.0, 100.0, 10.0};  ///< z error → Z [N]
-  PidGains roll{5.0, 0.0, 2.0, 10.0};            ///< roll → K [N m]
-  PidGains pitch{5.0, 0.0, 2.0, 10.0};           ///< pitch → M [N m]
-  PidGains yaw{5.0, 0.2, 3.4, 15.0, 2.0};        ///< heading error → N [N m]
-  double period = 0.02;                          ///< update period [s] (50 Hz)
-  double max_thrust = vehicle::t200_max_thrust;  ///< per thruster [N]
+  PidGains surge{40.0, 4.0, 56.0, 80.0, 10.0};              ///< x error → X [N]
+  PidGains sway{40.0, 4.0, 56.0, 80.0, 10.0};               ///< y error → Y [N]
+  PidGains heave{60.0, 8.0, 88.0, 100.0, 10.0};             ///< z error → Z [N]
+  PidGains roll{5.0, 0.0, 2.0, 10.0};                       ///< roll → K [N m]
+  PidGains pitch{5.0, 0.0, 2.0, 10.0};                      ///< pitch → M [N m]
+  PidGains yaw{5.0, 0.2, 3.4, 15.0, 2.0};                   ///< heading error → N [N m]
+  double period = 0.02;                                     ///< update period [s] (50 Hz)
+  double max_thrust = vehicle::von_benzon_t200_max_thrust;  ///< per thruster [N]
   /// The thrusters' curve (the chain command → thrust; vehicle::ThrusterChain).
   vehicle::ThrusterModel thruster_model = vehicle::t200_model;
   /// Largest horizontal error fed to the PIDs [m]: a far waypoint is approached at a steady

@@ -12,6 +12,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/vehicle/t200.hpp"
 
 namespace kelp::vehicle {
 
@@ -139,9 +140,9 @@ struct ThrusterModel {
 inline constexpr ThrusterModel t200_model{{8.9, 176.0, -404.1, 389.9, -140.3}, 0.971656, 30.62175};
 
 /// \brief Command at which the T200 curve peaks (`t200_model.peak_command`).
-inline constexpr double t200_peak_command = t200_model.peak_command;
+inline constexpr double von_benzon_t200_peak_command = t200_model.peak_command;
 /// \brief Largest T200 thrust the curve gives [N] (`t200_model.max_thrust`).
-inline constexpr double t200_max_thrust = t200_model.max_thrust;
+inline constexpr double von_benzon_t200_max_thrust = t200_model.max_thrust;
 
 namespace detail {
 /// F(u) and dF/du of an odd polynomial, u unclamped: with P(x) = Σ cₖ xᵏ and x = u², F = u P(x)
