@@ -276,3 +276,13 @@ TEST_CASE("Propulsion: float instantiation", "[propulsion]") {
   for (int k = 0; k < 100; ++k) advance(m, s, Eigen::Matrix<float, 1, 1>(0.5f), 0.01);
   CHECK(s.thrust(0) == Approx(t200_thrust(0.5f, float(s.battery.voltage))).epsilon(1e-4));
 }
+
+// Every public propulsion class template for both floating-point scalars.
+template struct kelp::vehicle::PropulsionParameters<double>;
+template struct kelp::vehicle::PropulsionParameters<float>;
+template class kelp::vehicle::PropulsionModel<double>;
+template class kelp::vehicle::PropulsionModel<float>;
+template struct kelp::vehicle::PropulsionState<double>;
+template struct kelp::vehicle::PropulsionState<float>;
+template struct kelp::vehicle::PropulsionStep<double>;
+template struct kelp::vehicle::PropulsionStep<float>;

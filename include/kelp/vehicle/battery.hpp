@@ -130,16 +130,21 @@ inline double terminal_voltage(const BatteryParameters& p, const BatteryState& s
 
 /// \brief The terminal voltage of a load whose current depends on the voltage: the root of
 /// g(V) = V − OCV + R (I_load(V) + I_hotel) on [0, OCV] (g is increasing when the load draws more
-/// at a higher voltage, as a thruster at a fixed command does; g(OCV) ≥ 0). Safeguarded secant
-/// (Illinois' false position) from the bracket, to 1e-9 V or 60 iterations: a handful of load
-/// evaluations per call. With the BlueROV2's eight thrusters at full command the loop gain
-/// R dI/dV is ≈ 0.5–0.8, so taking the previous step's voltage instead (an explicit lag of one
-/// step) would ring from step to step; this solves the coupling within the step.
+/// at a higher voltage, as a thruster at a fixed command does; g(OCV) ≥ 0), to |g| < 1e-9 V.
+/// From `guess` (e.g. the previous step's voltage; NaN or outside (0, OCV]: the OCV), one
+/// fixed-point step V₁ = OCV − R I(V₀) and secant steps, 2–4 load evaluations a call when the
+/// load changes little between calls; a secant step that leaves [0, OCV] or 8 that do not
+/// converge hand over to Illinois' false position on the bracket [0, OCV]. With the BlueROV2's
+/// eight thrusters at full command the loop gain R dI/dV is ≈ 0.5–0.8, so taking the previous
+/// step's voltage instead (an explicit lag of one step) would ring from step to step; this solves
+/// the coupling within the step. The returned voltage is always the point of the last load
+/// evaluation (a caller may keep what its load computed there).
 /// \param[in] load `double(double V)`, the load's current [A] at terminal voltage V (≥ 0).
-/// \returns V [V]; 0 when even at 0 V the hotel load alone pulls the pack below 0.
+/// \returns V [V]; 0 when even at 0 V the load pulls the pack below 0.
 /// \throws kelp::numerical_error when the load returns a non-finite or negative current.
 template <typename Load>
-double solve_terminal_voltage(const BatteryParameters& p, const BatteryState& s, Load&& load) {
+double solve_terminal_voltage(const BatteryParameters& p, const BatteryState& s, Load&& load,
+                              double guess = std::numeric_limits<double>::quiet_NaN()) {
   const double ocv = open_circuit_voltage(p, state_of_charge(p, s));
   const double r = p.internal_resistance;
   const auto g = [&](double v) {
@@ -149,18 +154,38 @@ double solve_terminal_voltage(const BatteryParameters& p, const BatteryState& s,
           "battery: the load's current is negative or not finite");
     return v - ocv + r * (i + p.hotel_current);
   };
-  if (r == 0.0) return ocv;
+  constexpr double tol = 1e-9;
+  if (r == 0.0) {
+    (void)g(ocv);
+    return ocv;
+  }
+  // Warm start: secant iterations.
+  double v0 = std::isfinite(guess) && guess > 0.0 && guess <= ocv ? guess : ocv;
+  double g0 = g(v0);
+  if (std::abs(g0) < tol) return v0;
+  double v1 = v0 - g0;  // the fixed-point step OCV − R I(V₀)
+  for (int k = 0; k < 8 && v1 >= 0.0 && v1 <= ocv; ++k) {
+    const double g1 = g(v1);
+    if (std::abs(g1) < tol) return v1;
+    if (g1 == g0) break;
+    const double v2 = v1 - g1 * (v1 - v0) / (g1 - g0);
+    v0 = v1;
+    g0 = g1;
+    v1 = v2;
+  }
+  // Safeguarded: Illinois on [0, OCV].
   double a = 0.0, b = ocv;
-  double ga = g(a), gb = g(b);
+  double ga = g(a);
   if (ga >= 0.0) return 0.0;
-  if (gb <= 0.0) return ocv;
+  double gb = g(b);
+  if (gb <= tol) return ocv;
   int side = 0;
   double v = b;
-  for (int k = 0; k < 60; ++k) {
+  for (int k = 0; k < 100; ++k) {
     v = (a * gb - b * ga) / (gb - ga);
     if (!(v > a && v < b)) v = 0.5 * (a + b);
     const double gv = g(v);
-    if (gv == 0.0 || b - a < 1e-9) break;
+    if (std::abs(gv) < tol || b - a < tol) break;
     if (gv < 0.0) {
       a = v;
       ga = gv;
@@ -172,7 +197,6 @@ double solve_terminal_voltage(const BatteryParameters& p, const BatteryState& s,
       if (side == 1) ga *= 0.5;
       side = 1;
     }
-    if (std::abs(gv) < 1e-9) break;
   }
   return v;
 }

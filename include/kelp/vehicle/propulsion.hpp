@@ -27,7 +27,8 @@
 /// not the current), plus the battery's hotel load. The terminal voltage V of the step solves
 /// V = OCV(SoC) − R I(V) within the step (solve_terminal_voltage: the loop gain R dI/dV of eight
 /// thrusters at full command is ≈ 0.5–0.8, too large to take the previous step's voltage without
-/// ringing); thrust and current then use that V; the battery's counters grow by I h and V I h.
+/// ringing; the previous step's voltage is only the solve's starting point, part of the state);
+/// thrust and current then use that V; the battery's counters grow by I h and V I h.
 ///
 /// **Mounting.** `facing(i)` = +1 when a positive command spins thruster i in its forward
 /// (stronger) direction and thrust along d_i results; −1 when the thruster is mounted the other
@@ -187,13 +188,20 @@ PropulsionStep<Scalar> advance(const PropulsionModel<Scalar>& m, PropulsionState
   };
   const BatteryParameters& bp = m.parameters().battery;
   const ThrusterVector<int>& facing = m.facing();
-  // The step's terminal voltage: the thrusters' current at V, in double.
-  const double v = solve_terminal_voltage(bp, s.battery, [&](double volts) {
-    double total = 0.0;
-    for (Eigen::Index i = 0; i < n; ++i)
-      total += t200_current(double(facing(i)) * value_of(command(i)), volts);
-    return total;
-  });
+  // The step's terminal voltage: the thrusters' current at V, in double (warm-started from the
+  // last step's voltage); the currents of the last evaluation, at the returned V, are kept.
+  ThrusterVector<double> currents(n);
+  const double v = solve_terminal_voltage(
+      bp, s.battery,
+      [&](double volts) {
+        double sum = 0.0;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          currents(i) = t200_current(double(facing(i)) * value_of(command(i)), volts);
+          sum += currents(i);
+        }
+        return sum;
+      },
+      s.battery.voltage);
   PropulsionStep<Scalar> out;
   ThrusterVector<Scalar> mean(n);
   double total = bp.hotel_current;
@@ -208,8 +216,8 @@ PropulsionStep<Scalar> advance(const PropulsionModel<Scalar>& m, PropulsionState
     const Scalar f0 = s.thrust(i);
     mean(i) = target + (f0 - target) * Scalar(average);
     s.thrust(i) = target + (f0 - target) * Scalar(decay);
-    s.current(i) = t200_current(double(facing(i)) * value_of(command(i)), v);
-    total += s.current(i);
+    s.current(i) = currents(i);
+    total += currents(i);
   }
   drain(s.battery, total, v, dt);
   out.wrench.noalias() = m.allocation().matrix() * mean;
