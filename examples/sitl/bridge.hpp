@@ -113,9 +113,9 @@ class Bridge {
         boat_(kv::blueboat<double>(model.environment().water_density(),
                                    model.environment().gravity())),
         rov_chain_(kv::ThrusterAllocationd(rov_.thruster_positions, rov_.thruster_directions),
-                   kv::t200_model, rov_.pwm),
+                   kv::t200_model, rov_.pwm, rov_.thruster_facing),
         boat_chain_(kv::ThrusterAllocationd(boat_.thruster_positions, boat_.thruster_directions),
-                    kv::t200_model, boat_.pwm) {
+                    kv::t200_model, boat_.pwm, boat_.thruster_facing) {
     kelp::check_positive(settings.rate, "rate");
     kelp::check_positive(settings.peer_timeout, "peer_timeout");
     auv_force_.setZero();
@@ -293,24 +293,25 @@ class Bridge {
   // BlueROV2 Heavy preset), ArduRover's skid steering ThrottleLeft on SERVO1 and ThrottleRight
   // on SERVO3 (ArduPilot Tools/autotest/default_params/rover-skid.parm). A channel without a
   // plausible pulse (0 = none, or outside 800–2200 µs) is taken as off.
-  double thrust_of(std::uint16_t pwm, const kv::ThrusterChaind& chain, double& command, Peer& p) {
+  double thrust_of(std::uint16_t pwm, const kv::ThrusterChaind& chain, Eigen::Index i,
+                   double& command, Peer& p) {
     command = 0;
     if (pwm == 0) return 0;
     if (pwm < 800 || pwm > 2200) {
       ++p.counters.pwm_out_of_range;
       return 0;
     }
-    return chain.thrust_of_pwm(static_cast<double>(pwm), &command);
+    return chain.thrust_of_pwm(i, static_cast<double>(pwm), &command);
   }
   void set_pwm(int slot, const ServoPacket& pkt) {
     Peer& p = peers_[static_cast<std::size_t>(slot)];
     if (slot == sub) {
       for (int i = 0; i < 8; ++i)
         auv_force_(i) =
-            thrust_of(pkt.pwm[static_cast<std::size_t>(i)], rov_chain_, auv_command_(i), p);
+            thrust_of(pkt.pwm[static_cast<std::size_t>(i)], rov_chain_, i, auv_command_(i), p);
     } else {
-      asv_force_(0) = thrust_of(pkt.pwm[0], boat_chain_, asv_command_(0), p);
-      asv_force_(1) = thrust_of(pkt.pwm[2], boat_chain_, asv_command_(1), p);
+      asv_force_(0) = thrust_of(pkt.pwm[0], boat_chain_, 0, asv_command_(0), p);
+      asv_force_(1) = thrust_of(pkt.pwm[2], boat_chain_, 1, asv_command_(1), p);
     }
   }
 

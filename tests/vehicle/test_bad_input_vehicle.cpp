@@ -195,7 +195,8 @@ TEST_CASE("bad input: thruster allocation with NaN wrenches and mismatched sizes
 
   // T200 curve and PWM mapping.
   REQUIRE_THROWS_AS(kv::t200_thrust_slope(kNan), kelp::invalid_argument);
-  CHECK(kv::t200_thrust_slope(0.0) == Approx(8.9));
+  CHECK(kv::thrust_slope(kv::von_benzon_t200_model, 0.0) == Approx(8.9));
+  CHECK(kv::t200_thrust_slope(0.0) == 0.0);  // the datasheet's dead band
   kv::PwmMapping<double> m;
   m.min_us = 2000.0;  // above neutral: invalid
   REQUIRE_THROWS_AS(kv::command_from_pwm(1700.0, m), kelp::invalid_argument);

@@ -130,9 +130,10 @@ TEMPLATE_TEST_CASE("BlueBoat at full thrust reaches its top speed near 3 m/s",
   const kv::ThrusterAllocation<S> thrusters(preset.thruster_positions, preset.thruster_directions);
   kv::VehicleWorkspace<S> ws;
   kv::VehicleState<S> x;
-  // Two T200 at full command: 2 × 30.4 N; surge damping 5 u + 5 u² (blueboat preset) ⇒ 3.02 m/s.
+  // Two T200 at full command on von Benzon's curve, 2 × 30.4 N (what the preset's assumed surge
+  // damping 5 u + 5 u² was chosen for) ⇒ 3.02 m/s.
   Eigen::Matrix<S, Eigen::Dynamic, 1> f(2);
-  f.setConstant(kv::t200_thrust(S(1)));
+  f.setConstant(kv::thrust(kv::von_benzon_t200_model, S(1)));
   const Vector6<S> tau = thrusters.wrench(f);
   CHECK(double(tau(0)) == Approx(60.8).epsilon(1e-6));
   CHECK(std::abs(double(tau(5))) < 1e-6);

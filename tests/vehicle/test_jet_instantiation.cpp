@@ -97,3 +97,29 @@ TEST_CASE("Jet: an RK4 step, the T200 inverse and the allocation run with deriva
   CHECK(u.v(1) == Approx(1.0 / kv::t200_thrust_slope(u.a)).epsilon(1e-9));
   CHECK(kv::t200_thrust(u).a == Approx(12.0).epsilon(1e-12));
 }
+
+TEST_CASE(
+    "Jet: T200 thrust and current derivatives in the command and the voltage, and of "
+    "the inverse",
+    "[vehicle][jet][t200]") {
+  for (double v : {8.0, 12.0, 14.8, 16.0, 19.0}) {
+    for (double u0 : {-0.9, -0.4, -0.1, 0.1, 0.45, 0.95}) {
+      INFO(u0 << " at " << v << " V");
+      const Jet f = kv::t200_thrust(Jet(u0, 0), Jet(v, 1));
+      const double h = 1e-6;
+      CHECK(f.a == kv::t200_thrust(u0, v));
+      CHECK(f.v(0) == Approx(kv::t200_thrust_slope(u0, v)).epsilon(1e-12));
+      const double dv = (kv::t200_thrust(u0, v + h) - kv::t200_thrust(u0, v - h)) / (2 * h);
+      CHECK(f.v(1) == Approx(dv).epsilon(1e-6));
+      const Jet i = kv::t200_current(Jet(u0, 0), Jet(v, 1));
+      const double di = (kv::t200_current(u0 + h, v) - kv::t200_current(u0 - h, v)) / (2 * h);
+      CHECK(i.v(0) == Approx(di).epsilon(1e-6));
+      // The inverse: ∂u/∂F = 1/F_u and ∂u/∂V = −F_V/F_u at the same point.
+      const double force = f.a;
+      const Jet c = kv::t200_command(Jet(force, 0), Jet(v, 1));
+      CHECK(c.a == Approx(u0).epsilon(1e-12));
+      CHECK(c.v(0) == Approx(1.0 / f.v(0)).epsilon(1e-9));
+      CHECK(c.v(1) == Approx(-f.v(1) / f.v(0)).epsilon(1e-9));
+    }
+  }
+}

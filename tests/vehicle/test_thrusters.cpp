@@ -89,30 +89,34 @@ TEST_CASE("BlueBoat skid steering: equal thrust surges, differential thrust yaws
   CHECK(got(5) == Approx(3).epsilon(0.02));
 }
 
-TEMPLATE_TEST_CASE("T200 curve, its peak and its inverse", "[vehicle][thrusters]", double, float) {
+TEMPLATE_TEST_CASE("von Benzon's T200 polynomial, its peak and its inverse", "[vehicle][thrusters]",
+                   double, float) {
   using S = TestType;
+  const kv::ThrusterModel& m = kv::von_benzon_t200_model;
   // F(1) = −140.3 + 389.9 − 404.1 + 176.0 + 8.9 = 30.4 N (sum of the coefficients).
-  CHECK(double(kv::t200_thrust(S(1))) == Approx(30.4).epsilon(1e-6));
-  CHECK(kv::t200_thrust(S(0)) == S(0));
-  CHECK(double(kv::t200_thrust(S(-0.6))) == Approx(-double(kv::t200_thrust(S(0.6)))));
-  CHECK(kv::t200_thrust(S(2)) == kv::t200_thrust(S(1)));  // clamped
+  CHECK(double(kv::thrust(m, S(1))) == Approx(30.4).epsilon(1e-6));
+  CHECK(kv::thrust(m, S(0)) == S(0));
+  CHECK(double(kv::thrust(m, S(-0.6))) == Approx(-double(kv::thrust(m, S(0.6)))));
+  CHECK(kv::thrust(m, S(2)) == kv::thrust(m, S(1)));  // clamped
   // The published constants: slope zero at the peak, peak value = max thrust.
-  CHECK(std::abs(kv::t200_thrust_slope(kv::von_benzon_t200_peak_command)) < 1e-3);  // measured 8e-5
-  CHECK(kv::t200_thrust(kv::von_benzon_t200_peak_command) ==
+  CHECK(std::abs(kv::thrust_slope(m, kv::von_benzon_t200_peak_command)) < 1e-3);  // 8e-5
+  CHECK(kv::thrust(m, kv::von_benzon_t200_peak_command) ==
         Approx(kv::von_benzon_t200_max_thrust).epsilon(1e-5));
   // Monotone on [0, u_peak].
   for (int i = 1; i <= 100; ++i) {
     const double u = kv::von_benzon_t200_peak_command * i / 100.0;
-    CHECK(kv::t200_thrust_slope(u) > 0);
+    CHECK(kv::thrust_slope(m, u) > 0);
   }
   const double tol = std::is_same<S, float>::value ? 1e-3 : 1e-9;
   for (double f = -30.0; f <= 30.0; f += 0.75) {
-    const S u = kv::t200_command(S(f));
-    CHECK(double(kv::t200_thrust(u)) == Approx(f).margin(tol * 30));
+    const S u = kv::command_for_thrust(m, S(f));
+    CHECK(double(kv::thrust(m, u)) == Approx(f).margin(tol * 30));
     CHECK(std::abs(double(u)) <= kv::von_benzon_t200_peak_command + 1e-6);
   }
-  CHECK(double(kv::t200_command(S(100))) == Approx(kv::von_benzon_t200_peak_command));
-  CHECK(double(kv::t200_command(S(-100))) == Approx(-kv::von_benzon_t200_peak_command));
+  CHECK(double(kv::command_for_thrust(m, S(100))) == Approx(kv::von_benzon_t200_peak_command));
+  CHECK(double(kv::command_for_thrust(m, S(-100))) == Approx(-kv::von_benzon_t200_peak_command));
+  // The datasheet curve is another model: 51.6 N forward at 16 V against 30.4 N.
+  CHECK(double(kv::thrust(kv::t200_model, S(1))) > 50.0);
 }
 
 TEMPLATE_TEST_CASE("PWM <-> command mapping with deadband", "[vehicle][thrusters]", double, float) {
@@ -159,7 +163,7 @@ TEMPLATE_TEST_CASE(
     CHECK(u(i) == u_ref(i));
     CHECK(f(i) == f_ref(i));
     S c(-7);
-    CHECK(chain.thrust_of_pwm(pwm(i), &c) == f_ref(i));
+    CHECK(chain.thrust_of_pwm(i, pwm(i), &c) == f_ref(i));
     CHECK(c == u_ref(i));
   }
   CHECK(u(2) == S(0));  // inside the dead band
@@ -167,17 +171,19 @@ TEMPLATE_TEST_CASE(
   const Vector6<S> w_ref = alloc.wrench(f_ref);
   CHECK((w - w_ref).norm() <= S(1e-5) * w_ref.norm());
   // The other way, as the controllers use it: desired force -> command -> delivered thrust,
-  // saturated at the curve's peak.
+  // saturated at the largest thrust that way (forward 51.6 N, reverse 39.8 N at 16 V).
   Eigen::Matrix<S, 8, 1> want, cmd, got;
-  want << S(-40), S(-30), S(-5), S(0), S(0.5), S(12), S(30.6), S(100);
+  want << S(-45), S(-30), S(-5), S(0), S(0.5), S(12), S(50), S(100);
   chain.commands_for(want, cmd, got);
+  const double up = kv::t200_max_thrust(16.0), down = kv::t200_max_reverse_thrust(16.0);
   for (int i = 0; i < 8; ++i) {
     CHECK(cmd(i) == kv::t200_command(want(i)));
     CHECK(got(i) == kv::t200_thrust(cmd(i)));
-    if (std::abs(double(want(i))) < kv::von_benzon_t200_max_thrust)
-      CHECK(double(got(i)) == Approx(double(want(i))).margin(1e-3));
+    const double wanted = double(want(i));
+    if (wanted < up && wanted > -down)
+      CHECK(double(got(i)) == Approx(wanted).margin(1e-3));
     else
-      CHECK(std::abs(double(got(i))) == Approx(kv::von_benzon_t200_max_thrust).epsilon(1e-5));
+      CHECK(double(got(i)) == Approx(wanted > 0 ? up : -down).epsilon(1e-5));
   }
   // One curve, written once: the slope is the derivative of the thrust (central differences).
   for (double x = -0.95; x <= 0.95; x += 0.05) {
@@ -186,14 +192,16 @@ TEMPLATE_TEST_CASE(
     CHECK(kv::t200_thrust_slope(x) == Approx(fd).epsilon(1e-6));
   }
   // A model with other coefficients changes the chain in one place.
-  kv::ThrusterModel half = kv::t200_model;
+  const kv::ThrusterChain<S> poly(alloc, kv::von_benzon_t200_model, rov.pwm);
+  kv::ThrusterModel half = kv::von_benzon_t200_model;
   for (double& c : half.odd_coefficients) c *= 0.5;
   half.max_thrust *= 0.5;
   const kv::ThrusterChain<S> weak(alloc, half, rov.pwm);
-  Eigen::Matrix<S, 8, 1> u2, f2;
+  Eigen::Matrix<S, 8, 1> u1, f1, u2, f2;
+  const Vector6<S> w1 = poly.wrench_from_pwm(pwm, u1, f1);
   const Vector6<S> w2 = weak.wrench_from_pwm(pwm, u2, f2);
-  CHECK((w2 - S(0.5) * w).norm() <= S(1e-5) * w.norm());
-  kv::ThrusterModel bad = kv::t200_model;
+  CHECK((w2 - S(0.5) * w1).norm() <= S(1e-5) * w1.norm());
+  kv::ThrusterModel bad = kv::von_benzon_t200_model;
   bad.peak_command = 1.5;
   CHECK_THROWS_AS(kv::ThrusterChain<S>(alloc, bad), kelp::invalid_argument);
 }

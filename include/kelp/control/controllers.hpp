@@ -125,16 +125,23 @@ class DisturbanceObserver {
 /// level. Defaults tuned for the BlueROV2 Heavy preset (surge mass with added mass ≈ 20 kg, heave
 /// ≈ 32 kg): natural frequencies ≈ 1.4 rad/s, about critically damped.
 struct AuvControllerSettings {
-  PidGains surge{40.0, 4.0, 56.0, 80.0, 10.0};              ///< x error → X [N]
-  PidGains sway{40.0, 4.0, 56.0, 80.0, 10.0};               ///< y error → Y [N]
-  PidGains heave{60.0, 8.0, 88.0, 100.0, 10.0};             ///< z error → Z [N]
-  PidGains roll{5.0, 0.0, 2.0, 10.0};                       ///< roll → K [N m]
-  PidGains pitch{5.0, 0.0, 2.0, 10.0};                      ///< pitch → M [N m]
-  PidGains yaw{5.0, 0.2, 3.4, 15.0, 2.0};                   ///< heading error → N [N m]
-  double period = 0.02;                                     ///< update period [s] (50 Hz)
-  double max_thrust = vehicle::von_benzon_t200_max_thrust;  ///< per thruster [N]
+  PidGains surge{40.0, 4.0, 56.0, 80.0, 10.0};   ///< x error → X [N]
+  PidGains sway{40.0, 4.0, 56.0, 80.0, 10.0};    ///< y error → Y [N]
+  PidGains heave{60.0, 8.0, 88.0, 100.0, 10.0};  ///< z error → Z [N]
+  PidGains roll{5.0, 0.0, 2.0, 10.0};            ///< roll → K [N m]
+  PidGains pitch{5.0, 0.0, 2.0, 10.0};           ///< pitch → M [N m]
+  PidGains yaw{5.0, 0.2, 3.4, 15.0, 2.0};        ///< heading error → N [N m]
+  double period = 0.02;                          ///< update period [s] (50 Hz)
+  /// Cap on every thruster's force [N], both ways; the thrusters' own limits at the supply
+  /// voltage (forward and reverse, with their facing) apply as well. Default: the T200's largest
+  /// forward thrust at the nominal 16 V (vehicle::t200_max_thrust, 51.6 N).
+  double max_thrust = vehicle::t200_max_thrust(vehicle::t200_nominal_voltage);
   /// The thrusters' curve (the chain command → thrust; vehicle::ThrusterChain).
   vehicle::ThrusterModel thruster_model = vehicle::t200_model;
+  /// ±1 per thruster (vehicle::VehiclePreset::thruster_facing); empty: all +1.
+  Eigen::VectorXd thruster_facing;
+  /// Supply voltage at the ESCs [V] the inverse uses until set_voltage() changes it.
+  double voltage = vehicle::t200_nominal_voltage;
   /// Largest horizontal error fed to the PIDs [m]: a far waypoint is approached at a steady
   /// pace instead of with the full error (a carrot on the line to it).
   double max_horizontal_error = 2.0;
@@ -163,7 +170,8 @@ class AuvController {
                 const vehicle::ThrusterAllocation<double>& thrusters,
                 const AuvControllerSettings& s = {})
       : settings_(s),
-        thrusters_(thrusters, s.thruster_model),
+        thrusters_(thrusters, s.thruster_model, vehicle::PwmMapping<double>(), s.thruster_facing,
+                   s.voltage),
         surge_(s.surge, "surge"),
         sway_(s.sway, "sway"),
         heave_(s.heave, "heave"),
@@ -236,12 +244,20 @@ class AuvController {
         heave_.update(eb.z(), dt, -nav.nu(2)), roll_.update(-rpy(0), dt, -nav.nu(3)),
         pitch_.update(-rpy(1), dt, -nav.nu(4)), yaw_.update(e_psi, dt, -nav.nu(5));
     if (settings_.compensate) tau -= observer_.estimate();
-    // Allocation, then uniform scaling so that no thruster exceeds max_thrust.
+    // Allocation, then uniform scaling so that no thruster exceeds its limit that way: the
+    // thruster's largest forward or reverse thrust at the supply voltage, capped at max_thrust.
     thrusters_.allocation().distribute(tau, force_);
-    const double peak = force_.cwiseAbs().maxCoeff();
-    command_.saturated = peak > settings_.max_thrust;
+    double scale = 1.0;
+    for (Eigen::Index i = 0; i < force_.size(); ++i) {
+      const double f = force_(i);
+      const double limit =
+          std::min(settings_.max_thrust, f >= 0.0 ? thrusters_.max_positive_thrust(i)
+                                                  : thrusters_.max_negative_thrust(i));
+      if (std::abs(f) * scale > limit) scale = limit / std::abs(f);
+    }
+    command_.saturated = scale < 1.0;
     if (command_.saturated) {
-      force_ *= settings_.max_thrust / peak;
+      force_ *= scale;
       // Anti-windup: the allocation could not deliver: keep the integrals where they were.
       surge_.set_integral(i_saved[0]);
       sway_.set_integral(i_saved[1]);
@@ -255,6 +271,14 @@ class AuvController {
   }
   /// \brief The last command.
   const AuvCommand& command() const { return command_; }
+  /// \brief Sets the thrusters' supply voltage [V] (e.g. the battery's, each step): the inverse
+  /// and the saturation use it from the next update on.
+  /// \throws kelp::invalid_argument outside [0, 20] V or not finite (nothing changes).
+  void set_voltage(double volts) { thrusters_.set_voltage(volts); }
+  /// \brief The thrusters' supply voltage [V].
+  double voltage() const { return thrusters_.voltage(); }
+  /// \brief The thruster chain (curve, facing, voltage) the inverse uses.
+  const vehicle::ThrusterChain<double>& thruster_chain() const { return thrusters_; }
   /// \brief The disturbance estimate (zero unless compensating).
   const Vector6<double>& disturbance_estimate() const { return observer_.estimate(); }
 
@@ -291,6 +315,10 @@ struct AsvControllerSettings {
   double observer_time_constant = 2.0;  ///< [s]
   /// The thrusters' curve (the chain command → thrust; vehicle::ThrusterChain).
   vehicle::ThrusterModel thruster_model = vehicle::t200_model;
+  /// ±1 per thruster (vehicle::VehiclePreset::thruster_facing); empty: both +1.
+  Eigen::VectorXd thruster_facing;
+  /// Supply voltage at the ESCs [V] the inverse uses until set_voltage() changes it.
+  double voltage = vehicle::t200_nominal_voltage;
 };
 
 /// \brief One ASV controller output.
@@ -311,7 +339,8 @@ class AsvController {
                 const vehicle::ThrusterAllocation<double>& thrusters,
                 const AsvControllerSettings& s = {})
       : settings_(s),
-        thrusters_(thrusters, s.thruster_model),
+        thrusters_(thrusters, s.thruster_model, vehicle::PwmMapping<double>(), s.thruster_facing,
+                   s.voltage),
         linear_(s.linear, "linear"),
         angular_(s.angular, "angular"),
         yaw_(s.yaw, "yaw"),
@@ -384,6 +413,14 @@ class AsvController {
   }
   /// \brief The last command.
   const AsvCommand& command() const { return command_; }
+  /// \brief Sets the thrusters' supply voltage [V] (e.g. the battery's, each step): the inverse
+  /// uses it from the next update on.
+  /// \throws kelp::invalid_argument outside [0, 20] V or not finite (nothing changes).
+  void set_voltage(double volts) { thrusters_.set_voltage(volts); }
+  /// \brief The thrusters' supply voltage [V].
+  double voltage() const { return thrusters_.voltage(); }
+  /// \brief The thruster chain (curve, facing, voltage) the inverse uses.
+  const vehicle::ThrusterChain<double>& thruster_chain() const { return thrusters_; }
   /// \brief The current target position, NED [m].
   const Vector3<double>& target() const { return target_; }
 

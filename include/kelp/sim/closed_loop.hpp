@@ -287,6 +287,7 @@ class ClosedLoop {
   }
   static kelp::control::AuvControllerSettings auv_settings(const Scenario& sc) {
     kelp::control::AuvControllerSettings s;
+    s.thruster_facing = kelp::vehicle::bluerov2_heavy<double>().thruster_facing;
     s.compensate = sc.compensation;
     s.period = 1.0 / sc.auv_rate;
     set_gains(s.surge, sc.auv_surge);
@@ -297,6 +298,7 @@ class ClosedLoop {
   }
   static kelp::control::AsvControllerSettings asv_settings(const Scenario& sc) {
     kelp::control::AsvControllerSettings s;
+    s.thruster_facing = kelp::vehicle::blueboat<double>().thruster_facing;
     s.compensate = sc.compensation;
     s.period = 1.0 / sc.asv_rate;
     s.thrust_clip = sc.asv_thrust_clip;
@@ -314,6 +316,20 @@ class ClosedLoop {
   // the metrics and the log.
   void observe() {
     const double t = state_.time;
+    // Propulsion: the controllers' inverse (command for a thrust) uses each battery's measured
+    // voltage (the last step's; its open-circuit voltage before the first).
+    const auto volts = [](const kelp::vehicle::PropulsionModeld& pm,
+                          const kelp::vehicle::PropulsionStated& x) {
+      return std::isfinite(x.battery.voltage)
+                 ? x.battery.voltage
+                 : kelp::vehicle::open_circuit_voltage(
+                       pm.parameters().battery,
+                       kelp::vehicle::state_of_charge(pm.parameters().battery, x.battery));
+    };
+    if (const auto* pm = model_.auv_propulsion())
+      auv_.set_voltage(volts(*pm, state_.auv_propulsion));
+    if (const auto* pm = model_.asv_propulsion())
+      asv_.set_voltage(volts(*pm, state_.asv_propulsion));
     auv_command_ = &auv_.update(kelp::control::navigation_of(state_.auv), t);
     asv_command_ = &asv_.update(kelp::control::navigation_of(state_.asv), state_.auv.position, t);
     // The AUV's error: distance from the survey path (the leg it is on); the boat's: its

@@ -80,8 +80,9 @@ Vector3<Scalar> bluerov2_attachment() {
   return Vector3<Scalar>(Scalar(-0.2), Scalar(0), Scalar(-0.05));
 }
 
-/// \brief The propulsion of a vehicle preset: its thrusters (positions, directions) on `battery`,
-/// with the T200 lag of `time_constant` [s] (0: none).
+/// \brief The propulsion of a vehicle preset: its thrusters (positions, directions, facing; the
+/// ESC command scale of its PWM mapping) on `battery`, with the T200 lag of `time_constant` [s]
+/// (0: none).
 template <typename Scalar>
 vehicle::PropulsionParameters<Scalar> propulsion_of(
     const vehicle::VehiclePreset<Scalar>& preset, const vehicle::BatteryParameters& battery,
@@ -91,6 +92,14 @@ vehicle::PropulsionParameters<Scalar> propulsion_of(
   p.directions = preset.thruster_directions;
   p.time_constant = time_constant;
   p.battery = battery;
+  const Eigen::Index n = preset.thruster_positions.cols();
+  p.facing = vehicle::ThrusterVector<int>::Ones(n);
+  for (Eigen::Index i = 0; i < preset.thruster_facing.size() && i < n; ++i)
+    p.facing(i) = preset.thruster_facing(i) < 0 ? -1 : 1;
+  p.esc_scale_forward =
+      double(value_of(preset.pwm.max_us - preset.pwm.neutral_us)) / vehicle::t200_esc_half_range_us;
+  p.esc_scale_reverse =
+      double(value_of(preset.pwm.neutral_us - preset.pwm.min_us)) / vehicle::t200_esc_half_range_us;
   return p;
 }
 

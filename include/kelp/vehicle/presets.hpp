@@ -15,7 +15,8 @@
 namespace kelp::vehicle {
 
 /// \brief A vehicle with its thrusters: dynamics parameters, thruster geometry (positive command ⇒
-/// thrust along the direction) and PWM mapping. Thrust per thruster follows t200_thrust().
+/// thrust along the direction), which way each thruster faces, and PWM mapping. Thrust per
+/// thruster follows t200_thrust() with its facing (ThrusterChain).
 /// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 struct VehiclePreset {
@@ -27,6 +28,10 @@ struct VehiclePreset {
   Matrix3X<Scalar> thruster_positions;
   /// d_i (unit), 3×n, body axes: thrust direction for a positive command (PWM above neutral).
   Matrix3X<Scalar> thruster_directions;
+  /// ±1 per thruster: +1 when a positive command gives the thruster's forward (stronger) thrust
+  /// along its direction (the T200 pushed towards its nose cone), −1 when it gives its reverse
+  /// thrust (see ThrusterChain).
+  Eigen::VectorXd thruster_facing;
   /// PWM ↔ command mapping of the ESCs.
   PwmMapping<Scalar> pwm;
 };
@@ -52,6 +57,18 @@ struct VehiclePreset {
 /// +1, so its positive thrust points aft-starboard, (−1, 1, 0)/√2; vertical thrusters push down
 /// (+z) for PWM > 1500. They are the opposite of von Benzon's drawn directions, which is the same
 /// as flipping the sign of an odd thrust curve.
+///
+/// Facing: all +1. ArduSub's motor factors are written for each thruster's forward direction,
+/// the way the front (cable side) of the T200 points; the propeller's handedness and the
+/// winding order are absorbed by MOTn_DIRECTION (Blue Robotics forum, "BlueROV2 Vectored
+/// Configuration Throttle Factor", https://discuss.bluerobotics.com/t/13210, and "BlueROV2 Heavy
+/// 6-DOF model", https://discuss.bluerobotics.com/t/13065: "model the force directions based on
+/// the front direction of each thruster ... which is effectively what ArduSub does"). So a
+/// positive output gives forward thrust along the directions above. This matches the frame:
+/// "the front two thrusters facing more backwards and the rear two thrusters facing more
+/// forwards" (https://discuss.bluerobotics.com/t/12044): motors 1–2 push aft and 3–4 forward
+/// with their strong side, so surge is about equally strong both ways (two forward and two
+/// reverse branches either way), and the verticals push down (+z) with their strong side.
 ///
 /// Free surface (Hydrostatics::submerged_free_surface): the hull is a box of height 0.254 m about
 /// the CB (Blue Robotics BlueROV2 Heavy technical details: height 254 mm); its buoyancy falls
@@ -95,6 +112,7 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
   p.thruster_directions << -s, -s, s, s, o, o, o, o,  //
       s, -s, s, -s, o, o, o, o,                       //
       o, o, o, o, one, one, one, one;
+  p.thruster_facing = Eigen::VectorXd::Ones(8);
   return p;
 }
 
@@ -123,7 +141,8 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   ThrottleLeft (SERVO1) and ThrottleRight (SERVO3) (ArduPilot
 ///   Tools/autotest/default_params/rover-skid.parm). Positions (−0.488, ∓0.295)
 ///   m from the paper framework's Gazebo model (converted from its y-left axes); depth 0.10 m
-///   below the waterline (assumed). Directions +x. PWM 1000–1500–2000 µs (rover.parm SERVO
+///   below the waterline (assumed). Directions +x, both facing forward (+1: a positive throttle
+///   gives each T200's stronger, forward thrust). PWM 1000–1500–2000 µs (rover.parm SERVO
 ///   limits) with the ±25 µs dead band.
 /// - Hull depth keel to deck 0.20 m (assumed; product height ≈ 0.33 m including the deck
 ///   electronics): the heave force saturates at the draft (fully emerged, net force = weight) and
@@ -132,9 +151,11 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   ≈ 0.2 m hulls and deck box), L_oa = 1.2 m (assumed from the product dimensions); constant
 ///   coefficients c_x = 0.6, c_y = 0.8 (assumed, mid-range of Fossen 2021 §10.1.1's values for
 ///   small craft), c_n = 0 (fore-aft symmetric profile assumed: no wind yaw moment).
-/// Resulting behaviour (checked by tests/vehicle): top speed 2.97 m/s at full command (the
-/// thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against the pure surge
-/// balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch 0.68 s.
+/// Resulting behaviour (checked by tests/vehicle): top speed 2.97 m/s with von Benzon's 30.4 N per
+/// thruster (the thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against
+/// the pure surge balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch
+/// 0.68 s. With the T200 datasheet (2 × 51.6 N at 16 V) the same damping gives ≈ 4.1 m/s, above
+/// the Blue Robotics figure: the assumed surge damping was chosen for the old curve.
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
 /// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
 /// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (the displaced volume is m/ρ).
@@ -177,6 +198,7 @@ VehiclePreset<Scalar> blueboat(const Scalar& density = Scalar(seawater_density),
       Scalar(-0.295), Scalar(0.295),                       //
       Scalar(0.10), Scalar(0.10);
   p.thruster_directions << Scalar(1), Scalar(1), Scalar(0), Scalar(0), Scalar(0), Scalar(0);
+  p.thruster_facing = Eigen::VectorXd::Ones(2);
   p.pwm.min_us = Scalar(1000);
   p.pwm.max_us = Scalar(2000);
   return p;

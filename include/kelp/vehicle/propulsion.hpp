@@ -35,6 +35,12 @@
 /// way round (a positive command still gives thrust along d_i, but from the propeller's reverse,
 /// weaker side): f_i = facing_i · t200_thrust(facing_i · u_i, V).
 ///
+/// **Commands.** u ∈ [−1, 1] is the normalised command of the vehicle's PWM mapping (as
+/// ThrusterChain and the controllers use it); the T200 data's command is the ESC's,
+/// u_esc = (pwm − 1500 µs)/400 µs: u_esc = u · esc_scale_forward (u > 0) or u · esc_scale_reverse,
+/// clamped to [−1, 1] (1 for the BlueROV2's 1100–1900 µs outputs, 1.25 for the BlueBoat's
+/// 1000–2000 µs: full thrust from 1900 µs on, as ThrusterChain does).
+///
 /// No heap allocation in advance(): per-thruster vectors have a fixed capacity of max_thrusters.
 #pragma once
 
@@ -71,6 +77,10 @@ struct PropulsionParameters {
   Matrix3X<Scalar> directions;
   /// ±1 per thruster (see the file comment); empty: all +1.
   ThrusterVector<int> facing;
+  /// u_esc / u for positive commands ((max_us − neutral_us)/400 µs of the PWM mapping), > 0.
+  double esc_scale_forward = 1.0;
+  /// u_esc / u for negative commands ((neutral_us − min_us)/400 µs), > 0.
+  double esc_scale_reverse = 1.0;
   /// First-order lag of the thrust [s]; 0: no lag.
   double time_constant = t200_time_constant;
   /// The battery the thrusters draw from.
@@ -88,6 +98,8 @@ void validate(const PropulsionParameters<Scalar>& p) {
              "propulsion.facing must be empty or have one entry per thruster");
   for (Eigen::Index i = 0; i < p.facing.size(); ++i)
     KELP_CHECK(p.facing(i) == 1 || p.facing(i) == -1, "propulsion.facing entries must be +1 or -1");
+  check_positive(p.esc_scale_forward, "propulsion.esc_scale_forward");
+  check_positive(p.esc_scale_reverse, "propulsion.esc_scale_reverse");
   KELP_CHECK(std::isfinite(p.time_constant) && p.time_constant >= 0.0,
              "propulsion.time_constant must be finite and >= 0");
   validate(p.battery);
@@ -179,9 +191,11 @@ PropulsionStep<Scalar> advance(const PropulsionModel<Scalar>& m, PropulsionState
              "thruster commands must be empty or have one entry per thruster");
   check_all_finite(commands, "thruster commands");
   check_state(m, s, "propulsion state");
-  const auto command = [&](Eigen::Index i) {
+  const double up = m.parameters().esc_scale_forward, down = m.parameters().esc_scale_reverse;
+  const auto command = [&](Eigen::Index i) {  // the ESC's command
     if (commands.size() == 0) return Scalar(0);
     Scalar u = Scalar(commands(i));
+    u = value_of(u) > 0.0 ? Scalar(u * Scalar(up)) : Scalar(u * Scalar(down));
     if (value_of(u) > 1.0) u = Scalar(1);
     if (value_of(u) < -1.0) u = Scalar(-1);
     return u;

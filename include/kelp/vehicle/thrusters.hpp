@@ -1,6 +1,7 @@
 /// \file
 /// \brief Thrusters: the allocation matrix from thruster positions and directions, a thruster
-/// model (its static thrust curve, written once; the Blue Robotics T200 preset) and its inverse,
+/// model (its static thrust curve, written once: the Blue Robotics T200 from its data by default,
+/// the von Benzon polynomial for comparison) and its inverse, a thruster's facing,
 /// the PWM ↔ normalised command mapping, and the chain PWM → command → thrust → wrench.
 #pragma once
 
@@ -115,34 +116,52 @@ class ThrusterAllocation {
   Eigen::Index rank_ = 0;
 };
 
-/// \brief The static thrust curve of one thruster model: an odd polynomial
-/// F(u) = Σₖ cₖ u^(2k+1) of the normalised command u ∈ [−1, 1] (clamped), with the command at
-/// which it peaks on [0, 1] and that peak. It is the one place a thruster's curve is written: the
-/// thrust, its slope and its inverse (thrust(), thrust_slope(), command_for_thrust()) and the
-/// chain PWM → command → thrust → wrench (ThrusterChain) all read it.
+/// \brief Which static curve a ThrusterModel stands for.
+enum class ThrusterCurve {
+  /// Blue Robotics T200 from its published data, asymmetric and voltage dependent
+  /// (kelp/vehicle/t200.hpp: t200_thrust(), t200_command()); the polynomial fields are unused.
+  t200_datasheet,
+  /// The odd polynomial of ThrusterModel's coefficients (symmetric, no voltage).
+  odd_polynomial,
+};
+
+/// \brief The static thrust curve of one thruster model, written once: either the T200
+/// datasheet fit (the default, t200_model) or an odd polynomial F(u) = Σₖ cₖ u^(2k+1) of the
+/// normalised command u ∈ [−1, 1] (clamped), with the command at which it peaks on [0, 1] and
+/// that peak (von_benzon_t200_model). The thrust, its slope and its inverse (thrust(),
+/// thrust_slope(), command_for_thrust()) and the chain PWM → command → thrust → wrench
+/// (ThrusterChain) all read it.
 struct ThrusterModel {
   /// Number of odd coefficients.
   static constexpr int order = 5;
-  /// c₀ … c₄ [N]: the coefficients of u, u³, u⁵, u⁷, u⁹.
+  /// The curve.
+  ThrusterCurve curve = ThrusterCurve::odd_polynomial;
+  /// c₀ … c₄ [N]: the coefficients of u, u³, u⁵, u⁷, u⁹ (odd_polynomial only).
   double odd_coefficients[order] = {0, 0, 0, 0, 0};
-  /// u_peak ∈ (0, 1]: F rises monotonically on [0, u_peak] (the inverse's branch).
+  /// u_peak ∈ (0, 1]: F rises monotonically on [0, u_peak] (the inverse's branch; polynomial).
   double peak_command = 1.0;
-  /// F(u_peak) [N], rounded down (the largest thrust the inverse delivers).
+  /// F(u_peak) [N], rounded down (the largest thrust the inverse delivers; polynomial).
   double max_thrust = 0.0;
 };
 
-/// \brief Blue Robotics T200 static thrust curve: F(u) = −140.3u⁹ + 389.9u⁷ − 404.1u⁵ + 176.0u³
-/// + 8.9u, F(1) ≈ 30.4 N (von Benzon et al. 2022, J. Mar. Sci. Eng. 10(12):1898, fit to the Blue
-/// Robotics T200 data; odd, so reverse = forward). The polynomial rises monotonically on
-/// [0, 0.971656] to 30.62 N and then falls slightly to 30.40 N at u = 1 (root of dF/du at
-/// 0.97165617, found by bisection in double and rounded down; F(u_peak) = 30.621753 N rounded
-/// down; the unit test re-checks both).
-inline constexpr ThrusterModel t200_model{{8.9, 176.0, -404.1, 389.9, -140.3}, 0.971656, 30.62175};
+/// \brief Blue Robotics T200 from its published performance data, forward/reverse asymmetric
+/// and voltage dependent (t200_thrust(), kelp/vehicle/t200.hpp): the default thruster model.
+inline constexpr ThrusterModel t200_model{ThrusterCurve::t200_datasheet};
 
-/// \brief Command at which the T200 curve peaks (`t200_model.peak_command`).
-inline constexpr double von_benzon_t200_peak_command = t200_model.peak_command;
-/// \brief Largest T200 thrust the curve gives [N] (`t200_model.max_thrust`).
-inline constexpr double von_benzon_t200_max_thrust = t200_model.max_thrust;
+/// \brief The T200 curve of von Benzon et al. 2022 (J. Mar. Sci. Eng. 10(12):1898), kept for
+/// comparison: F(u) = −140.3u⁹ + 389.9u⁷ − 404.1u⁵ + 176.0u³ + 8.9u, F(1) ≈ 30.4 N, odd (reverse
+/// = forward) and independent of the voltage. It rises monotonically on [0, 0.971656] to
+/// 30.62 N and then falls slightly to 30.40 N at u = 1 (root of dF/du at 0.97165617, found by
+/// bisection in double and rounded down; F(u_peak) = 30.621753 N rounded down; the unit test
+/// re-checks both). The datasheet fit gives 51.6 N forward and 39.8 N reverse at 16 V
+/// (t200_model).
+inline constexpr ThrusterModel von_benzon_t200_model{
+    ThrusterCurve::odd_polynomial, {8.9, 176.0, -404.1, 389.9, -140.3}, 0.971656, 30.62175};
+
+/// \brief Command at which the von Benzon curve peaks (`von_benzon_t200_model.peak_command`).
+inline constexpr double von_benzon_t200_peak_command = von_benzon_t200_model.peak_command;
+/// \brief Largest thrust of the von Benzon curve [N] (`von_benzon_t200_model.max_thrust`).
+inline constexpr double von_benzon_t200_max_thrust = von_benzon_t200_model.max_thrust;
 
 namespace detail {
 /// F(u) and dF/du of an odd polynomial, u unclamped: with P(x) = Σ cₖ xᵏ and x = u², F = u P(x)
@@ -162,10 +181,14 @@ void thrust_polynomial(const ThrusterModel& m, const Scalar& u, Scalar& f, Scala
 }  // namespace detail
 
 /// \brief Static thrust F(u) [N] of thruster model `m` for a normalised command u (clamped to
-/// [−1, 1]; positive: thrust along the thruster direction).
-/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+/// [−1, 1]) at a supply voltage [V] (used by the datasheet curve only; positive: thrust along
+/// the thruster's forward axis).
+/// \throws kelp::invalid_argument naming the command when u is not finite, or (datasheet) the
+/// voltage when it is not finite or outside [0, 20] V.
 template <typename Scalar>
-Scalar thrust(const ThrusterModel& m, const Scalar& u_in) {
+Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
+              const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  if (m.curve == ThrusterCurve::t200_datasheet) return t200_thrust(u_in, voltage);
   check_finite(u_in, "thruster command u");
   Scalar u = u_in;
   if (value_of(u) > 1.0) u = Scalar(1);
@@ -178,9 +201,11 @@ Scalar thrust(const ThrusterModel& m, const Scalar& u_in) {
 }
 
 /// \brief dF/du [N] of thrust() (same clamping: 0 outside [−1, 1]).
-/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+/// \throws kelp::invalid_argument as thrust().
 template <typename Scalar>
-Scalar thrust_slope(const ThrusterModel& m, const Scalar& u) {
+Scalar thrust_slope(const ThrusterModel& m, const Scalar& u,
+                    const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  if (m.curve == ThrusterCurve::t200_datasheet) return t200_thrust_slope(u, voltage);
   check_finite(u, "thruster command u");
   if (value_of(u) > 1.0 || value_of(u) < -1.0) return Scalar(0);
   Scalar f, d;
@@ -188,16 +213,41 @@ Scalar thrust_slope(const ThrusterModel& m, const Scalar& u) {
   return d;
 }
 
-/// \brief Inverse of the curve on its monotone branch: the command u ∈ [−u_peak, u_peak] with
-/// thrust(m, u) = force; forces beyond ±max_thrust saturate at ±u_peak.
-/// Newton's method safeguarded by bisection on the value (the bracket shrinks at every step; a
-/// Newton step that leaves it is replaced by the midpoint; 5–8 iterations instead of 60
-/// bisections), then one Newton correction in Scalar so that ceres::Jet derivatives follow the
-/// implicit-function theorem (du/dF = 1/F'(u)).
-/// \param[in] m thruster model \param[in] force desired thrust [N] along the thruster direction.
-/// \throws kelp::invalid_argument naming `thruster force` when the force is not finite.
+/// \brief Largest thrust [N] along the thruster's forward axis that model `m` delivers at a
+/// voltage [V] (datasheet: t200_max_thrust(); polynomial: max_thrust).
+/// \throws kelp::invalid_argument (datasheet) for a voltage outside [0, 20] V.
 template <typename Scalar>
-Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force) {
+Scalar max_forward_thrust(const ThrusterModel& m,
+                          const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  if (m.curve == ThrusterCurve::t200_datasheet) return t200_max_thrust(voltage);
+  return Scalar(m.max_thrust);
+}
+
+/// \brief Largest reverse thrust [N] (a positive magnitude) of model `m` at a voltage [V]
+/// (datasheet: t200_max_reverse_thrust(); polynomial: max_thrust, the curve being odd).
+/// \throws kelp::invalid_argument (datasheet) for a voltage outside [0, 20] V.
+template <typename Scalar>
+Scalar max_reverse_thrust(const ThrusterModel& m,
+                          const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  if (m.curve == ThrusterCurve::t200_datasheet) return t200_max_reverse_thrust(voltage);
+  return Scalar(m.max_thrust);
+}
+
+/// \brief Inverse of the curve on its monotone branch: the command u with
+/// thrust(m, u, V) = force. Datasheet: t200_command() (saturates at u = ±1 beyond the largest
+/// forward / reverse thrust at that voltage). Polynomial: u ∈ [−u_peak, u_peak], forces beyond
+/// ±max_thrust saturate at ±u_peak; Newton's method safeguarded by bisection on the value (the
+/// bracket shrinks at every step; a Newton step that leaves it is replaced by the midpoint; 5–8
+/// iterations instead of 60 bisections), then one Newton correction in Scalar so that
+/// ceres::Jet derivatives follow the implicit-function theorem (du/dF = 1/F'(u)).
+/// \param[in] m thruster model \param[in] force desired thrust [N] along the forward axis.
+/// \param[in] voltage supply voltage [V] (datasheet only).
+/// \throws kelp::invalid_argument naming the force when it is not finite, or (datasheet) the
+/// voltage.
+template <typename Scalar>
+Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force,
+                          const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  if (m.curve == ThrusterCurve::t200_datasheet) return t200_command(force, voltage);
   check_finite(force, "thruster force");
   const double f = value_of(force);
   if (f >= m.max_thrust) return Scalar(m.peak_command);
@@ -222,27 +272,29 @@ Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force) {
   return u + (force - thrust(m, u)) / thrust_slope(m, u);
 }
 
-/// \brief Blue Robotics T200 static thrust [N]: thrust(t200_model, u) (see t200_model).
+/// \brief T200 thrust [N] at the nominal supply voltage (t200_nominal_voltage, 16 V):
+/// t200_thrust(u, 16 V).
 /// \param[in] u normalised command (clamped to [−1, 1]).
-/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+/// \throws kelp::invalid_argument naming the command when u is not finite.
 template <typename Scalar>
 Scalar t200_thrust(const Scalar& u) {
-  return thrust(t200_model, u);
+  return t200_thrust(u, Scalar(t200_nominal_voltage));
 }
 
-/// \brief dF/du of t200_thrust() [N] (0 outside [−1, 1]): thrust_slope(t200_model, u).
-/// \throws kelp::invalid_argument naming `thruster command u` when u is not finite.
+/// \brief dF/du of t200_thrust(u) [N] at the nominal voltage (0 outside [−1, 1] and in the
+/// dead band).
+/// \throws kelp::invalid_argument naming the command when u is not finite.
 template <typename Scalar>
 Scalar t200_thrust_slope(const Scalar& u) {
-  return thrust_slope(t200_model, u);
+  return t200_thrust_slope(u, Scalar(t200_nominal_voltage));
 }
 
-/// \brief Inverse of the T200 curve: command_for_thrust(t200_model, force).
-/// \param[in] force desired thrust [N] along the thruster direction.
-/// \throws kelp::invalid_argument naming `thruster force` when the force is not finite.
+/// \brief Inverse of t200_thrust(u) at the nominal voltage: t200_command(force, 16 V).
+/// \param[in] force desired thrust [N] along the thruster's forward axis.
+/// \throws kelp::invalid_argument naming the force when it is not finite.
 template <typename Scalar>
 Scalar t200_command(const Scalar& force) {
-  return command_for_thrust(t200_model, force);
+  return t200_command(force, Scalar(t200_nominal_voltage));
 }
 
 /// \brief PWM pulse-width ↔ normalised command mapping of a bidirectional ESC.
@@ -314,39 +366,70 @@ Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMap
 }
 
 /// \brief Thrust [N] of a pulse width [µs] through the chain's first two links: the command
-/// u = command_from_pwm(pwm, pwm_map) (dead band, clamped) and the curve thrust(m, u).
-/// \param[out] command u, if not null.
-/// \throws kelp::invalid_argument when the pulse width is not finite or `pwm_map` is invalid.
+/// u = command_from_pwm(pwm, pwm_map) (dead band, clamped) and the curve thrust(m, u, V).
+/// \param[out] command u, if not null. \param[in] voltage supply voltage [V] (datasheet curve).
+/// \throws kelp::invalid_argument when the pulse width is not finite, `pwm_map` is invalid or
+/// the voltage is out of range.
 template <typename Scalar>
 Scalar thrust_from_pwm(const ThrusterModel& m, const Scalar& pwm_us,
-                       const PwmMapping<Scalar>& pwm_map, Scalar* command = nullptr) {
+                       const PwmMapping<Scalar>& pwm_map, Scalar* command = nullptr,
+                       const Scalar& voltage = Scalar(t200_nominal_voltage)) {
   const Scalar u = command_from_pwm(pwm_us, pwm_map);
   if (command != nullptr) *command = u;
-  return thrust(m, u);
+  return thrust(m, u, voltage);
 }
 
 /// \brief The whole thruster chain of a vehicle, in one place: PWM pulse width → normalised
-/// command (PwmMapping, dead band) → thrust (ThrusterModel's curve) → body wrench (the
-/// ThrusterAllocation). Controllers go the other way for their output (desired force → command →
-/// the thrust it really delivers) and the SITL bridge goes the whole way from the autopilot's PWM:
-/// both call it, so a new thruster curve is one ThrusterModel. Allocation-free after construction.
+/// command (PwmMapping, dead band) → thrust (ThrusterModel's curve at the supply voltage, with
+/// each thruster's facing) → body wrench (the ThrusterAllocation). Controllers go the other way
+/// for their output (desired force → command → the thrust it really delivers) and the SITL
+/// bridge goes the whole way from the autopilot's PWM: both call it, so a new thruster curve is
+/// one ThrusterModel. Allocation-free after construction.
+///
+/// Facing: thruster i's thrust along its direction d_i for a command u is
+/// sᵢ F(sᵢ u, V) with sᵢ = facing(i) = ±1: +1 when a positive command gives the thruster's
+/// forward (stronger) thrust along d_i, −1 when it gives its reverse thrust (a thruster mounted
+/// the other way round, e.g. with the opposite propeller and its output reversed).
 /// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 class ThrusterChain {
  public:
   /// \param[in] allocation the thruster set \param[in] model the thrusters' curve (all alike)
   /// \param[in] pwm the ESCs' PWM mapping
-  /// \throws kelp::invalid_argument when `pwm` is invalid (see `validate(const PwmMapping&)`)
-  /// or the model's peak command is not in (0, 1] or its max thrust not > 0.
+  /// \param[in] facing ±1 per thruster (see the class); empty: all +1.
+  /// \param[in] voltage supply voltage [V] (set_voltage()).
+  /// \throws kelp::invalid_argument when `pwm` is invalid (see `validate(const PwmMapping&)`),
+  /// the polynomial model's peak command is not in (0, 1] or its max thrust not > 0, `facing`
+  /// has a wrong size or an entry other than ±1, or the voltage is invalid.
   explicit ThrusterChain(const ThrusterAllocation<Scalar>& allocation,
                          const ThrusterModel& model = t200_model,
-                         const PwmMapping<Scalar>& pwm = PwmMapping<Scalar>())
+                         const PwmMapping<Scalar>& pwm = PwmMapping<Scalar>(),
+                         const Eigen::VectorXd& facing = Eigen::VectorXd(),
+                         double voltage = t200_nominal_voltage)
       : allocation_(allocation), model_(model), pwm_(pwm) {
     validate(pwm_);
-    KELP_CHECK(model.peak_command > 0.0 && model.peak_command <= 1.0,
-               "ThrusterModel: peak_command must be in (0, 1]");
-    check_positive(model.max_thrust, "ThrusterModel: max_thrust");
-    for (double c : model.odd_coefficients) check_finite(c, "ThrusterModel: odd_coefficients");
+    if (model.curve == ThrusterCurve::odd_polynomial) {
+      KELP_CHECK(model.peak_command > 0.0 && model.peak_command <= 1.0,
+                 "ThrusterModel: peak_command must be in (0, 1]");
+      check_positive(model.max_thrust, "ThrusterModel: max_thrust");
+      for (double c : model.odd_coefficients) check_finite(c, "ThrusterModel: odd_coefficients");
+    }
+    if (facing.size() == 0) {
+      facing_ = Eigen::VectorXd::Ones(allocation_.size());
+    } else {
+      KELP_CHECK(facing.size() == allocation_.size(),
+                 "thruster_facing must have one entry per thruster");
+      for (Eigen::Index i = 0; i < facing.size(); ++i)
+        KELP_CHECK(facing(i) == 1.0 || facing(i) == -1.0,
+                   "thruster_facing entries must be +1 or -1");
+      facing_ = facing;
+    }
+    if (model.curve == ThrusterCurve::t200_datasheet) {
+      // The datasheet's command is the ESC's: u = (pwm − 1500 µs)/400 µs, full at 1100 / 1900.
+      esc_up_ = value_of(pwm_.max_us - pwm_.neutral_us) / t200_esc_half_range_us;
+      esc_down_ = value_of(pwm_.neutral_us - pwm_.min_us) / t200_esc_half_range_us;
+    }
+    set_voltage(voltage);
   }
 
   /// \brief Number of thrusters.
@@ -357,20 +440,63 @@ class ThrusterChain {
   const ThrusterModel& model() const { return model_; }
   /// \brief The PWM mapping.
   const PwmMapping<Scalar>& pwm() const { return pwm_; }
+  /// \brief ±1 per thruster (see the class).
+  const Eigen::VectorXd& facing() const { return facing_; }
+
+  /// \brief Sets the supply voltage [V] at the ESCs that every thrust and command of the chain
+  /// uses from now on (the datasheet curve; the polynomial ignores it). Default
+  /// t200_nominal_voltage (16 V).
+  /// \throws kelp::invalid_argument when it is not finite or outside [0, 20] V (the chain is
+  /// left unchanged).
+  void set_voltage(double volts) {
+    detail::t200_check_voltage(volts);
+    voltage_ = volts;
+    const Scalar v(volts);
+    max_forward_ = value_of(max_forward_thrust(model_, v));
+    max_reverse_ = value_of(max_reverse_thrust(model_, v));
+  }
+  /// \brief The supply voltage [V].
+  double voltage() const { return voltage_; }
+
+  /// \brief Largest thrust [N] thruster i delivers along +d_i at the current voltage.
+  double max_positive_thrust(Eigen::Index i) const {
+    return facing_(i) > 0 ? max_forward_ : max_reverse_;
+  }
+  /// \brief Largest thrust [N] (a magnitude) thruster i delivers along −d_i.
+  double max_negative_thrust(Eigen::Index i) const {
+    return facing_(i) > 0 ? max_reverse_ : max_forward_;
+  }
 
   /// \brief Normalised command of a pulse width [µs] (command_from_pwm()).
   Scalar command_from_pwm(const Scalar& pwm_us) const {
     return vehicle::command_from_pwm(pwm_us, pwm_);
   }
-  /// \brief Thrust [N] of a normalised command (thrust()).
-  Scalar thrust_of_command(const Scalar& u) const { return thrust(model_, u); }
-  /// \brief Thrust [N] of a pulse width [µs]: thrust(command_from_pwm(pwm)).
-  /// \param[out] command the normalised command, if not null.
-  Scalar thrust_of_pwm(const Scalar& pwm_us, Scalar* command = nullptr) const {
-    return thrust_from_pwm(model_, pwm_us, pwm_, command);
+  /// \brief Thrust [N] of thruster i along d_i for a normalised command u (of this chain's PWM
+  /// mapping): facing · thrust(facing · u_esc, V). For the datasheet curve u_esc is the ESC's
+  /// command, u scaled to the ESC's 1100–1900 µs and clamped (e.g. the BlueBoat's 1000–2000 µs
+  /// mapping: u_esc = 1.25 u, full thrust from 1900 µs on); for a polynomial u_esc = u.
+  Scalar thrust_of_command(Eigen::Index i, const Scalar& u) const {
+    const Scalar s(facing_(i));
+    return s * thrust(model_, Scalar(s * esc_command(u)), Scalar(voltage_));
   }
-  /// \brief Command for a desired thrust [N] (command_for_thrust(); saturates at ±max_thrust).
-  Scalar command_for(const Scalar& force) const { return command_for_thrust(model_, force); }
+  /// \brief Thrust [N] of thruster i along d_i for a pulse width [µs].
+  /// \param[out] command the normalised command, if not null.
+  Scalar thrust_of_pwm(Eigen::Index i, const Scalar& pwm_us, Scalar* command = nullptr) const {
+    const Scalar u = command_from_pwm(pwm_us);
+    if (command != nullptr) *command = u;
+    return thrust_of_command(i, u);
+  }
+  /// \brief Command of thruster i for a desired thrust [N] along d_i: the inverse of
+  /// thrust_of_command(), facing · command_for_thrust(facing · force, V) taken back from the
+  /// ESC's command to the chain's (saturates at the largest thrust that way, |u| ≤ 1).
+  Scalar command_for(Eigen::Index i, const Scalar& force) const {
+    const Scalar s(facing_(i));
+    const Scalar ue = s * command_for_thrust(model_, Scalar(s * force), Scalar(voltage_));
+    Scalar u = value_of(ue) > 0.0 ? Scalar(ue / Scalar(esc_up_)) : Scalar(ue / Scalar(esc_down_));
+    if (value_of(u) > 1.0) u = Scalar(1);
+    if (value_of(u) < -1.0) u = Scalar(-1);
+    return u;
+  }
 
   /// \brief For desired per-thruster forces [N]: the commands and the thrust they deliver
   /// (saturated on the curve's monotone branch). All three have one entry per thruster.
@@ -381,8 +507,8 @@ class ThrusterChain {
     KELP_CHECK(forces.size() == size() && commands.size() == size() && delivered.size() == size(),
                "ThrusterChain: forces, commands and thrust need one entry per thruster");
     for (Eigen::Index i = 0; i < size(); ++i) {
-      commands(i) = command_for(forces(i));
-      delivered(i) = thrust_of_command(commands(i));
+      commands(i) = command_for(i, forces(i));
+      delivered(i) = thrust_of_command(i, commands(i));
     }
   }
 
@@ -393,7 +519,7 @@ class ThrusterChain {
                                        Eigen::MatrixBase<DT>& thrusts) const {
     KELP_CHECK(commands.size() == size() && thrusts.size() == size(),
                "ThrusterChain: commands and thrust need one entry per thruster");
-    for (Eigen::Index i = 0; i < size(); ++i) thrusts(i) = thrust_of_command(commands(i));
+    for (Eigen::Index i = 0; i < size(); ++i) thrusts(i) = thrust_of_command(i, commands(i));
     return allocation_.wrench(thrusts);
   }
 
@@ -420,6 +546,19 @@ class ThrusterChain {
   ThrusterAllocation<Scalar> allocation_;
   ThrusterModel model_;
   PwmMapping<Scalar> pwm_;
+  /// The ESC's command of the chain's: u_esc = u · esc_up_ (u > 0) or u · esc_down_, clamped.
+  Scalar esc_command(const Scalar& u) const {
+    check_finite(u, "thruster command u");
+    Scalar ue = value_of(u) > 0.0 ? Scalar(u * Scalar(esc_up_)) : Scalar(u * Scalar(esc_down_));
+    if (value_of(ue) > 1.0) ue = Scalar(1);
+    if (value_of(ue) < -1.0) ue = Scalar(-1);
+    return ue;
+  }
+
+  Eigen::VectorXd facing_;
+  double esc_up_ = 1.0, esc_down_ = 1.0;
+  double voltage_ = t200_nominal_voltage;
+  double max_forward_ = 0.0, max_reverse_ = 0.0;
 };
 
 /// \brief Thruster allocation in double precision.
