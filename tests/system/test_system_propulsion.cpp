@@ -48,9 +48,10 @@ TEST_CASE("System propulsion: commands drive the vehicles and drain the batterie
   // Forward thrust: the ROV has moved forward (north; it starts astern, heading north).
   CHECK(w.state.auv.nu(0) > 0.1);
   CHECK(w.state.auv.position.x() > x0 + 0.1);
-  // The thrust settled on the static curve at the step's voltage (20 ms lag, 2 s run).
+  // The thrust settled on the static curve at the step's voltage (20 ms lag, 2 s run; the
+  // lag trails the voltage's slow fall by ~1e-6 relative).
   CHECK(w.state.auv_propulsion.thrust(2) ==
-        Approx(vehicle::t200_thrust(0.5, r.auv_propulsion.voltage)).epsilon(1e-6));
+        Approx(vehicle::t200_thrust(0.5, r.auv_propulsion.voltage)).epsilon(1e-5));
   CHECK(r.auv_propulsion.current > 1.0);
   CHECK(r.auv_propulsion.voltage <
         vehicle::open_circuit_voltage(w.model.auv_propulsion()->parameters().battery, 1.0));

@@ -162,12 +162,21 @@ class ClosedLoop {
                         " steps of the scenario's duration)");
     // With propulsion, the controllers' per-thruster commands drive the thrusters (lag, battery);
     // without, their wrench is applied directly.
-    if (model_.auv_propulsion() != nullptr)
-      inputs_.auv_commands = auv_command_->command;
+    // The controllers' chains have the ESC's 1100–1900 µs mapping (their commands are the ESC's);
+    // the propulsion takes the vehicle's PWM mapping's (e.g. the BlueBoat's 1000–2000 µs).
+    const auto to_vehicle = [](const kelp::vehicle::PropulsionModeld& pm, const auto& esc,
+                               kelp::vehicle::ThrusterVector<double>& u) {
+      const auto& pp = pm.parameters();
+      u.resize(esc.size());
+      for (Eigen::Index i = 0; i < esc.size(); ++i)
+        u(i) = esc(i) > 0.0 ? esc(i) / pp.esc_scale_forward : esc(i) / pp.esc_scale_reverse;
+    };
+    if (const auto* pm = model_.auv_propulsion())
+      to_vehicle(*pm, auv_command_->command, inputs_.auv_commands);
     else
       inputs_.auv.tau = auv_command_->wrench;
-    if (model_.asv_propulsion() != nullptr)
-      inputs_.asv_commands = asv_command_->command;
+    if (const auto* pm = model_.asv_propulsion())
+      to_vehicle(*pm, asv_command_->command, inputs_.asv_commands);
     else
       inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
