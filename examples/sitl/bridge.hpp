@@ -248,6 +248,16 @@ class Bridge {
     r.attitude = x.attitude;
     if (is_sub && std::isfinite(model_.environment().seabed_depth()))
       r.rangefinder = std::max(0.0, model_.environment().seabed_depth() - x.position.z());
+    // The battery's terminal voltage and current over the last step (ArduPilot's JSON backend
+    // takes them as "battery": {"voltage", "current"}: libraries/SITL/SIM_JSON.h keytable, master).
+    if (model_.auv_propulsion() != nullptr && is_sub) {
+      r.battery_voltage = state_.auv_propulsion.battery.voltage;
+      r.battery_current = state_.auv_propulsion.battery.current;
+    }
+    if (model_.asv_propulsion() != nullptr && !is_sub) {
+      r.battery_voltage = state_.asv_propulsion.battery.voltage;
+      r.battery_current = state_.asv_propulsion.battery.current;
+    }
     return r;
   }
 
@@ -353,9 +363,19 @@ class Bridge {
     if (active == 0) return;
     if (settings_.start_together && steps_ == 0 && joined < 2) return;
     ks::SystemInputsd in;
-    in.auv.tau = peers_[sub].active ? rov_chain_.wrench(auv_force_) : kelp::Vector6<double>::Zero();
-    in.asv.tau =
-        peers_[rover].active ? boat_chain_.wrench(asv_force_) : kelp::Vector6<double>::Zero();
+    // A vehicle with propulsion in the system (the presets'): its autopilot's PWM commands drive
+    // the thrusters (their lag, their current from the battery); else the static thrust's wrench.
+    // An autopilot out of the lockstep: thrusters off (no commands, zero wrench).
+    if (model_.auv_propulsion() != nullptr) {
+      if (peers_[sub].active) in.auv_commands = auv_command_;
+    } else if (peers_[sub].active) {
+      in.auv.tau = rov_chain_.wrench(auv_force_);
+    }
+    if (model_.asv_propulsion() != nullptr) {
+      if (peers_[rover].active) in.asv_commands = asv_command_;
+    } else if (peers_[rover].active) {
+      in.asv.tau = boat_chain_.wrench(asv_force_);
+    }
     report_ = ks::step(model_, ws_, state_, in, 1.0 / settings_.rate);
     solver_stats_ += report_;
     ++steps_;

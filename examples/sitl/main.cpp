@@ -172,6 +172,21 @@ int run(const Options& o) {
       row.auv_command = bridge.auv_command();
       row.tension_asv = bridge.last_report().force_on_asv.norm();
       row.tension_auv = bridge.last_report().force_on_auv.norm();
+      // Propulsion: thrust as delivered (lagged), currents, batteries.
+      if (const auto* pm = bridge.model().asv_propulsion()) {
+        row.asv_thrust = s.asv_propulsion.thrust.head<2>();
+        row.asv_current = s.asv_propulsion.current.head<2>();
+        row.asv_voltage = s.asv_propulsion.battery.voltage;
+        row.asv_soc =
+            kelp::vehicle::state_of_charge(pm->parameters().battery, s.asv_propulsion.battery);
+      }
+      if (const auto* pm = bridge.model().auv_propulsion()) {
+        row.auv_thrust = s.auv_propulsion.thrust.head<8>();
+        row.auv_current = s.auv_propulsion.current.head<8>();
+        row.auv_voltage = s.auv_propulsion.battery.voltage;
+        row.auv_soc =
+            kelp::vehicle::state_of_charge(pm->parameters().battery, s.auv_propulsion.battery);
+      }
       log.row(row);
       next_log = t + 1.0 / log_rate;
     }
@@ -251,6 +266,21 @@ int run(const Options& o) {
   summary["math_library"] = kelp::simd::math_library_fingerprint();
   summary["tether_solver"] =
       kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters());
+  // Propulsion: the energy each battery delivered [Wh] and its final state of charge.
+  const auto battery = [&](const kelp::vehicle::PropulsionModeld* pm,
+                           const kelp::vehicle::PropulsionStated& x) {
+    nlohmann::json b;
+    if (pm == nullptr) return b;
+    b["energy_wh"] = x.battery.energy_drawn / 3600.0;
+    b["final_soc"] = kelp::vehicle::state_of_charge(pm->parameters().battery, x.battery);
+    return b;
+  };
+  if (bridge.model().auv_propulsion() != nullptr)
+    summary["auv_battery"] =
+        battery(bridge.model().auv_propulsion(), bridge.state().auv_propulsion);
+  if (bridge.model().asv_propulsion() != nullptr)
+    summary["asv_battery"] =
+        battery(bridge.model().asv_propulsion(), bridge.state().asv_propulsion);
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';

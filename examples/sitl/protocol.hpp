@@ -92,6 +92,10 @@ struct VehicleReply {
   kelp::Vector3<double> velocity{0, 0, 0};        ///< NED [m/s]
   kelp::Quaternion<double> attitude{1, 0, 0, 0};  ///< body → NED
   double rangefinder = NAN;                       ///< rng_1 [m]; NaN: not sent
+  /// Battery terminal voltage [V] and current [A], sent as "battery": {"voltage", "current"}
+  /// (ArduPilot's JSON backend, libraries/SITL/SIM_JSON.h on master, feeds them to its simulated
+  /// battery monitor); NaN (before the first step, or no battery): not sent.
+  double battery_voltage = NAN, battery_current = NAN;
 };
 
 /// The largest reply format_reply() writes.
@@ -117,6 +121,13 @@ inline std::size_t format_reply(const VehicleReply& r, char* buf, std::size_t ca
   if (std::isfinite(r.rangefinder)) {
     const int m =
         std::snprintf(buf + n, cap - static_cast<std::size_t>(n), ",\"rng_1\":%.6g", r.rangefinder);
+    if (m <= 0 || static_cast<std::size_t>(n + m) >= cap) return 0;
+    n += m;
+  }
+  if (std::isfinite(r.battery_voltage) && std::isfinite(r.battery_current)) {
+    const int m = std::snprintf(buf + n, cap - static_cast<std::size_t>(n),
+                                ",\"battery\":{\"voltage\":%.6g,\"current\":%.6g}",
+                                r.battery_voltage, r.battery_current);
     if (m <= 0 || static_cast<std::size_t>(n + m) >= cap) return 0;
     n += m;
   }

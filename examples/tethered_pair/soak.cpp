@@ -141,6 +141,10 @@ int main(int argc, char** argv) {
   sc.duration = 3600.0 * hours;
   sc.seed = 7;
   sc.explicit_fallback = true;  // counted, must not fire
+  // The soak tests the numerics over hours, not the endurance: batteries that last (the
+  // BlueROV2's 15.6 Ah pack is empty after some 20 min of this sea's station keeping).
+  sc.auv_battery.capacity_ah = 1e4;
+  sc.asv_battery.capacity_ah = 1e4;
 
   const double dt = 0.01;
   const long window_steps = 60000;  // 10 simulated minutes

@@ -164,8 +164,25 @@ class ClosedLoop {
     if (done())
       throw kelp::error("ClosedLoop::step: the run is over (" + std::to_string(steps_) +
                         " steps of the scenario's duration)");
-    inputs_.auv.tau = auv_command_->wrench;
-    inputs_.asv.tau = asv_command_->wrench;
+    // With propulsion, the controllers' per-thruster commands drive the thrusters (lag, battery);
+    // without, their wrench is applied directly.
+    // The controllers' chains have the ESC's 1100–1900 µs mapping (their commands are the ESC's);
+    // the propulsion takes the vehicle's PWM mapping's (e.g. the BlueBoat's 1000–2000 µs).
+    const auto to_vehicle = [](const kelp::vehicle::PropulsionModeld& pm, const auto& esc,
+                               kelp::vehicle::ThrusterVector<double>& u) {
+      const auto& pp = pm.parameters();
+      u.resize(esc.size());
+      for (Eigen::Index i = 0; i < esc.size(); ++i)
+        u(i) = esc(i) > 0.0 ? esc(i) / pp.esc_scale_forward : esc(i) / pp.esc_scale_reverse;
+    };
+    if (const auto* pm = model_.auv_propulsion())
+      to_vehicle(*pm, auv_command_->command, inputs_.auv_commands);
+    else
+      inputs_.auv.tau = auv_command_->wrench;
+    if (const auto* pm = model_.asv_propulsion())
+      to_vehicle(*pm, asv_command_->command, inputs_.asv_commands);
+    else
+      inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
     solver_stats_ += report_;
     ++k_;
@@ -279,6 +296,15 @@ class ClosedLoop {
                    {"slack_fraction", m.slack_fraction()}};
     s["tether_solver"] = solver_summary(solver_stats_, model_.parameters());
     s["energy_j"] = kelp::system::energy(model_, state_).total();
+    // Propulsion: the energy each vehicle's battery delivered [Wh] and its final state of charge.
+    const auto battery = [&](const kelp::vehicle::PropulsionModeld* pm,
+                             const kelp::vehicle::PropulsionStated& x, nlohmann::json& out) {
+      if (pm == nullptr) return;
+      out["energy_wh"] = x.battery.energy_drawn / 3600.0;
+      out["final_soc"] = kelp::vehicle::state_of_charge(pm->parameters().battery, x.battery);
+    };
+    battery(model_.auv_propulsion(), state_.auv_propulsion, s["auv"]);
+    battery(model_.asv_propulsion(), state_.asv_propulsion, s["asv"]);
     // What the numbers depend on beyond the scenario: the wave kernel's instruction path and the
     // C library's math (kelp/core/kernel_path.hpp); kelp-sweep merge compares them across runs.
     s["kernel"] = kelp::simd::kernel_name(model_.environment().waves().active_kernel());
@@ -334,6 +360,20 @@ class ClosedLoop {
   // the metrics and the log.
   void observe() {
     const double t = state_.time;
+    // Propulsion: the controllers' inverse (command for a thrust) uses each battery's measured
+    // voltage (the last step's; its open-circuit voltage before the first).
+    const auto volts = [](const kelp::vehicle::PropulsionModeld& pm,
+                          const kelp::vehicle::PropulsionStated& x) {
+      return std::isfinite(x.battery.voltage)
+                 ? x.battery.voltage
+                 : kelp::vehicle::open_circuit_voltage(
+                       pm.parameters().battery,
+                       kelp::vehicle::state_of_charge(pm.parameters().battery, x.battery));
+    };
+    if (const auto* pm = model_.auv_propulsion())
+      auv_.set_voltage(volts(*pm, state_.auv_propulsion));
+    if (const auto* pm = model_.asv_propulsion())
+      asv_.set_voltage(volts(*pm, state_.asv_propulsion));
     // What the controllers see: the true state, or the sensors' estimates (the boat takes the
     // ROV's position from the ROV's estimate, which it receives over the tether).
     if (navigation_) {
@@ -364,6 +404,21 @@ class ClosedLoop {
     row.auv_command = auv_command_->command;
     row.tension_asv = ta;
     row.tension_auv = tb;
+    // Propulsion: the thrust the thrusters deliver (lagged), their current, the batteries.
+    if (const auto* pm = model_.asv_propulsion()) {
+      const auto& x = state_.asv_propulsion;
+      row.asv_thrust = x.thrust.head<2>();
+      row.asv_current = x.current.head<2>();
+      row.asv_voltage = x.battery.voltage;
+      row.asv_soc = kelp::vehicle::state_of_charge(pm->parameters().battery, x.battery);
+    }
+    if (const auto* pm = model_.auv_propulsion()) {
+      const auto& x = state_.auv_propulsion;
+      row.auv_thrust = x.thrust.head<8>();
+      row.auv_current = x.current.head<8>();
+      row.auv_voltage = x.battery.voltage;
+      row.auv_soc = kelp::vehicle::state_of_charge(pm->parameters().battery, x.battery);
+    }
     if (k_ % log_every_ == 0) {
       if (k_ > 0) {
         RunMetrics& m = metrics_;

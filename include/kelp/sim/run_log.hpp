@@ -47,6 +47,14 @@ struct LogRow {
   Eigen::Matrix<double, 8, 1> auv_command =
       Eigen::Matrix<double, 8, 1>::Constant(none);  ///< normalised
   double tension_asv = 0, tension_auv = 0;          ///< tether force on each vehicle [N]
+  /// \name Propulsion: each battery's terminal voltage [V] and state of charge, each thruster's
+  /// current [A] (NaN without a propulsion model).
+  ///@{
+  double asv_voltage = none, asv_soc = none, auv_voltage = none, auv_soc = none;
+  Eigen::Vector2d asv_current = Eigen::Vector2d::Constant(none);  ///< port, starboard [A]
+  Eigen::Matrix<double, 8, 1> auv_current =
+      Eigen::Matrix<double, 8, 1>::Constant(none);  ///< [A], motor order
+  ///@}
 };
 
 /// \brief timeseries.csv and nodes.csv of a run, in a directory (the columns are documented in
@@ -68,7 +76,11 @@ class RunLog {
     for (int i = 1; i <= 8; ++i) ts_ << ",auv_thrust_" << i;
     ts_ << ",asv_command_port,asv_command_starboard";
     for (int i = 1; i <= 8; ++i) ts_ << ",auv_command_" << i;
-    ts_ << ",tension_asv,tension_auv\n";
+    ts_ << ",tension_asv,tension_auv";
+    // Propulsion.
+    ts_ << ",asv_voltage,asv_soc,asv_current_port,asv_current_starboard,auv_voltage,auv_soc";
+    for (int i = 1; i <= 8; ++i) ts_ << ",auv_current_" << i;
+    ts_ << '\n';
     nodes_ << "t,node,x,y,z\n";
   }
 
@@ -89,7 +101,13 @@ class RunLog {
     for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_thrust(i));
     ts_ << ',' << num(r.asv_command(0)) << ',' << num(r.asv_command(1));
     for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_command(i));
-    ts_ << ',' << num(r.tension_asv) << ',' << num(r.tension_auv) << '\n';
+    ts_ << ',' << num(r.tension_asv) << ',' << num(r.tension_auv);
+    // Propulsion.
+    for (double v :
+         {r.asv_voltage, r.asv_soc, r.asv_current(0), r.asv_current(1), r.auv_voltage, r.auv_soc})
+      ts_ << ',' << num(v);
+    for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_current(i));
+    ts_ << '\n';
   }
 
   /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv (one line a node).

@@ -54,6 +54,16 @@ struct NavigationSettings {
   kelp::nav::PairSensors sensors;  ///< every sensor's parameters (defaults: kelp/nav/sensors.hpp)
 };
 
+/// \brief A vehicle's battery in a scenario (`"battery": {"auv": {...}, "asv": {...}}`; see
+/// kelp::vehicle::BatteryParameters for the meaning and units of each field).
+struct BatteryScenario {
+  double capacity_ah;          ///< rated capacity [Ah]
+  int cells_in_series;         ///< series cells
+  double internal_resistance;  ///< pack resistance [Ω]
+  double initial_soc;          ///< state of charge at the start, [0, 1]
+  double hotel_current;        ///< electronics and lights [A]
+};
+
 /// \brief One run of the tethered pair, as a scenario file describes it (every field has the
 /// embedded default run's value until a file sets it). Angles in rad, lengths in m, NED.
 struct Scenario {
@@ -116,6 +126,18 @@ struct Scenario {
   std::string kernel = "auto";
   /// Navigation: perfect or from sensors (read by detail::parse_navigation()).
   NavigationSettings navigation;
+  /// \name Propulsion: the thrusters and batteries as part of the system (`"thrusters"`,
+  /// `"battery"`): on by default (the controllers' per-thruster commands drive the T200 model
+  /// through a first-order lag of `thruster_time_constant` [s] when `thruster_lag`, drawing from
+  /// the batteries); `propulsion` false: the controllers' wrench is applied directly (the
+  /// behaviour before issue 25). Defaults: kelp::vehicle::battery_presets.
+  ///@{
+  bool propulsion = true;
+  bool thruster_lag = true;
+  double thruster_time_constant = 0.02;
+  BatteryScenario asv_battery{31.2, 4, 0.02, 1.0, 0.0};
+  BatteryScenario auv_battery{15.6, 4, 0.04, 1.0, 0.0};
+  ///@}
 };
 
 /// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
@@ -388,7 +410,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   Scenario s;
   r.object(j, "",
            {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output",
-            "kernel", "deterministic", "navigation"});
+            "kernel", "deterministic", "navigation", "thrusters", "battery"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -487,6 +509,34 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.number(o, "/output", "node_rate", s.node_rate, 0.001, 100);
   }
   if (j.contains("navigation")) detail::parse_navigation(j.at("navigation"), r, s.navigation);
+  // Propulsion (thrusters' lag, batteries).
+  if (j.contains("thrusters")) {
+    const auto& t = j.at("thrusters");
+    r.object(t, "/thrusters", {"propulsion", "lag", "time_constant"});
+    r.boolean(t, "/thrusters", "propulsion", s.propulsion);
+    r.boolean(t, "/thrusters", "lag", s.thruster_lag);
+    r.number(t, "/thrusters", "time_constant", s.thruster_time_constant, 0.0, 10.0);
+  }
+  if (j.contains("battery")) {
+    const auto& b = j.at("battery");
+    r.object(b, "/battery", {"asv", "auv"});
+    for (const char* v : {"asv", "auv"}) {
+      if (!b.contains(v)) continue;
+      const std::string path = std::string("/battery/") + v;
+      BatteryScenario& x = std::string(v) == "asv" ? s.asv_battery : s.auv_battery;
+      const auto& o = b.at(v);
+      r.object(o, path,
+               {"capacity_ah", "cells_in_series", "internal_resistance", "initial_soc",
+                "hotel_current"});
+      r.number(o, path, "capacity_ah", x.capacity_ah, 0.01, 1e5);
+      std::uint64_t cells = std::uint64_t(x.cells_in_series);
+      r.integer(o, path, "cells_in_series", cells, 1, 1000);
+      x.cells_in_series = int(cells);
+      r.number(o, path, "internal_resistance", x.internal_resistance, 0.0, 100.0);
+      r.number(o, path, "initial_soc", x.initial_soc, 0.0, 1.0);
+      r.number(o, path, "hotel_current", x.hotel_current, 0.0, 1000.0);
+    }
+  }
   r.choice(j, "", "kernel", s.kernel, {"auto", "portable", "avx2", "avx512"});
   bool deterministic = false;
   r.boolean(j, "", "deterministic", deterministic);
@@ -565,6 +615,18 @@ inline nlohmann::json to_json(const Scenario& s) {
   // Navigation: likewise only when it differs from the default (perfect navigation).
   const nlohmann::json nav = detail::navigation_json(s.navigation);
   if (nav != detail::navigation_json(NavigationSettings{})) j["navigation"] = nav;
+  // Propulsion (thrusters' lag, batteries).
+  j["thrusters"] = {{"propulsion", s.propulsion},
+                    {"lag", s.thruster_lag},
+                    {"time_constant", s.thruster_time_constant}};
+  const auto battery = [](const BatteryScenario& b) {
+    return nlohmann::json{{"capacity_ah", b.capacity_ah},
+                          {"cells_in_series", b.cells_in_series},
+                          {"internal_resistance", b.internal_resistance},
+                          {"initial_soc", b.initial_soc},
+                          {"hotel_current", b.hotel_current}};
+  };
+  j["battery"] = {{"asv", battery(s.asv_battery)}, {"auv", battery(s.auv_battery)}};
   return j;
 }
 

@@ -53,6 +53,23 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (sc.line_model == "moordyn") tp.line_model = kelp::tether::LineModel::moordyn;
   params.asv_attachment = sc.asv_attachment;
   params.auv_attachment = sc.auv_attachment;
+  // Propulsion: the paper preset's (thrusters, batteries) with the scenario's lag and batteries,
+  // or none.
+  if (!sc.propulsion) {
+    params.asv_propulsion.reset();
+    params.auv_propulsion.reset();
+  } else {
+    const auto apply = [&](kelp::vehicle::PropulsionParametersd& p, const BatteryScenario& b) {
+      p.time_constant = sc.thruster_lag ? sc.thruster_time_constant : 0.0;
+      p.battery.capacity_ah = b.capacity_ah;
+      p.battery.cells_in_series = b.cells_in_series;
+      p.battery.internal_resistance = b.internal_resistance;
+      p.battery.initial_soc = b.initial_soc;
+      p.battery.hotel_current = b.hotel_current;
+    };
+    apply(*params.asv_propulsion, sc.asv_battery);
+    apply(*params.auv_propulsion, sc.auv_battery);
+  }
   ke::SeaStateOptions sea_options;
   sea_options.seed = sc.seed;
   sea_options.wave_components = sc.wave_components;

@@ -13,6 +13,11 @@
 ///   (−0.2, 0, −0.05) m from the CO (frame length 457 mm; Blue Robotics BlueROV2 technical
 ///   details).
 ///
+/// Propulsion: both vehicles' thrusters and batteries are part of the system
+/// (SystemParameters::asv_propulsion / auv_propulsion: T200 thrust lag of
+/// vehicle::t200_time_constant, the Blue Robotics battery presets of vehicle/battery.hpp); set
+/// them to std::nullopt for the earlier behaviour, where `inputs.tau` is the whole control wrench.
+///
 /// Tether discretisation: 0.5 m segments, the spacing of the paper's Gazebo beads (20 segments
 /// for 10 m). Against 0.25 m segments, the static shape of the default configuration moves by
 /// 2 cm (the nearly neutral line hangs under forces of a few centinewtons) and the end tensions
@@ -27,7 +32,9 @@
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/tether/presets.hpp"
+#include "kelp/vehicle/battery.hpp"
 #include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/propulsion.hpp"
 
 namespace kelp::system::presets {
 
@@ -73,19 +80,48 @@ Vector3<Scalar> bluerov2_attachment() {
   return Vector3<Scalar>(Scalar(-0.2), Scalar(0), Scalar(-0.05));
 }
 
+/// \brief The propulsion of a vehicle preset: its thrusters (positions, directions, facing; the
+/// ESC command scale of its PWM mapping) on `battery`, with the T200 lag of `time_constant` [s]
+/// (0: none).
+template <typename Scalar>
+vehicle::PropulsionParameters<Scalar> propulsion_of(
+    const vehicle::VehiclePreset<Scalar>& preset, const vehicle::BatteryParameters& battery,
+    double time_constant = vehicle::t200_time_constant) {
+  vehicle::PropulsionParameters<Scalar> p;
+  p.positions = preset.thruster_positions;
+  p.directions = preset.thruster_directions;
+  p.time_constant = time_constant;
+  p.battery = battery;
+  const Eigen::Index n = preset.thruster_positions.cols();
+  p.facing = vehicle::ThrusterVector<int>::Ones(n);
+  for (Eigen::Index i = 0; i < preset.thruster_facing.size() && i < n; ++i)
+    p.facing(i) = preset.thruster_facing(i) < 0 ? -1 : 1;
+  p.esc_scale_forward =
+      double(value_of(preset.pwm.max_us - preset.pwm.neutral_us)) / vehicle::t200_esc_half_range_us;
+  p.esc_scale_reverse =
+      double(value_of(preset.pwm.neutral_us - preset.pwm.min_us)) / vehicle::t200_esc_half_range_us;
+  return p;
+}
+
 /// \brief The paper's system: BlueBoat (ASV), BlueROV2 Heavy (AUV) and a tether of
 /// `tether_length` [m] (the paper evaluates 5, 10 and 15 m), in seawater; BDF2 tether steps of at
 /// most 10 ms with the library's Newton settings (tether::ImplicitOptions' defaults) and no
 /// explicit fallback (SystemParameters' default): a step Newton's method cannot converge, even
-/// split in halves, throws with the state unchanged.
+/// split in halves, throws with the state unchanged. Both vehicles have their propulsion (see the
+/// file comment): T200s with a 20 ms lag on the BlueBoat's two packs in parallel and the
+/// BlueROV2's one (vehicle::battery_presets).
 /// \throws kelp::invalid_argument for a non-positive length.
 template <typename Scalar>
 SystemParameters<Scalar> paper_system(Scalar tether_length = Scalar(10),
                                       TetherKind kind = TetherKind::rov_tether) {
   check_positive(tether_length, "tether_length");
   SystemParameters<Scalar> p;
-  p.asv = vehicle::blueboat<Scalar>().parameters;
-  p.auv = vehicle::bluerov2_heavy<Scalar>().parameters;
+  const vehicle::VehiclePreset<Scalar> boat = vehicle::blueboat<Scalar>();
+  const vehicle::VehiclePreset<Scalar> rov = vehicle::bluerov2_heavy<Scalar>();
+  p.asv = boat.parameters;
+  p.auv = rov.parameters;
+  p.asv_propulsion = propulsion_of(boat, vehicle::battery_presets::blueboat_battery());
+  p.auv_propulsion = propulsion_of(rov, vehicle::battery_presets::bluerov2_battery());
   p.asv_attachment = blueboat_attachment<Scalar>();
   p.auv_attachment = bluerov2_attachment<Scalar>();
   switch (kind) {

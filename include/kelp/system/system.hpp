@@ -42,9 +42,18 @@
 /// does not. With the line's drag and internal damping on, it also dissipates physically (how
 /// the two compare was not measured). A step that cannot be completed throws with every part of
 /// the state as it was.
+///
+/// **Propulsion (optional, per vehicle).** With `SystemParameters::asv_propulsion` /
+/// `auv_propulsion` set, a vehicle's thrusters are part of the system: each step advances them
+/// first under the inputs' per-thruster commands (vehicle::advance in vehicle/propulsion.hpp:
+/// the battery's terminal voltage solved for the step, each thrust's first-order lag integrated
+/// exactly) and adds the wrench of their mean thrust over the step, B f̄, to the vehicle's τ; the
+/// thrusters' and battery's state is part of SystemState. Without it (the default), `inputs.tau`
+/// is the whole control wrench, as before.
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -58,6 +67,7 @@
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
+#include "kelp/vehicle/propulsion.hpp"
 #include "kelp/vehicle/state.hpp"
 #include "kelp/vehicle/surroundings.hpp"
 #include "kelp/vehicle/water.hpp"
@@ -98,6 +108,12 @@ struct SystemParameters {
   /// chosen scheme's. false (the default): throw kelp::numerical_error with the state unchanged,
   /// as the tether step does, so that a run's results never silently depend on it.
   bool explicit_fallback = false;
+  /// The ASV's thrusters and battery (lag, current, voltage sag), driven by
+  /// SystemInputs::asv_commands; empty (the default): no propulsion model, `inputs.asv.tau` is
+  /// the control wrench.
+  std::optional<vehicle::PropulsionParameters<Scalar>> asv_propulsion;
+  /// The AUV's thrusters and battery; see asv_propulsion.
+  std::optional<vehicle::PropulsionParameters<Scalar>> auv_propulsion;
 };
 
 /// \brief Checks system parameters (the parts' own checks, kinematic tether ends, attachment
@@ -117,6 +133,8 @@ void validate(const SystemParameters<Scalar>& p) {
   check_positive(p.max_tether_dt, "max_tether_dt");
   KELP_CHECK(p.coupling_corrections >= 0 && p.coupling_corrections <= 16,
              "coupling_corrections must be in [0, 16]");
+  if (p.asv_propulsion) vehicle::validate(*p.asv_propulsion);
+  if (p.auv_propulsion) vehicle::validate(*p.auv_propulsion);
 }
 
 /// \brief A system built once from SystemParameters and an environment (copied; it is the one
@@ -134,6 +152,8 @@ class SystemModel {
         tether_(p.tether) {
     vehicle::check_same_water(asv_, environment_, "asv");
     vehicle::check_same_water(auv_, environment_, "auv");
+    if (p.asv_propulsion) asv_propulsion_.emplace(*p.asv_propulsion);
+    if (p.auv_propulsion) auv_propulsion_.emplace(*p.auv_propulsion);
   }
   const SystemParameters<Scalar>& parameters() const { return parameters_; }
   const environment::Environment<Scalar>& environment() const { return environment_; }
@@ -157,12 +177,21 @@ class SystemModel {
   const vehicle::VehicleModel<Scalar>& asv() const { return asv_; }
   const vehicle::VehicleModel<Scalar>& auv() const { return auv_; }
   const tether::TetherModel<Scalar>& tether() const { return tether_; }
+  /// \brief The ASV's propulsion, or null when the system has none for it.
+  const vehicle::PropulsionModel<Scalar>* asv_propulsion() const {
+    return asv_propulsion_ ? &*asv_propulsion_ : nullptr;
+  }
+  /// \brief The AUV's propulsion, or null when the system has none for it.
+  const vehicle::PropulsionModel<Scalar>* auv_propulsion() const {
+    return auv_propulsion_ ? &*auv_propulsion_ : nullptr;
+  }
 
  private:
   SystemParameters<Scalar> parameters_;
   environment::Environment<Scalar> environment_;
   vehicle::VehicleModel<Scalar> asv_, auv_;
   tether::TetherModel<Scalar> tether_;
+  std::optional<vehicle::PropulsionModel<Scalar>> asv_propulsion_, auv_propulsion_;
 };
 
 /// \brief Everything that determines the system's next step.
@@ -183,6 +212,10 @@ struct SystemState {
   /// Last accelerations ν̇ of the vehicles (body axes): the predictor of the attachment motion.
   Vector6<Scalar> asv_nu_dot = Vector6<Scalar>::Zero();
   Vector6<Scalar> auv_nu_dot = Vector6<Scalar>::Zero();  ///< see asv_nu_dot
+  /// The ASV's thrusters (lagged thrust) and battery (charge and energy drawn); empty when the
+  /// system has no propulsion for it.
+  vehicle::PropulsionState<Scalar> asv_propulsion;
+  vehicle::PropulsionState<Scalar> auv_propulsion;  ///< the AUV's; see asv_propulsion
   /// \brief Sets the clock of the system and of its parts to `t` [s] (e.g. to start a run at
   /// another time than 0).
   void set_time(double t) {
@@ -201,11 +234,17 @@ struct SystemState {
 };
 
 /// \brief The inputs of one system step: each vehicle's τ (control) and τ_ext (any other external
-/// wrench; the tether's is added by the step), body axes [N, N m].
+/// wrench; the tether's is added by the step), body axes [N, N m], and, for a vehicle with
+/// propulsion, its thrusters' normalised commands (held over the step; the thrust's wrench is
+/// added to τ).
 template <typename Scalar>
 struct SystemInputs {
   vehicle::VehicleInputs<Scalar> asv;  ///< the ASV's wrenches
   vehicle::VehicleInputs<Scalar> auv;  ///< the AUV's wrenches
+  /// The ASV's thruster commands u ∈ [−1, 1] (clamped), one per thruster in the propulsion's
+  /// order; empty: all 0. Must be empty when the ASV has no propulsion.
+  vehicle::ThrusterVector<Scalar> asv_commands;
+  vehicle::ThrusterVector<Scalar> auv_commands;  ///< the AUV's; see asv_commands
 };
 
 /// \brief The options of one system step.
@@ -256,6 +295,10 @@ struct SystemReport {
   /// Tether steps redone explicitly after the implicit scheme failed
   /// (SystemParameters::explicit_fallback).
   int tether_fallbacks = 0;
+  /// The ASV's propulsion over the step: the thrust's wrench, the battery's voltage and current
+  /// (zero without propulsion).
+  vehicle::PropulsionStep<Scalar> asv_propulsion;
+  vehicle::PropulsionStep<Scalar> auv_propulsion;  ///< the AUV's; see asv_propulsion
 };
 
 /// \brief Preallocated buffers of a system step.
@@ -392,6 +435,29 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   vehicle::detail::check_state(state.auv);
   check_all_finite(state.asv_nu_dot, "state.asv_nu_dot");
   check_all_finite(state.auv_nu_dot, "state.auv_nu_dot");
+  // Propulsion first, on copies committed with the rest (no heap: fixed-capacity vectors).
+  vehicle::VehicleInputs<Scalar> asv_in = inputs.asv, auv_in = inputs.auv;
+  vehicle::PropulsionState<Scalar> asv_prop = state.asv_propulsion;
+  vehicle::PropulsionState<Scalar> auv_prop = state.auv_propulsion;
+  SystemReport<Scalar> report;
+  const auto propel = [dt](const vehicle::PropulsionModel<Scalar>* m,
+                           vehicle::PropulsionState<Scalar>& x,
+                           const vehicle::ThrusterVector<Scalar>& u,
+                           vehicle::VehicleInputs<Scalar>& in, vehicle::PropulsionStep<Scalar>& r,
+                           const char* which) {
+    if (m == nullptr) {
+      KELP_CHECK(u.size() == 0, std::string("inputs.") + which +
+                                    "_commands: the system has no propulsion for the " + which);
+      return;
+    }
+    vehicle::check_state(*m, x, which[1] == 's' ? "state.asv_propulsion" : "state.auv_propulsion");
+    r = vehicle::advance(*m, x, u, dt);
+    in.tau += r.wrench;
+  };
+  propel(model.asv_propulsion(), asv_prop, inputs.asv_commands, asv_in, report.asv_propulsion,
+         "asv");
+  propel(model.auv_propulsion(), auv_prop, inputs.auv_commands, auv_in, report.auv_propulsion,
+         "auv");
   const SystemParameters<Scalar>& p = model.parameters();
   const auto& env = model.environment();
   const double t = state.time;
@@ -402,7 +468,6 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   // Everything a failure must restore.
   const detail::CouplingSnapshot<Scalar> before(state);
   ws.tether_backup.save(state.tether);
-  SystemReport<Scalar> report;
   try {
     tether::TetherBoundary<Scalar> ends;
     ends.start = detail::predicted_end(state.asv, state.asv_nu_dot, p.asv_attachment);
@@ -426,10 +491,10 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
       // The impulse the tether's integrator delivered to its ends, as a mean force.
       report.force_on_asv = ws.tether.end_impulse.on_start / Scalar(dt);
       report.force_on_auv = ws.tether.end_impulse.on_end / Scalar(dt);
-      state.asv_nu_dot = detail::step_vehicle(model.asv(), ws.asv, state.asv, env, t, dt,
-                                              inputs.asv, p.asv_attachment, report.force_on_asv);
-      state.auv_nu_dot = detail::step_vehicle(model.auv(), ws.auv, state.auv, env, t, dt,
-                                              inputs.auv, p.auv_attachment, report.force_on_auv);
+      state.asv_nu_dot = detail::step_vehicle(model.asv(), ws.asv, state.asv, env, t, dt, asv_in,
+                                              p.asv_attachment, report.force_on_asv);
+      state.auv_nu_dot = detail::step_vehicle(model.auv(), ws.auv, state.auv, env, t, dt, auv_in,
+                                              p.auv_attachment, report.force_on_auv);
       if (pass >= p.coupling_corrections) break;
       // Corrector: the end paths that start as before and reach the actual attachment points.
       const Scalar h(dt);
@@ -451,6 +516,8 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   state.time = state.tether.time;
   state.asv.time = state.time;
   state.auv.time = state.time;
+  state.asv_propulsion = asv_prop;
+  state.auv_propulsion = auv_prop;
   if (options.with_energy) report.energy = energy(model, state);
   return report;
 }
@@ -490,6 +557,8 @@ SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorksp
     ::kelp::detail::throw_numerical_error(
         "system::initial_state: the tether's static shape did not converge (residual " +
         std::to_string(double(value_of(r.residual))) + " N)");
+  if (model.asv_propulsion()) s.asv_propulsion = vehicle::initial_state(*model.asv_propulsion());
+  if (model.auv_propulsion()) s.auv_propulsion = vehicle::initial_state(*model.auv_propulsion());
   s.set_time(t);
   return s;
 }

@@ -209,3 +209,51 @@ TEST_CASE("lockstep: one clock for both, start with the first when asked, missed
     CHECK(f.bridge.counters(rover).repeats == 1);
   }
 }
+
+TEST_CASE(
+    "battery: the PWM drives the thrusters' propulsion and SITL is sent the battery's "
+    "voltage and current",
+    "[sitl][propulsion]") {
+  // The format: "battery": {"voltage", "current"} (ArduPilot SIM_JSON's keytable), only when
+  // known.
+  VehicleReply r;
+  char buf[max_reply_size];
+  CHECK(std::string(buf, format_reply(r, buf, sizeof buf)).find("battery") == std::string::npos);
+  r.battery_voltage = 15.25;
+  r.battery_current = 12.5;
+  const std::string s(buf, format_reply(r, buf, sizeof buf));
+  CHECK(s.find(",\"battery\":{\"voltage\":15.25,\"current\":12.5}}\n") != std::string::npos);
+
+  Fixture f(true);
+  REQUIRE(f.model.auv_propulsion() != nullptr);
+  Outbox out;
+  std::uint32_t frame = 0;
+  const auto both = [&](const std::vector<std::uint16_t>& sub_pwm) {
+    f.send(sub, frame, sub_pwm, 0, out);
+    f.send(rover, frame, {1700, 1500, 1700, 1500}, 0, out);
+    ++frame;
+  };
+  // Idle: no current but the (zero) hotel load, the open-circuit voltage.
+  both({1500, 1500, 1500, 1500, 1500, 1500, 1500, 1500});
+  REQUIRE(out.count == 2);
+  const double ocv =
+      kelp::vehicle::open_circuit_voltage(f.model.auv_propulsion()->parameters().battery, 1.0);
+  nlohmann::json sub_reply = reply_json(out.items[0].slot == sub ? out.items[0] : out.items[1]);
+  CHECK(sub_reply.at("battery").at("voltage").get<double>() == Approx(ocv).epsilon(1e-6));
+  CHECK(sub_reply.at("battery").at("current").get<double>() == 0.0);
+  // Full down on the vertical thrusters for 0.5 s: current drawn, the voltage sags, the thrust
+  // builds up through the lag to the static thrust at that voltage.
+  for (int k = 0; k < 600; ++k) both({1500, 1500, 1500, 1500, 1900, 1900, 1900, 1900});
+  sub_reply = reply_json(out.items[0].slot == sub ? out.items[0] : out.items[1]);
+  const double v = sub_reply.at("battery").at("voltage").get<double>();
+  const double i = sub_reply.at("battery").at("current").get<double>();
+  CHECK(i == Approx(4.0 * kelp::vehicle::t200_current(1.0, v)).epsilon(1e-4));
+  CHECK(i > 20.0);
+  CHECK(v < ocv - 0.5);
+  CHECK(f.bridge.state().auv_propulsion.thrust(4) ==
+        Approx(kelp::vehicle::t200_thrust(1.0, v)).epsilon(1e-3));
+  CHECK(f.bridge.state().auv_propulsion.battery.charge_drawn > 0.5 * i * 0.4);
+  // The boat's battery too.
+  const nlohmann::json boat = reply_json(out.items[0].slot == rover ? out.items[0] : out.items[1]);
+  CHECK(boat.at("battery").at("current").get<double>() > 1.0);
+}
