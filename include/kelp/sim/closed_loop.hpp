@@ -100,7 +100,8 @@ struct ClosedLoopOptions {
 
 /// \brief The tethered pair of a scenario flown by kelp's controllers, one step at a time.
 ///
-/// Built from a scenario: the world (world_setup()), the system at its initial state, the AUV's
+/// Built from a scenario: the world (world_setup()), the system at its start state (start_state():
+/// the sea ramped in, the vehicles and tether moving with the water), the AUV's
 /// controller following the scenario's waypoints (by default a square at the mission depth from
 /// the start) and the ASV's controller following the AUV. Every step (dt = 10 ms): the controllers'
 /// commands (computed from the current state) drive the system through `system::step`; then the
@@ -127,7 +128,7 @@ class ClosedLoop {
         options_(options),
         model_(world.parameters, world.environment),
         workspace_(model_),
-        state_(kelp::system::initial_state(model_, workspace_, world.start.asv, world.start.auv)),
+        state_(start_state(model_, workspace_, world, sc)),
         rov_thrusters_(rov_allocation()),
         boat_thrusters_(boat_allocation()),
         auv_(model_.auv(), rov_thrusters_, auv_settings(sc)),

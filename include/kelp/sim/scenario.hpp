@@ -81,6 +81,15 @@ struct Scenario {
   kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
   std::vector<double> auv_start;
   ///@}
+  /// \name Start (`"start": {"ramp": 10, "with_water": true}`): the sea (waves, current, wind)
+  /// is ramped in over the first `start_ramp` seconds (environment::Environment::set_ramp; 0:
+  /// the full sea at once), and with `start_with_water` the vehicles and the tether's nodes start
+  /// moving with the water at their positions (current + wave orbital velocity at t = 0; zero
+  /// while the ramp holds the sea at rest) instead of at rest in moving water.
+  ///@{
+  double start_ramp = 10.0;
+  bool start_with_water = true;
+  ///@}
   /// \name Control: the paper's disturbance compensation, the PID gains, the ASV's thrust clip
   /// [N] and the controllers' rates [Hz].
   ///@{
@@ -247,8 +256,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   Scenario s;
   r.object(j, "",
-           {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output",
-            "kernel", "deterministic"});
+           {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission",
+            "output", "kernel", "deterministic"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -303,6 +312,12 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
       const kelp::Vector3<double> p = r.vec3(v.at("auv_start"), "/vehicles/auv_start");
       s.auv_start = {p(0), p(1), p(2)};
     }
+  }
+  if (j.contains("start")) {
+    const auto& st = j.at("start");
+    r.object(st, "/start", {"ramp", "with_water"});
+    r.number(st, "/start", "ramp", s.start_ramp, 0, 1e5);
+    r.boolean(st, "/start", "with_water", s.start_with_water);
   }
   if (j.contains("control")) {
     const auto& c = j.at("control");
@@ -401,6 +416,7 @@ inline nlohmann::json to_json(const Scenario& s) {
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;
+  j["start"] = {{"ramp", s.start_ramp}, {"with_water", s.start_with_water}};
   j["control"] = {{"compensation", s.compensation},
                   {"asv",
                    {{"linear", g(s.asv_linear)},
