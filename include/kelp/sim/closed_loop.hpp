@@ -277,6 +277,13 @@ class ClosedLoop {
     set_gains(s.sway, sc.auv_sway);
     set_gains(s.heave, sc.auv_heave);
     set_gains(s.yaw, sc.auv_yaw);
+    if (sc.control_preset == "kelp") {
+      // Track the survey's legs (a reference moving at leg_speed, at most 1 m ahead), with the
+      // horizontal and vertical thrust saturated apart.
+      s.follow_legs = true;
+      s.max_horizontal_error = 1.0;
+      s.split_saturation = true;
+    }
     return s;
   }
   static kelp::control::AsvControllerSettings asv_settings(const Scenario& sc) {
@@ -284,6 +291,7 @@ class ClosedLoop {
     s.compensate = sc.compensation;
     s.period = 1.0 / sc.asv_rate;
     s.thrust_clip = sc.asv_thrust_clip;
+    if (sc.control_preset == "kelp") s.law = kelp::control::AsvLaw::track;
     const auto set = [&](kelp::control::PidGains& g, const Gains& x) {
       set_gains(g, x);
       g.output_limit = sc.asv_thrust_clip;
