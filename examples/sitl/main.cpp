@@ -21,6 +21,7 @@
 #include <string>
 
 #include "bridge.hpp"
+#include "default_world.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
@@ -34,16 +35,8 @@ namespace {
 std::atomic<bool> stop_requested{false};
 void on_signal(int) { stop_requested = true; }
 
-// The embedded default: kelp-tethered-pair's (the paper's moderate sea, a 10 m tether), but the
-// ROV starts at the surface 4 m astern of the boat, so that ArduSub has a dive to fly.
-kelp::sim::Scenario default_scenario() {
-  kelp::sim::Scenario s;
-  s.auv_start = {-4.0, 0.0, 0.3};
-  return s;
-}
-
 struct Options {
-  kelp::sim::Scenario scenario = default_scenario();
+  kelp::sim::Scenario scenario = kelp_sitl::default_scenario();
   std::string scenario_file = "(embedded default)";
   std::string bind = "127.0.0.1";
   int sub_port = 9002, rover_port = 9012;
@@ -132,8 +125,7 @@ int run(const Options& o) {
   ks::SystemWorkspaced ws(model);
   kelp_sitl::BridgeSettings settings = o.bridge;
   settings.start_together = o.start == "both";
-  kelp_sitl::Bridge bridge(model, ws,
-                           ks::initial_state(model, ws, setup.start.asv, setup.start.auv),
+  kelp_sitl::Bridge bridge(model, ws, kelp::sim::start_state(model, ws, setup, o.scenario),
                            setup.start, settings);
 
   UdpSocket sub(o.bind, o.sub_port), rover(o.bind, o.rover_port);

@@ -70,9 +70,11 @@ TEST_CASE("the closed loop samples at the log rate and flies the survey", "[sim]
   CHECK(loop.metrics().samples == 25);
   CHECK(loop.sample().t == loop.time());
   CHECK(std::abs(loop.time() - 5.0) < 1e-9);
-  // The default survey's first corner is 10 m ahead of the ROV's start; it heads there.
+  // The default survey's first corner is a side of the square (8 m) ahead of the ROV's start; it
+  // heads there.
   const double d1 = (loop.state().auv.position - loop.waypoints().front()).norm();
-  CHECK(d0 == Approx(10.0).margin(0.01));
+  CHECK(d0 == Approx(sc.square_side).margin(0.01));
+  CHECK(sc.square_side == 8.0);
   CHECK(d1 < d0 - 1.0);
   CHECK(loop.metrics().max_tension > 0.0);
   CHECK(std::isfinite(loop.summary()["energy_j"].get<double>()));

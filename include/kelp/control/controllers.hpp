@@ -145,7 +145,21 @@ struct AuvControllerSettings {
   /// Largest horizontal error fed to the PIDs [m]: a far waypoint is approached at a steady
   /// pace instead of with the full error (a carrot on the line to it).
   double max_horizontal_error = 2.0;
-  double acceptance_radius = 0.5;       ///< a waypoint is reached within this distance [m]
+  double acceptance_radius = 0.5;  ///< a waypoint is reached within this distance [m]
+  /// Follow the legs between waypoints, not just head for the next one: the position target is
+  /// a reference point that moves along the leg at `leg_speed` (from the vehicle's projection on
+  /// the leg when the leg begins; the first leg starts where the vehicle was at its first update
+  /// after follow()), never more than `max_horizontal_error` ahead of the vehicle's projection.
+  /// The PIDs then track a trajectory: a cross-track error (the current's set) is fed back in
+  /// full instead of as a fraction of a capped error towards the waypoint, the integrals learn
+  /// what the current costs along and across the leg, the reference's velocity is fed to the
+  /// derivative terms, and the vehicle faces along the leg. Off: the waypoint itself, capped.
+  bool follow_legs = false;
+  double leg_speed = 0.5;  ///< speed of the reference along a leg (follow_legs) [m/s]
+  /// Saturation: allocate and scale the horizontal (X, Y, N) and vertical (Z, K, M) demands
+  /// apart (then the sum uniformly if needed) instead of scaling the whole wrench uniformly, so
+  /// that heave saturation does not slow the vehicle down.
+  bool split_saturation = false;
   bool compensate = false;              ///< feed the estimated disturbance forward
   double observer_time_constant = 1.0;  ///< [s]
 };
@@ -186,6 +200,7 @@ class AuvController {
     command_.thrust = Eigen::VectorXd::Zero(thrusters.size());
     command_.command = Eigen::VectorXd::Zero(thrusters.size());
     force_ = Eigen::VectorXd::Zero(thrusters.size());
+    vertical_ = Eigen::VectorXd::Zero(thrusters.size());
   }
 
   /// \brief Hold this NED position and heading [rad].
@@ -204,6 +219,8 @@ class AuvController {
     waypoints_ = waypoints;
     next_ = 0;
     target_ = waypoints_.front();
+    has_leg_start_ = false;
+    leg_ = static_cast<std::size_t>(-1);
   }
   /// \brief Index of the waypoint being flown to (== count when all are reached).
   std::size_t next_waypoint() const { return waypoints_.empty() ? 0 : next_; }
@@ -217,52 +234,122 @@ class AuvController {
     if (!clock_.due(t, settings_.period, dt)) return command_;
     if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
     // Waypoints: advance when within the acceptance radius; face the direction of travel.
+    Vector3<double> aim = target_;                           // where the PIDs steer to
+    Vector3<double> aim_velocity = Vector3<double>::Zero();  // its velocity, NED
+    bool held = false;  // the reference waits for the vehicle (max_horizontal_error ahead)
     if (!waypoints_.empty()) {
+      if (!has_leg_start_) {
+        leg_start_ = nav.position;
+        has_leg_start_ = true;
+      }
       while (next_ < waypoints_.size() &&
              (waypoints_[next_] - nav.position).norm() < settings_.acceptance_radius)
         ++next_;
       target_ = waypoints_[std::min(next_, waypoints_.size() - 1)];
+      aim = target_;
       const Vector3<double> d = target_ - nav.position;
-      if (d.head<2>().norm() > 2.0 * settings_.acceptance_radius)
+      const Vector3<double> a =
+          next_ == 0 ? leg_start_ : waypoints_[std::min(next_, waypoints_.size()) - 1];
+      const Vector3<double> leg = target_ - a;
+      const double length = leg.norm();
+      if (settings_.follow_legs && next_ < waypoints_.size() &&
+          length > settings_.acceptance_radius) {
+        const Vector3<double> u = leg / length;
+        const double along = std::clamp((nav.position - a).dot(u), 0.0, length);
+        if (leg_ != next_) {  // a new leg: the reference starts level with the vehicle
+          leg_ = next_;
+          progress_ = along;
+        }
+        const double ahead = along + settings_.max_horizontal_error;
+        const double wanted = progress_ + settings_.leg_speed * dt;
+        held = wanted > ahead;
+        progress_ = std::min({wanted, ahead, length});
+        progress_ = std::max(progress_, 0.0);
+        aim = a + progress_ * u;
+        if (!held && progress_ < length) aim_velocity = settings_.leg_speed * u;
+        if (leg.head<2>().norm() > 2.0 * settings_.acceptance_radius)
+          heading_ = std::atan2(leg.y(), leg.x());
+      } else if (d.head<2>().norm() > 2.0 * settings_.acceptance_radius) {
         heading_ = std::atan2(d.y(), d.x());
+      }
     }
     const double psi = heading_of(nav.attitude);
-    Vector3<double> e = target_ - nav.position;
-    command_.position_error = e;
+    Vector3<double> e = aim - nav.position;
+    command_.position_error = target_ - nav.position;
     const double h = e.head<2>().norm();
-    if (h > settings_.max_horizontal_error) e.head<2>() *= settings_.max_horizontal_error / h;
+    // Capped (a far waypoint); following legs, the reference is already near, and its
+    // cross-track part is kept whole up to twice the cap.
+    const double cap = (settings_.follow_legs ? 2.0 : 1.0) * settings_.max_horizontal_error;
+    if (h > cap) e.head<2>() *= cap / h;
     // Error in the heading frame (yaw only); its rate is minus the body velocity (level flight).
     const double c = std::cos(psi), s = std::sin(psi);
     const Vector3<double> eb(c * e.x() + s * e.y(), -s * e.x() + c * e.y(), e.z());
+    const Vector3<double> vb(c * aim_velocity.x() + s * aim_velocity.y(),
+                             -s * aim_velocity.x() + c * aim_velocity.y(), aim_velocity.z());
     const Vector3<double> rpy = euler_from_quaternion(nav.attitude);
     const double e_psi = wrap_angle(heading_ - psi);
     command_.heading_error = e_psi;
     const double i_saved[4] = {surge_.integral(), sway_.integral(), heave_.integral(),
                                yaw_.integral()};
     Vector6<double> tau;
-    tau << surge_.update(eb.x(), dt, -nav.nu(0)), sway_.update(eb.y(), dt, -nav.nu(1)),
-        heave_.update(eb.z(), dt, -nav.nu(2)), roll_.update(-rpy(0), dt, -nav.nu(3)),
-        pitch_.update(-rpy(1), dt, -nav.nu(4)), yaw_.update(e_psi, dt, -nav.nu(5));
+    tau << surge_.update(eb.x(), dt, vb.x() - nav.nu(0)),
+        sway_.update(eb.y(), dt, vb.y() - nav.nu(1)), heave_.update(eb.z(), dt, vb.z() - nav.nu(2)),
+        roll_.update(-rpy(0), dt, -nav.nu(3)), pitch_.update(-rpy(1), dt, -nav.nu(4)),
+        yaw_.update(e_psi, dt, -nav.nu(5));
     if (settings_.compensate) tau -= observer_.estimate();
-    // Allocation, then uniform scaling so that no thruster exceeds its limit that way: the
-    // thruster's largest forward or reverse thrust at the supply voltage, capped at max_thrust.
-    thrusters_.allocation().distribute(tau, force_);
-    double scale = 1.0;
-    for (Eigen::Index i = 0; i < force_.size(); ++i) {
-      const double f = force_(i);
-      const double limit =
-          std::min(settings_.max_thrust, f >= 0.0 ? thrusters_.max_positive_thrust(i)
-                                                  : thrusters_.max_negative_thrust(i));
-      if (std::abs(f) * scale > limit) scale = limit / std::abs(f);
-    }
-    command_.saturated = scale < 1.0;
-    if (command_.saturated) {
-      force_ *= scale;
-      // Anti-windup: the allocation could not deliver: keep the integrals where they were.
-      surge_.set_integral(i_saved[0]);
-      sway_.set_integral(i_saved[1]);
-      heave_.set_integral(i_saved[2]);
-      yaw_.set_integral(i_saved[3]);
+    // Thruster i's limit for a force f: its largest forward or reverse thrust at the supply
+    // voltage, capped at max_thrust; fit(f) is the largest factor ≤ 1 that keeps every thruster
+    // of f within its limit.
+    const auto limit = [this](Eigen::Index i, double f) {
+      return std::min(settings_.max_thrust, f >= 0.0 ? thrusters_.max_positive_thrust(i)
+                                                     : thrusters_.max_negative_thrust(i));
+    };
+    const auto fit = [&limit](const Eigen::VectorXd& f) {
+      double scale = 1.0;
+      for (Eigen::Index i = 0; i < f.size(); ++i) {
+        const double l = limit(i, f(i));
+        if (std::abs(f(i)) * scale > l) scale = l / std::abs(f(i));
+      }
+      return scale;
+    };
+    if (settings_.split_saturation) {
+      // The horizontal (X, Y, N) and vertical (Z, K, M) parts allocated and scaled apart: a
+      // depth correction that saturates the vertical thrusters does not shrink the horizontal
+      // thrust (on a vehicle whose thrusters split so, e.g. the BlueROV2 Heavy, the groups are
+      // independent), then a final uniform scaling if the sum still exceeds a limit.
+      Vector6<double> part = tau;
+      part(2) = part(3) = part(4) = 0.0;
+      thrusters_.allocation().distribute(part, force_);
+      const double sh = fit(force_);
+      force_ *= sh;
+      part = tau - part;
+      thrusters_.allocation().distribute(part, vertical_);
+      const double sv = fit(vertical_);
+      vertical_ *= sv;
+      force_ += vertical_;
+      const double s = fit(force_);
+      force_ *= s;
+      command_.saturated = sh < 1.0 || sv < 1.0 || s < 1.0;
+      // Anti-windup per group: what a group could not deliver is not integrated.
+      if (sh < 1.0 || s < 1.0) {
+        surge_.set_integral(i_saved[0]);
+        sway_.set_integral(i_saved[1]);
+        yaw_.set_integral(i_saved[3]);
+      }
+      if (sv < 1.0 || s < 1.0) heave_.set_integral(i_saved[2]);
+    } else {
+      // Allocation, then uniform scaling so that no thruster exceeds its limit.
+      thrusters_.allocation().distribute(tau, force_);
+      const double s = fit(force_);
+      command_.saturated = s < 1.0;
+      if (command_.saturated) {
+        force_ *= s;
+        // Anti-windup: the allocation could not deliver: keep the integrals where they were.
+        surge_.set_integral(i_saved[0]);
+        sway_.set_integral(i_saved[1]);
+        heave_.set_integral(i_saved[2]);
+        yaw_.set_integral(i_saved[3]);
+      }
     }
     // The thrust the thrusters deliver for these commands (the curve saturates at its peak).
     thrusters_.commands_for(force_, command_.command, command_.thrust);
@@ -290,10 +377,30 @@ class AuvController {
   std::vector<Vector3<double>> waypoints_;
   std::size_t next_ = 0;
   Vector3<double> target_ = Vector3<double>::Zero();
+  Vector3<double> leg_start_ = Vector3<double>::Zero();  // where the first leg begins
+  bool has_leg_start_ = false;
+  std::size_t leg_ = static_cast<std::size_t>(-1);  // the leg `progress_` belongs to
+  double progress_ = 0.0;                           // the reference's distance along its leg [m]
   double heading_ = 0.0;
   AuvCommand command_;
-  Eigen::VectorXd force_;
+  Eigen::VectorXd force_, vertical_;
   SampleClock clock_;
+};
+
+/// \brief How the ASV follows its target.
+enum class AsvLaw {
+  /// The paper's pursuit (Buchholz et al. 2025): a PID on the distance pushes forward as far as the
+  /// bow points at the target, a PID on the bearing turns it; inside `arrive_radius` only the
+  /// heading is held (so a current carries the boat off until it turns back).
+  pursuit,
+  /// Velocity tracking (kelp's default): the boat is commanded the target's velocity over ground
+  /// (estimated from its successive positions, e.g. USBL fixes of the AUV, low-passed over
+  /// `target_velocity_time_constant`) plus `position_gain` × the position error, capped at
+  /// `max_speed`; the bow is turned to that velocity (`heading` PID) and the surge speed over
+  /// ground along the bow is held by the `speed` PID, whose integral learns the thrust that
+  /// current, wind and tether cost. Holding station, the commanded velocity points back up the
+  /// current, so the boat faces into it and stems it instead of drifting off and turning round.
+  track
 };
 
 /// \brief Settings of the ASV controller. Defaults: the paper's gains (Buchholz et al. 2025):
@@ -319,6 +426,21 @@ struct AsvControllerSettings {
   Eigen::VectorXd thruster_facing;
   /// Supply voltage at the ESCs [V] the inverse uses until set_voltage() changes it.
   double voltage = vehicle::t200_nominal_voltage;
+  /// The law (`pursuit`: the paper's, with `linear`, `angular`, `yaw`; `track`: the settings
+  /// below). The default is the paper's; kelp::sim's "kelp" preset is `track_settings()`.
+  AsvLaw law = AsvLaw::pursuit;
+  /// \name Velocity tracking (AsvLaw::track). Defaults sized for vehicle::blueboat (surge mass
+  /// with added mass ≈ 17 kg, yaw inertia ≈ 5.6 kg m², half track 0.295 m): heading loop
+  /// ω_n ≈ 1.9 rad/s, ζ ≈ 0.8; speed loop bandwidth ≈ 1.7 rad/s.
+  ///@{
+  PidGains speed{15.0, 6.0, 0.0, 30.0, 4.0};  ///< surge speed error [m/s] → common thrust [N]
+  PidGains heading{20.0, 0.0, 6.0, 30.0};     ///< heading error [rad] → differential [N]
+  double position_gain = 0.5;                 ///< position error → velocity [1/s]
+  double max_speed = 1.5;                     ///< cap of the commanded speed [m/s]
+  /// Below this commanded speed the heading is held rather than turned to it [m/s].
+  double turn_speed = 0.15;
+  double target_velocity_time_constant = 1.0;  ///< low-pass of the target's velocity [s]
+  ///@}
 };
 
 /// \brief One ASV controller output.
@@ -344,8 +466,14 @@ class AsvController {
         linear_(s.linear, "linear"),
         angular_(s.angular, "angular"),
         yaw_(s.yaw, "yaw"),
+        speed_(s.speed, "speed"),
+        heading_pid_(s.heading, "heading"),
         observer_(model, s.observer_time_constant) {
     KELP_CHECK(thrusters.size() == 2, "AsvController: needs two thrusters (port, starboard)");
+    check_positive(s.max_speed, "max_speed");
+    check_non_negative(s.position_gain, "position_gain");
+    check_non_negative(s.turn_speed, "turn_speed");
+    check_positive(s.target_velocity_time_constant, "target_velocity_time_constant");
     check_positive(s.period, "period");
     check_positive(s.thrust_clip, "thrust_clip");
     check_positive(s.arrive_radius, "arrive_radius");
@@ -381,7 +509,9 @@ class AsvController {
     command_.position_error = e;
     const double distance = e.norm();
     double common = 0.0, differential = 0.0;
-    if (distance > settings_.arrive_radius) {
+    if (settings_.law == AsvLaw::track) {
+      track(nav, e, psi, dt, common, differential);
+    } else if (distance > settings_.arrive_radius) {
       const double bearing = wrap_angle(std::atan2(e.y(), e.x()) - psi);
       command_.heading_error = bearing;
       // Push forward only as far as the bow points at the target.
@@ -423,11 +553,48 @@ class AsvController {
   const vehicle::ThrusterChain<double>& thruster_chain() const { return thrusters_; }
   /// \brief The current target position, NED [m].
   const Vector3<double>& target() const { return target_; }
+  /// \brief The target's estimated velocity over ground (AsvLaw::track; zero until two updates
+  /// have seen it), NED [m/s].
+  const Vector3<double>& target_velocity() const { return target_velocity_; }
 
  private:
+  // AsvLaw::track: velocity command from the target's velocity and the position error, heading
+  // to it, surge speed along the bow.
+  void track(const Navigation& nav, const Vector3<double>& e, double psi, double dt, double& common,
+             double& differential) {
+    if (has_last_target_) {
+      const Vector3<double> v = (target_ - last_target_) / dt;
+      const double a = dt / (settings_.target_velocity_time_constant + dt);
+      target_velocity_ += a * (v - target_velocity_);
+      target_velocity_.z() = 0.0;
+    }
+    last_target_ = target_;
+    has_last_target_ = true;
+    Vector3<double> v_cmd = target_velocity_ + settings_.position_gain * e;
+    const double speed = v_cmd.norm();
+    if (speed > settings_.max_speed) v_cmd *= settings_.max_speed / speed;
+    if (speed > settings_.turn_speed || !has_course_) {
+      course_ = speed > settings_.turn_speed ? std::atan2(v_cmd.y(), v_cmd.x()) : psi;
+      has_course_ = true;
+    }
+    const double e_psi = wrap_angle(course_ - psi);
+    command_.heading_error = e_psi;
+    // Surge speed over ground wanted along the bow (negative: back up).
+    const double u_wanted = v_cmd.x() * std::cos(psi) + v_cmd.y() * std::sin(psi);
+    const double clip = settings_.thrust_clip;
+    differential = std::clamp(heading_pid_.update(e_psi, dt, -nav.nu(5)), -clip, clip);
+    // Turning first: the common thrust gets what the differential leaves of the clip.
+    const double room = clip - std::abs(differential);
+    common = std::clamp(speed_.update(u_wanted - nav.nu(0), dt), -room, room);
+  }
+
   AsvControllerSettings settings_;
   vehicle::ThrusterChain<double> thrusters_;
-  Pid linear_, angular_, yaw_;
+  Pid linear_, angular_, yaw_, speed_, heading_pid_;
+  Vector3<double> last_target_ = Vector3<double>::Zero();
+  Vector3<double> target_velocity_ = Vector3<double>::Zero();
+  double course_ = 0.0;
+  bool has_last_target_ = false, has_course_ = false;
   DisturbanceObserver observer_;
   Vector3<double> target_ = Vector3<double>::Zero();
   double heading_ = 0.0, half_track_ = 0.0;

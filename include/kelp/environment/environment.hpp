@@ -11,6 +11,17 @@
 /// environment (e.g. `h.rho = env.water_density(); h.gravity = env.gravity();`) and the check
 /// passes.
 ///
+/// Start-up ramp: `set_ramp(T)` brings the sea in smoothly over its first T seconds. Every water
+/// and air velocity the environment reports (current, wave orbital velocity, wind), the wave
+/// elevation, slope and velocity gradient are multiplied by the half-cosine ramp
+/// r(t) = ½(1 − cos(π t / T)) for 0 ≤ t < T (0 before, 1 after), and the water acceleration gets
+/// the ramp's own part ṙ(t)·v, so that the water a body sees starts at rest and still moves
+/// consistently (its acceleration is the derivative of its velocity). Vehicles and a tether laid at
+/// rest at t = 0 then start in equilibrium instead of being struck by the full sea in their first
+/// step. This is the ramp WEC-Sim applies to its incident waves (NREL/Sandia, `simu.rampTime`;
+/// source/wavesReg.m: amplitude × (1 + cos(π + π t/T_r))/2, the same function), and the reason
+/// MoorDyn refines its initial line shape before a run (moordyn.readthedocs.io, "Initialization").
+///
 /// Frames and signs: world NED (x north, y east, z down, mean sea surface at z = 0). The surface
 /// elevation ζ is positive UP, so the free surface lies at NED z = −ζ. Units SI.
 #pragma once
@@ -151,6 +162,28 @@ class Environment {
     wind_ = wind;
     return *this;
   }
+  /// \brief Sets the start-up ramp T [s] (0: none, the default): the sea comes in over [0, T]
+  /// (see the file's comment). \throws kelp::invalid_argument naming `ramp` when T is not finite
+  /// or negative.
+  Environment& set_ramp(double duration) {
+    KELP_CHECK(std::isfinite(duration) && duration >= 0.0,
+               "ramp must be a finite, non-negative duration [s]");
+    ramp_ = duration;
+    return *this;
+  }
+  /// \brief The start-up ramp's duration T [s] (0: none).
+  double ramp() const { return ramp_; }
+  /// \brief The ramp factor r(t) ∈ [0, 1] at time t [s] and its rate ṙ(t) [1/s]:
+  /// r = ½(1 − cos(π t/T)) on [0, T), 0 before, 1 from T on (and always 1 without a ramp).
+  /// \param[in] t time [s] \param[out] rate ṙ(t) [1/s] \returns r(t)
+  double ramp_factor(double t, double& rate) const {
+    rate = 0.0;
+    if (!(ramp_ > 0.0) || t >= ramp_) return 1.0;
+    if (!(t > 0.0)) return 0.0;
+    const double w = kelp::pi / ramp_;
+    rate = 0.5 * w * std::sin(w * t);
+    return 0.5 * (1.0 - std::cos(w * t));
+  }
   /// \brief True when the water is still everywhere and at all times (no wave components and no
   /// current), so that water velocity and acceleration are zero at every point: callers such as
   /// the tether may skip their water queries.
@@ -180,6 +213,18 @@ class Environment {
       s.surface_slope = k.slope;
     }
     if (with_wind) s.wind = wind_.velocity(t);
+    double rate = 0.0;
+    const double r = ramp_factor(t, rate);
+    if (r < 1.0) {  // the start-up ramp: scaled fields, plus ṙ v in the water's acceleration
+      const Scalar rs(r), rd(rate);
+      s.wave_acceleration = rs * s.wave_acceleration + rd * (s.current + s.wave_velocity);
+      s.current *= rs;
+      s.wave_velocity *= rs;
+      s.wave_velocity_gradient *= rs;
+      s.surface_elevation *= rs;
+      s.surface_slope *= rs;
+      s.wind *= rs;
+    }
     return s;
   }
 
@@ -187,13 +232,18 @@ class Environment {
   /// \throws kelp::invalid_argument when there are waves and t is not finite.
   Scalar surface_elevation(Scalar x, Scalar y, double t) const {
     if (waves_.empty()) return Scalar(0);
-    return waves_.elevation(x, y, t);
+    double rate = 0.0;
+    const double r = ramp_factor(t, rate);
+    return r < 1.0 ? Scalar(r) * waves_.elevation(x, y, t) : waves_.elevation(x, y, t);
   }
 
   /// \brief Free-surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t).
   /// \throws kelp::invalid_argument when there are waves and t is not finite.
   Eigen::Matrix<Scalar, 2, 1> surface_slope(Scalar x, Scalar y, double t) const {
-    return waves_.slope(x, y, t);
+    double rate = 0.0;
+    const double r = ramp_factor(t, rate);
+    return r < 1.0 ? Eigen::Matrix<Scalar, 2, 1>(Scalar(r) * waves_.slope(x, y, t))
+                   : waves_.slope(x, y, t);
   }
 
   /// \brief Water velocity and acceleration at many NED points at once (e.g. all tether nodes);
@@ -211,6 +261,39 @@ class Environment {
                     Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
     KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
                "sample_water: velocity and acceleration must have as many columns as points");
+    sample_water_unramped(points, t, velocity, acceleration);
+    apply_ramp(t, velocity, acceleration);
+  }
+
+  /// \brief The same, plus the free-surface elevation ζ above each point [m] (positive up), from
+  /// the same wave sums: much cheaper than calling `surface_elevation` for each point.
+  /// \param[out] elevation n values [m]
+  void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
+                    Eigen::Ref<Matrix3X<Scalar>> velocity,
+                    Eigen::Ref<Matrix3X<Scalar>> acceleration,
+                    Eigen::Ref<VectorX<Scalar>> elevation) const {
+    KELP_CHECK(elevation.size() == points.cols(),
+               "sample_water: elevation must have one entry per point");
+    KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
+               "sample_water: velocity and acceleration must have as many columns as points");
+    if (waves_.empty()) {
+      sample_water_unramped(points, t, velocity, acceleration);
+      elevation.setZero();
+    } else {
+      waves_.kinematics(points, t, velocity, acceleration, elevation);
+      add_current(points, t, velocity);
+    }
+    if (apply_ramp(t, velocity, acceleration)) {
+      double rate = 0.0;
+      elevation *= Scalar(ramp_factor(t, rate));
+    }
+  }
+
+ private:
+  /// sample_water without the ramp (sizes checked by the caller).
+  void sample_water_unramped(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
+                             Eigen::Ref<Matrix3X<Scalar>> velocity,
+                             Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
     if (waves_.empty()) {  // calm sea: no wave pass, the current is written directly
       acceleration.setZero();
       if (current_.is_zero()) {
@@ -231,27 +314,18 @@ class Environment {
     add_current(points, t, velocity);
   }
 
-  /// \brief The same, plus the free-surface elevation ζ above each point [m] (positive up), from
-  /// the same wave sums: much cheaper than calling `surface_elevation` for each point.
-  /// \param[out] elevation n values [m]
-  void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
-                    Eigen::Ref<Matrix3X<Scalar>> velocity,
-                    Eigen::Ref<Matrix3X<Scalar>> acceleration,
-                    Eigen::Ref<VectorX<Scalar>> elevation) const {
-    KELP_CHECK(elevation.size() == points.cols(),
-               "sample_water: elevation must have one entry per point");
-    if (waves_.empty()) {
-      sample_water(points, t, velocity, acceleration);
-      elevation.setZero();
-      return;
-    }
-    KELP_CHECK(velocity.cols() == points.cols() && acceleration.cols() == points.cols(),
-               "sample_water: velocity and acceleration must have as many columns as points");
-    waves_.kinematics(points, t, velocity, acceleration, elevation);
-    add_current(points, t, velocity);
+  /// During the start-up ramp: acceleration ← r a + ṙ v, velocity ← r v. Returns whether it
+  /// applied (t inside the ramp).
+  bool apply_ramp(double t, Eigen::Ref<Matrix3X<Scalar>> velocity,
+                  Eigen::Ref<Matrix3X<Scalar>> acceleration) const {
+    double rate = 0.0;
+    const double r = ramp_factor(t, rate);
+    if (!(r < 1.0)) return false;
+    acceleration = Scalar(r) * acceleration + Scalar(rate) * velocity;
+    velocity *= Scalar(r);
+    return true;
   }
 
- private:
   /// Adds the current at each point to `velocity` (waves already written).
   void add_current(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                    Eigen::Ref<Matrix3X<Scalar>> velocity) const {
@@ -275,6 +349,7 @@ class Environment {
   Scalar air_density_ = Scalar(kelp::air_density);
   Scalar gravity_ = Scalar(kelp::standard_gravity);
   Scalar seabed_depth_ = Scalar(std::numeric_limits<double>::infinity());
+  double ramp_ = 0.0;  // start-up ramp T [s]
   CurrentModel<Scalar> current_;
   WaveField<Scalar> waves_;
   WindField<Scalar> wind_;

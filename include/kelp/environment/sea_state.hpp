@@ -61,6 +61,9 @@ struct SeaStateOptions {
   GustSpectrum gust = GustSpectrum::harris;  ///< gust spectrum (none for a steady wind)
   std::uint64_t seed = 1;                    ///< seed of waves (seed) and gusts (seed + 1)
   double seabed_depth = std::numeric_limits<double>::infinity();  ///< flat seabed [m]
+  /// Start-up ramp T [s]: waves, current and wind come in over [0, T] (Environment::set_ramp;
+  /// 0: the full sea from t = 0).
+  double ramp = 0.0;
 };
 
 namespace presets {
@@ -97,6 +100,7 @@ template <typename Scalar>
 Environment<Scalar> make_environment(const SeaState& s, const SeaStateOptions& o = {}) {
   Environment<Scalar> env;
   env.set_seabed_depth(Scalar(o.seabed_depth));
+  env.set_ramp(o.ramp);
   WaveFieldParameters w;
   w.spectrum.kind = SpectrumKind::jonswap;
   w.spectrum.significant_height = s.significant_height;

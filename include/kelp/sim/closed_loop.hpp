@@ -101,7 +101,8 @@ struct ClosedLoopOptions {
 
 /// \brief The tethered pair of a scenario flown by kelp's controllers, one step at a time.
 ///
-/// Built from a scenario: the world (world_setup()), the system at its initial state, the AUV's
+/// Built from a scenario: the world (world_setup()), the system at its start state (start_state():
+/// the sea ramped in, the vehicles and tether moving with the water), the AUV's
 /// controller following the scenario's waypoints (by default a square at the mission depth from
 /// the start) and the ASV's controller following the AUV. Every step (dt = 10 ms): the controllers'
 /// commands (computed from the current state) drive the system through `system::step`; then the
@@ -128,7 +129,7 @@ class ClosedLoop {
         options_(options),
         model_(world.parameters, world.environment),
         workspace_(model_),
-        state_(kelp::system::initial_state(model_, workspace_, world.start.asv, world.start.auv)),
+        state_(start_state(model_, workspace_, world, sc)),
         rov_thrusters_(rov_allocation()),
         boat_thrusters_(boat_allocation()),
         auv_(model_.auv(), rov_thrusters_, auv_settings(sc)),
@@ -338,6 +339,13 @@ class ClosedLoop {
     set_gains(s.sway, sc.auv_sway);
     set_gains(s.heave, sc.auv_heave);
     set_gains(s.yaw, sc.auv_yaw);
+    if (sc.control_preset == "kelp") {
+      // Track the survey's legs (a reference moving at leg_speed, at most 1 m ahead), with the
+      // horizontal and vertical thrust saturated apart.
+      s.follow_legs = true;
+      s.max_horizontal_error = 1.0;
+      s.split_saturation = true;
+    }
     return s;
   }
   static kelp::control::AsvControllerSettings asv_settings(const Scenario& sc) {
@@ -346,6 +354,7 @@ class ClosedLoop {
     s.compensate = sc.compensation;
     s.period = 1.0 / sc.asv_rate;
     s.thrust_clip = sc.asv_thrust_clip;
+    if (sc.control_preset == "kelp") s.law = kelp::control::AsvLaw::track;
     const auto set = [&](kelp::control::PidGains& g, const Gains& x) {
       set_gains(g, x);
       g.output_limit = sc.asv_thrust_clip;

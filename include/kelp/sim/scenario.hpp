@@ -100,12 +100,25 @@ struct Scenario {
   kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
   std::vector<double> auv_start;
   ///@}
-  /// \name Control: the paper's disturbance compensation, the PID gains, the ASV's thrust clip
-  /// [N] and the controllers' rates [Hz].
+  /// \name Start (`"start": {"ramp": 10, "with_water": true}`): the sea (waves, current, wind)
+  /// is ramped in over the first `start_ramp` seconds (environment::Environment::set_ramp; 0:
+  /// the full sea at once), and with `start_with_water` the vehicles and the tether's nodes start
+  /// moving with the water at their positions (current + wave orbital velocity at t = 0; zero
+  /// while the ramp holds the sea at rest) instead of at rest in moving water.
   ///@{
+  double start_ramp = 10.0;
+  bool start_with_water = true;
+  ///@}
+  /// \name Control: the preset, the paper's disturbance compensation, the PID gains, the ASV's
+  /// thrust clip [N] and the controllers' rates [Hz].
+  ///@{
+  /// "kelp" (default): the boat tracks the ROV's velocity and position
+  /// (control::AsvLaw::track), thrust clip 25 N; "paper": Buchholz et al.'s pursuit with their
+  /// gains (`asv_linear`, `asv_angular`, `asv_yaw`: used by this preset only), clip 15 N.
+  std::string control_preset = "kelp";
   bool compensation = false;
   Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
-  double asv_thrust_clip = 15.0, asv_rate = 10.0;
+  double asv_thrust_clip = 25.0, asv_rate = 10.0;
   double auv_rate = 50.0;
   Gains auv_surge{40.0, 4.0, 56.0}, auv_sway{40.0, 4.0, 56.0}, auv_heave{60.0, 8.0, 88.0},
       auv_yaw{5.0, 0.2, 3.4};
@@ -114,7 +127,7 @@ struct Scenario {
   /// start.
   ///@{
   std::vector<kelp::Vector3<double>> waypoints;
-  double depth = 5.0, square_side = 10.0;
+  double depth = 5.0, square_side = 8.0;
   ///@}
   /// \name Output: rows of timeseries.csv and snapshots of nodes.csv per simulated second [Hz].
   ///@{
@@ -409,8 +422,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   Scenario s;
   r.object(j, "",
-           {"duration", "seed", "sea", "tether", "vehicles", "control", "mission", "output",
-            "kernel", "deterministic", "navigation", "thrusters", "battery"});
+           {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission",
+            "output", "kernel", "deterministic", "navigation", "thrusters", "battery"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -466,9 +479,17 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
       s.auv_start = {p(0), p(1), p(2)};
     }
   }
+  if (j.contains("start")) {
+    const auto& st = j.at("start");
+    r.object(st, "/start", {"ramp", "with_water"});
+    r.number(st, "/start", "ramp", s.start_ramp, 0, 1e5);
+    r.boolean(st, "/start", "with_water", s.start_with_water);
+  }
   if (j.contains("control")) {
     const auto& c = j.at("control");
-    r.object(c, "/control", {"compensation", "asv", "auv"});
+    r.object(c, "/control", {"preset", "compensation", "asv", "auv"});
+    r.choice(c, "/control", "preset", s.control_preset, {"kelp", "paper"});
+    if (s.control_preset == "paper") s.asv_thrust_clip = 15.0;  // the paper's, unless set below
     r.boolean(c, "/control", "compensation", s.compensation);
     if (c.contains("asv")) {
       const auto& a = c.at("asv");
@@ -592,7 +613,9 @@ inline nlohmann::json to_json(const Scenario& s) {
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;
-  j["control"] = {{"compensation", s.compensation},
+  j["start"] = {{"ramp", s.start_ramp}, {"with_water", s.start_with_water}};
+  j["control"] = {{"preset", s.control_preset},
+                  {"compensation", s.compensation},
                   {"asv",
                    {{"linear", g(s.asv_linear)},
                     {"angular", g(s.asv_angular)},

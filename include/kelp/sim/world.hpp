@@ -13,7 +13,10 @@
 #include "kelp/environment/sea_state.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/system/presets.hpp"
+#include "kelp/system/system.hpp"
+#include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
+#include "kelp/vehicle/surroundings.hpp"
 
 namespace kelp {
 namespace sim {
@@ -73,6 +76,7 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   ke::SeaStateOptions sea_options;
   sea_options.seed = sc.seed;
   sea_options.wave_components = sc.wave_components;
+  sea_options.ramp = sc.start_ramp;
   ke::SeaState sea = ke::presets::calm();
   if (sc.sea == "moderate") sea = ke::presets::moderate();
   if (sc.sea == "rough") sea = ke::presets::rough();
@@ -113,6 +117,31 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   }
   env.waves().active_kernel();
   return {params, env, start};
+}
+
+/// \brief The state a run of the scenario starts from: `system::initial_state` (the vehicles at
+/// their start poses, the tether's static shape between them) at t = 0 and, with the scenario's
+/// `start_with_water`, the vehicles and the tether's nodes moving with the water there
+/// (vehicle body velocity = the water's current + wave orbital velocity at the CO in body axes, no
+/// rotation; tether::move_with_water). While the start ramp holds the sea at rest (t = 0 with a
+/// ramp) that velocity is zero. Every program on kelp::sim starts here (kelp-tethered-pair,
+/// kelp-sweep, kelp-sitl), so a run flown by kelp's controllers and one flown by SITL start alike.
+/// \throws kelp::numerical_error when the tether's static shape does not converge.
+inline kelp::system::SystemStated start_state(const kelp::system::SystemModeld& model,
+                                              kelp::system::SystemWorkspaced& ws,
+                                              const WorldSetup& world, const Scenario& sc) {
+  kelp::system::SystemStated s =
+      kelp::system::initial_state(model, ws, world.start.asv, world.start.auv);
+  if (sc.start_with_water) {
+    const auto& env = model.environment();
+    for (kelp::vehicle::VehicleState<double>* v : {&s.asv, &s.auv}) {
+      const auto e = env.sample(v->position, s.time, false);
+      v->nu.head<3>() = v->attitude.conjugate() * (e.current + e.wave_velocity);
+      v->nu.tail<3>().setZero();
+    }
+    kelp::tether::move_with_water(model.tether(), env, s.tether);
+  }
+  return s;
 }
 
 }  // namespace sim

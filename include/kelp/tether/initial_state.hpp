@@ -65,6 +65,21 @@ TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, con
   return s;
 }
 
+/// \brief Sets every node's velocity to the water's (current + wave orbital velocity, as
+/// `env.sample_water` gives it at the node's position and the state's time), so that a line laid
+/// in moving water starts drifting with it instead of at rest: no drag impulse in its first step.
+/// Positions, time and integrator history are left as they are. \param[in] model the tether
+/// \param[in] env environment (`sample_water(points, t, velocity, acceleration)`)
+/// \param[in,out] state the tether's state
+template <typename Scalar, typename Env>
+void move_with_water(const TetherModel<Scalar>& model, const Env& env, TetherState<Scalar>& state) {
+  KELP_CHECK(state.position.cols() == model.segments() + 1 &&
+                 state.velocity.cols() == state.position.cols(),
+             "move_with_water: the state does not match the model");
+  Matrix3X<Scalar> acceleration(3, state.position.cols());
+  env.sample_water(state.position, state.time, state.velocity, acceleration);
+}
+
 /// \brief Catenary initial state refined by `solve_static_equilibrium` with both ends fixed at
 /// `start_ned`, `end_ned` (free ends of the model stay free). Returns the solve's result (check
 /// `converged`); the state is written to `state` when the solve returns.

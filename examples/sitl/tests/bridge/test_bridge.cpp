@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bridge.hpp"
+#include "default_world.hpp"
 #include "kelp/sim/world.hpp"
 
 using namespace kelp_sitl;
@@ -256,4 +257,44 @@ TEST_CASE(
   // The boat's battery too.
   const nlohmann::json boat = reply_json(out.items[0].slot == rover ? out.items[0] : out.items[1]);
   CHECK(boat.at("battery").at("current").get<double>() > 1.0);
+}
+
+TEST_CASE("calm start: the ROV resting in the default world reads about g in its first second",
+          "[sitl][start]") {
+  // kelp-sitl's own world (default_world.hpp, world_setup, start_state), both autopilots at
+  // neutral (1500 µs on every channel: no thrust), 1 s of frames at the bridge's rate. The
+  // specific force is what the bridge sends as ArduSub's accelerometer (reply_of: v̇ + ω × v from
+  // the state's auv_nu_dot, minus gravity, in body axes).
+  const auto worst = [](const kelp::sim::Scenario& sc) {
+    const kelp::sim::WorldSetup setup = kelp::sim::world_setup(sc, "test");
+    const kelp::system::SystemModeld model(setup.parameters, setup.environment);
+    kelp::system::SystemWorkspaced ws(model);
+    Bridge bridge(model, ws, kelp::sim::start_state(model, ws, setup, sc), setup.start, {});
+    const std::vector<std::uint16_t> neutral(16, 1500);
+    const auto a = packet(servo_magic_16, 0, neutral), b = packet(servo_magic_32, 0, neutral);
+    const double g = model.environment().gravity();
+    double e = 0;
+    Outbox out;
+    for (std::uint32_t k = 0; k < 1200; ++k) {
+      auto pa = packet(servo_magic_16, k, neutral), pb = packet(servo_magic_32, k, neutral);
+      out.clear();
+      bridge.receive(sub, pa.data(), pa.size(), Endpoint{0x0100007F, 5000}, 0, out);
+      bridge.receive(rover, pb.data(), pb.size(), Endpoint{0x0100007F, 5001}, 0, out);
+      REQUIRE(out.count == 2);
+      REQUIRE(bridge.auv_thrust().isZero());
+      e = std::max(e, std::abs(bridge.reply_of(sub).accel_body.norm() - g));
+    }
+    CHECK(bridge.state().time == Approx(1.0));
+    return e;
+  };
+  kelp::sim::Scenario sc = default_scenario();
+  const double calm = worst(sc);
+  INFO("worst |f - g| with the default start: " << calm << " m/s^2");
+  CHECK(calm < 3.0);
+  // The start transient this guards against: the sea at full strength from t = 0.
+  sc.start_ramp = 0;
+  sc.start_with_water = false;
+  const double abrupt = worst(sc);
+  INFO("worst |f - g| without the ramp: " << abrupt << " m/s^2");
+  CHECK(abrupt > 3.0);
 }
