@@ -541,13 +541,13 @@ class Mission {
 
   // As wait_for, but the time-out counts in the vehicle's own clock (time_boot_ms), so that it
   // means the same simulated time at any SITL --speedup. While the vehicle has not reported its
-  // time yet the wall clock counts instead; a wall-clock backstop of 3 x timeout + 60 s ends
+  // time yet the wall clock counts instead; a wall-clock backstop of 10 x timeout + 60 s ends
   // the wait if the vehicle's clock stops (a lost link is caught sooner by the HEARTBEAT check).
   template <class Pred, class Message, class Status>
   void wait_for_clock(const Vehicle& v, Pred pred, double timeout, const Message& message,
                       Status status) {
     const auto wall_start = Clock::now();
-    const auto wall_end = wall_start + seconds(3.0 * timeout + 60.0);
+    const auto wall_end = wall_start + seconds(10.0 * timeout + 60.0);
     const std::optional<std::uint32_t> clock0 = v.clock_ms;
     auto next_status = wall_start + std::chrono::seconds(5);
     const auto expired = [&] {
@@ -576,9 +576,10 @@ class Mission {
 
   // Holds depth for `duration` s of the vehicle's own clock (time_boot_ms of its
   // LOCAL_POSITION_NED), so that the hold lasts the same simulated time at any SITL --speedup;
-  // reports the depth range seen. Gives up after 2 × duration + 60 s of wall time.
+  // reports the depth range seen. Gives up after 10 × duration + 60 s of wall time (a SITL in
+  // lockstep with a loaded machine may run well below real time; a lost link is caught sooner).
   void hold_depth(Vehicle& v, double duration) {
-    const auto wall_end = Clock::now() + seconds(2.0 * duration + 60.0);
+    const auto wall_end = Clock::now() + seconds(10.0 * duration + 60.0);
     auto next_status = Clock::now() + std::chrono::seconds(5);
     const std::uint32_t t0 = v.local->time_boot_ms;
     double lo = v.local->z, hi = v.local->z;
@@ -597,7 +598,7 @@ class Mission {
       spin(std::min(wall_end, next_status));
     }
     throw std::runtime_error(v.name + ": its clock did not advance " + fmt(duration) + " s in " +
-                             fmt(2.0 * duration + 60.0) + " s of wall time");
+                             fmt(10.0 * duration + 60.0) + " s of wall time");
   }
 
   // One round: periodic sends, poll() until input or `until` (at most 20 ms), read, dispatch,
