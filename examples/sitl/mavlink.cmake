@@ -7,7 +7,7 @@ add_executable(kelp-mission mission.cpp)
 target_include_directories(kelp-mission PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(kelp-mission PRIVATE kelp_warnings CLI11::CLI11)
 target_compile_features(kelp-mission PRIVATE cxx_std_17)
-install(TARGETS kelp-mission RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS kelp-mission RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT sitl)
 
 if(KELP_BUILD_TESTS)
   # The codec: CRC, definitions, framing, parser against corrupt and random input.

@@ -1,7 +1,10 @@
 // kelp-mission: flies the tethered mission on two ArduPilot SITL instances over MAVLink: the
 // BlueROV2 Heavy AUV (ArduSub) dives, holds depth and surveys a square while the BlueBoat ASV
 // (ArduRover) follows it on the surface. See mission/mission.hpp for the mission and
-// mission/csv_log.hpp for the logs; params/*.parm for the vehicles' parameters.
+// mission/csv_log.hpp for the logs; params/*.parm for the vehicles' parameters. Periodic
+// messages and the dive and survey time-outs follow the vehicles' own clocks (time_boot_ms), so
+// a SITL --speedup changes nothing the vehicles see; a mode change kelp-mission did not command
+// (a failsafe) is reported and ends the mission (exit 1).
 //
 //   kelp-mission --sub tcp:127.0.0.1:5760 --rover tcp:127.0.0.1:5770 --depth 5 --hold 60
 //                --survey-side 10 --log kelp-mission-log
@@ -52,16 +55,18 @@ int main(int argc, char** argv) {
   app.add_option("--mode-timeout", o.mode_timeout, "s of retries per mode change")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--dive-timeout", o.dive_timeout, "s to reach the depth")
+  app.add_option("--dive-timeout", o.dive_timeout, "s of the sub's clock to reach the depth")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--leg-timeout", o.leg_timeout, "s per side of the survey square")
+  app.add_option("--leg-timeout", o.leg_timeout,
+                 "s of the sub's clock per side of the survey square")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--retry-interval", o.retry_interval, "s between command retries")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  app.add_option("--link-timeout", o.link_timeout, "s without HEARTBEAT that count as a lost link")
+  app.add_option("--link-timeout", o.link_timeout,
+                 "wall s without HEARTBEAT that count as a lost link")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--dive-throttle", o.dive_throttle,

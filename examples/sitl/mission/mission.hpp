@@ -8,9 +8,18 @@
 // sent the AUV's latitude/longitude at 1 Hz, so it stays above it. Finally both are put in a
 // safe state (AUV MANUAL and disarmed, boat HOLD and disarmed).
 //
-// One thread, poll() on both sockets. Every wait is bounded; a time-out, a refusal, a lost link
-// or an unexpected disarm ends the mission with a message naming the vehicle, the command and
-// the MAV_RESULT, an attempt to leave both vehicles safe, and exit code 1.
+// One thread, poll() on both sockets. Every wait is bounded; a time-out, a refusal, a lost link,
+// an unexpected disarm or a mode change kelp-mission did not command (a failsafe, a pilot) ends
+// the mission with a message naming the vehicle, the command and the MAV_RESULT, an attempt to
+// leave both vehicles safe, and exit code 1. Failsafes (HEARTBEAT system_status CRITICAL or
+// EMERGENCY) are reported as they happen and counted in the summary printed at the end.
+//
+// Two clocks. A SITL runs at --speedup times real time (or slower, when the lockstep with the
+// physics cannot keep up), and its failsafes count in its own time: ArduRover's GCS failsafe
+// fires after FS_GCS_TIMEOUT s of *its* clock without a GCS HEARTBEAT. So every periodic
+// message (HEARTBEAT, MANUAL_CONTROL, the targets) goes out when either the vehicle's clock
+// (time_boot_ms of SYSTEM_TIME, ATTITUDE, LOCAL_POSITION_NED, GLOBAL_POSITION_INT) or the wall
+// clock has advanced by its period, and the dive and survey time-outs count in the sub's clock.
 #pragma once
 
 #include <poll.h>
@@ -41,21 +50,21 @@ namespace kelp_sitl::mission {
 struct Options {
   std::string sub = "tcp:127.0.0.1:5760";    // ArduSub SERIAL0; "none": no AUV
   std::string rover = "tcp:127.0.0.1:5770";  // ArduRover SERIAL0 (-I1); "none": no boat
-  double depth = 5.0;            // m, target depth (LOCAL_POSITION_NED z, down from the EKF origin)
-  double depth_tolerance = 0.3;  // m: the dive ends at depth - tolerance
-  double hold = 60.0;            // s in ALT_HOLD at depth
-  double survey_side = 10.0;     // m, side of the square (0: no survey)
-  double survey_radius = 1.0;    // m: a corner counts as reached within this horizontal distance
+  double depth = 5.0;  // m, target depth (LOCAL_POSITION_NED z, down from the EKF origin)
+  double depth_tolerance = 0.05;  // m: the dive ends at depth - tolerance
+  double hold = 60.0;             // s in ALT_HOLD at depth
+  double survey_side = 10.0;      // m, side of the square (0: no survey)
+  double survey_radius = 1.0;     // m: a corner counts as reached within this horizontal distance
   std::string log_dir = "kelp-mission-log";
   double connect_timeout = 60.0;    // s, per vehicle, retrying the TCP connect
   double heartbeat_timeout = 30.0;  // s for the first HEARTBEAT after connecting
   double arm_timeout = 60.0;        // s of arming retries (the EKF needs 10-30 s after boot)
   double position_timeout = 120.0;  // s for the sub's first LOCAL_POSITION_NED (before arming)
   double mode_timeout = 30.0;       // s of mode-change retries (GUIDED needs a position)
-  double dive_timeout = 120.0;      // s to reach the depth
-  double leg_timeout = 120.0;       // s per side of the square
+  double dive_timeout = 120.0;      // s of the sub's clock to reach the depth
+  double leg_timeout = 120.0;       // s of the sub's clock per side of the square
   double retry_interval = 3.0;      // s between repeats of a refused or unanswered command
-  double link_timeout = 5.0;        // s without HEARTBEAT during the mission: link lost
+  double link_timeout = 5.0;        // wall s without HEARTBEAT during the mission: link lost
   int dive_throttle = 300;          // MANUAL_CONTROL z while diving (0..1000, 500 neutral)
 };
 
@@ -80,9 +89,141 @@ struct Vehicle {
   std::string last_text;                   // last STATUSTEXT
   bool expect_armed = false;
   Clock::time_point armed_since{};
+  // The vehicle's clock: the latest time_boot_ms it reported (ms since its boot).
+  std::optional<std::uint32_t> clock_ms;
+  // Mode watch: the mode kelp-mission last set (none before its first command); while a
+  // command is under way (`changing_mode`) the HEARTBEAT may still show the old one.
+  std::optional<std::uint32_t> commanded_mode;
+  bool changing_mode = false;
+  std::optional<std::uint32_t> uncommanded_mode;  // set when seen, cleared when reported
+  std::vector<std::string> events;                // mode changes not commanded, failsafes
+  int uncommanded_mode_changes = 0;
+  int failsafes = 0;
 
   bool armed() const { return (heartbeat.base_mode & mavlink::kModeFlagSafetyArmed) != 0; }
+  bool is_sub() const { return heartbeat.type == mavlink::kTypeSubmarine; }
+  // The vehicle's clock in s, or "?" while unknown (for messages).
+  std::string clock_text() const {
+    if (!clock_ms) return "?";
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(1) << *clock_ms / 1000.0;
+    return s.str();
+  }
 };
+
+// A periodic message: due when the vehicle's clock or the wall clock has advanced by the period
+// since it was last sent. The vehicle's clock keeps the rate right in simulated time at any
+// --speedup; the wall clock keeps it going before the vehicle has reported its time and when
+// its clock runs slower than real time. A clock that went back (a reboot) counts as due.
+struct Pace {
+  Clock::time_point wall{};
+  std::optional<std::uint32_t> clock_ms;
+
+  bool due(const Vehicle& v, double period_s, Clock::time_point now) {
+    const auto period =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
+    const auto period_ms = static_cast<std::uint32_t>(period_s * 1000.0);
+    const bool wall_due = now - wall >= period;
+    const bool clock_due = v.clock_ms && (!clock_ms || *v.clock_ms < *clock_ms ||
+                                          *v.clock_ms - *clock_ms >= period_ms);
+    if (!wall_due && !clock_due) return false;
+    wall = now;
+    clock_ms = v.clock_ms;
+    return true;
+  }
+};
+
+// ArduPilot's mode names for the messages (ArduSub/mode.h and Rover/mode.h, Mode::Number).
+inline std::string mode_name(bool sub, std::uint32_t mode) {
+  const char* n = nullptr;
+  if (sub) {
+    switch (mode) {
+      case 0:
+        n = "STABILIZE";
+        break;
+      case 1:
+        n = "ACRO";
+        break;
+      case 2:
+        n = "ALT_HOLD";
+        break;
+      case 3:
+        n = "AUTO";
+        break;
+      case 4:
+        n = "GUIDED";
+        break;
+      case 7:
+        n = "CIRCLE";
+        break;
+      case 9:
+        n = "SURFACE";
+        break;
+      case 16:
+        n = "POSHOLD";
+        break;
+      case 19:
+        n = "MANUAL";
+        break;
+      case 20:
+        n = "MOTOR_DETECT";
+        break;
+      case 21:
+        n = "SURFTRAK";
+        break;
+      default:
+        break;
+    }
+  } else {
+    switch (mode) {
+      case 0:
+        n = "MANUAL";
+        break;
+      case 1:
+        n = "ACRO";
+        break;
+      case 3:
+        n = "STEERING";
+        break;
+      case 4:
+        n = "HOLD";
+        break;
+      case 5:
+        n = "LOITER";
+        break;
+      case 6:
+        n = "FOLLOW";
+        break;
+      case 7:
+        n = "SIMPLE";
+        break;
+      case 8:
+        n = "DOCK";
+        break;
+      case 9:
+        n = "CIRCLE";
+        break;
+      case 10:
+        n = "AUTO";
+        break;
+      case 11:
+        n = "RTL";
+        break;
+      case 12:
+        n = "SMART_RTL";
+        break;
+      case 15:
+        n = "GUIDED";
+        break;
+      case 16:
+        n = "INITIALISING";
+        break;
+      default:
+        break;
+    }
+  }
+  return (n != nullptr ? std::string(n) : std::string("mode")) + " (" + std::to_string(mode) + ")";
+}
 
 class Mission {
  public:
@@ -190,13 +331,14 @@ class Mission {
           std::to_string(opt_.dive_throttle) + ")");
     manual_z_ = static_cast<std::int16_t>(opt_.dive_throttle);
     const double target = opt_.depth - opt_.depth_tolerance;
-    wait_for([&] { return sub_->local && sub_->local->z >= target; }, opt_.dive_timeout,
-             [&] {
-               return "sub: did not reach " + fmt(opt_.depth) + " m within " +
-                      fmt(opt_.dive_timeout) + " s (depth " +
-                      (sub_->local ? fmt(sub_->local->z) + " m" : std::string("unknown")) + ")";
-             },
-             [&] { return "depth " + (sub_->local ? fmt(sub_->local->z) : "?") + " m"; });
+    wait_for_clock(
+        *sub_, [&] { return sub_->local && sub_->local->z >= target; }, opt_.dive_timeout,
+        [&] {
+          return "sub: did not reach " + fmt(opt_.depth) + " m within " + fmt(opt_.dive_timeout) +
+                 " s (depth " +
+                 (sub_->local ? fmt(sub_->local->z) + " m" : std::string("unknown")) + ")";
+        },
+        [&] { return "depth " + (sub_->local ? fmt(sub_->local->z) : "?") + " m"; });
     manual_z_ = kNeutralZ;
     phase("sub: at " + fmt(sub_->local->z) + " m; holding depth for " + fmt(opt_.hold) + " s");
     hold_depth(*sub_, opt_.hold);
@@ -228,14 +370,15 @@ class Mission {
       t.target_system = sub_->sysid;
       t.target_component = mavlink::kCompAutopilot1;
       local_target_ = t;
-      next_local_target_ = Clock::now();
+      local_target_pace_ = Pace{};  // the new corner goes out at once
       auto distance = [&] { return std::hypot(sub_->local->x - tx, sub_->local->y - ty); };
-      wait_for([&] { return distance() <= opt_.survey_radius; }, opt_.leg_timeout,
-               [&] {
-                 return "sub: corner " + std::to_string(i + 1) + " not reached within " +
-                        fmt(opt_.leg_timeout) + " s (" + fmt(distance()) + " m away)";
-               },
-               [&] { return "distance " + fmt(distance()) + " m"; });
+      wait_for_clock(
+          *sub_, [&] { return distance() <= opt_.survey_radius; }, opt_.leg_timeout,
+          [&] {
+            return "sub: corner " + std::to_string(i + 1) + " not reached within " +
+                   fmt(opt_.leg_timeout) + " s (" + fmt(distance()) + " m away)";
+          },
+          [&] { return "distance " + fmt(distance()) + " m"; });
       from_x = tx;
       from_y = ty;
     }
@@ -296,12 +439,18 @@ class Mission {
 
   void set_mode(Vehicle& v, std::uint32_t mode, const std::string& name, double timeout = -1) {
     if (timeout < 0) timeout = opt_.mode_timeout;
+    // From here until the HEARTBEAT shows the new mode, neither the old nor the new one is a
+    // change kelp-mission did not command.
+    v.commanded_mode = mode;
+    v.changing_mode = true;
     // param1: base_mode with MAV_MODE_FLAG_CUSTOM_MODE_ENABLED; param2: ArduPilot's mode number.
     command(v, mavlink::kCmdDoSetMode,
             {static_cast<float>(mavlink::kModeFlagCustomModeEnabled), static_cast<float>(mode)},
             "mode " + name + " (" + std::to_string(mode) + ")", timeout);
     wait_for([&] { return v.heartbeat.custom_mode == mode; }, std::max(timeout, 3.0),
              v.name + ": mode " + name + " was accepted but the HEARTBEAT does not show it");
+    v.changing_mode = false;
+    v.uncommanded_mode.reset();
   }
 
   // COMMAND_LONG repeated every retry_interval until COMMAND_ACK ACCEPTED or `timeout`.
@@ -390,11 +539,47 @@ class Mission {
     }
   }
 
+  // As wait_for, but the time-out counts in the vehicle's own clock (time_boot_ms), so that it
+  // means the same simulated time at any SITL --speedup. While the vehicle has not reported its
+  // time yet the wall clock counts instead; a wall-clock backstop of 10 x timeout + 60 s ends
+  // the wait if the vehicle's clock stops (a lost link is caught sooner by the HEARTBEAT check).
+  template <class Pred, class Message, class Status>
+  void wait_for_clock(const Vehicle& v, Pred pred, double timeout, const Message& message,
+                      Status status) {
+    const auto wall_start = Clock::now();
+    const auto wall_end = wall_start + seconds(10.0 * timeout + 60.0);
+    const std::optional<std::uint32_t> clock0 = v.clock_ms;
+    auto next_status = wall_start + std::chrono::seconds(5);
+    const auto expired = [&] {
+      const auto now = Clock::now();
+      if (now >= wall_end) return true;
+      if (clock0 && v.clock_ms && *v.clock_ms >= *clock0)
+        return (*v.clock_ms - *clock0) / 1000.0 >= timeout;
+      return now - wall_start >= seconds(timeout);
+    };
+    while (!pred()) {
+      if (expired()) {
+        if constexpr (std::is_invocable_v<Message>)
+          throw MissionError(message());
+        else
+          throw MissionError(message);
+      }
+      const auto now = Clock::now();
+      if (now >= next_status) {
+        const std::string s = status();
+        if (!s.empty()) phase("  " + s);
+        next_status = now + std::chrono::seconds(5);
+      }
+      spin(std::min(wall_end, next_status));
+    }
+  }
+
   // Holds depth for `duration` s of the vehicle's own clock (time_boot_ms of its
   // LOCAL_POSITION_NED), so that the hold lasts the same simulated time at any SITL --speedup;
-  // reports the depth range seen. Gives up after 2 × duration + 60 s of wall time.
+  // reports the depth range seen. Gives up after 10 × duration + 60 s of wall time (a SITL in
+  // lockstep with a loaded machine may run well below real time; a lost link is caught sooner).
   void hold_depth(Vehicle& v, double duration) {
-    const auto wall_end = Clock::now() + seconds(2.0 * duration + 60.0);
+    const auto wall_end = Clock::now() + seconds(10.0 * duration + 60.0);
     auto next_status = Clock::now() + std::chrono::seconds(5);
     const std::uint32_t t0 = v.local->time_boot_ms;
     double lo = v.local->z, hi = v.local->z;
@@ -413,7 +598,7 @@ class Mission {
       spin(std::min(wall_end, next_status));
     }
     throw std::runtime_error(v.name + ": its clock did not advance " + fmt(duration) + " s in " +
-                             fmt(2.0 * duration + 60.0) + " s of wall time");
+                             fmt(10.0 * duration + 60.0) + " s of wall time");
   }
 
   // One round: periodic sends, poll() until input or `until` (at most 20 ms), read, dispatch,
@@ -447,6 +632,11 @@ class Mission {
       if (v->have_heartbeat && now - v->last_heartbeat > seconds(opt_.link_timeout))
         throw MissionError(v->name + ": no HEARTBEAT for " + fmt(opt_.link_timeout) +
                            " s: link lost");
+      if (v->uncommanded_mode) {
+        const std::string what = v->events.back();
+        v->uncommanded_mode.reset();
+        throw MissionError(what);
+      }
       if (v->expect_armed && !v->armed() && now - v->armed_since > std::chrono::seconds(2))
         throw MissionError(
             v->name + " disarmed unexpectedly" +
@@ -454,26 +644,27 @@ class Mission {
     }
   }
 
-  // HEARTBEAT 1 Hz to both; MANUAL_CONTROL 20 Hz to the sub (ArduSub's pilot-input failsafe);
-  // the boat's follow target 1 Hz; the sub's survey target 2 Hz.
+  // HEARTBEAT 1 Hz to each vehicle (its GCS failsafe); MANUAL_CONTROL 20 Hz to the sub
+  // (ArduSub's pilot-input failsafe); the boat's follow target 1 Hz; the sub's survey target
+  // 2 Hz. Each in the receiving vehicle's clock and at least as often in wall time (Pace).
   void periodic() {
     const auto now = Clock::now();
-    if (now >= next_heartbeat_) {
-      mavlink::Heartbeat hb;
-      hb.type = mavlink::kTypeGcs;
-      hb.autopilot = mavlink::kAutopilotInvalid;
-      for (Vehicle* v : vehicles())
-        if (v->link.is_open()) send(*v, hb);
-      next_heartbeat_ = now + std::chrono::seconds(1);
+    for (Vehicle* v : vehicles()) {
+      if (!v->link.is_open()) continue;
+      if (heartbeat_pace_[v == sub_.get() ? 0 : 1].due(*v, 1.0, now)) {
+        mavlink::Heartbeat hb;
+        hb.type = mavlink::kTypeGcs;
+        hb.autopilot = mavlink::kAutopilotInvalid;
+        send(*v, hb);
+      }
     }
-    if (sub_ && sub_->link.is_open() && now >= next_manual_) {
+    if (sub_ && sub_->link.is_open() && manual_pace_.due(*sub_, 0.05, now)) {
       mavlink::ManualControl mc;
       mc.z = manual_z_;
       mc.target = sub_->sysid;
       send(*sub_, mc);
-      next_manual_ = now + std::chrono::milliseconds(50);
     }
-    if (following_ && boat_ && sub_ && sub_->global && now >= next_follow_) {
+    if (following_ && boat_ && sub_ && sub_->global && follow_pace_.due(*boat_, 1.0, now)) {
       mavlink::SetPositionTargetGlobalInt t;
       t.lat_int = sub_->global->lat;
       t.lon_int = sub_->global->lon;
@@ -482,12 +673,9 @@ class Mission {
       t.target_system = boat_->sysid;
       t.target_component = mavlink::kCompAutopilot1;
       send(*boat_, t);
-      next_follow_ = now + std::chrono::seconds(1);
     }
-    if (local_target_ && sub_ && now >= next_local_target_) {
+    if (local_target_ && sub_ && local_target_pace_.due(*sub_, 0.5, now))
       send(*sub_, *local_target_);
-      next_local_target_ = now + std::chrono::milliseconds(500);
-    }
   }
 
   void handle(Vehicle& v, const mavlink::Frame& f) {
@@ -496,22 +684,30 @@ class Mission {
       // Only the autopilot's own HEARTBEAT (a GCS or a camera may share the link).
       if (hb->autopilot == mavlink::kAutopilotInvalid) return;
       if (v.have_heartbeat && f.sysid != v.sysid) return;
+      const bool first = !v.have_heartbeat;
+      const mavlink::Heartbeat before = v.heartbeat;
       v.sysid = f.sysid;
       v.have_heartbeat = true;
       v.last_heartbeat = Clock::now();
       v.heartbeat = *hb;
+      watch(v, first, before);
       return;
     }
     if (!v.have_heartbeat || f.sysid != v.sysid) return;
     if (auto m = mavlink::decode<mavlink::LocalPositionNed>(f)) {
       v.local = *m;
+      v.clock_ms = m->time_boot_ms;
       log_->write(t, v.name, *m);
     } else if (auto g = mavlink::decode<mavlink::GlobalPositionInt>(f)) {
       v.global = *g;
+      v.clock_ms = g->time_boot_ms;
       log_->write(t, v.name, *g);
     } else if (auto a = mavlink::decode<mavlink::Attitude>(f)) {
       v.attitude = *a;
+      v.clock_ms = a->time_boot_ms;
       log_->write(t, v.name, *a);
+    } else if (auto st = mavlink::decode<mavlink::SystemTime>(f)) {
+      v.clock_ms = st->time_boot_ms;
     } else if (auto s = mavlink::decode<mavlink::Statustext>(f)) {
       v.last_text = mavlink::to_string(s->text);
       phase(v.name + " says (" + mavlink::severity_name(s->severity) + "): " + v.last_text);
@@ -522,14 +718,54 @@ class Mission {
     }
   }
 
+  // The mode and failsafe watch, on each HEARTBEAT of the vehicle. A mode other than the one
+  // kelp-mission set (outside its own mode changes) is a change it did not command: reported
+  // now, and spin() ends the mission with it. A system_status entering MAV_STATE_CRITICAL or
+  // EMERGENCY (ArduPilot's report of an active failsafe, GCS_Common.cpp / each vehicle's
+  // vehicle_system_status()) is reported with the last STATUSTEXT and counted.
+  void watch(Vehicle& v, bool first, const mavlink::Heartbeat& before) {
+    const auto failsafe = [](std::uint8_t status) { return status == 5 || status == 6; };
+    const std::string at = " at " + v.clock_text() + " s of its clock";
+    const std::string text =
+        v.last_text.empty() ? "" : "; last STATUSTEXT: \"" + v.last_text + "\"";
+    if (failsafe(v.heartbeat.system_status) && (first || !failsafe(before.system_status))) {
+      ++v.failsafes;
+      v.events.push_back(v.name + ": failsafe (HEARTBEAT system_status " +
+                         (v.heartbeat.system_status == 5 ? "CRITICAL" : "EMERGENCY") + ")" + at +
+                         text);
+      phase(v.events.back());
+    }
+    if (first || !v.commanded_mode || v.changing_mode) return;
+    const std::uint32_t mode = v.heartbeat.custom_mode;
+    if (mode == before.custom_mode || mode == *v.commanded_mode) return;
+    ++v.uncommanded_mode_changes;
+    v.events.push_back(v.name + ": mode changed from " + mode_name(v.is_sub(), before.custom_mode) +
+                       " to " + mode_name(v.is_sub(), mode) + at +
+                       " without a command from kelp-mission (a failsafe or another ground "
+                       "station)" +
+                       text);
+    phase(v.events.back());
+    if (checks_) v.uncommanded_mode = mode;
+  }
+
+  // The summary: per vehicle, what the link carried and what happened that kelp-mission did not
+  // ask for. Frames of message types kelp-mission does not decode (ArduPilot streams dozens)
+  // are well-formed and simply not used: "ignored", not errors. Malformed input is counted
+  // apart: CRC mismatches, impossible lengths, unknown incompatibility flags, stray bytes.
   void print_link_stats() {
     if (log_) log_->flush();
     for (Vehicle* v : vehicles()) {
       const auto& s = v->link.stats();
-      out_ << v->name << " link: " << s.frames << " frames; dropped: " << s.bad_crc << " bad CRC, "
-           << s.bad_length << " bad length, " << s.bad_flags << " bad flags, " << s.unknown_msgid
-           << " of unknown messages; " << s.junk_bytes << " bytes outside frames; "
-           << v->link.dropped_frames() << " frames not sent" << std::endl;
+      out_ << v->name << " link: " << s.frames << " frames used, " << s.unknown_msgid
+           << " frames of other message types ignored; malformed: " << s.bad_crc << " bad CRC, "
+           << s.bad_length << " bad length, " << s.bad_flags << " bad flags, " << s.junk_bytes
+           << " bytes outside frames; " << v->link.dropped_frames()
+           << " frames not sent (send buffer full)" << std::endl;
+      out_ << v->name << ": " << v->uncommanded_mode_changes
+           << " mode changes not commanded by kelp-mission, " << v->failsafes << " failsafes"
+           << (v->clock_ms ? "; its clock at " + v->clock_text() + " s" : std::string())
+           << std::endl;
+      for (const std::string& e : v->events) out_ << "  " << e << std::endl;
     }
   }
 
@@ -552,7 +788,8 @@ class Mission {
   bool checks_ = true;  // link and arming checks in spin()
   std::int16_t manual_z_ = kNeutralZ;
   std::optional<mavlink::SetPositionTargetLocalNed> local_target_;
-  Clock::time_point next_heartbeat_{}, next_manual_{}, next_follow_{}, next_local_target_{};
+  std::array<Pace, 2> heartbeat_pace_{};  // sub, boat
+  Pace manual_pace_, follow_pace_, local_target_pace_;
 };
 
 }  // namespace kelp_sitl::mission

@@ -4,6 +4,12 @@
 // with COMMAND_ACK (refusing arming as scripted, with a "PreArm: ..." STATUSTEXT), and "flies":
 // in ALT_HOLD the depth follows MANUAL_CONTROL z; in GUIDED the position moves toward the last
 // target received. It records what the client sent, for the test to check afterwards.
+//
+// Its clock (time_boot_ms, the kinematics, the failsafes) runs `clock_speed` times faster than
+// the wall clock, as a SITL at --speedup does. Optionally it has ArduPilot's GCS failsafe (a
+// mode change to `failsafe_mode` and system_status CRITICAL after `gcs_failsafe_timeout` s of
+// its clock without a GCS HEARTBEAT, as ArduRover's FS_GCS_ENABLE / FS_GCS_TIMEOUT) or a
+// scripted failsafe some time after it entered GUIDED.
 #pragma once
 
 #include <arpa/inet.h>
@@ -40,8 +46,12 @@ struct FakeConfig {
   bool banner = false;              // plain text before the first frame (as ArduSub prints)
   double speed = 8.0;               // m/s horizontal in GUIDED
   double descent_rate = 3.0;        // m/s at full stick
-  double heartbeat_hz = 5.0;
+  double heartbeat_hz = 5.0;        // per wall second (as the state messages, 20 Hz)
   double origin_lat = 33.810313, origin_lon = -118.393867;
+  double clock_speed = 1.0;             // its seconds per wall second
+  double gcs_failsafe_timeout = -1.0;   // s of its clock without GCS HEARTBEAT (< 0: none)
+  double failsafe_after_guided = -1.0;  // s of its clock in GUIDED, then failsafe (< 0: never)
+  std::uint32_t failsafe_mode = 4;      // Rover HOLD
 };
 
 // What the fake received.
@@ -55,8 +65,10 @@ struct FakeRecord {
   std::vector<int> arm_states;       // accepted arm (1) / disarm (0), in order
   std::vector<mv::SetPositionTargetLocalNed> local_targets;
   std::vector<mv::SetPositionTargetGlobalInt> global_targets;
-  std::vector<std::uint8_t> senders;  // sysid of every frame received
-  bool dive_before_position = false;  // MANUAL_CONTROL z < 500 before any position was sent
+  std::vector<std::uint8_t> senders;        // sysid of every frame received
+  bool dive_before_position = false;        // MANUAL_CONTROL z < 500 before any position was sent
+  std::vector<double> gcs_heartbeat_clock;  // its clock (s) at each GCS HEARTBEAT
+  bool failsafe = false;                    // a failsafe fired
 };
 
 class FakeAutopilot {
@@ -120,6 +132,9 @@ class FakeAutopilot {
     auto last = Clock::now();
     auto next_hb = last, next_pos = last;
     mv::Parser parser;
+    const auto clock = [&](Clock::time_point t) {
+      return cfg_.clock_speed * std::chrono::duration<double>(t - start).count();
+    };
     while (!stop_) {
       pollfd p{fd_, POLLIN, 0};
       if (::poll(&p, 1, 10) == 1) {
@@ -127,15 +142,17 @@ class FakeAutopilot {
         const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
         if (n <= 0) break;  // client gone
         parser.feed(buf, static_cast<std::size_t>(n), [&](const mv::Frame& f) {
-          handle(f, std::chrono::duration<double>(Clock::now() - start).count());
+          handle(f, std::chrono::duration<double>(Clock::now() - start).count(),
+                 clock(Clock::now()));
         });
       }
       const auto now = Clock::now();
       if (cfg_.silent || (cfg_.silent_after >= 0 &&
                           std::chrono::duration<double>(now - start).count() > cfg_.silent_after))
         continue;
-      step(std::chrono::duration<double>(now - last).count());
+      step(cfg_.clock_speed * std::chrono::duration<double>(now - last).count());
       last = now;
+      check_failsafes(clock(now));
       if (now >= next_hb) {
         send_heartbeat();
         next_hb = now + std::chrono::duration_cast<Clock::duration>(
@@ -143,8 +160,7 @@ class FakeAutopilot {
       }
       if (now >= next_pos &&
           std::chrono::duration<double>(now - start).count() >= cfg_.position_after) {
-        send_state(static_cast<std::uint32_t>(
-            std::chrono::duration_cast<std::chrono::milliseconds>(now - start).count()));
+        send_state(static_cast<std::uint32_t>(clock(now) * 1000.0));
         next_pos = now + std::chrono::milliseconds(50);
       }
     }
@@ -165,18 +181,43 @@ class FakeAutopilot {
     hb.type = cfg_.mav_type;
     hb.autopilot = mv::kAutopilotArdupilotmega;
     hb.base_mode = static_cast<std::uint8_t>(81 | (armed_ ? 128 : 0));
-    hb.system_status = armed_ ? 4 : 3;
+    hb.system_status = failsafe_ ? 5 : armed_ ? 4 : 3;  // CRITICAL, ACTIVE, STANDBY
     send(hb);
+  }
+
+  // ArduPilot's GCS failsafe, counted in its own clock, and the scripted one.
+  void check_failsafes(double t) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (failsafe_ || !armed_) return;
+    std::string why;
+    if (cfg_.gcs_failsafe_timeout >= 0 && last_gcs_heartbeat_ >= 0 &&
+        t - last_gcs_heartbeat_ > cfg_.gcs_failsafe_timeout)
+      why = "Failsafe. GCS";
+    const std::uint32_t guided = cfg_.mav_type == mv::kTypeSubmarine ? 4u : 15u;
+    if (mode_ == guided && cfg_.failsafe_after_guided >= 0 && guided_since_ >= 0 &&
+        t - guided_since_ > cfg_.failsafe_after_guided)
+      why = "Failsafe. Scripted";
+    if (why.empty()) return;
+    failsafe_ = true;
+    record_.failsafe = true;
+    mode_ = cfg_.failsafe_mode;
+    have_target_ = false;
+    lock.unlock();
+    mv::Statustext s;
+    s.severity = 2;
+    s.text = mv::to_chars<50>(why);
+    send(s);
   }
 
   void send_state(std::uint32_t t_ms) {
     mv::LocalPositionNed lp;
     mv::GlobalPositionInt gp;
     mv::Attitude att;
+    mv::SystemTime st;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       position_sent_ = true;
-      lp.time_boot_ms = gp.time_boot_ms = att.time_boot_ms = t_ms;
+      lp.time_boot_ms = gp.time_boot_ms = att.time_boot_ms = st.time_boot_ms = t_ms;
       lp.x = static_cast<float>(x_);
       lp.y = static_cast<float>(y_);
       lp.z = static_cast<float>(z_);
@@ -188,6 +229,7 @@ class FakeAutopilot {
       gp.hdg = 65535;
       att.yaw = static_cast<float>(yaw_);
     }
+    send(st);
     send(lp);
     send(gp);
     send(att);
@@ -219,11 +261,14 @@ class FakeAutopilot {
     send(a);
   }
 
-  void handle(const mv::Frame& f, double t) {
+  // t: wall s since the start; clock: its own clock, s.
+  void handle(const mv::Frame& f, double t, double clock) {
     std::unique_lock<std::mutex> lock(mutex_);
     record_.senders.push_back(f.sysid);
     if (auto hb = mv::decode<mv::Heartbeat>(f)) {
       ++record_.gcs_heartbeats;
+      record_.gcs_heartbeat_clock.push_back(clock);
+      last_gcs_heartbeat_ = clock;
       record_.gcs_heartbeat_ok = record_.gcs_heartbeat_ok && f.sysid == 255 && f.compid == 190 &&
                                  hb->type == mv::kTypeGcs && hb->autopilot == mv::kAutopilotInvalid;
     } else if (auto mc = mv::decode<mv::ManualControl>(f)) {
@@ -252,6 +297,7 @@ class FakeAutopilot {
       } else if (c->command == mv::kCmdDoSetMode) {
         mode_ = static_cast<std::uint32_t>(c->param2);
         record_.modes.push_back(mode_);
+        guided_since_ = clock;
         have_target_ = false;
         lock.unlock();
         ack(c->command, mv::Result::Accepted);
@@ -294,6 +340,9 @@ class FakeAutopilot {
   double tx_ = 0, ty_ = 0, tz_ = 0;
   bool have_target_ = false;
   bool position_sent_ = false;
+  bool failsafe_ = false;
+  double last_gcs_heartbeat_ = -1.0;  // its clock, s
+  double guided_since_ = -1.0;        // its clock at the last mode change, s
 };
 
 }  // namespace kelp_sitl::test

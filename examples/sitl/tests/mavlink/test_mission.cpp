@@ -265,3 +265,93 @@ TEST_CASE("kelp-mission: a vehicle that stops talking mid-mission fails it; the 
   CHECK_FALSE(boat.armed());
   std::filesystem::remove_all(o.log_dir);
 }
+
+// At SITL --speedup 10 the vehicles' clocks run ten times faster than the wall clock, and
+// their failsafes count in their clocks: ArduRover's GCS failsafe (FS_GCS_TIMEOUT 5 s in
+// params/blueboat.parm) fired when kelp-mission sent one HEARTBEAT per wall second (one per
+// ~7.6 simulated seconds in a real run). Paced by the vehicles' clocks, HEARTBEATs reach both
+// at least once per second of their time and the mission completes.
+TEST_CASE("kelp-mission paces HEARTBEATs by the vehicles' clocks: no GCS failsafe at 10x",
+          "[mission]") {
+  FakeConfig sub_cfg;
+  sub_cfg.clock_speed = 10.0;
+  sub_cfg.gcs_failsafe_timeout = 5.0;
+  sub_cfg.failsafe_mode = 19;  // MANUAL, as ArduSub's FS_GCS_ENABLE 2 would
+  FakeAutopilot sub(sub_cfg);
+  FakeConfig boat_cfg = boat_config();
+  boat_cfg.clock_speed = 10.0;
+  boat_cfg.gcs_failsafe_timeout = 5.0;
+  FakeAutopilot boat(boat_cfg);
+  Options o = short_options("fastclock");
+  o.sub = sub.endpoint();
+  o.rover = boat.endpoint();
+  o.hold = 40.0;  // s of the sub's clock: 4 s of wall time
+  o.survey_side = 20.0;
+
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("held depth between") != std::string::npos);
+  CHECK(r.out.find("0 mode changes not commanded by kelp-mission, 0 failsafes") !=
+        std::string::npos);
+  for (const FakeAutopilot* f : {&sub, &boat}) {
+    const auto rec = const_cast<FakeAutopilot*>(f)->record();
+    CHECK_FALSE(rec.failsafe);
+    REQUIRE(rec.gcs_heartbeat_clock.size() > 20);
+    double max_gap = 0;
+    for (std::size_t i = 1; i < rec.gcs_heartbeat_clock.size(); ++i)
+      max_gap = std::max(max_gap, rec.gcs_heartbeat_clock[i] - rec.gcs_heartbeat_clock[i - 1]);
+    CHECK(max_gap < 2.5);  // s of the vehicle's clock; the failsafe needs 5
+  }
+  std::filesystem::remove_all(o.log_dir);
+}
+
+// A mode change kelp-mission did not command (here the boat's failsafe puts it in HOLD while
+// it follows the sub) is reported with the vehicle's clock and the STATUSTEXT, ends the mission
+// (the boat would hold there for good) and is counted in the summary.
+TEST_CASE("kelp-mission reports a mode change it did not command and stops the mission",
+          "[mission]") {
+  FakeConfig sub_cfg;
+  FakeAutopilot sub(sub_cfg);
+  FakeConfig boat_cfg = boat_config();
+  boat_cfg.failsafe_after_guided = 1.0;
+  FakeAutopilot boat(boat_cfg);
+  Options o = short_options("uncommanded");
+  o.sub = sub.endpoint();
+  o.rover = boat.endpoint();
+  o.hold = 10.0;
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 1);
+  CHECK(boat.record().failsafe);
+  CHECK(r.err.find("FAILED: boat: mode changed from GUIDED (15) to HOLD (4) at ") !=
+        std::string::npos);
+  CHECK(r.err.find("without a command from kelp-mission") != std::string::npos);
+  CHECK(r.err.find("Failsafe. Scripted") != std::string::npos);
+  CHECK(r.out.find("boat: failsafe (HEARTBEAT system_status CRITICAL)") != std::string::npos);
+  CHECK(r.out.find("boat: 1 mode changes not commanded by kelp-mission, 1 failsafes") !=
+        std::string::npos);
+  CHECK(r.out.find("sub: 0 mode changes not commanded by kelp-mission, 0 failsafes") !=
+        std::string::npos);
+  // Both left safe: the sub MANUAL and disarmed, the boat HOLD and disarmed.
+  CHECK_FALSE(sub.armed());
+  CHECK_FALSE(boat.armed());
+  std::filesystem::remove_all(o.log_dir);
+}
+
+TEST_CASE("kelp-mission's summary tells ignored message types from malformed frames", "[mission]") {
+  FakeAutopilot sub{FakeConfig{}};
+  Options o = short_options("summary");
+  o.sub = sub.endpoint();
+  o.rover = "none";
+  o.survey_side = 0.0;
+  const Run r = run_mission(o);
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find(" frames of other message types ignored; malformed: 0 bad CRC, 0 bad "
+                   "length, 0 bad flags, ") != std::string::npos);
+  CHECK(r.out.find("unknown messages") == std::string::npos);
+  std::filesystem::remove_all(o.log_dir);
+}
