@@ -327,23 +327,23 @@ class AuvController {
       const double sv = fit(vertical_);
       vertical_ *= sv;
       force_ += vertical_;
-      const double s = fit(force_);
-      force_ *= s;
-      command_.saturated = sh < 1.0 || sv < 1.0 || s < 1.0;
+      const double sa = fit(force_);
+      force_ *= sa;
+      command_.saturated = sh < 1.0 || sv < 1.0 || sa < 1.0;
       // Anti-windup per group: what a group could not deliver is not integrated.
-      if (sh < 1.0 || s < 1.0) {
+      if (sh < 1.0 || sa < 1.0) {
         surge_.set_integral(i_saved[0]);
         sway_.set_integral(i_saved[1]);
         yaw_.set_integral(i_saved[3]);
       }
-      if (sv < 1.0 || s < 1.0) heave_.set_integral(i_saved[2]);
+      if (sv < 1.0 || sa < 1.0) heave_.set_integral(i_saved[2]);
     } else {
       // Allocation, then uniform scaling so that no thruster exceeds its limit.
       thrusters_.allocation().distribute(tau, force_);
-      const double s = fit(force_);
-      command_.saturated = s < 1.0;
+      const double sa = fit(force_);
+      command_.saturated = sa < 1.0;
       if (command_.saturated) {
-        force_ *= s;
+        force_ *= sa;
         // Anti-windup: the allocation could not deliver: keep the integrals where they were.
         surge_.set_integral(i_saved[0]);
         sway_.set_integral(i_saved[1]);
