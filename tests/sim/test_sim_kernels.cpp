@@ -110,16 +110,19 @@ TEST_CASE("deterministic runs give the same summary and logs, bit for bit, on ev
     CHECK(!f.summary.at("scenario").contains("kernel"));
     if (p == KernelPath::portable) continue;
     const bool kernel_differs = wave_kernel_differs(rough_run(), p);
-    const bool run_differs = f.summary != free_portable.summary;
+    // The summaries without the field that names the path (which always differs).
+    nlohmann::json a = f.summary, b = free_portable.summary;
+    a.erase("kernel");
+    b.erase("kernel");
+    const bool run_differs = a != b;
     WARN("without the deterministic mode the " << name << " path's run "
                                                << (run_differs ? "differs from" : "equals")
                                                << " the portable one on this CPU");
-    // Where the wave kernels differ, the closed loop carries the difference into the summary:
-    // the deterministic runs above would have differed without the mode.
-    if (kernel_differs) {
-      CHECK(run_differs);
-      CHECK(f.timeseries != free_portable.timeseries);
-    }
+    // Where the wave kernels differ, the closed loop carries the difference into the summary's
+    // numbers: the deterministic runs above would have differed without the mode. (Not always
+    // into the time series' printed digits: since the calm start and the "kelp" controllers the
+    // two paths' runs stay within ~1e-15 relative of each other over these 30 s.)
+    if (kernel_differs) CHECK(run_differs);
   }
 }
 
