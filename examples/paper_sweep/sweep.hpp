@@ -166,10 +166,11 @@ inline std::string value_text(const json& v) {
 }  // namespace detail
 
 /// The paper's grid: tether length {5, 10, 15} m × sea {moderate, rough} × compensation
-/// {off, on} × seeds 1–5, 300 s each.
+/// {off, on} × seeds 1–5, 300 s each, flown by the paper's controllers (the scenario's
+/// `"control": {"preset": "paper"}`: the grid reproduces the paper's evaluation of them).
 inline json default_sweep_json() {
   return json::parse(R"({
-    "base": {"duration": 300},
+    "base": {"duration": 300, "control": {"preset": "paper"}},
     "axes": [
       {"path": "/tether/length", "values": [5, 10, 15]},
       {"path": "/sea", "values": ["moderate", "rough"]},
