@@ -134,6 +134,22 @@ const T200Branch& t200_branch(const Scalar& command, Scalar& magnitude, double& 
   return u < 0.0 ? t200_reverse : t200_forward;
 }
 
+/// The operating point of a command at a supply voltage (both checked): the branch of u's sign,
+/// the sign, and s = (|u| − u₀(V)) / (1 − u₀(V)) past the dead band with its span 1 − u₀(V).
+/// \returns false inside the dead band (|u| ≤ u₀: no thrust, no current; s is then unset).
+template <typename Scalar>
+bool t200_point(const Scalar& command, const Scalar& voltage, const T200Branch*& branch,
+                double& sign, Scalar& s, Scalar& span) {
+  t200_check_voltage(voltage);
+  Scalar m;
+  branch = &t200_branch(command, m, sign);
+  const Scalar u0 = t200_dead_band(voltage);
+  if (value_of(m) <= value_of(u0)) return false;
+  span = Scalar(1) - u0;
+  s = (m - u0) / span;
+  return true;
+}
+
 }  // namespace detail
 
 /// \brief The ESC's dead band [normalised command] at a supply voltage: |u| ≤ u₀(V) gives no
@@ -157,31 +173,26 @@ Scalar t200_dead_band(const Scalar& voltage) {
 /// \throws kelp::invalid_argument when a value is not finite or the voltage is outside [0, 20] V.
 template <typename Scalar>
 Scalar t200_thrust(const Scalar& command, const Scalar& voltage) {
-  detail::t200_check_voltage(voltage);
-  Scalar m;
-  double sign;
-  const detail::T200Branch& b = detail::t200_branch(command, m, sign);
-  const Scalar u0 = detail::t200_dead_band(voltage);
-  if (value_of(m) <= value_of(u0)) return Scalar(0);
-  const Scalar s = (m - u0) / (Scalar(1) - u0);
-  return Scalar(sign * t200_kgf) * detail::t200_poly<Scalar>(b.thrust, s, voltage, nullptr);
+  const detail::T200Branch* b = nullptr;
+  double sign = 1.0;
+  Scalar s, span;
+  if (!detail::t200_point(command, voltage, b, sign, s, span)) return Scalar(0);
+  return Scalar(sign * t200_kgf) * detail::t200_poly<Scalar>(b->thrust, s, voltage, nullptr);
 }
 
 /// \brief dF/du of t200_thrust() [N] (≥ 0; 0 in the dead band and for |u| > 1).
 /// \throws kelp::invalid_argument as t200_thrust().
 template <typename Scalar>
 Scalar t200_thrust_slope(const Scalar& command, const Scalar& voltage) {
-  detail::t200_check_voltage(voltage);
-  Scalar m;
-  double sign;
-  const detail::T200Branch& b = detail::t200_branch(command, m, sign);
+  const detail::T200Branch* b = nullptr;
+  double sign = 1.0;
+  Scalar s, span;
   const double u = value_of(command);
-  const Scalar u0 = detail::t200_dead_band(voltage);
-  if (value_of(m) <= value_of(u0) || u > 1.0 || u < -1.0) return Scalar(0);
-  const Scalar s = (m - u0) / (Scalar(1) - u0);
+  if (!detail::t200_point(command, voltage, b, sign, s, span) || u > 1.0 || u < -1.0)
+    return Scalar(0);
   Scalar ds;
-  detail::t200_poly<Scalar>(b.thrust, s, voltage, &ds);
-  return Scalar(t200_kgf) * ds / (Scalar(1) - u0);
+  detail::t200_poly<Scalar>(b->thrust, s, voltage, &ds);
+  return Scalar(t200_kgf) * ds / span;
 }
 
 /// \brief Supply current drawn by one T200 and its ESC [A] (≥ 0; 0 in the dead band).
@@ -190,14 +201,11 @@ Scalar t200_thrust_slope(const Scalar& command, const Scalar& voltage) {
 /// \throws kelp::invalid_argument as t200_thrust().
 template <typename Scalar>
 Scalar t200_current(const Scalar& command, const Scalar& voltage) {
-  detail::t200_check_voltage(voltage);
-  Scalar m;
-  double sign;
-  const detail::T200Branch& b = detail::t200_branch(command, m, sign);
-  const Scalar u0 = detail::t200_dead_band(voltage);
-  if (value_of(m) <= value_of(u0)) return Scalar(0);
-  const Scalar s = (m - u0) / (Scalar(1) - u0);
-  const Scalar i = detail::t200_poly<Scalar>(b.current, s, voltage, nullptr);
+  const detail::T200Branch* b = nullptr;
+  double sign = 1.0;
+  Scalar s, span;
+  if (!detail::t200_point(command, voltage, b, sign, s, span)) return Scalar(0);
+  const Scalar i = detail::t200_poly<Scalar>(b->current, s, voltage, nullptr);
   return value_of(i) > 0.0 ? i : Scalar(0);
 }
 
