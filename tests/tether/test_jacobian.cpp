@@ -37,6 +37,10 @@ struct Config {
   // stretching (its dashpot pulling).
   bool fold = false;
   double bending = 0.5, cat = 0.3, damping = 20.0;
+  // The line parted at this segment (TetherState::parted; -1: intact).
+  int parted = -1;
+  // Both ends clamped (EndMotion::direction) in random directions.
+  bool clamp = false;
 };
 
 // A short, soft, thick line (so that drag, added mass and the band are not swamped by the axial
@@ -127,6 +131,17 @@ struct Scene {
     }
     ws.water_frozen = true;
     ws.water_is_zero = false;
+    if (c.parted >= 0) {
+      kt::TetherState<double> st(model);
+      st.parted(c.parted) = 1;
+      kt::detail::load_parted(st, ws);
+    }
+    if (c.clamp) {
+      kt::TetherBoundary<double> b;
+      b.start.direction = Vector3<double>(1.0, 0.5 * u(rng), 0.5 * u(rng));
+      b.end.direction = Vector3<double>(-1.0, 0.5 * u(rng), 0.5 * u(rng));
+      kt::detail::load_clamps(model, b, ws);
+    }
   }
   // compute_forces at (xx, vv); returns the forces and M_i d_i per node.
   void forces(const Matrix3X<double>& xx, const Matrix3X<double>& vv, Matrix3X<double>& f,
@@ -293,6 +308,22 @@ TEST_CASE("whole Jacobian: every block matches central differences of compute_fo
     Config c;
     c.fold = true;
     configs.push_back({"a segment folded below the dashpot's fade length", c});
+  }
+  {
+    Config c;
+    c.parted = 5;
+    configs.push_back({"a parted segment (TetherState::parted) inside the line", c});
+  }
+  {
+    Config c;
+    c.parted = 0;
+    c.free_end = true;
+    configs.push_back({"parted at the kinematic start, free far end", c});
+  }
+  {
+    Config c;
+    c.clamp = true;
+    configs.push_back({"both ends clamped (EndMotion::direction)", c});
   }
   for (const auto& [name, c] : configs)
     for (unsigned seed = 1; seed <= 6; ++seed) {

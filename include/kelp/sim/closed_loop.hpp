@@ -28,6 +28,7 @@
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
+#include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/solver_stats.hpp"
@@ -147,6 +148,8 @@ class ClosedLoop {
     }
     auv_.follow(waypoints_);
     asv_.follow_auv();
+    // At most one parting per segment: no allocation in a step when the line parts.
+    failures_.reserve(std::size_t(model_.tether().segments()));
     if (sc.navigation.mode == "sensors")
       navigation_ = std::make_unique<kelp::nav::PairNavigation>(sc.navigation.sensors,
                                                                 sc.navigation.seed, model_, state_);
@@ -186,6 +189,11 @@ class ClosedLoop {
       inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
     solver_stats_ += report_;
+    if (report_.tether.partings > 0) {
+      // The line parted in this step (kelp/tether/failure.hpp): kept for the summary and logged.
+      failures_.push_back(report_.tether.failure);
+      if (options_.log) options_.log->line_parted(report_.tether.failure);
+    }
     ++k_;
     if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
     observe();
@@ -243,6 +251,10 @@ class ClosedLoop {
   const RunMetrics& metrics() const { return metrics_; }
   /// \brief How hard the tether's solver has worked so far (every step's report summed).
   const kelp::system::SolverStatsd& solver_stats() const { return solver_stats_; }
+  /// \brief The AUV's turns about the tether at its attachment (updated at every step).
+  const TurnCounter& turn_counter() const { return turns_; }
+  /// \brief The tether's partings so far (at most one per step; kelp/tether/failure.hpp).
+  const std::vector<kelp::tether::LineFailured>& line_failures() const { return failures_; }
   /// \brief The sensors and filters when the scenario's navigation mode is "sensors", else null.
   const kelp::nav::PairNavigation* navigation() const { return navigation_.get(); }
 
@@ -279,7 +291,9 @@ class ClosedLoop {
   /// tether solver's work (`tether_solver`, see solver_summary()), final energy, the wave
   /// kernel's instruction path (`kernel`: "portable", "avx2" or "avx512") and the fingerprint of
   /// the C library's math (`math_library`), the scenario file and the scenario with every field
-  /// as used.
+  /// as used. `tether` also holds the AUV's turns about the tether (`net_turns`,
+  /// `max_abs_turns`: TurnCounter) and the line's partings (`line_failures`: time, segment,
+  /// position, tension; empty while it holds).
   nlohmann::json summary() const {
     const RunMetrics& m = metrics_;
     nlohmann::json s;
@@ -294,7 +308,17 @@ class ClosedLoop {
                 {"second_half_max_distance_to_auv_m", m.late_asv_distance}};
     s["tether"] = {{"max_tension_n", m.max_tension},
                    {"mean_tension_auv_n", m.auv_mean_tension()},
-                   {"slack_fraction", m.slack_fraction()}};
+                   {"slack_fraction", m.slack_fraction()},
+                   {"net_turns", turns_.turns()},
+                   {"max_abs_turns", turns_.max_abs_turns()}};
+    // The line's partings: when, which segment, where, under what force.
+    nlohmann::json parted = nlohmann::json::array();
+    for (const auto& f : failures_)
+      parted.push_back({{"time_s", f.time},
+                        {"segment", f.segment},
+                        {"position_m", {f.position.x(), f.position.y(), f.position.z()}},
+                        {"tension_n", f.tension}});
+    s["tether"]["line_failures"] = parted;
     s["tether_solver"] = solver_summary(solver_stats_, model_.parameters());
     s["energy_j"] = kelp::system::energy(model_, state_).total();
     // Propulsion: the energy each vehicle's battery delivered [Wh] and its final state of charge.
@@ -413,6 +437,10 @@ class ClosedLoop {
     row.auv_command = auv_command_->command;
     row.tension_asv = ta;
     row.tension_auv = tb;
+    // The AUV's turns about the tether (its attachment is the tether's last node).
+    turns_.update(state_.auv, state_.tether, int(state_.tether.position.cols()) - 1);
+    row.tether_turns = turns_.turns();
+    row.parted_segments = state_.tether.parted_segments();
     // Propulsion: the thrust the thrusters deliver (lagged), their current, the batteries.
     if (const auto* pm = model_.asv_propulsion()) {
       const auto& x = state_.asv_propulsion;
@@ -469,6 +497,8 @@ class ClosedLoop {
   LogRow sample_;
   RunMetrics metrics_;
   kelp::system::SolverStatsd solver_stats_;
+  TurnCounter turns_;
+  std::vector<kelp::tether::LineFailured> failures_;
   // Navigation from sensors ("sensors" mode); null: the controllers see the true state.
   std::unique_ptr<kelp::nav::PairNavigation> navigation_;
 };

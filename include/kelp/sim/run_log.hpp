@@ -1,7 +1,7 @@
 /// \file
 /// \brief The log of a run of the tethered pair: timeseries.csv (one row per sample: both
-/// vehicles, the AUV's target and errors, thrusts, commands, end tensions) and nodes.csv (the
-/// tether's node positions).
+/// vehicles, the AUV's target and errors, thrusts, commands, end tensions, the tether's turns),
+/// nodes.csv (the tether's node positions) and events.csv (the line parting).
 ///
 /// The format is shared by kelp-tethered-pair and kelp-sitl and plotted by
 /// examples/tethered_pair/plot_run.py; its columns are documented in
@@ -20,6 +20,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/tether/failure.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/vehicle/state.hpp"
 
@@ -55,20 +56,26 @@ struct LogRow {
   Eigen::Matrix<double, 8, 1> auv_current =
       Eigen::Matrix<double, 8, 1>::Constant(none);  ///< [A], motor order
   ///@}
+  /// Net turns of the AUV about the tether at its attachment (TurnCounter) [-].
+  double tether_turns = none;
+  /// Segments of the tether that have parted (TetherState::parted) [-].
+  double parted_segments = none;
 };
 
-/// \brief timeseries.csv and nodes.csv of a run, in a directory (the columns are documented in
-/// examples/tethered_pair/README.md). Writes the header lines when constructed.
+/// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
+/// documented in examples/tethered_pair/README.md). Writes the header lines when constructed.
 class RunLog {
  public:
-  /// \brief Creates `dir` (and its parents) and the two files in it, each with its header line.
+  /// \brief Creates `dir` (and its parents) and the three files in it, each with its header line.
   /// \throws kelp::error when the files cannot be opened for writing; std::filesystem's error
   /// when the directory cannot be created.
   explicit RunLog(const std::filesystem::path& dir) {
     std::filesystem::create_directories(dir);
     ts_.open(dir / "timeseries.csv");
     nodes_.open(dir / "nodes.csv");
-    if (!ts_ || !nodes_) throw kelp::error("cannot write the run's CSV files in " + dir.string());
+    events_.open(dir / "events.csv");
+    if (!ts_ || !nodes_ || !events_)
+      throw kelp::error("cannot write the run's CSV files in " + dir.string());
     ts_ << "t,asv_x,asv_y,asv_z,asv_roll,asv_pitch,asv_yaw,asv_u,asv_v,asv_r,"
            "auv_x,auv_y,auv_z,auv_roll,auv_pitch,auv_yaw,auv_u,auv_v,auv_w,"
            "auv_target_x,auv_target_y,auv_target_z,auv_error,asv_error,"
@@ -80,8 +87,11 @@ class RunLog {
     // Propulsion.
     ts_ << ",asv_voltage,asv_soc,asv_current_port,asv_current_starboard,auv_voltage,auv_soc";
     for (int i = 1; i <= 8; ++i) ts_ << ",auv_current_" << i;
+    // The tether: turns at the ROV, parted segments.
+    ts_ << ",tether_turns,tether_parted_segments";
     ts_ << '\n';
     nodes_ << "t,node,x,y,z\n";
+    events_ << "t,event,segment,x,y,z,tension\n";
   }
 
   /// \brief Appends one row to timeseries.csv.
@@ -107,7 +117,18 @@ class RunLog {
          {r.asv_voltage, r.asv_soc, r.asv_current(0), r.asv_current(1), r.auv_voltage, r.auv_soc})
       ts_ << ',' << num(v);
     for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_current(i));
+    ts_ << ',' << num(r.tether_turns) << ',' << num(r.parted_segments);
     ts_ << '\n';
+  }
+
+  /// \brief Appends the tether's parting to events.csv (`t,event,segment,x,y,z,tension`, event
+  /// `line_parted`): its time [s], segment, position NED [m] and axial force [N].
+  void line_parted(const kelp::tether::LineFailured& f) {
+    events_ << num(f.time) << ",line_parted," << f.segment;
+    for (double v : {f.position.x(), f.position.y(), f.position.z(), f.tension})
+      events_ << ',' << num(v);
+    events_ << '\n';
+    events_.flush();
   }
 
   /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv (one line a node).
@@ -126,6 +147,7 @@ class RunLog {
   void close() {
     ts_.close();
     nodes_.close();
+    events_.close();
   }
 
  private:
@@ -133,7 +155,7 @@ class RunLog {
     std::snprintf(buf_, sizeof buf_, "%.6g", v);
     return buf_;
   }
-  std::ofstream ts_, nodes_;
+  std::ofstream ts_, nodes_, events_;
   char buf_[64] = {};
 };
 

@@ -89,6 +89,9 @@ struct Scenario {
   double normal_drag = -1, tangential_drag = -1;
   /// The line model, "kelp" (default) or "moordyn" (MoorDyn v2's: kelp::tether::LineModel).
   std::string line_model = "kelp";
+  /// Breaking strength [N] (tether::TetherParameters::breaking_strength; 0: never parts; unset,
+  /// -1: the kind's, 1557 N for the rov_tether).
+  double breaking_strength = -1;
   ///@}
   /// Redo a tether step whose implicit solve fails with RK4 instead of stopping the run
   /// (system::SystemParameters::explicit_fallback; counted in the summary's
@@ -451,10 +454,11 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   if (j.contains("tether")) {
     const auto& t = j.at("tether");
-    r.object(
-        t, "/tether",
-        {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
-         "internal_damping", "normal_drag", "tangential_drag", "explicit_fallback", "line_model"});
+    r.object(t, "/tether",
+             {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
+              "internal_damping", "normal_drag", "tangential_drag", "explicit_fallback",
+              "line_model", "breaking_strength"});
+    r.number(t, "/tether", "breaking_strength", s.breaking_strength, 0, 1e7);
     r.number(t, "/tether", "diameter", s.diameter, 1e-4, 0.5);
     r.number(t, "/tether", "mass_per_length", s.mass_per_length, 1e-4, 100);
     r.number(t, "/tether", "axial_stiffness", s.axial_stiffness, 1, 1e10);
@@ -608,6 +612,7 @@ inline nlohmann::json to_json(const Scenario& s) {
   opt("internal_damping", s.internal_damping, -1);
   opt("normal_drag", s.normal_drag, -1);
   opt("tangential_drag", s.tangential_drag, -1);
+  opt("breaking_strength", s.breaking_strength, -1);
   j["tether"]["explicit_fallback"] = s.explicit_fallback;
   if (s.line_model != "kelp") j["tether"]["line_model"] = s.line_model;
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},

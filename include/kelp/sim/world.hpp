@@ -49,6 +49,7 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
   if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
   if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
+  if (sc.breaking_strength >= 0) tp.breaking_strength = sc.breaking_strength;
   params.explicit_fallback = sc.explicit_fallback;
   if (sc.line_model != "kelp" && sc.line_model != "moordyn")
     throw scenario_error(file + ": /tether/line_model: expected \"kelp\" or \"moordyn\", got \"" +

@@ -284,7 +284,8 @@ template <typename Scalar>
 struct SystemReport {
   /// The tether integration: sub-steps, Newton iterations, worst residual, retries, summed over
   /// the step's coupling passes (SystemParameters::coupling_corrections) and its explicit
-  /// fallback, if any.
+  /// fallback, if any; its `partings` and `failure` are the committed pass's (the line parted in
+  /// this step: tether::TetherParameters::breaking_strength, kelp/tether/failure.hpp).
   tether::StepReport<Scalar> tether;
   /// Tether force on each vehicle over the step, NED [N]: the impulse the tether's integrator
   /// delivered to that end divided by dt (for BDF2, the end force at t + h).
@@ -472,10 +473,14 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     tether::TetherBoundary<Scalar> ends;
     ends.start = detail::predicted_end(state.asv, state.asv_nu_dot, p.asv_attachment);
     ends.end = detail::predicted_end(state.auv, state.auv_nu_dot, p.auv_attachment);
+    // The line's partings of the committed (last) coupling pass: an earlier pass's are undone
+    // with its tether state.
+    tether::StepReport<Scalar> pass_report;
     for (int pass = 0;; ++pass) {
       try {
-        report.tether +=
+        pass_report =
             tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, tether_options);
+        report.tether += pass_report;
       } catch (const kelp::numerical_error&) {
         if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
         // The failed step left the tether as it was: redo it explicitly.
@@ -484,8 +489,9 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
         tether::AdvanceOptions<Scalar> fallback = tether_options;
         fallback.max_dt = std::min(p.max_tether_dt, double(value_of(h)));
         fallback.integrator = tether::Integrator::rk4;
-        report.tether +=
+        pass_report =
             tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, fallback);
+        report.tether += pass_report;
         ++report.tether_fallbacks;
       }
       // The impulse the tether's integrator delivered to its ends, as a mean force.
@@ -507,6 +513,8 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
       state.asv = before.asv;
       state.auv = before.auv;
     }
+    report.tether.partings = pass_report.partings;
+    report.tether.failure = pass_report.failure;
   } catch (const kelp::error&) {
     before.restore(state);
     ws.tether_backup.restore(state.tether);

@@ -483,8 +483,10 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
   const Scalar l = model.segment_length();
   const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
+  // A parted segment (TetherState::parted) has no force on any branch.
   const auto true_branch = [&](int s) {
-    return segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s));
+    return ws.is_parted(s) ? Scalar(0)
+                           : segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s));
   };
   // Updates the branches from the extension and rate predicted by ws.delta; true if any changed.
   const auto update = [&]() {
@@ -495,7 +497,9 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
       if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
       if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
       const Scalar now =
-          segment_branch(model, ws.stretched_length(s) - l + gh * w, ws.seg_rate(s) + w);
+          ws.is_parted(s)
+              ? Scalar(0)
+              : segment_branch(model, ws.stretched_length(s) - l + gh * w, ws.seg_rate(s) + w);
       if (now != ws.seg_branch(s)) {
         changed = true;
         ws.seg_branch(s) = now;
@@ -506,7 +510,8 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
   bool on_true_branch = true;
   for (int s = 0; s < n; ++s) {
     const Scalar bt = true_branch(s);
-    const bool banded = band > Scalar(0) && ws.stretched_length(s) >= (Scalar(1) - band) * l;
+    const bool banded =
+        band > Scalar(0) && ws.stretched_length(s) >= (Scalar(1) - band) * l && !ws.is_parted(s);
     ws.seg_branch(s) = banded ? Scalar(2) : bt;
     if (ws.seg_branch(s) != bt) on_true_branch = false;
   }
@@ -565,7 +570,8 @@ int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scala
       }
       for (int s = 0; s < n; ++s) {
         const Scalar b = ws.seg_branch(s);
-        if (b == segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s))) {
+        if (ws.is_parted(s) ||
+            b == segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s))) {
           ws.seg_k_uu(s) = ws.seg_true_k_uu(s);
           ws.seg_c_uu(s) = ws.seg_true_c_uu(s);
         } else {

@@ -59,7 +59,10 @@ struct AdvanceOptions {
 /// \brief One step of length `dt` [s] with the scheme of `options` (dispatch to
 /// step_symplectic_euler, step_rk2, step_rk4, step_implicit_euler or step_bdf2, which take the
 /// same arguments): `step(model, ws, env, state, boundary, dt, options)`, kelp's calling
-/// convention (model, workspace, environment, state, inputs, dt, options).
+/// convention (model, workspace, environment, state, inputs, dt, options). After the step, a line
+/// with a breaking strength parts where a segment's axial force exceeds it
+/// (part_if_overloaded, kelp/tether/failure.hpp): StepReport::partings and
+/// StepReport::failure say so.
 /// \throws as the individual steps; kelp::invalid_argument for an Integrator value outside the
 /// enumeration.
 template <typename Scalar, typename Env>
@@ -67,19 +70,24 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
                         const Env& env, TetherState<Scalar>& state,
                         const TetherBoundary<Scalar>& boundary, double dt,
                         const StepOptions<Scalar>& options = {}) {
-  switch (options.integrator) {
-    case Integrator::symplectic_euler:
-      return step_symplectic_euler(model, ws, env, state, boundary, dt);
-    case Integrator::rk2:
-      return step_rk2(model, ws, env, state, boundary, dt);
-    case Integrator::rk4:
-      return step_rk4(model, ws, env, state, boundary, dt);
-    case Integrator::implicit_euler:
-      return step_implicit_euler(model, ws, env, state, boundary, dt, options.implicit);
-    case Integrator::bdf2:
-      return step_bdf2(model, ws, env, state, boundary, dt, options.implicit);
-  }
-  ::kelp::detail::throw_invalid_argument("integrator is not a kelp::tether::Integrator value");
+  const auto dispatch = [&]() -> StepReport<Scalar> {
+    switch (options.integrator) {
+      case Integrator::symplectic_euler:
+        return step_symplectic_euler(model, ws, env, state, boundary, dt);
+      case Integrator::rk2:
+        return step_rk2(model, ws, env, state, boundary, dt);
+      case Integrator::rk4:
+        return step_rk4(model, ws, env, state, boundary, dt);
+      case Integrator::implicit_euler:
+        return step_implicit_euler(model, ws, env, state, boundary, dt, options.implicit);
+      case Integrator::bdf2:
+        return step_bdf2(model, ws, env, state, boundary, dt, options.implicit);
+    }
+    ::kelp::detail::throw_invalid_argument("integrator is not a kelp::tether::Integrator value");
+  };
+  StepReport<Scalar> report = dispatch();
+  if (part_if_overloaded(model, state, report.failure)) report.partings = 1;
+  return report;
 }
 
 /// \brief Sub-stepping driver: advances `state` by `duration` [s] in n = ⌈duration/max_dt⌉ equal

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
 
 #include "kelp/core/simd.hpp"
 #include "kelp/core/types.hpp"
@@ -56,6 +57,8 @@ struct ForcePass {
   Eigen::Index vs;
   /// When set: M⁻¹F of every node is written here as well (3 × (N+1), column-major).
   Scalar* acc = nullptr;
+  /// One flag per segment when the line has parted (TetherWorkspace::parted), else null.
+  const std::uint8_t* parted = nullptr;
   Scalar X(int k, int i) const { return x[i * xs + k]; }
   Scalar V(int k, int i) const { return v[i * vs + k]; }
   /// The positions as a 3 × (N+1) matrix.
@@ -289,7 +292,11 @@ EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspac
     if (c.mass_turns) {
       const Scalar* w = &ws.pass_buffer(0, kMassRate + k);
       if constexpr (P::lanes == 1) {
-        const Scalar prev = i > 0 ? w[i - 1] : -w[0], next = i < c.n ? w[i + 1] : -w[c.n];
+        // At an end of the line or of a parted piece the node's own w stands for its neighbour's
+        // (its chord is its own segment: detail::chord_nodes).
+        const bool cut_before = i == 0 || (c.parted && c.parted[i - 1]);
+        const bool cut_after = i == c.n || (c.parted && c.parted[i]);
+        const Scalar prev = cut_before ? -w[i] : w[i - 1], next = cut_after ? -w[i] : w[i + 1];
         f[k] = f[k] + (P::all(prev) - P::all(next));
       } else {
         f[k] = f[k] + (P::load(w + i - 1) - P::load(w + i + 1));

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
 #include <type_traits>
 #include <utility>
 
@@ -80,12 +81,27 @@ struct NodeTangent {
   Vector3<Scalar> q;
 };
 
-/// The NodeTangent of node i of positions `x` (3 × (n+1)).
+/// The two nodes whose difference is node i's chord, x_hi − x_lo: i ± 1 inside a piece of line,
+/// the node itself on the side of an end (node 0, node n, or a segment that has parted:
+/// `parted` null or one flag per segment), so that the free end of a parted piece takes its
+/// own segment's direction as the ends of the line do.
+struct ChordNodes {
+  int lo, hi;
+};
+inline ChordNodes chord_nodes(int i, int n, const std::uint8_t* parted = nullptr) {
+  const bool cut_before = i == 0 || (parted && parted[i - 1]);
+  const bool cut_after = i == n || (parted && parted[i]);
+  return {cut_before ? i : i - 1, cut_after ? i : i + 1};
+}
+
+/// The NodeTangent of node i of positions `x` (3 × (n+1)); `parted` as in chord_nodes.
 template <typename Scalar, typename DX>
-NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n) {
+NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n,
+                                 const std::uint8_t* parted = nullptr) {
   using std::sqrt;
   NodeTangent<Scalar> t;
-  t.chord = x.col(i < n ? i + 1 : n) - x.col(i > 0 ? i - 1 : 0);
+  const ChordNodes cn = chord_nodes(i, n, parted);
+  t.chord = x.col(cn.hi) - x.col(cn.lo);
   const Scalar c2 = t.chord.squaredNorm();
   t.inv_c2 = c2 > Scalar(0) ? Scalar(1) / c2 : Scalar(0);
   t.inv_c = sqrt(t.inv_c2);
@@ -134,8 +150,9 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
   // Tangent: unit(r_{i+1} − r_{i−1}) inside, the adjacent segment at the ends. The drag below
   // is written with the unnormalised chord and 1/|c|² so that its square root and the
   // tangent's run in parallel instead of one after the other.
-  const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
-  const NodeTangent<Scalar> nt = node_tangent<Scalar>(c.positions(), i, n);
+  const ChordNodes span = chord_nodes(i, n, c.parted);
+  const int hi = span.hi, lo = span.lo;
+  const NodeTangent<Scalar> nt = node_tangent<Scalar>(c.positions(), i, n, c.parted);
   const V3& chord = nt.chord;
   const Scalar inv_c2 = nt.inv_c2, inv_c = nt.inv_c;
   const V3& q = nt.q;
@@ -271,6 +288,8 @@ void bending_forces(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   ws.bending.setZero();
   const Scalar k = c.p->bending_stiffness * c.inv_l;
   for (int i = 1; i < c.n; ++i) {
+    // No moment is carried across a parted segment.
+    if (c.parted && (c.parted[i - 1] || c.parted[i])) continue;
     const Scalar la = ws.stretched_length(i - 1), lb = ws.stretched_length(i);
     if (!(la > Scalar(0) && lb > Scalar(0))) continue;
     const V3 ua = ws.direction.col(i - 1), ub = ws.direction.col(i);
@@ -280,6 +299,47 @@ void bending_forces(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
     ws.bending.col(i - 1) += fa;
     ws.bending.col(i + 1) += fb;
     ws.bending.col(i) -= fa + fb;
+  }
+  // A clamped end (EndMotion::direction t): E = 2k (1 − t·u) with u the end segment's direction
+  // away from the end, the same pair of forces with t in place of the neighbouring segment's
+  // direction, at twice the stiffness (the beam's rotation between the clamp and its first node
+  // is taken over half a segment; with k: the tip deflection's error is 1.5/N of P L³/(3EI), with
+  // 2k the trapezoidal rule's 1/(2N²)).
+  const int n = c.n;
+  if (ws.clamp_start.squaredNorm() > Scalar(0) && !(c.parted && c.parted[0])) {
+    const Scalar lb = ws.stretched_length(0);
+    if (lb > Scalar(0)) {
+      const V3 ub = ws.direction.col(0), t = ws.clamp_start;
+      const V3 fb = (Scalar(2) * k / lb) * (t - t.dot(ub) * ub);
+      ws.bending.col(1) += fb;
+      ws.bending.col(0) -= fb;
+    }
+  }
+  if (ws.clamp_end.squaredNorm() > Scalar(0) && !(c.parted && c.parted[n - 1])) {
+    const Scalar la = ws.stretched_length(n - 1);
+    if (la > Scalar(0)) {
+      // The line leaves node N along −u_{N−1}: E = 2k (1 + t·u_{N−1}).
+      const V3 ua = ws.direction.col(n - 1), t = -ws.clamp_end;
+      const V3 fa = (Scalar(-2) * k / la) * (t - t.dot(ua) * ua);
+      ws.bending.col(n - 1) += fa;
+      ws.bending.col(n) -= fa;
+    }
+  }
+}
+
+/// Zeroes the axial force of the parted segments (TetherState::parted) and its Jacobian terms:
+/// a parted segment carries no force between its two nodes.
+template <bool WithJacobian, typename Scalar>
+void parted_segments(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  for (int s = 0; s < c.n; ++s) {
+    if (!c.parted[s]) continue;
+    ws.tension(s) = Scalar(0);
+    for (int k = 0; k < 3; ++k) ws.pass_buffer(s, kSegmentForce + k) = Scalar(0);
+    if constexpr (WithJacobian) {
+      ws.seg_k_uu(s) = Scalar(0);
+      ws.seg_k_perp(s) = Scalar(0);
+      ws.seg_c_uu(s) = Scalar(0);
+    }
   }
 }
 
@@ -316,6 +376,15 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   if constexpr (wide)
     for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, packed, ws, s);
   for (; s < n; ++s) segment_block<WithJacobian, false>(c, single, ws, s);
+  if (c.parted) {
+    // A parted line (TetherState::parted) takes the general path: its parted segments carry no
+    // axial force, and the nodes beside them are ends of their pieces (chord_nodes).
+    parted_segments<WithJacobian>(c, ws);
+    if (c.bending) bending_forces(c, ws);
+    for (int i = 0; i <= n; ++i) node_general<WithJacobian>(c, ws, i);
+    for (int i = 0; i <= n; ++i) finish_block<false>(c, ws, i);
+    return;
+  }
   if (c.bending) bending_forces(c, ws);
   node_general<WithJacobian>(c, ws, 0);
   int i = 1;
@@ -372,6 +441,7 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   // Added-mass rate terms (see compute_forces); none when Cat = Can (b = 0) and none in
   // MoorDyn's line model (TetherModel::added_mass_rate_terms).
   c.mass_turns = model.added_mass_rate_terms();
+  c.parted = ws.any_parted ? ws.parted.data() : nullptr;
 
   // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
   // gives zeros everywhere, which the buffers keep from the last time they were zeroed.
@@ -542,12 +612,16 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
   const Scalar rho = Scalar(env.water_density()), g = Scalar(env.gravity());
   const Scalar l = model.segment_length();
   Scalar e(0);
+  const std::uint8_t* parted =
+      state.parted.size() == n && state.parted.any() ? state.parted.data() : nullptr;
   for (int s = 0; s < n; ++s) {
+    if (parted && parted[s]) continue;  // a parted segment stores no energy
     const Scalar ls = (state.position.col(s + 1) - state.position.col(s)).norm();
     if (ls > l) e += Scalar(0.5) * model.axial_spring() * (ls - l) * (ls - l);
   }
   if (p.bending_stiffness > Scalar(0))
     for (int i = 1; i < n; ++i) {
+      if (parted && (parted[i - 1] || parted[i])) continue;
       const Vector3<Scalar> a = state.position.col(i) - state.position.col(i - 1);
       const Vector3<Scalar> b = state.position.col(i + 1) - state.position.col(i);
       const Scalar na = a.norm(), nb = b.norm();
@@ -555,7 +629,7 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
         e += p.bending_stiffness / l * (Scalar(1) - a.dot(b) / (na * nb));
     }
   for (int i = 0; i <= n; ++i) {
-    const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n).q;
+    const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n, parted).q;
     const Scalar zeta =
         Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
     const Scalar z = state.position(2, i);

@@ -56,11 +56,12 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
   bool same = true;
   for (int s = 0; s < model.segments(); ++s) {
     const Scalar ls = ws.stretched_length(s);
-    const bool taut = band > Scalar(0) ? ls >= taut_from : ls > l;
-    const Scalar b = taut && band > Scalar(0) ? Scalar(2)
-                                              : (clamp && !(ws.tension(s) > Scalar(0))
-                                                     ? Scalar(0)
-                                                     : (ls > l ? Scalar(2) : Scalar(1)));
+    const bool taut = !ws.is_parted(s) && (band > Scalar(0) ? ls >= taut_from : ls > l);
+    const Scalar b = ws.is_parted(s)            ? Scalar(0)
+                     : taut && band > Scalar(0) ? Scalar(2)
+                                                : (clamp && !(ws.tension(s) > Scalar(0))
+                                                       ? Scalar(0)
+                                                       : (ls > l ? Scalar(2) : Scalar(1)));
     same = same && b == branch(s);
   }
   return same;
@@ -552,6 +553,8 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
                                  const TetherBoundary<Scalar>& boundary, double dt, bool bdf2,
                                  const ImplicitOptions<Scalar>& options) {
   detail::check_step_inputs(model, ws, state, boundary, dt);
+  detail::load_parted(state, ws);
+  detail::load_clamps(model, boundary, ws);
   detail::check_implicit_options(options);
   detail::check_resolvable(model, state, options);
   // A tolerance below what the arithmetic resolves asks Newton's method for noise (a stiff float

@@ -63,7 +63,7 @@ SegmentJacobian<Scalar> segment_jacobian(const TetherModel<Scalar>& model,
   out.k.setZero();
   out.c.setZero();
   out.tension = Scalar(0);
-  if (!(ls > Scalar(0))) return out;
+  if (!(ls > Scalar(0)) || ws.is_parted(s)) return out;
   const Vector3<Scalar> u = ws.direction.col(s);
   const Vector3<Scalar> e = v.col(s + 1) - v.col(s);
   const Scalar r = u.dot(e), ext = ls - model.segment_length();
@@ -131,6 +131,7 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     for (int i = 1; i < n; ++i) {
       const Scalar la = ws.stretched_length(i - 1), lb = ws.stretched_length(i);
       if (!(la > Scalar(0) && lb > Scalar(0))) continue;
+      if (ws.is_parted(i - 1) || ws.is_parted(i)) continue;  // as bending_forces
       const V3 ua = ws.direction.col(i - 1), ub = ws.direction.col(i);
       const Scalar cs = ua.dot(ub);
       const M3 pa = eye - ua * ua.transpose(), pb = eye - ub * ub.transpose();
@@ -150,6 +151,34 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
       sink.x(i, i, M3(ab - aa + bb - ba), one);
       sink.x(i, i + 1, M3(ab + bb), -one);
     }
+    // Clamped ends (see bending_forces): the pair of forces ±f with the clamp direction t fixed,
+    // stiffness 2k; ∂f/∂(segment vector) as bb (start) and aa (far end) above.
+    if (ws.clamp_start.squaredNorm() > Scalar(0) && !ws.is_parted(0) &&
+        ws.stretched_length(0) > Scalar(0)) {
+      const Scalar lb = ws.stretched_length(0);
+      const V3 ub = ws.direction.col(0), t = ws.clamp_start;
+      const M3 pb = eye - ub * ub.transpose();
+      const V3 pbt = pb * t;
+      const M3 bb = (Scalar(-2) * k / (lb * lb)) *
+                    (ub * pbt.transpose() + pbt * ub.transpose() + t.dot(ub) * pb);
+      sink.x(1, 1, bb, one);
+      sink.x(1, 0, bb, -one);
+      sink.x(0, 1, bb, -one);
+      sink.x(0, 0, bb, one);
+    }
+    if (ws.clamp_end.squaredNorm() > Scalar(0) && !ws.is_parted(n - 1) &&
+        ws.stretched_length(n - 1) > Scalar(0)) {
+      const Scalar la = ws.stretched_length(n - 1);
+      const V3 ua = ws.direction.col(n - 1), t = -ws.clamp_end;
+      const M3 pa = eye - ua * ua.transpose();
+      const V3 pat = pa * t;
+      const M3 aa = (Scalar(2) * k / (la * la)) *
+                    (ua * pat.transpose() + pat * ua.transpose() + t.dot(ua) * pa);
+      sink.x(n - 1, n, aa, one);
+      sink.x(n - 1, n - 1, aa, -one);
+      sink.x(n, n, aa, -one);
+      sink.x(n, n - 1, aa, one);
+    }
   }
 
   // Nodes.
@@ -158,7 +187,8 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
   const Scalar can = p.normal_added_mass, cat = p.tangential_added_mass;
   const bool mass_turns = model.added_mass_rate_terms();  // as compute_forces
   for (int i = 0; i <= n; ++i) {
-    const int hi = i < n ? i + 1 : n, lo = i > 0 ? i - 1 : 0;
+    const ChordNodes cnodes = chord_nodes(i, n, ws.any_parted ? ws.parted.data() : nullptr);
+    const int hi = cnodes.hi, lo = cnodes.lo;
     const V3 chord = x.col(hi) - x.col(lo);
     const Scalar c2 = chord.squaredNorm();
     const Scalar inv_c = c2 > Scalar(0) ? Scalar(1) / sqrt(c2) : Scalar(0);

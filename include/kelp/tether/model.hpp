@@ -109,6 +109,11 @@ struct TetherParameters {
   /// couples nodes i−1 and i+1), so keep EI/l³ ≪ node mass / dt² there, or use
   /// JacobianKind::whole, which has it; the explicit stable-dt estimate accounts for it.
   Scalar bending_stiffness = Scalar(0);
+  /// Breaking strength [N]: when a segment's axial force exceeds it at the end of a step, the
+  /// line parts there (TetherState::parted; see kelp/tether/failure.hpp). 0 or +∞ (the default
+  /// 0): the line never parts. The Fathom ROV tether is rated at 350 lbf = 1557 N
+  /// (tether::presets::rov_tether).
+  Scalar breaking_strength = Scalar(0);
   /// Normal drag coefficient Cdn [-] (on the projected area d·l).
   Scalar normal_drag = Scalar(1.2);
   /// Tangential drag coefficient Cdt [-] (on the wetted surface π·d·l, as MoorDyn does).
@@ -146,8 +151,9 @@ struct TetherParameters {
 /// \brief Checks tether parameters.
 /// \throws kelp::invalid_argument naming the offending field: segments in [1, 100000]; length,
 /// diameter, mass_per_length, axial_stiffness, friction_velocity finite and > 0; the rest finite
-/// and ≥ 0; every magnitude at most its bound in kelp::tether::limits; segments at least 1 µm
-/// long; end modes EndMode values; line_model a LineModel value.
+/// and ≥ 0 (breaking_strength may be +∞); every magnitude at most its bound in
+/// kelp::tether::limits; segments at least 1 µm long; end modes EndMode values; line_model a
+/// LineModel value.
 template <typename Scalar>
 void validate(const TetherParameters<Scalar>& p) {
   // Each magnitude finite and of the right sign, then below a generous physical bound (far above
@@ -167,6 +173,9 @@ void validate(const TetherParameters<Scalar>& p) {
   bounded(p.axial_stiffness, limits::max_axial_stiffness, "axial_stiffness", false);
   bounded(p.internal_damping, limits::max_axial_stiffness, "internal_damping", true);
   bounded(p.bending_stiffness, limits::max_bending_stiffness, "bending_stiffness", true);
+  // +∞ is allowed (never parts), as is 0.
+  KELP_CHECK(!(p.breaking_strength < Scalar(0)) && p.breaking_strength == p.breaking_strength,
+             "breaking_strength must be >= 0 (0 or infinity: the line never parts)");
   bounded(p.normal_drag, limits::max_coefficient, "normal_drag", true);
   bounded(p.tangential_drag, limits::max_coefficient, "tangential_drag", true);
   bounded(p.normal_added_mass, limits::max_coefficient, "normal_added_mass", true);
@@ -239,6 +248,10 @@ class TetherModel {
   /// model with Cat ≠ Can. False for LineModel::moordyn and whenever Cat = Can (the added mass is
   /// then isotropic and does not turn with the tangent).
   bool added_mass_rate_terms() const { return rate_terms_; }
+  /// \brief True when the line can part: a breaking strength that is positive and finite.
+  bool can_part() const {
+    return p_.breaking_strength > Scalar(0) && is_finite(p_.breaking_strength);
+  }
   /// \brief Number of segments N.
   int segments() const { return p_.segments; }
   /// \brief Number of nodes N + 1.

@@ -28,7 +28,8 @@ namespace kelp::tether::presets {
 /// Diameter 7.6 mm (Blue Robotics, standard Fathom); mass per length ρ_fresh A = 0.0454 kg/m, the
 /// neutrally-buoyant-in-fresh-water variant, so it is slightly buoyant in seawater
 /// (−0.011 N/m); EA = E π d²/4 = 2.92 kN with von Benzon et al.'s E = 6.437e7 Pa; Cdn 1.2,
-/// Cdt 0.01, internal damping 100 N s (von Benzon et al. 2022, Table A1); Can 1, Cat 0.
+/// Cdt 0.01, internal damping 100 N s (von Benzon et al. 2022, Table A1); Can 1, Cat 0;
+/// breaking strength 1557 N (350 lbf, Blue Robotics' Fathom ROV Tether R2 documentation).
 /// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m, a segment length not
 /// finite and > 0, or more than 100000 segments.
 template <typename Scalar>
@@ -52,6 +53,9 @@ TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = S
   p.internal_damping = Scalar(100);
   p.normal_added_mass = Scalar(1);
   p.tangential_added_mass = Scalar(0);
+  // Blue Robotics, "Fathom ROV Tether (R2)" documentation: "350+ lb breaking strength",
+  // 350 lbf × 4.44822 N/lbf = 1557 N.
+  p.breaking_strength = Scalar(1557);
   return p;
 }
 

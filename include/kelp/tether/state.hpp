@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -16,6 +17,9 @@
 #include "kelp/tether/model.hpp"
 
 namespace kelp::tether {
+
+/// \brief One flag per segment (0 or 1), e.g. TetherState::parted.
+using SegmentFlags = Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1>;
 
 namespace detail {
 /// Scalars kept per step of the implicit steps' block elimination (see
@@ -104,6 +108,12 @@ struct TetherState {
   double previous_dt = 0.0;
   /// The implicit steps' kept Newton matrix (see KeptNewtonMatrix; ImplicitOptions::newton).
   KeptNewtonMatrix<Scalar> newton;
+  /// Per segment: 1 when the line has parted there (TetherParameters::breaking_strength, see
+  /// kelp/tether/failure.hpp), else 0. A parted segment carries no axial force and no bending;
+  /// its two nodes become the free ends of the two pieces. Empty or all zero: an intact line
+  /// (a state assembled by hand may leave it empty). A re-mesh that inserts or removes nodes
+  /// must carry these flags with their segments.
+  SegmentFlags parted;
 
   TetherState() = default;
   /// \brief Zero state sized for `model`, no history.
@@ -111,9 +121,13 @@ struct TetherState {
       : position(Matrix3X<Scalar>::Zero(3, model.nodes())),
         velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
         previous_position(Matrix3X<Scalar>::Zero(3, model.nodes())),
-        previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())) {
+        previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        parted(SegmentFlags::Zero(model.segments())) {
     newton.resize(model.nodes());
   }
+
+  /// \brief Number of parted segments (0 for an intact line). O(N).
+  int parted_segments() const { return parted.size() ? int(parted.template cast<int>().sum()) : 0; }
 
   /// \brief True when the state carries the previous step (BDF2 history).
   bool has_history() const { return previous_dt > 0.0; }
@@ -138,6 +152,14 @@ struct EndMotion {
   Vector3<Scalar> velocity = Vector3<Scalar>::Zero();
   /// Acceleration, NED [m/s²] (also enters the end force through the end node's inertia).
   Vector3<Scalar> acceleration = Vector3<Scalar>::Zero();
+  /// Zero (the default): a pinned end, free to turn. A unit vector, NED: a clamped end, the
+  /// direction in which the line leaves the end point (towards node 1 at the start, towards
+  /// node N − 1 at the far end), held over the step. With a bending stiffness EI > 0 the line
+  /// then has the bending energy 2EI/l·(1 − t·u) at that end (u the direction of its end segment
+  /// away from the end; the angle is taken over half a segment, as a clamped beam's rotation
+  /// between the wall and its first node: see compute_forces); with EI = 0 it changes nothing.
+  /// Its length is ignored (normalised); it must be finite.
+  Vector3<Scalar> direction = Vector3<Scalar>::Zero();
 
   /// \brief Position τ seconds into the step.
   Vector3<Scalar> position_at(Scalar tau) const {
@@ -146,7 +168,9 @@ struct EndMotion {
   /// \brief Velocity τ seconds into the step.
   Vector3<Scalar> velocity_at(Scalar tau) const { return velocity + tau * acceleration; }
   /// \brief The same motion seen from τ seconds into the step (position and velocity at τ).
-  EndMotion after(Scalar tau) const { return {position_at(tau), velocity_at(tau), acceleration}; }
+  EndMotion after(Scalar tau) const {
+    return {position_at(tau), velocity_at(tau), acceleration, direction};
+  }
 };
 
 /// \brief Prescribed motion of both ends (an entry is ignored when that end is free).
@@ -197,6 +221,7 @@ struct StateBackup {
   Matrix3X<Scalar> position, velocity, previous_position, previous_velocity;
   double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
   KeptNewtonMatrix<Scalar> newton;
+  SegmentFlags parted;
 
   /// \brief Sizes the buffers for `nodes` nodes.
   /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1].
@@ -205,6 +230,7 @@ struct StateBackup {
     for (Matrix3X<Scalar>* m : {&position, &velocity, &previous_position, &previous_velocity})
       m->setZero(3, nodes);
     newton.resize(nodes);
+    parted.setZero(nodes - 1);
   }
   /// \brief Copies `s` (history and kept Newton matrix included).
   void save(const TetherState<Scalar>& s) {
@@ -221,6 +247,7 @@ struct StateBackup {
     newton.age = s.newton.age;
     newton.pause = s.newton.pause;
     newton.backoff = s.newton.backoff;
+    parted = s.parted;
   }
   /// \brief Puts the saved state back into `s`.
   void restore(TetherState<Scalar>& s) const {
@@ -237,6 +264,7 @@ struct StateBackup {
     s.newton.age = newton.age;
     s.newton.pause = newton.pause;
     s.newton.backoff = newton.backoff;
+    s.parted = parted;
   }
 };
 
@@ -295,6 +323,18 @@ struct TetherWorkspace {
   VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
   VectorX<Scalar> seg_true_c_uu;  ///< seg_c_uu saved while the active-set passes modify it
   VectorX<Scalar> seg_rate;       ///< segment stretch rate u_s·(v_{s+1} − v_s) [m/s]
+  /// The parted segments the force evaluation uses (1: parted; see TetherState::parted), copied
+  /// from the state by every step (detail::load_parted); set it the same way before calling
+  /// compute_forces by hand on a state whose line has parted
+  SegmentFlags parted;
+  /// True when any entry of `parted` is set (the force passes then take their general path)
+  bool any_parted = false;
+  /// Unit clamp directions of the start and far end (EndMotion::direction; zero: pinned) the
+  /// force evaluation uses, copied from the boundary by every step (detail::load_clamps); set
+  /// them the same way before calling compute_forces by hand on a clamped line
+  Vector3<Scalar> clamp_start = Vector3<Scalar>::Zero(), clamp_end = Vector3<Scalar>::Zero();
+  /// \brief True when segment s has parted (in the flags of the last detail::load_parted).
+  bool is_parted(int s) const { return any_parted && parted(s) != 0; }
   /// Branch of segment s in the Newton step's linear model: 0 no force (slack, or clamped at
   /// zero), 1 dashpot only (slack), 2 elastic plus dashpot (taut)
   VectorX<Scalar> seg_branch;
@@ -342,6 +382,9 @@ struct TetherWorkspace {
     entry_backup.resize(nodes);
     retry_backup.resize(nodes);
     water_is_zero = true;
+    any_parted = false;
+    clamp_start.setZero();
+    clamp_end.setZero();
   }
 
   /// \brief True when every buffer has the size resize(nodes) gives it (false for a
@@ -377,6 +420,7 @@ struct TetherWorkspace {
     f(w.newton_lu, 9, 5 * n);
     f(w.newton_factor, detail::newton_factor_size(nodes), 1);
     f(w.newton_branch, s, 1);
+    f(w.parted, s, 1);
   }
 };
 
@@ -387,6 +431,34 @@ template <typename Scalar>
 void check_workspace(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws) {
   KELP_CHECK(ws.fits(model.nodes()),
              "the workspace was not built for this tether: use TetherWorkspace(model)");
+}
+
+/// Copies the state's parted segments into the workspace (TetherWorkspace::parted), which the
+/// force evaluation reads; a state without flags (empty) is an intact line. O(N) bytes.
+template <typename Scalar>
+void load_parted(const TetherState<Scalar>& state, TetherWorkspace<Scalar>& ws) {
+  if (state.parted.size() == ws.parted.size() && state.parted.any()) {
+    ws.parted = state.parted;
+    ws.any_parted = true;
+  } else if (ws.any_parted) {
+    ws.parted.setZero();
+    ws.any_parted = false;
+  }
+}
+
+/// Copies the boundary's clamp directions (EndMotion::direction, normalised; zero for a pinned
+/// or free end) into the workspace (TetherWorkspace::clamp_start, clamp_end).
+template <typename Scalar>
+void load_clamps(const TetherModel<Scalar>& model, const TetherBoundary<Scalar>& b,
+                 TetherWorkspace<Scalar>& ws) {
+  const auto unit = [](const Vector3<Scalar>& d) -> Vector3<Scalar> {
+    const Scalar n = d.norm();
+    return n > Scalar(0) ? Vector3<Scalar>(d / n) : Vector3<Scalar>::Zero();
+  };
+  const TetherParameters<Scalar>& p = model.parameters();
+  ws.clamp_start =
+      p.start_mode == EndMode::kinematic ? unit(b.start.direction) : Vector3<Scalar>::Zero();
+  ws.clamp_end = p.end_mode == EndMode::kinematic ? unit(b.end.direction) : Vector3<Scalar>::Zero();
 }
 
 /// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.
@@ -418,6 +490,8 @@ void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& st
   check_all_finite(state.velocity, "state.velocity");
   check_finite(state.time, "state.time");
   check_non_negative(state.previous_dt, "state.previous_dt");
+  KELP_CHECK(state.parted.size() == 0 || state.parted.size() == model.segments(),
+             "state.parted must be empty or have one flag per segment");
   if (state.has_history()) {
     KELP_CHECK(state.previous_position.cols() == model.nodes() &&
                    state.previous_velocity.cols() == model.nodes(),
@@ -438,6 +512,8 @@ void check_boundary(const TetherBoundary<Scalar>& b) {
   check_all_finite(b.end.position, "boundary.end.position");
   check_all_finite(b.end.velocity, "boundary.end.velocity");
   check_all_finite(b.end.acceleration, "boundary.end.acceleration");
+  check_all_finite(b.start.direction, "boundary.start.direction");
+  check_all_finite(b.end.direction, "boundary.end.direction");
 }
 
 /// \brief Straight-line state: nodes evenly spaced from `start_ned` to `end_ned`, at rest.

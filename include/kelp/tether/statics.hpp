@@ -88,6 +88,8 @@ template <typename Scalar, typename Env>
   b.end.velocity.setZero();
   b.start.acceleration.setZero();
   b.end.acceleration.setZero();
+  detail::load_parted(state, ws);
+  detail::load_clamps(model, boundary, ws);
   // Keep the entry state (no single step uses that backup) and iterate on `state` itself,
   // restoring it on error.
   ws.entry_backup.save(state);

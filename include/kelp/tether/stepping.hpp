@@ -15,6 +15,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/tether/failure.hpp"
 #include "kelp/tether/forces.hpp"
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/state.hpp"
@@ -207,8 +208,13 @@ struct StepReport {
   /// attempt, when a symmetric matrix formed at the iterate contracted the residual by less than
   /// `max_contraction`, or after the symmetric attempts did not converge.
   int whole_jacobian_attempts = 0;
+  /// Times the line parted (TetherParameters::breaking_strength; kelp/tether/failure.hpp).
+  int partings = 0;
+  /// The first parting of these steps (valid when partings > 0).
+  LineFailure<Scalar> failure;
 
-  /// \brief Adds another step's report: counts add up, the residual is the worst.
+  /// \brief Adds another step's report: counts add up, the residual is the worst, the first
+  /// parting is kept.
   StepReport& operator+=(const StepReport& o) {
     substeps += o.substeps;
     force_evaluations += o.force_evaluations;
@@ -219,6 +225,8 @@ struct StepReport {
     factorisations += o.factorisations;
     reused_factorisations += o.reused_factorisations;
     whole_jacobian_attempts += o.whole_jacobian_attempts;
+    if (partings == 0 && o.partings > 0) failure = o.failure;
+    partings += o.partings;
     return *this;
   }
 };
@@ -315,6 +323,8 @@ void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<S
     state.previous_velocity.setZero(3, model.nodes());
     state.previous_dt = 0.0;
   }
+  KELP_CHECK(state.parted.size() == 0 || state.parted.size() == model.segments(),
+             "state.parted must be empty or have one flag per segment");
   if (state.newton.factor.size() != newton_factor_size(model.nodes()) ||
       state.newton.branch.size() != model.segments())
     state.newton.resize(model.nodes());
@@ -397,6 +407,8 @@ void begin_explicit_step(const TetherModel<Scalar>& model, TetherWorkspace<Scala
                          TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
                          double dt) {
   check_step_inputs(model, ws, state, boundary, dt);
+  load_parted(state, ws);
+  load_clamps(model, boundary, ws);
   ws.x0 = state.position;
   ws.v0 = state.velocity;
   apply_boundary(model, boundary, Scalar(0), ws.x0, ws.v0);
