@@ -10,4 +10,5 @@
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
+#include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"

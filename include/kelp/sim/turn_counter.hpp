@@ -22,30 +22,48 @@ namespace sim {
 ///
 /// At every update: the vehicle's heading ψ (the azimuth of its body x axis in NED, atan2 of the
 /// rotation matrix's (1,0) and (0,0) entries, so that it is defined at any roll and pitch short of
-/// the body x axis pointing straight up or down) and the tether's azimuth α at the attachment (the
-/// horizontal direction from the attachment node to its neighbour on the line). The relative angle
-/// φ = ψ − α is unwrapped continuously: each update adds its change wrapped to (−π, π], so the
-/// count is signed (positive: the vehicle turned clockwise seen from above, NED's positive yaw,
-/// relative to the tether) and continuous through any number of turns, as long as φ changes by
-/// less than half a turn between two updates (the sim updates at every 10 ms step).
+/// the body x axis pointing straight up or down) and the tether's azimuth α at the attachment: the
+/// horizontal direction from the attachment node to the first node at least `reference_length`
+/// of line away from it (or the line's other end). The relative angle φ = ψ − α is unwrapped
+/// continuously: each update adds its change wrapped to (−π, π], so the count is signed
+/// (positive: the vehicle turned clockwise seen from above, NED's positive yaw, relative to the
+/// tether) and continuous through any number of turns, as long as φ changes by less than half a
+/// turn between two updates (the sim updates at every 10 ms step).
+///
+/// Why a reference length rather than the last segment: the lumped-mass line has no torsion, so a
+/// vehicle spinning on the spot drags its last segment round with the attachment point (a 0.2 m
+/// lever on a 0.5 m segment), and the last segment's azimuth would follow the vehicle's heading;
+/// a metre or two of line away the line's direction is where the line goes, which is what the
+/// tether twists (or wraps) against.
 ///
 /// A tether within `vertical_angle` of the vertical at the attachment has no meaningful azimuth:
 /// α is then held at its last value (at the first update, the vehicle's heading, so φ starts at 0),
 /// and the vehicle's own yaw counts in full, which is the twist about a vertical tether. Each
-/// piece of a parted line still has a segment at the vehicle, whose direction is used.
+/// piece of a parted line still has its segments at the vehicle, whose direction is used.
 class TurnCounter {
  public:
   /// Angle from the vertical [rad] within which the tether's azimuth is held (0.1 rad ≈ 5.7°).
   static constexpr double vertical_angle = 0.1;
 
+  /// \brief A counter that takes the tether's direction over `reference_length` [m] of line
+  /// (default 2 m; 0: the attachment's own segment).
+  explicit TurnCounter(double reference_length = 2.0) : reference_(reference_length) {}
+
   /// \brief Updates the count with the vehicle state `vehicle` and the tether state `tether`,
-  /// whose node `node` is the vehicle's attachment (0 or the last node); its neighbour on the
-  /// line gives the tether's direction.
+  /// whose node `node` is the vehicle's attachment (0 or the last node).
   void update(const vehicle::VehicleStated& vehicle, const tether::TetherStated& tether, int node) {
     const Matrix3<double> r = vehicle.attitude.toRotationMatrix();
     const double heading = std::atan2(r(1, 0), r(0, 0));
     const int last = int(tether.position.cols()) - 1;
-    const int other = node == 0 ? std::min(1, last) : node - 1;
+    const int step = node == 0 ? 1 : -1;
+    // The first node at least reference_ of line away (along the nodes), or the other end.
+    int other = node;
+    double along = 0.0;
+    while (other + step >= 0 && other + step <= last) {
+      along += (tether.position.col(other + step) - tether.position.col(other)).norm();
+      other += step;
+      if (along >= reference_) break;
+    }
     const Vector3<double> d = tether.position.col(other) - tether.position.col(node);
     const double horizontal = d.head<2>().norm();
     if (horizontal > std::sin(vertical_angle) * d.norm() && horizontal > 0.0)
@@ -72,7 +90,7 @@ class TurnCounter {
     a = std::remainder(a, 2.0 * kelp::pi);
     return a <= -kelp::pi ? a + 2.0 * kelp::pi : a;
   }
-  double azimuth_ = 0.0, phi_ = 0.0, turns_ = 0.0, max_abs_ = 0.0;
+  double reference_ = 2.0, azimuth_ = 0.0, phi_ = 0.0, turns_ = 0.0, max_abs_ = 0.0;
   bool started_ = false;
 };
 
