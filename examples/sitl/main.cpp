@@ -19,12 +19,14 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "bridge.hpp"
 #include "default_world.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
+#include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"
 
 namespace fs = std::filesystem;
@@ -149,9 +151,18 @@ int run(const Options& o) {
   const double log_rate = o.log_rate > 0 ? o.log_rate : o.scenario.log_rate;
   const double node_rate = o.node_rate > 0 ? o.node_rate : o.scenario.node_rate;
   double next_log = 0, next_nodes = 0, next_status = wall0 + o.status_interval;
+  // The ROV's turns about the tether and the line's partings, at every step (as kelp::sim's
+  // ClosedLoop keeps them).
+  kelp::sim::TurnCounter turns;
+  std::vector<kelp::tether::LineFailured> failures;
   const auto log_state = [&]() {
     const ks::SystemStated& s = bridge.state();
     const double t = s.time;
+    turns.update(s.auv, s.tether, int(s.tether.position.cols()) - 1);
+    if (bridge.last_report().tether.partings > 0) {
+      failures.push_back(bridge.last_report().tether.failure);
+      log.line_parted(failures.back());
+    }
     if (t + 1e-9 >= next_log) {
       kelp::sim::LogRow row;
       row.t = t;
@@ -164,6 +175,8 @@ int run(const Options& o) {
       row.auv_command = bridge.auv_command();
       row.tension_asv = bridge.last_report().force_on_asv.norm();
       row.tension_auv = bridge.last_report().force_on_auv.norm();
+      row.tether_turns = turns.turns();
+      row.parted_segments = s.tether.parted_segments();
       // Propulsion: thrust as delivered (lagged), currents, batteries.
       if (const auto* pm = bridge.model().asv_propulsion()) {
         row.asv_thrust = s.asv_propulsion.thrust.head<2>();
@@ -273,6 +286,14 @@ int run(const Options& o) {
   if (bridge.model().asv_propulsion() != nullptr)
     summary["asv_battery"] =
         battery(bridge.model().asv_propulsion(), bridge.state().asv_propulsion);
+  summary["tether"] = {{"net_turns", turns.turns()}, {"max_abs_turns", turns.max_abs_turns()}};
+  summary["tether"]["line_failures"] = nlohmann::json::array();
+  for (const auto& f : failures)
+    summary["tether"]["line_failures"].push_back(
+        {{"time_s", f.time},
+         {"segment", f.segment},
+         {"position_m", {f.position.x(), f.position.y(), f.position.z()}},
+         {"tension_n", f.tension}});
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
