@@ -512,6 +512,12 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 ///   as MoorDyn v2 does;
 /// - seabed (z_i > h): upward (z_i − h) kb d l_i + ż_i cb d l_i (≥ 0), and saturated-viscous
 ///   friction −μ_f N v_h / max(|v_h|, v_f);
+/// - bending (EI > 0): EI/l (1 − u_{i−1}·u_i) at every interior node, and 2EI/l (1 − t·u) at a
+///   clamped end (the unit direction t in `ws.clamp_start` / `ws.clamp_end`, which the steps copy
+///   from EndMotion::direction; u the end segment's direction away from the end);
+/// - a parted segment (`ws.parted`, which the steps copy from TetherState::parted) carries no
+///   axial force and no bending moment, and the nodes beside it are the ends of their pieces
+///   (their tangent is their own segment: kelp/tether/failure.hpp);
 /// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,
 ///   which goes from 1 to 0 as the node rises through the free surface over one cable diameter
 ///   centred on the surface, ½ at the surface (detail::submerged_fraction): nodes in air get none.

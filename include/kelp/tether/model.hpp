@@ -107,7 +107,9 @@ struct TetherParameters {
   /// EI/l · (1 − u_{i−1}·u_i) at each interior node, i.e. ½ EI κ² l for small angles with
   /// κ = θ/l. Enters the implicit schemes' symmetric Jacobian through the residual only (it
   /// couples nodes i−1 and i+1), so keep EI/l³ ≪ node mass / dt² there, or use
-  /// JacobianKind::whole, which has it; the explicit stable-dt estimate accounts for it.
+  /// JacobianKind::whole, which has it; the explicit stable-dt estimate accounts for it. An end
+  /// is pinned (free to turn) unless its EndMotion::direction is set: a clamped end adds
+  /// 2EI/l · (1 − t·u) there (see compute_forces).
   Scalar bending_stiffness = Scalar(0);
   /// Breaking strength [N]: when a segment's axial force exceeds it at the end of a step, the
   /// line parts there (TetherState::parted; see kelp/tether/failure.hpp). 0 or +∞ (the default
