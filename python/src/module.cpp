@@ -2,6 +2,8 @@
 #include "bindings.hpp"
 
 namespace kelp_python {
+/// kelp.Tether and kelp.TetherState (tether.cpp).
+void bind_tether(py::module_& m);
 /// kelp._kelp._step_loop, the C++ baseline of benchmarks/python_step_overhead.py (timing.cpp).
 void bind_timing(py::module_& m);
 }  // namespace kelp_python
@@ -16,6 +18,7 @@ PYBIND11_MODULE(_kelp, m) {
   kelp_python::bind_vehicle(m);
   kelp_python::bind_environment(m);
   kelp_python::bind_catenary(m);
+  kelp_python::bind_tether(m);
   kelp_python::bind_system(m);
   kelp_python::bind_timing(m);
   kelp_python::bind_scenario(m);

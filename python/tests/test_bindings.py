@@ -260,3 +260,49 @@ def test_help_is_useful():
         for k, v in vars(cls).items():
             if not k.startswith("_"):
                 assert getattr(v, "__doc__", None), f"{cls.__name__}.{k} has no docstring"
+
+
+# ---- the tether on its own ------------------------------------------------------------------
+
+def test_tether_static_shape_matches_the_catenary_and_stays():
+    t = kelp.Tether.rov_tether(10.0, 0.5)
+    assert t.nodes == 21 and t.segment_length == pytest.approx(0.5)
+    # Deep enough that the buoyant line's arch (w < 0) stays under the surface.
+    start, end = np.array([0.0, 0.0, 5.0]), np.array([6.0, 0.0, 7.0])
+    x = t.initial_state(start, end)
+    assert x.position.shape == (21, 3)
+    np.testing.assert_allclose(x.position[0], start, atol=1e-12)
+    np.testing.assert_allclose(x.position[-1], end, atol=1e-12)
+    w = t.weight_per_length()
+    assert w < 0  # slightly buoyant in seawater
+    cat = kelp.catenary(horizontal=6.0, vertical=-2.0, length=10.0, weight_per_length=w)
+    assert cat.ok
+    np.testing.assert_allclose(x.position, cat.points(21) + start, atol=1e-6)
+    # Held between fixed ends in still water the line stays near its catenary, and the ends
+    # feel the catenary's pull (direction of the force on the start end).
+    for _ in range(200):
+        f = t.step(x, start, end, 0.01)
+    assert x.time == pytest.approx(2.0)
+    mid = x.position[10]
+    np.testing.assert_allclose(mid, cat.points(21)[10] + start, atol=0.05)
+    assert f["substeps"] >= 1 and f["force_on_start"].shape == (3,)
+    assert np.all(np.isfinite(x.velocity))
+    pos = x.position
+    del x
+    gc.collect()
+    assert pos.shape == (21, 3)  # the view kept its state alive
+
+
+def test_tether_bad_input():
+    t = kelp.Tether.rov_tether(10.0, 0.5)
+    x = t.initial_state([0, 0, 0], [6, 0, 2])
+    before = x.copy()
+    with pytest.raises(kelp.InvalidArgument, match="end: expected shape \\(3,\\)"):
+        t.step(x, [0, 0, 0], [6, 0], 0.01)
+    with pytest.raises(kelp.InvalidArgument, match="duration"):
+        t.step(x, [0, 0, 0], [6, 0, 2], -0.01)
+    with pytest.raises(kelp.InvalidArgument, match="length"):
+        kelp.Tether.rov_tether(-1.0)
+    with pytest.raises(kelp.InvalidArgument, match="position: expected shape \\(21, 3\\)"):
+        x.position = np.zeros((20, 3))
+    np.testing.assert_array_equal(x.position, before.position)
