@@ -255,7 +255,8 @@ def test_help_is_useful():
     for name in ("step", "initial_state", "inputs", "energy", "from_scenario"):
         assert getattr(kelp.System, name).__doc__
     for cls in (kelp.Vehicle, kelp.VehicleState, kelp.Environment, kelp.Catenary,
-                kelp.SystemState, kelp.SystemInputs, kelp.SystemReport):
+                kelp.SystemState, kelp.SystemInputs, kelp.SystemReport, kelp.Tether,
+                kelp.TetherState):
         assert cls.__doc__
         for k, v in vars(cls).items():
             if not k.startswith("_"):
