@@ -7,6 +7,7 @@
 #pragma once
 
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/run.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
