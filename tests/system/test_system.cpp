@@ -580,7 +580,7 @@ TEST_CASE("the paper's system presets build, start from a static tether and step
   //   current plus 4 σ of the orbital speed at the surface, σ² = Σ ½ a_j² ω_j² (deep water:
   //   horizontal and vertical orbital velocities each of that variance, so the speed exceeds
   //   4 σ with probability e^{−8} ≈ 3e-4, and 30 s hold ~4 wave periods), plus 0.5 m/s for the
-  //   wind's drift and the tether's pull (the boat's top speed under full thrust is 2.97 m/s);
+  //   wind's drift and the tether's pull (the boat's top speed under full thrust is 3.0 m/s);
   // - end forces bounded by the static catenary of the start state plus the drag of the whole
   //   line held broadside to that largest flow, ½ ρ C_dn d L (U_c + 4 σ)²: a guard against
   //   blow-ups and snap loads (a line jerked taut carries EA·strain, 290 N per 10 % strain for

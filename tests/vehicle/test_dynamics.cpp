@@ -9,10 +9,12 @@
 
 #include "kelp/core/rotation.hpp"
 #include "kelp/environment/sea_state.hpp"
+#include "kelp/vehicle/battery.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/kinematics.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/t200.hpp"
 #include "kelp/vehicle/thrusters.hpp"
 
 using kelp::Matrix6;
@@ -130,25 +132,35 @@ TEMPLATE_TEST_CASE("BlueBoat at full thrust reaches its top speed near 3 m/s",
   const kv::ThrusterAllocation<S> thrusters(preset.thruster_positions, preset.thruster_directions);
   kv::VehicleWorkspace<S> ws;
   kv::VehicleState<S> x;
-  // Two T200 at full command on von Benzon's curve, 2 × 30.4 N (what the preset's assumed surge
-  // damping 5 u + 5 u² was chosen for) ⇒ 3.02 m/s.
+  // Two T200 at full command on the datasheet curve, at the voltage a full BlueBoat pack holds
+  // under their current (OCV 16.7 V less 20 mΩ × 2 × 23.4 A ⇒ 15.76 V, 2 × 50.8 N): the top
+  // speed Blue Robotics lists for the boat, 3.0 m/s, is what the preset's surge damping
+  // 5 u + 8.8 u² is tuned to.
+  const kv::BatteryParameters pack = kv::battery_presets::blueboat_battery();
+  const double v = kv::solve_terminal_voltage(
+      pack, kv::BatteryState{}, [](double volts) { return 2 * kv::t200_current(1.0, volts); });
+  CHECK(v == Approx(15.76).margin(0.01));
+  const double f1 = kv::t200_thrust(1.0, v);
+  CHECK(f1 == Approx(50.8).margin(0.1));
   Eigen::Matrix<S, Eigen::Dynamic, 1> f(2);
-  f.setConstant(kv::thrust(kv::von_benzon_t200_model, S(1)));
+  f.setConstant(S(f1));
   const Vector6<S> tau = thrusters.wrench(f);
-  CHECK(double(tau(0)) == Approx(60.8).epsilon(1e-6));
+  CHECK(double(tau(0)) == Approx(2 * f1).epsilon(1e-6));
   CHECK(std::abs(double(tau(5))) < 1e-6);
   for (int k = 0; k < 6000; ++k) kv::step_rk4(model, ws, x, {tau, Vector6<S>::Zero()}, S(0.01));
-  // Pure surge balance: 5 u + 5 u² = 60.8 ⇒ 3.023 m/s. The thrusters sit 0.10 m below the CO, so
-  // the boat trims bow-up (≈ 0.03 rad) and the heave restoring force then has a surge component:
-  // the simulated top speed is ≈ 2 % lower (2.966 m/s when this test was written).
-  const double u_top = steady_speed(5, 5, 60.8);
+  // Pure surge balance: 5 u + 8.8 u² = 101.5 N ⇒ 3.12 m/s. The thrusters sit 0.10 m below the
+  // CO and the heave added mass (15 kg) exceeds the surge one (2.25 kg), so the thrusters' moment
+  // and the Munk moment (Z_ẇ − X_u̇) u w trim the bow up and the heave restoring force then has a
+  // surge component: the simulated top speed is ≈ 4 % lower (2.997 m/s, 7.9° bow up, when this
+  // test was written; with the heave added mass set to the surge one it is 3.10 m/s at 3.0°).
+  const double u_top = steady_speed(5, 8.8, 2 * f1);
   CHECK(double(x.nu(0)) < u_top);
-  CHECK(double(x.nu(0)) == Approx(u_top).epsilon(0.03));
-  CHECK(double(x.nu(0)) == Approx(3.0).epsilon(0.03));
-  // Thrusters below the waterline trim the bow up slightly but the boat stays upright.
+  CHECK(double(x.nu(0)) == Approx(u_top).epsilon(0.06));
+  CHECK(double(x.nu(0)) == Approx(3.0).epsilon(0.02));
+  // Thrusters below the waterline trim the bow up but the boat stays upright.
   const Vector3<S> e = kelp::euler_from_quaternion(x.attitude);
   CHECK(double(e(1)) > 0.01);  // bow up
-  CHECK(double(e(1)) < 0.1);
+  CHECK(double(e(1)) < 0.2);
   CHECK(std::abs(double(e(0))) < 1e-6);
 }
 

@@ -3,6 +3,8 @@
 
 - shards 0..2 of 3 merged give the unsharded table, byte for byte (CSV and Markdown);
 - deleting one run's result and rerunning reruns that run only, and the table is unchanged;
+- the shipped sweeps/paper.json is the embedded grid, and sweeps/paper_navigation.json's
+  perfect-navigation runs are the same runs (reused by hash); its sensors runs run;
 - bad sweep files (unknown JSON path, empty axis, non-finite value, a value the scenario
   refuses, a bad --shard, nesting too deep, an index past an array's end, too many runs) are
   refused with exit status 3 and a message naming the path;
@@ -94,6 +96,33 @@ def main(program, small, work):
     code, out, err = run(program, "--sweep", small, "--out", full, "--no-plot", "--quiet")
     check(code == 0 and "1 ran, 7 reused" in out, "resume did not rerun exactly one run: " + out)
     check(read(os.path.join(full, "table.csv")) == table, "the resumed table differs")
+
+    # The shipped sweep files: sweeps/paper.json is the embedded grid, and
+    # sweeps/paper_navigation.json is that grid times navigation "perfect" / "sensors" whose
+    # perfect half is the same runs (same hashes), so it reuses the embedded grid's results. One
+    # run of each (300 s) suffices: run 0 of each file is the grid's first point, seed 1.
+    sweeps = os.path.dirname(os.path.abspath(small))
+    shipped = os.path.join(work, "shipped")
+    code, out, err = run(program, "--out", shipped, "--shard", "0/60", "--quiet")
+    check(code == 0 and "1 ran, 0 reused" in out, "embedded grid, run 0: " + out + err)
+    code, out, err = run(program, "--sweep", os.path.join(sweeps, "paper.json"), "--out", shipped,
+                         "--shard", "0/60", "--quiet")
+    check(code == 0 and "0 ran, 1 reused" in out,
+          "sweeps/paper.json's run 0 is not the embedded grid's: " + out + err)
+    nav = os.path.join(sweeps, "paper_navigation.json")
+    code, out, err = run(program, "--sweep", nav, "--out", shipped, "--shard", "0/120", "--quiet")
+    check(code == 0 and "0 ran, 1 reused" in out,
+          "paper_navigation.json's perfect-navigation run 0 is not the embedded grid's: " + out +
+          err)
+    # Run 5: the same point with navigation from sensors (the last axis varies fastest).
+    code, out, err = run(program, "--sweep", nav, "--out", shipped, "--shard", "5/120", "--quiet")
+    check(code == 0 and "1 ran, 0 reused" in out, "paper_navigation.json run 5: " + out + err)
+    modes = []
+    for name in os.listdir(os.path.join(shipped, "runs")):
+        with open(os.path.join(shipped, "runs", name)) as f:
+            modes.append(json.load(f)["summary"].get("navigation", {}).get("mode", "perfect"))
+    modes.sort()
+    check(modes == ["perfect", "sensors"], "navigation modes of the shipped runs: %s" % modes)
 
     # Bad sweep files.
     base = json.load(open(small))

@@ -25,7 +25,10 @@
 ///   MS5837 library). It reads the CO's depth (no wave pressure, no lever arm).
 /// - **DVL**: Water Linked DVL A50. Bottom lock from 0.05 to 50 m altitude (Water Linked's A50
 ///   page: "0.05 – 50 meter range", ping rate 4–26 Hz altitude dependent; range-mode table: 5–6 Hz
-///   between 1.5 and 14 m, the default 5 Hz). Velocity noise σ = 0.001 m/s + 1 % of the speed:
+///   between 1.5 and 14 m, the default 5 Hz; Water Linked's DVL protocol, docs/dvl/dvl-protocol.md
+///   of waterlinked/waterlinked.github.io: a velocity report per ping at 2–26 Hz depending on the
+///   altitude; its FAQ: up to 15 Hz close to the seabed, typically 2–4 Hz higher up). Velocity
+///   noise σ = 0.001 m/s + 1 % of the speed:
 ///   ±0.1 cm/s long-term accuracy (A50 key specifications) and the 1 % accuracy of the standard
 ///   edition (Water Linked on Blue Robotics' forum, "DVL-A50 Accuracy"); per-ping noise is not
 ///   published. Beyond the bottom-lock range it water-tracks (Water Linked, "Water Tracking": the
@@ -34,20 +37,29 @@
 ///   the DVL (current plus wave orbital velocity there) with an assumed σ of 0.05 m/s; with
 ///   `water_track` off it gives no fix there.
 /// - **Compass**: the Navigator's MEMSIC MMC5983MA magnetometer, heading accuracy ±0.5° (MMC5983MA
-///   data sheet), taken as the heading noise σ; rate 50 Hz. A heading, not a field vector: the
+///   data sheet; likewise SparkFun's MMC5983MA breakout and library pages: 0.4 mG total RMS noise
+///   "enabling a heading accuracy of ±0.5°"), taken as the heading noise σ; rate 50 Hz
+///   (assumed; the part outputs up to 1000 Hz). A heading, not a field vector: the
 ///   hard- and soft-iron calibration is assumed done (`bias` models what it leaves).
 /// - **GPS** (on the boat): a u-blox M8-class receiver (NEO-M8N data sheet, UBX-15031086:
-///   horizontal accuracy 2.5 m CEP, 2.0 m with SBAS), at 5 Hz (ArduPilot's GPS_RATE_MS default
-///   of 200 ms). CEP 2.5 m is σ ≈ 2.1 m per axis (CEP = 1.1774 σ for a circular Gaussian); it is
-///   split (an assumption: autonomous-fix errors are mostly slow, atmospheric and orbital) into a
-///   first-order Gauss–Markov error of σ 2.0 m and 120 s correlation time plus 0.5 m white noise
-///   (√(2.0² + 0.5²) = 2.06 m). Vertical errors are `vertical_factor` (2) times the horizontal.
+///   horizontal accuracy 2.5 m CEP, 2.0 m with SBAS), at 5 Hz (ArduPilot's GPS1_RATE_MS,
+///   formerly GPS_RATE_MS, default 200 ms: libraries/AP_GPS/AP_GPS_Params.cpp, "Lowering below
+///   5Hz(default) is not allowed"). CEP 2.5 m is σ ≈ 2.1 m per axis (CEP = 1.1774 σ for a circular
+///   Gaussian); it is split (an assumption: autonomous-fix errors are mostly slow, atmospheric and
+///   orbital) into a first-order Gauss–Markov error of σ 2.0 m and 120 s correlation time plus 0.5
+///   m white noise (√(2.0² + 0.5²) = 2.06 m). Vertical errors are `vertical_factor` (2) times the
+///   horizontal.
 /// - **USBL**: Water Linked Underwater GPS G2 with a locator on the ROV: σ per axis = 0.05 m + 1 %
 ///   of the slant range (Water Linked quote ±1 % of the range for the Underwater GPS; the 5 cm
 ///   floor is an assumption), 1 Hz, 0.5 s latency, 10 % of the fixes lost and none beyond 100 m:
-///   the rate, latency, dropout and floor are assumptions (set them from your system's log). The
-///   fix is computed on the boat: its own position estimate plus the measured relative position
-///   turned by its heading error, so the boat's GPS error carries over into the ROV's fix.
+///   the rate, latency, dropout, floor and range are assumptions, and the ±1 % is not in Water
+///   Linked's online documentation as checked on 2026-11-25 (set them from your system's log).
+///   Water Linked, "Underwater GPS G2" (docs/underwater-gps/introduction.md of
+///   waterlinked/waterlinked.github.io): range up to 300 m in the R300 edition; the G2 is a
+///   short-baseline (SBL) system, a locator heard by four receivers, rather than a USBL; kelp
+///   models its fixes the same way. The fix is computed on the boat: its own position estimate
+///   plus the measured relative position turned by its heading error, so the boat's GPS error
+///   carries over into the ROV's fix.
 #pragma once
 
 #include <Eigen/Core>

@@ -132,9 +132,14 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 /// - Added mass: surge 2.25 kg, sway 23.13 kg, yaw 2.79 kg m² (Heron-class 3-DOF model of the
 ///   paper's framework; the unsymmetric sway–yaw coupling is dropped); heave 15 kg
 ///   (assumed ≈ m), roll 0.12, pitch 0.2 kg m² (assumed ≈ 10 % of the inertia).
-/// - Damping: surge linear 5 N s/m, quadratic 5 N s²/m² (assumed, chosen so that two T200 at
-///   full command, 2 × 30.4 N = 60.8 N, give a top speed 5u + 5u² = 60.8 ⇒ u ≈ 3.0 m/s, the Blue
-///   Robotics figure); sway linear 20 (assumed) and quadratic 99.99 (Heron model); heave linear
+/// - Damping: surge linear 5 N s/m (assumed) and quadratic 8.8 N s²/m², chosen so that the
+///   simulated top speed at full command is 3.0 m/s, the maximum speed Blue Robotics lists for the
+///   standard BlueBoat with two batteries on board (Blue Robotics staff, "Blueboat | 4x M200?",
+///   discuss.bluerobotics.com/t/blueboat-4x-m200/19831: "We do list the maximum speed of the
+///   standard BlueBoat, with only two batteries on board, as 3.0 m/s"), with two T200 on the
+///   datasheet curve (t200.hpp) at the voltage of a full blueboat_battery() under their full
+///   current: 15.76 V, 2 × 50.8 N (see below); sway linear 20 (assumed) and quadratic 99.99
+///   (Heron model); heave linear
 ///   100, roll 8, pitch 8 (assumed, ≈ 0.2 of critical damping), quadratic heave 50, roll 2,
 ///   pitch 2 (assumed); yaw linear 10 (assumed) and quadratic 3.49 (Heron model).
 /// - Thrusters: 2 × T200, left (port) first then right, as ArduRover's skid steering outputs
@@ -151,11 +156,13 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 ///   ≈ 0.2 m hulls and deck box), L_oa = 1.2 m (assumed from the product dimensions); constant
 ///   coefficients c_x = 0.6, c_y = 0.8 (assumed, mid-range of Fossen 2021 §10.1.1's values for
 ///   small craft), c_n = 0 (fore-aft symmetric profile assumed: no wind yaw moment).
-/// Resulting behaviour (checked by tests/vehicle): top speed 2.97 m/s with von Benzon's 30.4 N per
-/// thruster (the thrusters' lever arm below the CO trims the bow up ≈ 4° and costs ≈ 2 % against
-/// the pure surge balance 3.02 m/s); damped natural periods heave 0.81 s, roll 0.43 s, pitch
-/// 0.68 s. With the T200 datasheet (2 × 51.6 N at 16 V) the same damping gives ≈ 4.1 m/s, above
-/// the Blue Robotics figure: the assumed surge damping was chosen for the old curve.
+/// Resulting behaviour (checked by tests/vehicle): top speed 3.00 m/s with the T200 datasheet
+/// thrust at the full pack's 15.76 V (2 × 50.8 N; 4 % below the pure surge balance
+/// 5u + 8.8u² = 101.5 N ⇒ 3.12 m/s: the thrusters' lever arm below the CO and the Munk moment
+/// of the heave added mass, (Z_ẇ − X_u̇) u w, trim the bow up ≈ 8° at that speed, and the heave
+/// restoring force then has a surge component); damped natural periods heave 0.81 s, roll
+/// 0.43 s, pitch 0.68 s. (Until 2026-11 the surge quadratic damping was 5, chosen for von
+/// Benzon's 30.4 N curve: with the datasheet thrust it gave 3.3 m/s.)
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
 /// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
 /// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (the displaced volume is m/ρ).
@@ -187,7 +194,7 @@ VehiclePreset<Scalar> blueboat(const Scalar& density = Scalar(seawater_density),
   Vector6<Scalar> ma, dl, dq;
   ma << Scalar(2.25), Scalar(23.13), Scalar(15.0), Scalar(0.12), Scalar(0.2), Scalar(2.79);
   dl << Scalar(5.0), Scalar(20.0), Scalar(100.0), Scalar(8.0), Scalar(8.0), Scalar(10.0);
-  dq << Scalar(5.0), Scalar(99.99), Scalar(50.0), Scalar(2.0), Scalar(2.0), Scalar(3.49);
+  dq << Scalar(8.8), Scalar(99.99), Scalar(50.0), Scalar(2.0), Scalar(2.0), Scalar(3.49);
   v.added_mass = ma.asDiagonal();
   v.damping.linear = dl.asDiagonal();
   v.damping.quadratic = dq;
