@@ -1,0 +1,29 @@
+// The kelp Python extension module (kelp._kelp): what its translation units share.
+//
+// The module is split in several .cpp files (one per area of the library), each defining one
+// bind_*() function that module.cpp calls in the order below; every python/src/*.cpp is compiled
+// into the module (python/CMakeLists.txt globs them). To add bindings of a new area: declare its
+// bind_*() here, define it in a new .cpp, call it from module.cpp. kelp.Batch and the learning
+// environment have their hooks ready: bind_batch() (batch.cpp) and bind_learning()
+// (learning.cpp), each defined there as an empty function until filled.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace kelp_python {
+
+namespace py = pybind11;
+
+/// kelp.Error, kelp.InvalidArgument (a ValueError), kelp.NumericalError (a RuntimeError),
+/// kelp.ScenarioError (an InvalidArgument) and the translation of kelp's C++ exceptions to them
+/// (errors.cpp). Called first.
+void bind_errors(py::module_& m);
+
+/// kelp.Batch: many worlds at once (batch.cpp). Called after everything else, so that it may use
+/// every type bound before it.
+void bind_batch(py::module_& m);
+
+/// The learning environment's C++ part, if any (learning.cpp). Called last.
+void bind_learning(py::module_& m);
+
+}  // namespace kelp_python
