@@ -119,11 +119,14 @@ class TetheredPairEnv {
 
   /// \brief Starts a new episode: the scenario's world with `seed` as its sea's seed, at rest
   /// (the scenario's start), the action zero. Allocates (it builds the world).
-  /// \throws as the constructor.
+  /// \throws as the constructor; the environment is then as it was.
   void reset(std::uint64_t seed) {
+    // The new world is built aside: if that throws, the environment is as it was.
+    Scenario sc = scenario_;
+    sc.seed = seed;
+    auto loop = std::make_unique<ClosedLoop>(sc);
     scenario_.seed = seed;
-    loop_.reset();  // the old loop points at our commands: drop it first
-    loop_ = std::make_unique<ClosedLoop>(scenario_);
+    loop_ = std::move(loop);
     fly_by_controllers(controllers_);
     error_.clear();
     terminated_ = false;
