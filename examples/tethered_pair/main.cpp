@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 
 namespace fs = std::filesystem;
@@ -40,13 +40,13 @@ std::string plot_script() {
 }
 
 int run(const Options& o) {
-  kelp::sim::SimulateOptions so;
-  so.log_dir = o.out;
-  so.progress = !o.quiet && isatty(2);
-  so.scenario_file = o.scenario_file;
-  nlohmann::json summary = kelp::sim::simulate(o.scenario, so);
-  summary["kelp_version"] = KELP_VERSION_STRING;
-  std::ofstream(fs::path(o.out) / "summary.json") << summary.dump(2) << '\n';
+  // What kelp.run_scenario (Python) runs too: the same summary from the same scenario.
+  kelp::sim::RunOptions ro;
+  ro.out = o.out;
+  ro.progress = !o.quiet && isatty(2);
+  ro.scenario_file = o.scenario_file;
+  ro.version = KELP_VERSION_STRING;
+  const nlohmann::json summary = kelp::sim::run_scenario(o.scenario, ro);
   const double duration = summary["simulated_s"], wall = summary["wall_s"];
   const double auv_rms = summary["auv"]["rms_path_error_m"],
                asv_rms = summary["asv"]["rms_distance_to_auv_m"],
@@ -122,10 +122,12 @@ int main(int argc, char** argv) {
       o.scenario = kelp::sim::load_scenario(file);
       o.scenario_file = file;
     }
-    if (duration > 0) o.scenario.duration = duration;
-    if (seed >= 0) o.scenario.seed = static_cast<std::uint64_t>(seed);
-    if (!kernel.empty()) o.scenario.kernel = kernel;
-    if (deterministic) o.scenario.kernel = "portable";
+    kelp::sim::ScenarioOverrides overrides;
+    overrides.duration = duration;
+    overrides.seed = seed;
+    overrides.kernel = kernel;
+    overrides.deterministic = deterministic;
+    o.scenario = kelp::sim::apply_overrides(o.scenario, overrides);
     return run(o);
   } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-tethered-pair: invalid scenario: %s\n", e.what());

@@ -16,6 +16,8 @@ kelp::sim's scenarios (``kelp.run_scenario``); see ``help(kelp.<name>)``.
 from ._kelp import *  # noqa: F401,F403
 from ._kelp import __version__, Error, InvalidArgument, NumericalError, ScenarioError  # noqa: F401
 
+from .scenario import run_scenario  # noqa: F401
+
 # Pure-Python parts, one module each (their names are re-exported here).
 from .batch import *  # noqa: F401,F403
 from .learning import *  # noqa: F401,F403

@@ -19,6 +19,9 @@ namespace py = pybind11;
 /// (errors.cpp). Called first.
 void bind_errors(py::module_& m);
 
+/// kelp.run_scenario's C++ part, kelp._kelp._run_scenario (scenario.cpp).
+void bind_scenario(py::module_& m);
+
 /// kelp.Batch: many worlds at once (batch.cpp). Called after everything else, so that it may use
 /// every type bound before it.
 void bind_batch(py::module_& m);

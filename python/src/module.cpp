@@ -8,6 +8,7 @@ PYBIND11_MODULE(_kelp, m) {
       "package, not this module.";
   m.attr("__version__") = KELP_VERSION_STRING;
   kelp_python::bind_errors(m);
+  kelp_python::bind_scenario(m);
   kelp_python::bind_batch(m);
   kelp_python::bind_learning(m);
 }

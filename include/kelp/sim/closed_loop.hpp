@@ -97,6 +97,9 @@ struct ClosedLoopOptions {
   /// Called after every step, before the new state is sampled (e.g. the soak test's checks);
   /// empty: nothing is called.
   std::function<void(const StepView&)> on_step;
+  /// Called with every sample taken at the log rate (the rows of the log, t = 0 included), with
+  /// or without a log; empty: nothing is called.
+  std::function<void(const LogRow&)> on_sample;
 };
 
 /// \brief The tethered pair of a scenario flown by kelp's controllers, one step at a time.
@@ -464,6 +467,7 @@ class ClosedLoop {
         }
       }
       if (options_.log) options_.log->row(row);
+      if (options_.on_sample) options_.on_sample(row);
     }
     if (options_.log && k_ % node_every_ == 0) options_.log->nodes(t, state_.tether);
   }
@@ -501,6 +505,8 @@ struct SimulateOptions {
   std::string scenario_file = "(embedded default)";  ///< named in errors and in the summary
   /// Called after every step (e.g. the soak test's checks); empty: nothing is called.
   std::function<void(const StepView&)> on_step;
+  /// Called with every sample at the log rate (ClosedLoopOptions::on_sample); empty: none.
+  std::function<void(const LogRow&)> on_sample;
 };
 
 /// \brief Runs a scenario to its end in a ClosedLoop and returns its summary (the JSON
@@ -516,6 +522,7 @@ inline nlohmann::json simulate(const Scenario& sc, const SimulateOptions& o = {}
   lo.scenario_file = o.scenario_file;
   lo.log = log.get();
   lo.on_step = o.on_step;
+  lo.on_sample = o.on_sample;
   ClosedLoop loop(sc, setup, lo);
   const long steps = loop.total_steps();
   const auto wall0 = std::chrono::steady_clock::now();

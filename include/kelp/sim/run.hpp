@@ -1,0 +1,87 @@
+/// \file
+/// \brief What kelp-tethered-pair runs, as a function: a scenario with the command line's
+/// overrides (duration, seed, wave kernel), simulated by simulate(), its summary stamped with
+/// kelp's version and written as summary.json beside the CSV log.
+///
+/// The program and the Python package (`kelp.run_scenario`) both call run_scenario(), so the
+/// same scenario and seed give the same summary, bit for bit, from either. Part of the optional
+/// `kelp::sim` component.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "kelp/core/error.hpp"
+#include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/run_log.hpp"
+#include "kelp/sim/scenario.hpp"
+
+namespace kelp {
+namespace sim {
+
+/// \brief What a run may change in its scenario (kelp-tethered-pair's `--duration`, `--seed`,
+/// `--kernel`, `--deterministic`); an unset field keeps the scenario's value.
+struct ScenarioOverrides {
+  double duration = -1;    ///< simulated time [s]; > 0 overrides
+  std::int64_t seed = -1;  ///< seed of the waves and gusts; >= 0 overrides
+  std::string
+      kernel;  ///< wave kernel path ("auto", "portable", "avx2", "avx512"); non-empty overrides
+  bool deterministic = false;  ///< true: the kernel "portable" (the same numbers on every CPU)
+};
+
+/// \brief The scenario with the overrides applied.
+/// \throws kelp::invalid_argument for a non-finite duration, or `deterministic` with a kernel
+/// other than "portable".
+inline Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o) {
+  KELP_CHECK(!std::isnan(o.duration), "ScenarioOverrides::duration must not be NaN");
+  KELP_CHECK(
+      !o.deterministic || o.kernel.empty() || o.kernel == "portable",
+      "ScenarioOverrides: deterministic pins the kernel \"portable\", not \"" + o.kernel + "\"");
+  if (o.duration > 0) sc.duration = o.duration;
+  if (o.seed >= 0) sc.seed = static_cast<std::uint64_t>(o.seed);
+  if (!o.kernel.empty()) sc.kernel = o.kernel;
+  if (o.deterministic) sc.kernel = "portable";
+  return sc;
+}
+
+/// \brief Options of run_scenario().
+struct RunOptions {
+  /// Directory of the run's files (timeseries.csv and nodes.csv through RunLog, summary.json),
+  /// created if needed; empty: nothing is written.
+  std::string out;
+  std::string scenario_file = "(embedded default)";  ///< named in errors and in the summary
+  bool progress = false;                             ///< a progress bar on stderr
+  std::string version;  ///< the summary's `kelp_version` (empty: the field is left out)
+  /// Called with every sample the log takes (the rows of timeseries.csv, at the scenario's log
+  /// rate), whether or not a log is written; empty: nothing is called.
+  std::function<void(const LogRow&)> on_sample;
+};
+
+/// \brief Runs a scenario as kelp-tethered-pair does: simulate() (with the CSV log in `out`),
+/// the summary's `kelp_version`, and summary.json (the summary, indented by 2) in `out`.
+/// \returns the summary (summary.json's content).
+/// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
+/// file cannot be written.
+inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {}) {
+  SimulateOptions so;
+  so.log_dir = o.out;
+  so.progress = o.progress;
+  so.scenario_file = o.scenario_file;
+  so.on_sample = o.on_sample;
+  nlohmann::json summary = simulate(sc, so);
+  if (!o.version.empty()) summary["kelp_version"] = o.version;
+  if (!o.out.empty()) {
+    std::ofstream f(std::filesystem::path(o.out) / "summary.json");
+    f << summary.dump(2) << '\n';
+    if (!f) throw kelp::error("cannot write summary.json in " + o.out);
+  }
+  return summary;
+}
+
+}  // namespace sim
+}  // namespace kelp

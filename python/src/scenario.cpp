@@ -1,0 +1,160 @@
+// kelp.run_scenario's C++ part: kelp::sim::run_scenario (what kelp-tethered-pair runs) on a
+// scenario file or text, with the program's overrides, its samples collected as columns.
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "kelp/core/rotation.hpp"
+#include "kelp/sim/run.hpp"
+
+namespace kelp_python {
+
+namespace {
+
+// The columns of timeseries.csv (kelp::sim::RunLog; examples/tethered_pair/README.md), in order.
+std::vector<std::string> column_names() {
+  std::vector<std::string> c = {"t",
+                                "asv_x",
+                                "asv_y",
+                                "asv_z",
+                                "asv_roll",
+                                "asv_pitch",
+                                "asv_yaw",
+                                "asv_u",
+                                "asv_v",
+                                "asv_r",
+                                "auv_x",
+                                "auv_y",
+                                "auv_z",
+                                "auv_roll",
+                                "auv_pitch",
+                                "auv_yaw",
+                                "auv_u",
+                                "auv_v",
+                                "auv_w",
+                                "auv_target_x",
+                                "auv_target_y",
+                                "auv_target_z",
+                                "auv_error",
+                                "asv_error",
+                                "asv_thrust_port",
+                                "asv_thrust_starboard"};
+  for (int i = 1; i <= 8; ++i) c.push_back("auv_thrust_" + std::to_string(i));
+  c.insert(c.end(), {"asv_command_port", "asv_command_starboard"});
+  for (int i = 1; i <= 8; ++i) c.push_back("auv_command_" + std::to_string(i));
+  c.insert(c.end(), {"tension_asv", "tension_auv", "asv_voltage", "asv_soc", "asv_current_port",
+                     "asv_current_starboard", "auv_voltage", "auv_soc"});
+  for (int i = 1; i <= 8; ++i) c.push_back("auv_current_" + std::to_string(i));
+  return c;
+}
+
+// One sample's values in column_names()' order, appended to `out`.
+void append_row(const kelp::sim::LogRow& r, std::vector<double>& out) {
+  const Eigen::Vector3d ea = kelp::euler_from_quaternion(r.asv->attitude);
+  const Eigen::Vector3d eb = kelp::euler_from_quaternion(r.auv->attitude);
+  const auto& a = *r.asv;
+  const auto& b = *r.auv;
+  out.insert(out.end(), {r.t,
+                         a.position.x(),
+                         a.position.y(),
+                         a.position.z(),
+                         ea.x(),
+                         ea.y(),
+                         ea.z(),
+                         a.nu(0),
+                         a.nu(1),
+                         a.nu(5),
+                         b.position.x(),
+                         b.position.y(),
+                         b.position.z(),
+                         eb.x(),
+                         eb.y(),
+                         eb.z(),
+                         b.nu(0),
+                         b.nu(1),
+                         b.nu(2),
+                         r.auv_target.x(),
+                         r.auv_target.y(),
+                         r.auv_target.z(),
+                         r.auv_error,
+                         r.asv_error,
+                         r.asv_thrust(0),
+                         r.asv_thrust(1)});
+  for (int i = 0; i < 8; ++i) out.push_back(r.auv_thrust(i));
+  out.insert(out.end(), {r.asv_command(0), r.asv_command(1)});
+  for (int i = 0; i < 8; ++i) out.push_back(r.auv_command(i));
+  out.insert(out.end(), {r.tension_asv, r.tension_auv, r.asv_voltage, r.asv_soc, r.asv_current(0),
+                         r.asv_current(1), r.auv_voltage, r.auv_soc});
+  for (int i = 0; i < 8; ++i) out.push_back(r.auv_current(i));
+}
+
+}  // namespace
+
+void bind_scenario(py::module_& m) {
+  m.def(
+      "_run_scenario",
+      [](const std::optional<std::string>& file, const std::optional<std::string>& text,
+         std::optional<double> duration, std::optional<std::int64_t> seed,
+         const std::optional<std::string>& kernel, bool deterministic,
+         const std::optional<std::string>& out, bool timeseries) {
+        kelp::sim::Scenario sc;
+        kelp::sim::RunOptions ro;
+        if (file) {
+          sc = kelp::sim::load_scenario(*file);
+          ro.scenario_file = *file;
+        } else if (text) {
+          sc = kelp::sim::parse_scenario(*text, "(dict)");
+          ro.scenario_file = "(dict)";
+        }
+        kelp::sim::ScenarioOverrides ov;
+        if (duration) {
+          KELP_CHECK(std::isfinite(*duration) && *duration > 0,
+                     "run_scenario: duration must be a finite number > 0 [s]");
+          ov.duration = *duration;
+        }
+        if (seed) {
+          KELP_CHECK(*seed >= 0, "run_scenario: seed must be >= 0");
+          ov.seed = *seed;
+        }
+        if (kernel) ov.kernel = *kernel;
+        ov.deterministic = deterministic;
+        sc = kelp::sim::apply_overrides(sc, ov);
+        if (out) ro.out = *out;
+        ro.version = KELP_VERSION_STRING;
+        const std::vector<std::string> names = column_names();
+        std::vector<double> rows;
+        if (timeseries) {
+          rows.reserve(names.size() * static_cast<std::size_t>(sc.duration * sc.log_rate + 2.0));
+          ro.on_sample = [&rows](const kelp::sim::LogRow& r) { append_row(r, rows); };
+        }
+        std::string summary;
+        {
+          py::gil_scoped_release release;
+          summary = kelp::sim::run_scenario(sc, ro).dump();
+        }
+        if (!timeseries) return py::make_tuple(summary, py::none());
+        // One (columns, samples) array; each column a contiguous view into it.
+        const std::size_t nc = names.size(), nr = rows.size() / nc;
+        py::array_t<double> table({nc, nr});
+        auto t = table.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < nr; ++i)
+          for (std::size_t j = 0; j < nc; ++j)
+            t(static_cast<py::ssize_t>(j), static_cast<py::ssize_t>(i)) = rows[i * nc + j];
+        py::dict columns;
+        for (std::size_t j = 0; j < nc; ++j) columns[py::str(names[j])] = table[py::int_(j)];
+        return py::make_tuple(summary, columns);
+      },
+      py::arg("file"), py::arg("text"), py::arg("duration"), py::arg("seed"), py::arg("kernel"),
+      py::arg("deterministic"), py::arg("out"), py::arg("timeseries"),
+      "kelp::sim::run_scenario on a scenario file (`file`), a scenario's JSON text (`text`) or "
+      "the embedded default (both None), with kelp-tethered-pair's overrides. Returns (the "
+      "summary as JSON text, the samples as a dict of columns or None). Use kelp.run_scenario.");
+}
+
+}  // namespace kelp_python

@@ -1,0 +1,110 @@
+"""kelp.run_scenario runs what kelp-tethered-pair runs: the same summary, bit for bit, for the
+same scenario and seed; its time series equals the program's CSV; bad scenarios are named."""
+
+import csv
+import json
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import kelp
+
+WALL = ("wall_s", "realtime_factor")
+
+
+def without_wall(summary):
+    return {k: v for k, v in summary.items() if k not in WALL}
+
+
+def cli_summary(cli, out, *args):
+    subprocess.run([cli, "--quiet", "--no-plots", "--out", str(out), *args], check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(out / "summary.json") as f:
+        return json.load(f)
+
+
+def test_summary_equals_the_cli_bit_for_bit(tethered_pair_cli, scenarios_dir, tmp_path):
+    # A shipped scenario with a seed and a duration other than its own: every number of
+    # summary.json (parsed from its shortest round-trip decimal form) equals the dict's exactly.
+    scenario = str(scenarios_dir / "paper_10m_moderate.json")
+    expected = cli_summary(tethered_pair_cli, tmp_path / "cli", "--scenario", scenario,
+                           "--duration", "8", "--seed", "7")
+    got = kelp.run_scenario(scenario, duration=8, seed=7)
+    assert set(WALL) <= set(got)
+    assert without_wall(got) == without_wall(expected)
+    assert got["scenario"]["seed"] == 7 and got["simulated_s"] == 8
+    assert got["scenario_file"] == scenario
+    assert got["kelp_version"] == kelp.__version__
+    # Floats compared by their bits too (== would let -0.0 equal 0.0).
+    a, b = got["auv"]["rms_path_error_m"], expected["auv"]["rms_path_error_m"]
+    assert a.hex() == b.hex() and a > 0
+
+
+def test_default_scenario_equals_the_cli_and_another_seed_differs(tethered_pair_cli, tmp_path):
+    expected = cli_summary(tethered_pair_cli, tmp_path / "cli", "--duration", "5", "--seed", "3")
+    got = kelp.run_scenario(duration=5, seed=3)
+    assert without_wall(got) == without_wall(expected)
+    assert got["scenario_file"] == "(embedded default)"
+    other = kelp.run_scenario(duration=5, seed=4)
+    assert other["energy_j"] != got["energy_j"]
+
+
+def test_a_dict_runs_like_its_file(scenarios_dir):
+    path = scenarios_dir / "calm_hold.json"
+    with open(path) as f:
+        d = json.load(f)
+    from_file = without_wall(kelp.run_scenario(path, duration=3))
+    from_dict = without_wall(kelp.run_scenario(d, duration=3))
+    assert from_dict["scenario_file"] == "(dict)"
+    from_file.pop("scenario_file"), from_dict.pop("scenario_file")
+    assert from_dict == from_file
+
+
+def test_out_writes_the_programs_files_and_timeseries_equals_the_csv(tmp_path):
+    summary, ts = kelp.run_scenario(duration=3, seed=2, out=tmp_path, timeseries=True)
+    assert {p.name for p in tmp_path.iterdir()} >= {"summary.json", "timeseries.csv",
+                                                     "nodes.csv"}
+    with open(tmp_path / "summary.json") as f:
+        assert without_wall(json.load(f)) == without_wall(summary)
+    with open(tmp_path / "timeseries.csv") as f:
+        rows = list(csv.reader(f))
+    header, rows = rows[0], rows[1:]
+    # Every column kelp.run_scenario returns is one of the CSV's, in the CSV's order.
+    names = list(ts)
+    assert names == [h for h in header if h in ts]
+    assert {"t", "auv_x", "asv_yaw", "tension_auv", "auv_soc", "auv_current_8"} <= set(names)
+    n = len(rows)
+    assert n == 31  # t = 0 and 10 samples a second for 3 s
+    for name in names:
+        col = ts[name]
+        assert col.shape == (n,) and col.dtype == np.float64
+        printed = np.array([float(r[header.index(name)]) for r in rows])
+        # The CSV prints 6 significant digits (%.6g); the arrays are the full doubles.
+        np.testing.assert_allclose(col, printed, rtol=6e-6, atol=1e-300, equal_nan=True,
+                                   err_msg=name)
+    assert ts["t"][0] == 0 and ts["t"][-1] == pytest.approx(3.0)
+    # The columns are views of one table: no copy per column, kept alive by the arrays.
+    assert np.shares_memory(ts["t"], ts["auv_x"]) or ts["t"].base is ts["auv_x"].base
+    t = ts["t"]
+    del ts
+    assert t[-1] == pytest.approx(3.0)
+
+
+def test_bad_scenarios_are_named():
+    with pytest.raises(kelp.ScenarioError, match=r"\(dict\): /sea/nonsense") as info:
+        kelp.run_scenario({"sea": {"nonsense": 1}}, duration=1)
+    assert isinstance(info.value, ValueError)
+    with pytest.raises(kelp.ScenarioError, match="/tether/length"):
+        kelp.run_scenario({"tether": {"length": -3}}, duration=1)
+    with pytest.raises(kelp.ScenarioError, match="no_such_file.json: cannot be read"):
+        kelp.run_scenario("no_such_file.json")
+    with pytest.raises(kelp.InvalidArgument, match="duration"):
+        kelp.run_scenario(duration=-1)
+    with pytest.raises(kelp.InvalidArgument, match="duration"):
+        kelp.run_scenario(duration=math.nan)
+    with pytest.raises(kelp.InvalidArgument, match="seed"):
+        kelp.run_scenario(duration=1, seed=-2)
+    with pytest.raises(kelp.InvalidArgument, match="deterministic"):
+        kelp.run_scenario(duration=1, kernel="avx2", deterministic=True)
