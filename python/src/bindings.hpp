@@ -19,6 +19,19 @@ namespace py = pybind11;
 /// (errors.cpp). Called first.
 void bind_errors(py::module_& m);
 
+/// kelp.VehicleState, kelp.Vehicle, kelp.t200_thrust/t200_current (vehicle.cpp).
+void bind_vehicle(py::module_& m);
+
+/// kelp.Environment (environment.cpp).
+void bind_environment(py::module_& m);
+
+/// kelp.catenary and kelp.Catenary (catenary.cpp).
+void bind_catenary(py::module_& m);
+
+/// kelp.System, kelp.SystemState, kelp.SystemInputs, kelp.SystemReport (system.cpp; after
+/// bind_vehicle and bind_environment, whose types it returns).
+void bind_system(py::module_& m);
+
 /// kelp.run_scenario's C++ part, kelp._kelp._run_scenario (scenario.cpp).
 void bind_scenario(py::module_& m);
 
