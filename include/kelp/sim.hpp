@@ -1,12 +1,16 @@
 /// \file
 /// \brief kelp::sim, the optional component the programs sit on: scenario files, the world a
-/// scenario builds, the closed loop (kelp's controllers flying the tethered pair) and the run log.
+/// scenario builds, the closed loop (kelp's controllers flying the tethered pair), the run log,
+/// a gym-style environment's core (pair_env.hpp) and a batch of worlds on a thread pool
+/// (batch.hpp: a program that uses it links Threads::Threads).
 ///
 /// Needs nlohmann-json besides Eigen: link the target kelp::sim, found with
 /// `find_package(kelp CONFIG REQUIRED COMPONENTS sim)`. Not included by kelp/kelp.hpp.
 #pragma once
 
+#include "kelp/sim/batch.hpp"
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/pair_env.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"

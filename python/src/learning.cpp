@@ -1,9 +1,102 @@
-// The learning environment's C++ part (issue 27, item 5), if it needs one. Until then, nothing
-// is bound.
+// The gym-style environment's C++ core (kelp::sim::TetheredPairEnv) as kelp._kelp.PairEnvCore;
+// kelp.TetheredPairEnv (python/kelp/learning.py) gives it gymnasium's API.
+#include <pybind11/numpy.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
 #include "bindings.hpp"
+#include "kelp/sim/pair_env.hpp"
+#include "kelp/sim/scenario.hpp"
 
 namespace kelp_python {
 
-void bind_learning(py::module_&) {}
+void bind_learning(py::module_& m) {
+  namespace ks = kelp::sim;
+  using Env = ks::TetheredPairEnv;
+  py::class_<Env>(m, "PairEnvCore", R"(The C++ core of kelp.TetheredPairEnv (use that instead).
+
+A scenario's world whose ROV (and optionally boat) is flown by an action through the ROV
+controller's thrust allocation, with a 20-entry observation and the reward
+-path_weight * path error - energy_weight * battery energy (see kelp.TetheredPairEnv).)")
+      .def(py::init([](const std::string& text, const std::string& name, double control_period,
+                       bool boat_action, double max_path_error, double path_weight,
+                       double energy_weight) {
+             ks::PairEnvOptions o;
+             o.control_period = control_period;
+             o.boat_action = boat_action;
+             o.max_path_error = max_path_error;
+             o.path_weight = path_weight;
+             o.energy_weight = energy_weight;
+             return std::make_unique<Env>(ks::parse_scenario(text, name), o);
+           }),
+           py::arg("scenario_json"), py::arg("scenario_name"), py::arg("control_period") = 0.1,
+           py::arg("boat_action") = false, py::arg("max_path_error") = 20.0,
+           py::arg("path_weight") = 1.0, py::arg("energy_weight") = 0.01,
+           "An environment over the scenario in JSON text (its name is used in errors).")
+      .def("reset", &Env::reset, py::arg("seed"),
+           "New episode: the scenario's world with `seed` as its sea's seed.")
+      .def(
+          "step",
+          [](Env& e, py::array_t<double, py::array::c_style | py::array::forcecast> action) {
+            if (action.ndim() != 1 || action.shape(0) != e.action_size())
+              throw kelp::invalid_argument("TetheredPairEnv.step: the action must have shape (" +
+                                           std::to_string(e.action_size()) + ",), got ndim " +
+                                           std::to_string(action.ndim()) + ", size " +
+                                           std::to_string(action.size()));
+            const double r = e.step(action.data());
+            return py::make_tuple(r, e.terminated(), e.truncated());
+          },
+          py::arg("action"),
+          "Applies the action for one control period; returns (reward, terminated, truncated).")
+      .def(
+          "observation",
+          [](const Env& e) {
+            py::array_t<double> o(Env::observation_size);
+            std::copy(e.observation().begin(), e.observation().end(), o.mutable_data());
+            return o;
+          },
+          "A copy of the current observation (20 floats).")
+      .def_property_readonly("action_size", &Env::action_size, "Entries of an action.")
+      .def_property_readonly_static(
+          "observation_size", [](py::object) { return Env::observation_size; },
+          "Entries of an observation.")
+      .def_property_readonly_static(
+          "action_scale",
+          [](py::object) {
+            py::tuple t(Env::action_scale.size());
+            for (std::size_t i = 0; i < Env::action_scale.size(); ++i) t[i] = Env::action_scale[i];
+            return t;
+          },
+          "The ROV wrench an action entry of 1 asks for [N, N m] (X, Y, Z, K, M, N).")
+      .def_property_readonly("substeps", &Env::substeps, "System steps (10 ms) per step.")
+      .def_property_readonly(
+          "time", [](const Env& e) { return e.loop().time(); }, "Simulation time [s].")
+      .def_property_readonly(
+          "path_error", [](const Env& e) { return e.observation()[19]; },
+          "The ROV's distance from its survey leg [m].")
+      .def_property_readonly("energy_drawn", &Env::energy_drawn,
+                             "Energy the ROV's battery delivered since reset [J].")
+      .def_property_readonly(
+          "saturated", [](const Env& e) { return e.rov_command().saturated; },
+          "The ROV's action asked for more than its thrusters give.")
+      .def_property_readonly("terminated", &Env::terminated, "The episode terminated.")
+      .def_property_readonly("truncated", &Env::truncated, "The episode was truncated.")
+      .def_property_readonly("error", &Env::error, "Why a step failed ('' otherwise).")
+      .def_property_readonly(
+          "auv_position",
+          [](const Env& e) {
+            const auto& p = e.loop().state().auv.position;
+            return py::make_tuple(p.x(), p.y(), p.z());
+          },
+          "The ROV's position, NED [m].")
+      .def(
+          "summary",
+          [](const Env& e) {
+            return py::module_::import("json").attr("loads")(e.loop().summary().dump());
+          },
+          "The episode's summary so far, as kelp-tethered-pair's summary.json (no wall time).");
+}
 
 }  // namespace kelp_python

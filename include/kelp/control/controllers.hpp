@@ -120,6 +120,70 @@ class DisturbanceObserver {
   Vector6<double> estimate_ = Vector6<double>::Zero();
 };
 
+/// \brief The factors (each in (0, 1]) by which allocate_wrench() scaled the thrust down to keep
+/// every thruster within its limit; all 1 when nothing saturated.
+struct AllocationScales {
+  double horizontal = 1.0;  ///< the horizontal group (X, Y, N); split saturation only
+  double vertical = 1.0;    ///< the vertical group (Z, K, M); split saturation only
+  double total = 1.0;       ///< the whole (the sum of the groups with split saturation)
+  /// \brief True when any factor is below 1 (the wrench was not delivered in full).
+  bool saturated() const { return horizontal < 1.0 || vertical < 1.0 || total < 1.0; }
+};
+
+/// \brief Allocates a desired body wrench to a thruster set and saturates it, as AuvController
+/// does (and so kelp::sim's gym-style environment, whose action is such a wrench): minimum-norm
+/// forces f = B⁺ τ (vehicle::ThrusterAllocation::distribute), then scaled so that no thruster
+/// exceeds its limit, min(max_thrust, its largest forward or reverse thrust at the chain's supply
+/// voltage). With `split_saturation` the horizontal (X, Y, N) and vertical (Z, K, M) parts are
+/// allocated and scaled apart, then the sum uniformly if it still exceeds a limit; otherwise the
+/// whole is scaled uniformly. No allocation.
+/// \param[in] chain the thrusters (allocation, curve, facing, voltage)
+/// \param[in] tau desired body wrench [N, N m] \param[in] max_thrust cap on every thruster [N]
+/// \param[in] split_saturation see above
+/// \param[out] force the thrusters' forces [N] (one entry per thruster, already sized)
+/// \param[out] scratch a buffer of the same size (the vertical part's forces)
+/// \returns the scale factors applied.
+/// \throws kelp::invalid_argument for a non-finite `tau` or wrongly sized buffers.
+inline AllocationScales allocate_wrench(const vehicle::ThrusterChain<double>& chain,
+                                        const Vector6<double>& tau, double max_thrust,
+                                        bool split_saturation, Eigen::VectorXd& force,
+                                        Eigen::VectorXd& scratch) {
+  KELP_CHECK(scratch.size() == force.size(), "allocate_wrench: scratch must be sized as force");
+  // fit(f) is the largest factor ≤ 1 that keeps every thruster of f within its limit.
+  const auto fit = [&](const Eigen::VectorXd& f) {
+    double scale = 1.0;
+    for (Eigen::Index i = 0; i < f.size(); ++i) {
+      const double l = std::min(
+          max_thrust, f(i) >= 0.0 ? chain.max_positive_thrust(i) : chain.max_negative_thrust(i));
+      if (std::abs(f(i)) * scale > l) scale = l / std::abs(f(i));
+    }
+    return scale;
+  };
+  AllocationScales s;
+  if (split_saturation) {
+    // A depth correction that saturates the vertical thrusters does not shrink the horizontal
+    // thrust (on a vehicle whose thrusters split so, e.g. the BlueROV2 Heavy, the groups are
+    // independent).
+    Vector6<double> part = tau;
+    part(2) = part(3) = part(4) = 0.0;
+    chain.allocation().distribute(part, force);
+    s.horizontal = fit(force);
+    force *= s.horizontal;
+    part = tau - part;
+    chain.allocation().distribute(part, scratch);
+    s.vertical = fit(scratch);
+    scratch *= s.vertical;
+    force += scratch;
+    s.total = fit(force);
+    force *= s.total;
+  } else {
+    chain.allocation().distribute(tau, force);
+    s.total = fit(force);
+    if (s.total < 1.0) force *= s.total;
+  }
+  return s;
+}
+
 /// \brief Settings of the AUV controller. Force PIDs act on position errors in the heading frame
 /// [m → N], the yaw PID on the heading error [rad → N m], roll and pitch PIDs keep the vehicle
 /// level. Defaults tuned for the BlueROV2 Heavy preset (surge mass with added mass ≈ 20 kg, heave
@@ -297,59 +361,23 @@ class AuvController {
         roll_.update(-rpy(0), dt, -nav.nu(3)), pitch_.update(-rpy(1), dt, -nav.nu(4)),
         yaw_.update(e_psi, dt, -nav.nu(5));
     if (settings_.compensate) tau -= observer_.estimate();
-    // Thruster i's limit for a force f: its largest forward or reverse thrust at the supply
-    // voltage, capped at max_thrust; fit(f) is the largest factor ≤ 1 that keeps every thruster
-    // of f within its limit.
-    const auto limit = [this](Eigen::Index i, double f) {
-      return std::min(settings_.max_thrust, f >= 0.0 ? thrusters_.max_positive_thrust(i)
-                                                     : thrusters_.max_negative_thrust(i));
-    };
-    const auto fit = [&limit](const Eigen::VectorXd& f) {
-      double scale = 1.0;
-      for (Eigen::Index i = 0; i < f.size(); ++i) {
-        const double l = limit(i, f(i));
-        if (std::abs(f(i)) * scale > l) scale = l / std::abs(f(i));
-      }
-      return scale;
-    };
+    const AllocationScales sc = allocate_wrench(thrusters_, tau, settings_.max_thrust,
+                                                settings_.split_saturation, force_, vertical_);
+    command_.saturated = sc.saturated();
     if (settings_.split_saturation) {
-      // The horizontal (X, Y, N) and vertical (Z, K, M) parts allocated and scaled apart: a
-      // depth correction that saturates the vertical thrusters does not shrink the horizontal
-      // thrust (on a vehicle whose thrusters split so, e.g. the BlueROV2 Heavy, the groups are
-      // independent), then a final uniform scaling if the sum still exceeds a limit.
-      Vector6<double> part = tau;
-      part(2) = part(3) = part(4) = 0.0;
-      thrusters_.allocation().distribute(part, force_);
-      const double sh = fit(force_);
-      force_ *= sh;
-      part = tau - part;
-      thrusters_.allocation().distribute(part, vertical_);
-      const double sv = fit(vertical_);
-      vertical_ *= sv;
-      force_ += vertical_;
-      const double sa = fit(force_);
-      force_ *= sa;
-      command_.saturated = sh < 1.0 || sv < 1.0 || sa < 1.0;
       // Anti-windup per group: what a group could not deliver is not integrated.
-      if (sh < 1.0 || sa < 1.0) {
+      if (sc.horizontal < 1.0 || sc.total < 1.0) {
         surge_.set_integral(i_saved[0]);
         sway_.set_integral(i_saved[1]);
         yaw_.set_integral(i_saved[3]);
       }
-      if (sv < 1.0 || sa < 1.0) heave_.set_integral(i_saved[2]);
-    } else {
-      // Allocation, then uniform scaling so that no thruster exceeds its limit.
-      thrusters_.allocation().distribute(tau, force_);
-      const double sa = fit(force_);
-      command_.saturated = sa < 1.0;
-      if (command_.saturated) {
-        force_ *= sa;
-        // Anti-windup: the allocation could not deliver: keep the integrals where they were.
-        surge_.set_integral(i_saved[0]);
-        sway_.set_integral(i_saved[1]);
-        heave_.set_integral(i_saved[2]);
-        yaw_.set_integral(i_saved[3]);
-      }
+      if (sc.vertical < 1.0 || sc.total < 1.0) heave_.set_integral(i_saved[2]);
+    } else if (command_.saturated) {
+      // Anti-windup: the allocation could not deliver: keep the integrals where they were.
+      surge_.set_integral(i_saved[0]);
+      sway_.set_integral(i_saved[1]);
+      heave_.set_integral(i_saved[2]);
+      yaw_.set_integral(i_saved[3]);
     }
     // The thrust the thrusters deliver for these commands (the curve saturates at its peak).
     thrusters_.commands_for(force_, command_.command, command_.thrust);

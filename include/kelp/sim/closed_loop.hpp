@@ -182,14 +182,16 @@ class ClosedLoop {
       for (Eigen::Index i = 0; i < esc.size(); ++i)
         u(i) = esc(i) > 0.0 ? esc(i) / pp.esc_scale_forward : esc(i) / pp.esc_scale_reverse;
     };
+    const kelp::control::AuvCommand& auv = auv_override_ ? *auv_override_ : *auv_command_;
     if (const auto* pm = model_.auv_propulsion())
-      to_vehicle(*pm, auv_command_->command, inputs_.auv_commands);
+      to_vehicle(*pm, auv.command, inputs_.auv_commands);
     else
-      inputs_.auv.tau = auv_command_->wrench;
+      inputs_.auv.tau = auv.wrench;
+    const kelp::control::AsvCommand& asv = asv_override_ ? *asv_override_ : *asv_command_;
     if (const auto* pm = model_.asv_propulsion())
-      to_vehicle(*pm, asv_command_->command, inputs_.asv_commands);
+      to_vehicle(*pm, asv.command, inputs_.asv_commands);
     else
-      inputs_.asv.tau = asv_command_->wrench;
+      inputs_.asv.tau = asv.wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
     solver_stats_ += report_;
     if (report_.tether.partings > 0) {
@@ -243,8 +245,22 @@ class ClosedLoop {
   const kelp::control::AuvController& auv_controller() const { return auv_; }
   /// \brief The ASV's controller.
   const kelp::control::AsvController& asv_controller() const { return asv_; }
-  /// \brief The AUV's command for the next step.
+  /// \brief The AUV's controller's command for the next step (applied unless overridden).
   const kelp::control::AuvCommand& auv_command() const { return *auv_command_; }
+  /// \brief Flies the AUV by `command` instead of its controller from the next step on (e.g. a
+  /// learning agent's action, kelp::sim::PairEnv): its per-thruster commands (the ESC's, as the
+  /// controller's) drive the propulsion, or without propulsion its wrench is applied. The
+  /// controller keeps running (its waypoint and leg bookkeeping still defines the path error of
+  /// the metrics) but its commands are not applied. Not owned: it must outlive its use; it is
+  /// read at every step, so it may be changed between steps. Null: the controller flies again.
+  void set_auv_override(const kelp::control::AuvCommand* command) { auv_override_ = command; }
+  /// \brief The command overriding the AUV's controller, or null.
+  const kelp::control::AuvCommand* auv_override() const { return auv_override_; }
+  /// \brief Flies the ASV by `command` instead of its controller from the next step on; see
+  /// set_auv_override(). Null: the controller flies again.
+  void set_asv_override(const kelp::control::AsvCommand* command) { asv_override_ = command; }
+  /// \brief The command overriding the ASV's controller, or null.
+  const kelp::control::AsvCommand* asv_override() const { return asv_override_; }
   /// \brief The ASV's command for the next step.
   const kelp::control::AsvCommand& asv_command() const { return *asv_command_; }
   /// \brief The sample of the current state (what a log row holds; its vehicle states point into
@@ -434,10 +450,11 @@ class ClosedLoop {
     row.auv_target = auv_.target();
     row.auv_error = e_auv;
     row.asv_error = e_asv;
-    row.asv_thrust << asv_command_->left, asv_command_->right;
-    row.auv_thrust = auv_command_->thrust;
-    row.asv_command = asv_command_->command;
-    row.auv_command = auv_command_->command;
+    const kelp::control::AsvCommand& asv = asv_override_ ? *asv_override_ : *asv_command_;
+    row.asv_thrust << asv.left, asv.right;
+    row.auv_thrust = (auv_override_ ? auv_override_ : auv_command_)->thrust;
+    row.asv_command = asv.command;
+    row.auv_command = (auv_override_ ? auv_override_ : auv_command_)->command;
     row.tension_asv = ta;
     row.tension_auv = tb;
     // The AUV's turns about the tether (its attachment is the tether's last node).
@@ -498,6 +515,8 @@ class ClosedLoop {
   kelp::system::SystemReportd report_;
   const kelp::control::AuvCommand* auv_command_ = nullptr;
   const kelp::control::AsvCommand* asv_command_ = nullptr;
+  const kelp::control::AuvCommand* auv_override_ = nullptr;  // set_auv_override()
+  const kelp::control::AsvCommand* asv_override_ = nullptr;  // set_asv_override()
   LogRow sample_;
   RunMetrics metrics_;
   kelp::system::SolverStatsd solver_stats_;

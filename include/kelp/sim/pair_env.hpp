@@ -1,0 +1,259 @@
+/// \file
+/// \brief The core of a gym-style environment over the tethered pair: a scenario's ClosedLoop
+/// whose ROV (and optionally boat) is flown by an action instead of its controller, with a fixed
+/// observation, a documented reward and the episode's end.
+///
+/// The action goes through the same thrust allocation and saturation as the ROV's controller
+/// (control::allocate_wrench on the controller's own thruster chain, at its battery's voltage),
+/// so an agent and the controller command the vehicle alike. Python's `kelp.TetheredPairEnv`
+/// (gymnasium's API: reset → (obs, info), step → (obs, reward, terminated, truncated, info)) and
+/// `kelp.Batch` sit on it. Part of the optional `kelp::sim` component.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "kelp/control/controllers.hpp"
+#include "kelp/core/error.hpp"
+#include "kelp/core/rotation.hpp"
+#include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/scenario.hpp"
+
+namespace kelp {
+namespace sim {
+
+/// \brief Options of a TetheredPairEnv.
+struct PairEnvOptions {
+  /// Time between two actions [s]: a multiple of ClosedLoop::dt (10 ms), the action held
+  /// over it (zero-order hold).
+  double control_period = 0.1;
+  /// The action also drives the boat (two more entries: port and starboard thrust); false: the
+  /// boat's controller follows the ROV as in the scenario's runs.
+  bool boat_action = false;
+  /// The episode terminates when the ROV is farther than this from the survey path [m].
+  double max_path_error = 20.0;
+  /// Reward per metre of path error, per control period (see TetheredPairEnv).
+  double path_weight = 1.0;
+  /// Reward per joule the ROV's battery delivers (see TetheredPairEnv) [1/J].
+  double energy_weight = 0.01;
+};
+
+/// \brief The tethered pair of a scenario as a reinforcement-learning environment (the core of
+/// Python's `kelp.TetheredPairEnv`).
+///
+/// **Episode.** reset(seed) builds the scenario's world with `seed` as its sea's seed (waves,
+/// gusts): the same seed gives the same episode, bit for bit. step(action) holds the action for
+/// `control_period` (k = control_period / 10 ms system steps of the ClosedLoop); the episode is
+/// *truncated* when the scenario's duration is reached and *terminated* when the ROV is farther
+/// than `max_path_error` from the survey path or a step fails (kelp::numerical_error: the world
+/// stays as it was before the failing step; error() says why).
+///
+/// **Action** (action_size() = 6, or 8 with `boat_action`), each entry in [−1, 1] (clipped):
+/// the ROV's desired body wrench [X, Y, Z, K, M, N] as fractions of (80 N, 80 N, 100 N, 10 N m,
+/// 10 N m, 15 N m) — the output limits of the ROV controller's PIDs
+/// (control::AuvControllerSettings) — allocated to its eight thrusters by
+/// control::allocate_wrench with split saturation, as the controller's "kelp" preset does; with
+/// `boat_action`, then the boat's port and starboard thrust as fractions of the scenario's
+/// `asv_thrust_clip` (25 N by default), through its controller's thruster chain.
+///
+/// **Observation** (observation_size() = 20 doubles, unbounded): [0, 3) the ROV's position
+/// minus its current waypoint (NED [m]); [3, 6) its roll, pitch, yaw (ZYX Euler [rad]); [6, 12)
+/// its body velocity ν (u, v, w [m/s], p, q, r [rad/s]); [12, 15) the boat's position minus the
+/// ROV's (NED [m]); [15] the boat's yaw [rad]; [16, 19) the tether's force on the ROV (NED [N]);
+/// [19] the ROV's path error e (its distance from the survey leg it flies, as in the run's
+/// metrics [m]).
+///
+/// **Reward** per step: r = −path_weight · e − energy_weight · ΔE, with e the path error after
+/// the step [m] and ΔE the energy the ROV's battery delivered during it [J] (0 in a scenario
+/// without propulsion). The defaults (1 /m, 0.01 /J) make 1 m of error cost as much as 100 J
+/// (the ROV's thrusters hovering and cruising draw ~50–300 W, i.e. 5–30 J per 0.1 s).
+///
+/// No heap allocation in step(). The environment holds references into itself: it can be
+/// neither copied nor moved.
+class TetheredPairEnv {
+ public:
+  /// Observation entries.
+  static constexpr int observation_size = 20;
+  /// ROV action entries (the boat's two follow with PairEnvOptions::boat_action).
+  static constexpr int rov_action_size = 6;
+  /// \brief The wrench an action entry of 1 asks for [N, N m] (see the class).
+  static constexpr std::array<double, 6> action_scale{80.0, 80.0, 100.0, 10.0, 10.0, 15.0};
+
+  /// \brief An environment over `scenario` (its seed replaced by reset()'s); built at seed
+  /// `scenario.seed`.
+  /// \throws kelp::invalid_argument for a control period that is not a positive multiple of
+  /// 10 ms, non-positive weights or max_path_error; scenario_error, kelp::invalid_argument from
+  /// the world (world_setup()).
+  explicit TetheredPairEnv(const Scenario& scenario, const PairEnvOptions& options = {})
+      : scenario_(scenario), options_(options) {
+    check_positive(options.control_period, "control_period");
+    const double k = options.control_period / ClosedLoop::dt;
+    KELP_CHECK(std::abs(k - std::round(k)) < 1e-9 && std::round(k) >= 1,
+               "control_period must be a positive multiple of 0.01 s, got " +
+                   std::to_string(options.control_period));
+    substeps_ = std::lround(k);
+    check_positive(options.max_path_error, "max_path_error");
+    check_non_negative(options.path_weight, "path_weight");
+    check_non_negative(options.energy_weight, "energy_weight");
+    const Eigen::Index n = 8;  // the BlueROV2 Heavy's thrusters
+    force_ = Eigen::VectorXd::Zero(n);
+    scratch_ = Eigen::VectorXd::Zero(n);
+    rov_.thrust = Eigen::VectorXd::Zero(n);
+    rov_.command = Eigen::VectorXd::Zero(n);
+    reset(scenario.seed);
+  }
+
+  TetheredPairEnv(const TetheredPairEnv&) = delete;
+  TetheredPairEnv& operator=(const TetheredPairEnv&) = delete;
+
+  /// \brief Entries of an action: 6, or 8 with PairEnvOptions::boat_action.
+  int action_size() const { return options_.boat_action ? 8 : 6; }
+  /// \brief System steps (10 ms) per step().
+  long substeps() const { return substeps_; }
+  /// \brief The options.
+  const PairEnvOptions& options() const { return options_; }
+
+  /// \brief Starts a new episode: the scenario's world with `seed` as its sea's seed, at rest
+  /// (the scenario's start), the action zero. Allocates (it builds the world).
+  /// \throws as the constructor; the environment is then as it was.
+  void reset(std::uint64_t seed) {
+    // The new world is built aside: if that throws, the environment is as it was.
+    Scenario sc = scenario_;
+    sc.seed = seed;
+    auto loop = std::make_unique<ClosedLoop>(sc);
+    scenario_.seed = seed;
+    loop_ = std::move(loop);
+    fly_by_controllers(controllers_);
+    error_.clear();
+    terminated_ = false;
+    reward_ = 0.0;
+    const std::array<double, 8> zero{};
+    apply(zero.data());
+    observe(obs_.data());
+  }
+
+  /// \brief Sets the action held from the next step on: `action` points to action_size()
+  /// entries, each clipped to [−1, 1]. No allocation.
+  /// \throws kelp::invalid_argument for a non-finite entry (the action is then unchanged).
+  void apply(const double* action) {
+    for (int i = 0; i < action_size(); ++i)
+      KELP_CHECK(std::isfinite(action[i]), "action[" + std::to_string(i) + "] is not finite");
+    const auto clip = [](double a) { return a < -1.0 ? -1.0 : (a > 1.0 ? 1.0 : a); };
+    Vector6<double> tau;
+    for (int i = 0; i < 6; ++i) tau(i) = clip(action[i]) * action_scale[static_cast<size_t>(i)];
+    const auto& chain = loop_->auv_controller().thruster_chain();
+    const control::AllocationScales s =
+        control::allocate_wrench(chain, tau, max_thrust_, true, force_, scratch_);
+    chain.commands_for(force_, rov_.command, rov_.thrust);
+    rov_.wrench = chain.wrench(rov_.thrust);
+    rov_.saturated = s.saturated();
+    if (options_.boat_action) {
+      const auto& boat = loop_->asv_controller().thruster_chain();
+      const double c = scenario_.asv_thrust_clip;
+      const Eigen::Vector2d wanted(clip(action[6]) * c, clip(action[7]) * c);
+      boat_.left = wanted(0);
+      boat_.right = wanted(1);
+      boat.commands_for(wanted, boat_.command, boat_thrust_);
+      boat_.wrench = boat.wrench(boat_thrust_);
+    }
+  }
+
+  /// \brief Lets the scenario's controllers fly the vehicles (true) or the action (false, the
+  /// default) from the next step on; the controllers run all along, so switching is seamless.
+  /// kelp::sim::Batch flies by the controllers when it is given no actions.
+  void fly_by_controllers(bool yes) {
+    controllers_ = yes;
+    loop_->set_auv_override(yes ? nullptr : &rov_);
+    loop_->set_asv_override(yes || !options_.boat_action ? nullptr : &boat_);
+  }
+  /// \brief True when the scenario's controllers fly the vehicles (fly_by_controllers()).
+  bool flown_by_controllers() const { return controllers_; }
+
+  /// \brief One control period: applies `action` (see apply()) and advances the world by
+  /// substeps() system steps, then observes it. Does nothing once the episode has ended
+  /// (terminated() or truncated()) but return 0. No allocation.
+  /// \returns the reward of the step (see the class).
+  /// \throws kelp::invalid_argument for a bad action (nothing is stepped).
+  double step(const double* action) {
+    if (terminated_ || truncated()) return 0.0;
+    apply(action);
+    return advance();
+  }
+
+  /// \brief As step() with the action set earlier (apply()), e.g. by kelp::sim::Batch.
+  double advance() {
+    if (terminated_ || truncated()) return 0.0;
+    const double e0 = energy_drawn();
+    try {
+      for (long i = 0; i < substeps_ && !loop_->done(); ++i) loop_->step();
+    } catch (const kelp::error& e) {
+      error_ = e.what();
+      terminated_ = true;
+    }
+    observe(obs_.data());
+    const double path_error = obs_[19];
+    if (!(path_error <= options_.max_path_error)) terminated_ = true;
+    reward_ = -options_.path_weight * path_error - options_.energy_weight * (energy_drawn() - e0);
+    return reward_;
+  }
+
+  /// \brief Writes the observation of the current state (observation_size entries) to `out`.
+  void observe(double* out) const {
+    const auto& s = loop_->state();
+    const Vector3<double> rel = s.auv.position - loop_->auv_controller().target();
+    const Vector3<double> rpy = euler_from_quaternion(s.auv.attitude);
+    const Vector3<double> boat = s.asv.position - s.auv.position;
+    const Vector3<double>& f = loop_->last_report().force_on_auv;
+    for (int i = 0; i < 3; ++i) {
+      out[i] = rel(i);
+      out[3 + i] = rpy(i);
+      out[12 + i] = boat(i);
+      out[16 + i] = f(i);
+    }
+    for (int i = 0; i < 6; ++i) out[6 + i] = s.auv.nu(i);
+    out[15] = euler_from_quaternion(s.asv.attitude).z();
+    out[19] = loop_->sample().auv_error;
+  }
+
+  /// \brief The observation after the last reset() or step().
+  const std::array<double, observation_size>& observation() const { return obs_; }
+  /// \brief The reward of the last step (0 after reset()).
+  double reward() const { return reward_; }
+  /// \brief True when the ROV left the path by more than max_path_error or a step failed.
+  bool terminated() const { return terminated_; }
+  /// \brief True when the scenario's duration has been simulated (and not terminated).
+  bool truncated() const { return !terminated_ && loop_->done(); }
+  /// \brief Why the episode terminated on a failed step (empty otherwise).
+  const std::string& error() const { return error_; }
+  /// \brief The world (state, metrics, summary; its ROV is flown by the action).
+  const ClosedLoop& loop() const { return *loop_; }
+  /// \brief The ROV's command of the current action (thrusts, commands, wrench, saturation).
+  const control::AuvCommand& rov_command() const { return rov_; }
+  /// \brief The energy the ROV's battery has delivered since reset() [J] (0 without propulsion).
+  double energy_drawn() const {
+    return loop_->model().auv_propulsion() ? loop_->state().auv_propulsion.battery.energy_drawn
+                                           : 0.0;
+  }
+
+ private:
+  Scenario scenario_;
+  PairEnvOptions options_;
+  long substeps_ = 1;
+  double max_thrust_ = control::AuvControllerSettings{}.max_thrust;  // the controller's cap [N]
+  std::unique_ptr<ClosedLoop> loop_;
+  control::AuvCommand rov_;
+  control::AsvCommand boat_;
+  Eigen::Vector2d boat_thrust_ = Eigen::Vector2d::Zero();
+  Eigen::VectorXd force_, scratch_;
+  std::array<double, observation_size> obs_{};
+  double reward_ = 0.0;
+  bool terminated_ = false, controllers_ = false;
+  std::string error_;
+};
+
+}  // namespace sim
+}  // namespace kelp
