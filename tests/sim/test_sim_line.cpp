@@ -157,3 +157,30 @@ TEST_CASE("a line with a low breaking strength parts in a run, which reports it"
   CHECK(d["tether"]["line_failures"].empty());
   CHECK(std::abs(d["tether"]["net_turns"].get<double>()) < 1.0);
 }
+
+TEST_CASE("system::step reports a parting once, with coupling corrections, and restores it",
+          "[sim][failure]") {
+  // The paper's system with a 1 N line and one corrector pass: the step that parts the line
+  // reports it once (the pass that is undone does not count), the state keeps one parted
+  // segment, and later steps report none.
+  auto params = sp::paper_system(10.0, sp::TetherKind::rov_tether);
+  params.tether.breaking_strength = 1.0;
+  params.coupling_corrections = 1;
+  const kelp::system::SystemModeld model(params, sp::environment<double>(sp::Sea::calm));
+  kelp::system::SystemWorkspaced ws(model);
+  const auto start = sp::paper_start(10.0);
+  kelp::system::SystemStated s = kelp::system::initial_state(model, ws, start.asv, start.auv);
+  kelp::system::SystemInputsd in;
+  in.auv.tau(0) = -30.0;  // the ROV pulls away from the boat
+  int partings = 0, first = -1;
+  for (int k = 0; k < 500; ++k) {
+    const auto r = kelp::system::step(model, ws, s, in, 0.01);
+    if (r.tether.partings > 0 && first < 0) first = k;
+    partings += r.tether.partings;
+    CHECK(s.tether.parted_segments() == partings);
+  }
+  INFO("first parting at step " << first);
+  CHECK(first >= 0);
+  CHECK(partings >= 1);
+  CHECK(s.tether.position.allFinite());
+}
