@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "kelp/control/controllers.hpp"
+#include "kelp/control/tether_management.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/nav/pair.hpp"
@@ -147,6 +149,21 @@ class ClosedLoop {
     }
     auv_.follow(waypoints_);
     asv_.follow_auv();
+    if (sc.winch.enabled) {
+      kelp::control::TetherManagementSettings& w = winch_settings_;
+      w.strategy = kelp::control::winch_strategy_from_name(sc.winch.strategy);
+      w.tension_low = sc.winch.tension_low;
+      w.tension_high = sc.winch.tension_high;
+      w.tension_gain = sc.winch.tension_gain;
+      w.slack = sc.winch.slack;
+      w.extra_length = sc.winch.extra_length;
+      w.length_per_depth = sc.winch.length_per_depth;
+      w.length_per_offset = sc.winch.length_per_offset;
+      w.length_gain = sc.winch.length_gain;
+      kelp::control::validate(w);
+    }
+    line_mass_start_ = kelp::tether::line_mass(model_.tether_of(state_), state_.tether);
+    length_start_ = kelp::tether::unstretched_length(model_.tether_of(state_), state_.tether);
     if (sc.navigation.mode == "sensors")
       navigation_ = std::make_unique<kelp::nav::PairNavigation>(sc.navigation.sensors,
                                                                 sc.navigation.seed, model_, state_);
@@ -186,6 +203,7 @@ class ClosedLoop {
       inputs_.asv.tau = asv_command_->wrench;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
     solver_stats_ += report_;
+    remesh_ += report_.remesh;
     ++k_;
     if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
     observe();
@@ -295,6 +313,21 @@ class ClosedLoop {
     s["tether"] = {{"max_tension_n", m.max_tension},
                    {"mean_tension_auv_n", m.auv_mean_tension()},
                    {"slack_fraction", m.slack_fraction()}};
+    // The line's structural mass and unstretched length at the start and the end (they differ
+    // with a winch, which pays line out and reels it in).
+    const auto& line = model_.tether_of(state_);
+    s["tether"]["line_mass_start_kg"] = line_mass_start_;
+    s["tether"]["line_mass_end_kg"] = kelp::tether::line_mass(line, state_.tether);
+    s["tether"]["length_start_m"] = length_start_;
+    s["tether"]["length_end_m"] = kelp::tether::unstretched_length(line, state_.tether);
+    if (model_.winch())
+      s["tether"]["winch"] = {
+          {"strategy", kelp::control::winch_strategy_name(winch_settings_.strategy)},
+          {"nodes_inserted", remesh_.inserted},
+          {"nodes_removed", remesh_.removed},
+          {"remesh_kinetic_energy_lost_j", remesh_.kinetic_energy_lost},
+          {"min_length_m", min_length_},
+          {"max_length_m", max_length_}};
     s["tether_solver"] = solver_summary(solver_stats_, model_.parameters());
     s["energy_j"] = kelp::system::energy(model_, state_).total();
     // Propulsion: the energy each vehicle's battery delivered [Wh] and its final state of charge.
@@ -413,6 +446,29 @@ class ClosedLoop {
     row.auv_command = auv_command_->command;
     row.tension_asv = ta;
     row.tension_auv = tb;
+    // The line out, and with a winch its payout rate, its pull and the next command.
+    {
+      const auto& line = model_.tether_of(state_);
+      row.tether_length = kelp::tether::unstretched_length(line, state_.tether);
+      min_length_ = std::min(min_length_, row.tether_length);
+      max_length_ = std::max(max_length_, row.tether_length);
+      if (model_.winch()) {
+        row.payout_rate = state_.tether.payout_rate;
+        row.winch_pull = kelp::tether::winch_pull(line, state_.tether);
+        // What the winch's strategy sees: its load cell, its line counter, and the vehicles'
+        // positions as the controllers see them.
+        const kelp::Vector3<double> boat =
+            navigation_ ? navigation_->asv().position : state_.asv.position;
+        const kelp::Vector3<double> rov =
+            navigation_ ? navigation_->auv().position : state_.auv.position;
+        kelp::control::TetherManagementInput in;
+        in.pull = row.winch_pull;
+        in.length = row.tether_length;
+        in.depth = rov.z() - boat.z();
+        in.horizontal_offset = (rov - boat).head<2>().norm();
+        inputs_.winch_payout_rate = kelp::control::winch_command(winch_settings_, in);
+      }
+    }
     // Propulsion: the thrust the thrusters deliver (lagged), their current, the batteries.
     if (const auto* pm = model_.asv_propulsion()) {
       const auto& x = state_.asv_propulsion;
@@ -471,6 +527,12 @@ class ClosedLoop {
   kelp::system::SolverStatsd solver_stats_;
   // Navigation from sensors ("sensors" mode); null: the controllers see the true state.
   std::unique_ptr<kelp::nav::PairNavigation> navigation_;
+  // The winch's strategy, its re-meshes so far, the line's mass and length at the start and
+  // the range of its length.
+  kelp::control::TetherManagementSettings winch_settings_;
+  kelp::tether::RemeshReport<double> remesh_;
+  double line_mass_start_ = 0, length_start_ = 0;
+  double min_length_ = std::numeric_limits<double>::infinity(), max_length_ = 0;
 };
 
 /// \brief Options of simulate().

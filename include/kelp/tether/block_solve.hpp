@@ -453,12 +453,8 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
 }
 
 /// The branch compute_forces takes for a segment of extension e = l_s − l [m] and stretch rate r
-/// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot).
-template <typename Scalar>
-Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r) {
-  return segment_branch(model, e, r, model.axial_spring(), model.axial_damper());
-}
-/// segment_branch with the segment's own EA/l_s and BA/l_s (segment 0 at a winch).
+/// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot), with the
+/// segment's EA/l_s and BA/l_s (its own for segment 0 at a winch).
 template <typename Scalar>
 Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r, Scalar ea_l,
                       Scalar ba_l) {
@@ -466,6 +462,12 @@ Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r, Scal
   const Scalar force = (elastic ? ea_l * e : Scalar(0)) + ba_l * r;
   if (!model.parameters().compressive_damping && !(force > Scalar(0))) return Scalar(0);
   return elastic ? Scalar(2) : Scalar(1);
+}
+
+/// segment_branch with the model's uniform EA/l and BA/l.
+template <typename Scalar>
+Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r) {
+  return segment_branch(model, e, r, model.axial_spring(), model.axial_damper());
 }
 
 /// Primal–dual active set for the kinks of the axial force (semismooth Newton on
