@@ -423,4 +423,15 @@ RemeshReport<Scalar> advance_winch(const WinchModel<Scalar>& model, WinchWorkspa
   return report;
 }
 
+/// \brief Double-precision aliases.
+using WinchParametersd = WinchParameters<double>;
+using WinchModeld = WinchModel<double>;
+using WinchWorkspaced = WinchWorkspace<double>;
+using RemeshReportd = RemeshReport<double>;
+/// \brief Single-precision aliases.
+using WinchParametersf = WinchParameters<float>;
+using WinchModelf = WinchModel<float>;
+using WinchWorkspacef = WinchWorkspace<float>;
+using RemeshReportf = RemeshReport<float>;
+
 }  // namespace kelp::tether
