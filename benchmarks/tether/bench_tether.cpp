@@ -17,10 +17,10 @@
 //   BM_WholeNewtonFactor/<N>       its block LU factorisation; BM_WholeNewtonSolve/<N> one solve
 //   BM_WinchStep/<kind>/<N>        one system-like step of the line on a winch at its start
 //                                  (kelp/tether/winch.hpp): advance_winch then a 10 ms BDF2
-//                                  advance. plain: the winch holds (no re-mesh); remesh: the
-//                                  winch reverses at full speed every step around the insertion
-//                                  threshold, so that every step inserts or removes a node (and
-//                                  restarts BDF2's history and the kept Newton matrix)
+//                                  advance. plain: the winch holds (no re-mesh); remesh: every
+//                                  10th step the winch moves at full speed across a threshold,
+//                                  inserting or removing a node (restarting BDF2's history and
+//                                  the kept Newton matrix); remesh_per_step = 0.1
 // Counters: ns_per_node = time / (force evaluations × nodes) — for the implicit schemes this
 // includes the Jacobian assembly and the block-tridiagonal solves; realtime_factor = simulated
 // seconds per CPU second; evals_per_step, newton_per_step and factor_per_step (Newton matrices
@@ -111,15 +111,28 @@ void BM_WinchStep(benchmark::State& st, bool remesh) {
   // Just under the insertion threshold: paying out at 0.5 m/s crosses it in one step, and
   // reeling in after the insertion (segment 0 then just over 0.5 l) removes the node again.
   state.winch_length = 1.5 * l - 0.5 * w.max_speed * dt;
-  double remeshes = 0, sign = 1;
+  double remeshes = 0, newton = 0, substeps = 0, whole = 0;
+  long k = 0;
   for (auto _ : st) {
-    const kt::RemeshReport<double> r =
-        kt::advance_winch(wm, wws, state, ws, remesh ? sign * w.max_speed : 0.0, dt);
-    sign = -sign;
+    // remesh: one step paying out (a node inserted), 9 holding, one reeling in (the node
+    // removed), 9 holding: a re-mesh every 10 steps, BDF2 and the kept Newton matrix recovering
+    // in between (a re-mesh at every step drives the line at the step's frequency).
+    const long phase = k++ % 20;
+    const double command =
+        !remesh ? 0.0 : (phase == 0 ? w.max_speed : (phase == 10 ? -w.max_speed : 0.0));
+    const kt::RemeshReport<double> r = kt::advance_winch(wm, wws, state, ws, command, dt);
     remeshes += r.inserted + r.removed;
-    kt::advance(wm.line_of(state), ws, s.env, state, s.boundary(state.time), dt);
+    const kt::StepReportd rep =
+        kt::advance(wm.line_of(state), ws, s.env, state, s.boundary(state.time), dt);
+    newton += rep.newton_iterations;
+    substeps += rep.substeps;
+    whole += rep.whole_jacobian_attempts;
     benchmark::DoNotOptimize(state.position.data());
   }
+  const double iters = static_cast<double>(st.iterations());
+  st.counters["newton_per_step"] = newton / iters;
+  st.counters["substeps_per_step"] = substeps / iters;
+  st.counters["whole_per_step"] = whole / iters;
   st.counters["remesh_per_step"] = remeshes / static_cast<double>(st.iterations());
   st.counters["realtime_factor"] =
       benchmark::Counter(static_cast<double>(st.iterations()) * dt, benchmark::Counter::kIsRate);
