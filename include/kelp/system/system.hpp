@@ -523,8 +523,13 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
       } catch (const kelp::numerical_error&) {
         if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
         // The failed step left the tether as it was: redo it explicitly.
+        // (With a winch, segment 0 may be as short as r·l (r = remove_ratio): node 1's springs
+        // EA/(r l) + EA/l over its mass μ(1 + r) l/2 give a frequency 1/√r times the uniform
+        // line's, hence the factor √r.)
+        using std::sqrt;
         const Scalar h =
-            tether::estimate_stable_dt(line, tether::Integrator::rk4, env.water_density());
+            tether::estimate_stable_dt(line, tether::Integrator::rk4, env.water_density()) *
+            (model.winch() ? sqrt(model.winch()->winch().remove_ratio) : Scalar(1));
         tether::AdvanceOptions<Scalar> fallback = tether_options;
         fallback.max_dt = std::min(p.max_tether_dt, double(value_of(h)));
         fallback.integrator = tether::Integrator::rk4;
