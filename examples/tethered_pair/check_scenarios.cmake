@@ -105,7 +105,6 @@ string(JSON mass1 GET "${summary}" tether line_mass_end_kg)
 string(JSON length1 GET "${summary}" tether length_end_m)
 string(JSON waypoints GET "${summary}" auv waypoints_reached)
 string(JSON fallbacks GET "${summary}" tether_solver explicit_fallbacks)
-math(EXPR net "${inserted} - ${removed}")
 message(STATUS "winch dive: line out ${shortest}..${longest} m (ends at ${length1} m), ${inserted} "
                "nodes inserted, ${removed} removed, line mass ${mass0} -> ${mass1} kg, "
                "${waypoints} waypoints")
