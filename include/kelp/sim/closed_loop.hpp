@@ -151,7 +151,7 @@ class ClosedLoop {
     asv_.follow_auv();
     if (sc.winch.enabled) {
       kelp::control::TetherManagementSettings& w = winch_settings_;
-      w.strategy = kelp::control::winch_strategy_from_name(sc.winch.strategy);
+      w.strategy = kelp::control::winch_strategy_from_name(sc.winch_strategy);
       w.tension_low = sc.winch.tension_low;
       w.tension_high = sc.winch.tension_high;
       w.tension_gain = sc.winch.tension_gain;

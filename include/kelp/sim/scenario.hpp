@@ -65,14 +65,13 @@ struct BatteryScenario {
 };
 
 /// \brief The boat's winch of a scenario (`"tether": {"winch": {...}}`): the winch
-/// (kelp::tether::WinchParameters) and its tether management strategy
-/// (kelp::control::TetherManagementSettings; "hold", "constant_tension", "slack",
-/// "depth_following"). Lengths in m, speeds in m/s, forces in N.
+/// (kelp::tether::WinchParameters) and its tether management settings
+/// (kelp::control::TetherManagementSettings; the strategy's name is Scenario::winch_strategy).
+/// Lengths in m, speeds in m/s, forces in N.
 struct WinchScenario {
   bool enabled = false;  ///< a `winch` object was given
   double max_speed = 0.5, max_acceleration = 0.5, max_pull = 400;
   double min_length = 5, max_length = 60;
-  std::string strategy = "depth_following";
   double tension_low = 5, tension_high = 25, tension_gain = 0.02;
   double slack = 0.3;
   double extra_length = 3, length_per_depth = 1, length_per_offset = 1, length_gain = 0.5;
@@ -110,6 +109,9 @@ struct Scenario {
   bool explicit_fallback = false;
   /// The boat's winch (`"tether": {"winch": {...}}`); disabled by default (a fixed length).
   WinchScenario winch;
+  /// Its strategy: "hold", "constant_tension", "slack" or "depth_following" (kept here rather
+  /// than in WinchScenario, which GCC 12 then warns about as maybe uninitialised in Scenario{}).
+  std::string winch_strategy = "depth_following";
   /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
   /// empty: the paper's start, 5 m down astern of the boat).
   ///@{
@@ -496,7 +498,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
       r.number(w, p, "max_pull", x.max_pull, 1, 1e6);
       r.number(w, p, "min_length", x.min_length, 0.5, 1000);
       r.number(w, p, "max_length", x.max_length, 0.5, 1000);
-      r.choice(w, p, "strategy", x.strategy,
+      r.choice(w, p, "strategy", s.winch_strategy,
                {"hold", "constant_tension", "slack", "depth_following"});
       r.number(w, p, "tension_low", x.tension_low, 0, 1e5);
       r.number(w, p, "tension_high", x.tension_high, 0, 1e5);
@@ -663,7 +665,7 @@ inline nlohmann::json to_json(const Scenario& s) {
                             {"max_pull", w.max_pull},
                             {"min_length", w.min_length},
                             {"max_length", w.max_length},
-                            {"strategy", w.strategy},
+                            {"strategy", s.winch_strategy},
                             {"tension_low", w.tension_low},
                             {"tension_high", w.tension_high},
                             {"tension_gain", w.tension_gain},
