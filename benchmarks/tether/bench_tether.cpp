@@ -15,6 +15,12 @@
 //                                  ImplicitOptions::check_convergence)
 //   BM_WholeNewtonAssemble/<N>     assembly of the whole Newton matrix (kelp/tether/jacobian.hpp)
 //   BM_WholeNewtonFactor/<N>       its block LU factorisation; BM_WholeNewtonSolve/<N> one solve
+//   BM_WinchStep/<kind>/<N>        one system-like step of the line on a winch at its start
+//                                  (kelp/tether/winch.hpp): advance_winch then a 10 ms BDF2
+//                                  advance. plain: the winch holds (no re-mesh); remesh: every
+//                                  10th step the winch moves at full speed across a threshold,
+//                                  inserting or removing a node (restarting BDF2's history and
+//                                  the kept Newton matrix); remesh_per_step = 0.1
 // Counters: ns_per_node = time / (force evaluations × nodes) — for the implicit schemes this
 // includes the Jacobian assembly and the block-tridiagonal solves; realtime_factor = simulated
 // seconds per CPU second; evals_per_step, newton_per_step and factor_per_step (Newton matrices
@@ -31,6 +37,7 @@
 #include "kelp/tether/jacobian.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/tether/whole_newton.hpp"
+#include "kelp/tether/winch.hpp"
 
 namespace kt = kelp::tether;
 using kelp::Vector3;
@@ -89,6 +96,48 @@ void BM_TetherStep(benchmark::State& st, kt::Integrator integ, bool linearly_imp
   }
 }
 
+void BM_WinchStep(benchmark::State& st, bool remesh) {
+  const int n = static_cast<int>(st.range(0));
+  Setup s(n);
+  kt::WinchParameters<double> w;
+  w.min_length = 0.5 * s.model.parameters().length;
+  w.max_length = 2 * s.model.parameters().length;
+  w.max_acceleration = 1000;  // the speed reverses within a step
+  const kt::WinchModel<double> wm(s.model.parameters(), w);
+  kt::WinchWorkspace<double> wws(wm);
+  kt::TetherWorkspaced ws(wm.line(n));
+  kt::TetherStated state = s.state;
+  const double l = wm.segment_length(), dt = 0.01;
+  // Just under the insertion threshold: paying out at 0.5 m/s crosses it in one step, and
+  // reeling in after the insertion (segment 0 then just over 0.5 l) removes the node again.
+  state.winch_length = 1.5 * l - 0.5 * w.max_speed * dt;
+  double remeshes = 0, newton = 0, substeps = 0, whole = 0;
+  long k = 0;
+  for (auto _ : st) {
+    // remesh: one step paying out (a node inserted), 9 holding, one reeling in (the node
+    // removed), 9 holding: a re-mesh every 10 steps, BDF2 and the kept Newton matrix recovering
+    // in between (a re-mesh at every step drives the line at the step's frequency).
+    const long phase = k++ % 20;
+    const double command =
+        !remesh ? 0.0 : (phase == 0 ? w.max_speed : (phase == 10 ? -w.max_speed : 0.0));
+    const kt::RemeshReport<double> r = kt::advance_winch(wm, wws, state, ws, command, dt);
+    remeshes += r.inserted + r.removed;
+    const kt::StepReportd rep =
+        kt::advance(wm.line_of(state), ws, s.env, state, s.boundary(state.time), dt);
+    newton += rep.newton_iterations;
+    substeps += rep.substeps;
+    whole += rep.whole_jacobian_attempts;
+    benchmark::DoNotOptimize(state.position.data());
+  }
+  const double iters = static_cast<double>(st.iterations());
+  st.counters["newton_per_step"] = newton / iters;
+  st.counters["substeps_per_step"] = substeps / iters;
+  st.counters["whole_per_step"] = whole / iters;
+  st.counters["remesh_per_step"] = remeshes / static_cast<double>(st.iterations());
+  st.counters["realtime_factor"] =
+      benchmark::Counter(static_cast<double>(st.iterations()) * dt, benchmark::Counter::kIsRate);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   for (int n : {10, 20, 50, 100, 200}) b->Arg(n);
   b->Unit(benchmark::kMicrosecond);
@@ -97,6 +146,8 @@ void sizes(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_TetherForces)->Apply(sizes)->Unit(benchmark::kNanosecond);
+BENCHMARK_CAPTURE(BM_WinchStep, plain, false)->Arg(20)->Arg(100)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_WinchStep, remesh, true)->Arg(20)->Arg(100)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_TetherStep, symplectic_euler, kt::Integrator::symplectic_euler)->Apply(sizes);
 BENCHMARK_CAPTURE(BM_TetherStep, rk2, kt::Integrator::rk2)->Apply(sizes);
 BENCHMARK_CAPTURE(BM_TetherStep, rk4, kt::Integrator::rk4)->Apply(sizes);

@@ -2,7 +2,8 @@
 #  - each kind of bad scenario is refused with a non-zero exit, a message naming the JSON path, and
 #    no output directory;
 #  - the calm hold scenario: after settling the AUV holds its depth within 5 cm and the boat keeps
-#    within 1 m of its target (above the AUV).
+#    within 1 m of its target (above the AUV);
+#  - the winch dive (scenarios/winch_dive.json): the line paid out by at least 20 m and reeled back.
 cmake_minimum_required(VERSION 3.19)  # string(JSON)
 
 set(bad_unknown_key [=[{"tether": {"length": 10, "colour": "yellow"}}]=])
@@ -24,6 +25,10 @@ set(bad_vector [=[{"vehicles": {"asv_attachment": [0, "x", 0]}}]=])
 set(path_vector "/vehicles/asv_attachment/1")
 set(bad_gains [=[{"control": {"asv": {"linear": [0.5, -0.1, 0.05]}}}]=])
 set(path_gains "/control/asv/linear")
+set(bad_winch [=[{"tether": {"length": 10, "winch": {"strategy": "yank"}}}]=])
+set(path_winch "/tether/winch/strategy")
+set(bad_winch_range [=[{"tether": {"length": 10, "winch": {"min_length": 12}}}]=])
+set(path_winch_range "/tether/length")
 set(bad_not_json [=[{"duration": 10,]=])
 set(path_not_json "not valid JSON")
 # Nested 100000 levels deep (found by fuzz/fuzz_scenario): refused before parsing; it used to
@@ -34,7 +39,7 @@ set(bad_too_deep "{\"vehicles\": {\"asv_attachment\": ${open}${close}}}")
 set(path_too_deep "nested more than 64 levels")
 
 foreach(kind unknown_key wrong_type out_of_range non_finite empty_waypoints short_tether choice
-             vector gains not_json too_deep)
+             vector gains winch winch_range not_json too_deep)
   set(file "${OUT}/${kind}.json")
   file(WRITE "${file}" "${bad_${kind}}")
   file(REMOVE_RECURSE "${OUT}/${kind}_out")
@@ -78,4 +83,34 @@ message(STATUS "calm hold, second half: AUV depth error up to ${depth} m, boat u
                "from its target")
 if(depth GREATER 0.05 OR boat GREATER 1.0)
   message(FATAL_ERROR "calm hold: depth error ${depth} m (limit 0.05), boat ${boat} m (limit 1)")
+endif()
+
+# The winch dive: the ROV dives from 5 m to 30 m and returns in the moderate sea while the boat's
+# winch pays out and reels in by depth following: at least 20 m of payout change, back near the
+# start's length, the summary's line mass following the length (0.5 m segments re-meshed at the
+# winch), every waypoint reached, no fallback.
+file(REMOVE_RECURSE "${OUT}/winch")
+execute_process(COMMAND "${PROGRAM}" --scenario "${SCENARIOS}/winch_dive.json" --out "${OUT}/winch"
+                        --quiet --no-plots RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "winch_dive failed: ${out} ${err}")
+endif()
+file(READ "${OUT}/winch/summary.json" summary)
+string(JSON longest GET "${summary}" tether winch max_length_m)
+string(JSON shortest GET "${summary}" tether winch min_length_m)
+string(JSON inserted GET "${summary}" tether winch nodes_inserted)
+string(JSON removed GET "${summary}" tether winch nodes_removed)
+string(JSON mass0 GET "${summary}" tether line_mass_start_kg)
+string(JSON mass1 GET "${summary}" tether line_mass_end_kg)
+string(JSON length1 GET "${summary}" tether length_end_m)
+string(JSON waypoints GET "${summary}" auv waypoints_reached)
+string(JSON fallbacks GET "${summary}" tether_solver explicit_fallbacks)
+message(STATUS "winch dive: line out ${shortest}..${longest} m (ends at ${length1} m), ${inserted} "
+               "nodes inserted, ${removed} removed, line mass ${mass0} -> ${mass1} kg, "
+               "${waypoints} waypoints")
+if(longest LESS 30 OR length1 GREATER 15 OR waypoints LESS 4 OR NOT fallbacks EQUAL 0
+   OR inserted LESS 40)
+  message(FATAL_ERROR "winch dive: line out up to ${longest} m (>= 30), ends at ${length1} m "
+                      "(<= 15), ${inserted} insertions (>= 40), ${waypoints} waypoints (4), "
+                      "${fallbacks} fallbacks (0)")
 endif()

@@ -5,6 +5,7 @@
 
 #include "kelp/control/controllers.hpp"
 #include "kelp/control/pid.hpp"
+#include "kelp/control/tether_management.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
@@ -26,6 +27,7 @@
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/tether/presets.hpp"
+#include "kelp/tether/winch.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "kelp/control/controllers.hpp"
+#include "kelp/control/tether_management.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/nav/pair.hpp"
@@ -153,6 +155,21 @@ class ClosedLoop {
     asv_.follow_auv();
     // At most one parting per segment: no allocation in a step when the line parts.
     failures_.reserve(std::size_t(model_.tether().segments()));
+    if (sc.winch.enabled) {
+      kelp::control::TetherManagementSettings& w = winch_settings_;
+      w.strategy = kelp::control::winch_strategy_from_name(sc.winch_strategy);
+      w.tension_low = sc.winch.tension_low;
+      w.tension_high = sc.winch.tension_high;
+      w.tension_gain = sc.winch.tension_gain;
+      w.slack = sc.winch.slack;
+      w.extra_length = sc.winch.extra_length;
+      w.length_per_depth = sc.winch.length_per_depth;
+      w.length_per_offset = sc.winch.length_per_offset;
+      w.length_gain = sc.winch.length_gain;
+      kelp::control::validate(w);
+    }
+    line_mass_start_ = kelp::tether::line_mass(model_.tether_of(state_), state_.tether);
+    length_start_ = kelp::tether::unstretched_length(model_.tether_of(state_), state_.tether);
     if (sc.navigation.mode == "sensors")
       navigation_ = std::make_unique<kelp::nav::PairNavigation>(sc.navigation.sensors,
                                                                 sc.navigation.seed, model_, state_);
@@ -199,6 +216,7 @@ class ClosedLoop {
       failures_.push_back(report_.tether.failure);
       if (options_.log) options_.log->line_parted(report_.tether.failure);
     }
+    remesh_ += report_.remesh;
     ++k_;
     if (options_.on_step) options_.on_step(StepView{k_, model_, state_, report_});
     observe();
@@ -338,6 +356,21 @@ class ClosedLoop {
                         {"position_m", {f.position.x(), f.position.y(), f.position.z()}},
                         {"tension_n", f.tension}});
     s["tether"]["line_failures"] = parted;
+    // The line's structural mass and unstretched length at the start and the end (they differ
+    // with a winch, which pays line out and reels it in).
+    const auto& line = model_.tether_of(state_);
+    s["tether"]["line_mass_start_kg"] = line_mass_start_;
+    s["tether"]["line_mass_end_kg"] = kelp::tether::line_mass(line, state_.tether);
+    s["tether"]["length_start_m"] = length_start_;
+    s["tether"]["length_end_m"] = kelp::tether::unstretched_length(line, state_.tether);
+    if (model_.winch())
+      s["tether"]["winch"] = {
+          {"strategy", kelp::control::winch_strategy_name(winch_settings_.strategy)},
+          {"nodes_inserted", remesh_.inserted},
+          {"nodes_removed", remesh_.removed},
+          {"remesh_kinetic_energy_lost_j", remesh_.kinetic_energy_lost},
+          {"min_length_m", min_length_},
+          {"max_length_m", max_length_}};
     s["tether_solver"] = solver_summary(solver_stats_, model_.parameters());
     s["energy_j"] = kelp::system::energy(model_, state_).total();
     // Propulsion: the energy each vehicle's battery delivered [Wh] and its final state of charge.
@@ -461,6 +494,29 @@ class ClosedLoop {
     turns_.update(state_.auv, state_.tether, int(state_.tether.position.cols()) - 1);
     row.tether_turns = turns_.turns();
     row.parted_segments = state_.tether.parted_segments();
+    // The line out, and with a winch its payout rate, its pull and the next command.
+    {
+      const auto& line = model_.tether_of(state_);
+      row.tether_length = kelp::tether::unstretched_length(line, state_.tether);
+      min_length_ = std::min(min_length_, row.tether_length);
+      max_length_ = std::max(max_length_, row.tether_length);
+      if (model_.winch()) {
+        row.payout_rate = state_.tether.payout_rate;
+        row.winch_pull = kelp::tether::winch_pull(line, state_.tether);
+        // What the winch's strategy sees: its load cell, its line counter, and the vehicles'
+        // positions as the controllers see them.
+        const kelp::Vector3<double> boat =
+            navigation_ ? navigation_->asv().position : state_.asv.position;
+        const kelp::Vector3<double> rov =
+            navigation_ ? navigation_->auv().position : state_.auv.position;
+        kelp::control::TetherManagementInput in;
+        in.pull = row.winch_pull;
+        in.length = row.tether_length;
+        in.depth = rov.z() - boat.z();
+        in.horizontal_offset = (rov - boat).head<2>().norm();
+        inputs_.winch_payout_rate = kelp::control::winch_command(winch_settings_, in);
+      }
+    }
     // Propulsion: the thrust the thrusters deliver (lagged), their current, the batteries.
     if (const auto* pm = model_.asv_propulsion()) {
       const auto& x = state_.asv_propulsion;
@@ -524,6 +580,12 @@ class ClosedLoop {
   std::vector<kelp::tether::LineFailured> failures_;
   // Navigation from sensors ("sensors" mode); null: the controllers see the true state.
   std::unique_ptr<kelp::nav::PairNavigation> navigation_;
+  // The winch's strategy, its re-meshes so far, the line's mass and length at the start and
+  // the range of its length.
+  kelp::control::TetherManagementSettings winch_settings_;
+  kelp::tether::RemeshReport<double> remesh_;
+  double line_mass_start_ = 0, length_start_ = 0;
+  double min_length_ = std::numeric_limits<double>::infinity(), max_length_ = 0;
 };
 
 /// \brief Options of simulate().

@@ -48,6 +48,11 @@ struct LogRow {
   Eigen::Matrix<double, 8, 1> auv_command =
       Eigen::Matrix<double, 8, 1>::Constant(none);  ///< normalised
   double tension_asv = 0, tension_auv = 0;          ///< tether force on each vehicle [N]
+  /// \name Winch: the unstretched line out [m], and with a winch its payout rate [m/s] and the
+  /// pull at the winch [N] (NaN without a winch).
+  ///@{
+  double tether_length = none, payout_rate = none, winch_pull = none;
+  ///@}
   /// \name Propulsion: each battery's terminal voltage [V] and state of charge, each thruster's
   /// current [A] (NaN without a propulsion model).
   ///@{
@@ -87,8 +92,8 @@ class RunLog {
     // Propulsion.
     ts_ << ",asv_voltage,asv_soc,asv_current_port,asv_current_starboard,auv_voltage,auv_soc";
     for (int i = 1; i <= 8; ++i) ts_ << ",auv_current_" << i;
-    // The tether: turns at the ROV, parted segments.
-    ts_ << ",tether_turns,tether_parted_segments";
+    // The tether: turns at the ROV, parted segments; its length out, the winch's rate and pull.
+    ts_ << ",tether_turns,tether_parted_segments,tether_length,payout_rate,winch_pull";
     ts_ << '\n';
     nodes_ << "t,node,x,y,z\n";
     events_ << "t,event,segment,x,y,z,tension\n";
@@ -117,7 +122,9 @@ class RunLog {
          {r.asv_voltage, r.asv_soc, r.asv_current(0), r.asv_current(1), r.auv_voltage, r.auv_soc})
       ts_ << ',' << num(v);
     for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_current(i));
-    ts_ << ',' << num(r.tether_turns) << ',' << num(r.parted_segments);
+    for (double v :
+         {r.tether_turns, r.parted_segments, r.tether_length, r.payout_rate, r.winch_pull})
+      ts_ << ',' << num(v);
     ts_ << '\n';
   }
 

@@ -64,6 +64,19 @@ struct BatteryScenario {
   double hotel_current;        ///< electronics and lights [A]
 };
 
+/// \brief The boat's winch of a scenario (`"tether": {"winch": {...}}`): the winch
+/// (kelp::tether::WinchParameters) and its tether management settings
+/// (kelp::control::TetherManagementSettings; the strategy's name is Scenario::winch_strategy).
+/// Lengths in m, speeds in m/s, forces in N.
+struct WinchScenario {
+  bool enabled = false;  ///< a `winch` object was given
+  double max_speed = 0.5, max_acceleration = 0.5, max_pull = 400;
+  double min_length = 5, max_length = 60;
+  double tension_low = 5, tension_high = 25, tension_gain = 0.02;
+  double slack = 0.3;
+  double extra_length = 3, length_per_depth = 1, length_per_offset = 1, length_gain = 0.5;
+};
+
 /// \brief One run of the tethered pair, as a scenario file describes it (every field has the
 /// embedded default run's value until a file sets it). Angles in rad, lengths in m, NED.
 struct Scenario {
@@ -97,6 +110,11 @@ struct Scenario {
   /// (system::SystemParameters::explicit_fallback; counted in the summary's
   /// `tether_solver.explicit_fallbacks`). Off by default: a run stops with an error instead.
   bool explicit_fallback = false;
+  /// The boat's winch (`"tether": {"winch": {...}}`); disabled by default (a fixed length).
+  WinchScenario winch;
+  /// Its strategy: "hold", "constant_tension", "slack" or "depth_following" (kept here rather
+  /// than in WinchScenario, which GCC 12 then warns about as maybe uninitialised in Scenario{}).
+  std::string winch_strategy = "depth_following";
   /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
   /// empty: the paper's start, 5 m down astern of the boat).
   ///@{
@@ -457,7 +475,7 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.object(t, "/tether",
              {"length", "kind", "segment_length", "diameter", "mass_per_length", "axial_stiffness",
               "internal_damping", "normal_drag", "tangential_drag", "explicit_fallback",
-              "line_model", "breaking_strength"});
+              "line_model", "breaking_strength", "winch"});
     r.number(t, "/tether", "breaking_strength", s.breaking_strength, 0, 1e7);
     r.number(t, "/tether", "diameter", s.diameter, 1e-4, 0.5);
     r.number(t, "/tether", "mass_per_length", s.mass_per_length, 1e-4, 100);
@@ -470,6 +488,36 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.number(t, "/tether", "segment_length", s.segment_length, 0.05, 10);
     r.boolean(t, "/tether", "explicit_fallback", s.explicit_fallback);
     r.choice(t, "/tether", "line_model", s.line_model, {"kelp", "moordyn"});
+    if (t.contains("winch")) {
+      const auto& w = t.at("winch");
+      const std::string p = "/tether/winch";
+      r.object(w, p,
+               {"max_speed", "max_acceleration", "max_pull", "min_length", "max_length", "strategy",
+                "tension_low", "tension_high", "tension_gain", "slack", "extra_length",
+                "length_per_depth", "length_per_offset", "length_gain"});
+      WinchScenario& x = s.winch;
+      x.enabled = true;
+      r.number(w, p, "max_speed", x.max_speed, 0.01, 10);
+      r.number(w, p, "max_acceleration", x.max_acceleration, 0.01, 100);
+      r.number(w, p, "max_pull", x.max_pull, 1, 1e6);
+      r.number(w, p, "min_length", x.min_length, 0.5, 1000);
+      r.number(w, p, "max_length", x.max_length, 0.5, 1000);
+      r.choice(w, p, "strategy", s.winch_strategy,
+               {"hold", "constant_tension", "slack", "depth_following"});
+      r.number(w, p, "tension_low", x.tension_low, 0, 1e5);
+      r.number(w, p, "tension_high", x.tension_high, 0, 1e5);
+      r.number(w, p, "tension_gain", x.tension_gain, 0, 10);
+      r.number(w, p, "slack", x.slack, 0, 10);
+      r.number(w, p, "extra_length", x.extra_length, 0, 1000);
+      r.number(w, p, "length_per_depth", x.length_per_depth, 0, 10);
+      r.number(w, p, "length_per_offset", x.length_per_offset, 0, 10);
+      r.number(w, p, "length_gain", x.length_gain, 0, 100);
+      if (x.max_length < x.min_length) r.fail(p + "/max_length", "expected at least min_length");
+      if (x.tension_high <= x.tension_low)
+        r.fail(p + "/tension_high", "expected more than tension_low");
+      if (s.tether_length < x.min_length || s.tether_length > x.max_length)
+        r.fail("/tether/length", "expected within the winch's [min_length, max_length]");
+    }
   }
   if (j.contains("vehicles")) {
     const auto& v = j.at("vehicles");
@@ -615,6 +663,23 @@ inline nlohmann::json to_json(const Scenario& s) {
   opt("breaking_strength", s.breaking_strength, -1);
   j["tether"]["explicit_fallback"] = s.explicit_fallback;
   if (s.line_model != "kelp") j["tether"]["line_model"] = s.line_model;
+  if (s.winch.enabled) {
+    const WinchScenario& w = s.winch;
+    j["tether"]["winch"] = {{"max_speed", w.max_speed},
+                            {"max_acceleration", w.max_acceleration},
+                            {"max_pull", w.max_pull},
+                            {"min_length", w.min_length},
+                            {"max_length", w.max_length},
+                            {"strategy", s.winch_strategy},
+                            {"tension_low", w.tension_low},
+                            {"tension_high", w.tension_high},
+                            {"tension_gain", w.tension_gain},
+                            {"slack", w.slack},
+                            {"extra_length", w.extra_length},
+                            {"length_per_depth", w.length_per_depth},
+                            {"length_per_offset", w.length_per_offset},
+                            {"length_gain", w.length_gain}};
+  }
   j["vehicles"] = {{"asv_attachment", v3(s.asv_attachment)},
                    {"auv_attachment", v3(s.auv_attachment)}};
   if (!s.auv_start.empty()) j["vehicles"]["auv_start"] = s.auv_start;

@@ -55,6 +55,15 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     throw scenario_error(file + ": /tether/line_model: expected \"kelp\" or \"moordyn\", got \"" +
                          sc.line_model + "\"");
   if (sc.line_model == "moordyn") tp.line_model = kelp::tether::LineModel::moordyn;
+  if (sc.winch.enabled) {
+    kelp::tether::WinchParameters<double> w;
+    w.max_speed = sc.winch.max_speed;
+    w.max_acceleration = sc.winch.max_acceleration;
+    w.max_pull = sc.winch.max_pull;
+    w.min_length = sc.winch.min_length;
+    w.max_length = sc.winch.max_length;
+    params.winch = w;
+  }
   params.asv_attachment = sc.asv_attachment;
   params.auv_attachment = sc.auv_attachment;
   // Propulsion: the paper preset's (thrusters, batteries) with the scenario's lag and batteries,

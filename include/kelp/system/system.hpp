@@ -50,6 +50,16 @@
 /// exactly) and adds the wrench of their mean thrust over the step, B f̄, to the vehicle's τ; the
 /// thrusters' and battery's state is part of SystemState. Without it (the default), `inputs.tau`
 /// is the whole control wrench, as before.
+///
+/// **Winch (optional).** With `SystemParameters::winch` set, the tether's start end (on the ASV)
+/// runs over a winch (kelp/tether/winch.hpp): after the tether and the vehicles have been
+/// advanced, the winch moves its payout rate towards `SystemInputs::winch_payout_rate` within its
+/// limits, segment 0's unstretched length changes by rate·h, and nodes are inserted or removed
+/// there (reported in SystemReport::remesh). The tether's node count then changes between steps:
+/// SystemModel::tether_of(state) is the line model of a state, and the buffers of every count are
+/// built with the workspace, so a step allocates nothing. The momentum a removed node hands to
+/// the ASV's attachment (RemeshReport::impulse_on_start, at most μl/2 times the speed of node 1
+/// relative to the winch) is reported, not applied to the ASV.
 #pragma once
 
 #include <Eigen/Core>
@@ -65,6 +75,7 @@
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/winch.hpp"
 #include "kelp/vehicle/integrators.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/propulsion.hpp"
@@ -114,6 +125,10 @@ struct SystemParameters {
   std::optional<vehicle::PropulsionParameters<Scalar>> asv_propulsion;
   /// The AUV's thrusters and battery; see asv_propulsion.
   std::optional<vehicle::PropulsionParameters<Scalar>> auv_propulsion;
+  /// A winch at the tether's start end (on the ASV) that pays out and reels in during the run
+  /// (kelp/tether/winch.hpp; commanded by SystemInputs::winch_payout_rate). Empty (the default):
+  /// the tether keeps its length and node count.
+  std::optional<tether::WinchParameters<Scalar>> winch;
 };
 
 /// \brief Checks system parameters (the parts' own checks, kinematic tether ends, attachment
@@ -154,6 +169,7 @@ class SystemModel {
     vehicle::check_same_water(auv_, environment_, "auv");
     if (p.asv_propulsion) asv_propulsion_.emplace(*p.asv_propulsion);
     if (p.auv_propulsion) auv_propulsion_.emplace(*p.auv_propulsion);
+    if (p.winch) winch_.emplace(p.tether, *p.winch);
   }
   const SystemParameters<Scalar>& parameters() const { return parameters_; }
   const environment::Environment<Scalar>& environment() const { return environment_; }
@@ -177,6 +193,14 @@ class SystemModel {
   const vehicle::VehicleModel<Scalar>& asv() const { return asv_; }
   const vehicle::VehicleModel<Scalar>& auv() const { return auv_; }
   const tether::TetherModel<Scalar>& tether() const { return tether_; }
+  /// \brief The winch and its line at every node count (null without a winch).
+  const tether::WinchModel<Scalar>* winch() const { return winch_ ? &*winch_ : nullptr; }
+  /// \brief The tether model of `state`: tether() without a winch, else the winch's line with
+  /// the state's node count.
+  template <typename State>
+  const tether::TetherModel<Scalar>& tether_of(const State& state) const {
+    return winch_ ? winch_->line_of(state.tether) : tether_;
+  }
   /// \brief The ASV's propulsion, or null when the system has none for it.
   const vehicle::PropulsionModel<Scalar>* asv_propulsion() const {
     return asv_propulsion_ ? &*asv_propulsion_ : nullptr;
@@ -192,6 +216,7 @@ class SystemModel {
   vehicle::VehicleModel<Scalar> asv_, auv_;
   tether::TetherModel<Scalar> tether_;
   std::optional<vehicle::PropulsionModel<Scalar>> asv_propulsion_, auv_propulsion_;
+  std::optional<tether::WinchModel<Scalar>> winch_;
 };
 
 /// \brief Everything that determines the system's next step.
@@ -245,6 +270,9 @@ struct SystemInputs {
   /// order; empty: all 0. Must be empty when the ASV has no propulsion.
   vehicle::ThrusterVector<Scalar> asv_commands;
   vehicle::ThrusterVector<Scalar> auv_commands;  ///< the AUV's; see asv_commands
+  /// Commanded payout rate of the winch [m/s] (positive: paying out); the winch follows it
+  /// within its limits (tether::limited_payout_rate). Must be 0 without a winch.
+  Scalar winch_payout_rate = Scalar(0);
 };
 
 /// \brief The options of one system step.
@@ -275,7 +303,7 @@ SystemEnergy<Scalar> energy(const SystemModel<Scalar>& model, const SystemState<
                           vehicle::surroundings(model.asv(), env, state.asv, state.time));
   e.auv = vehicle::energy(model.auv(), state.auv,
                           vehicle::surroundings(model.auv(), env, state.auv, state.time));
-  e.tether = tether::tether_energy(model.tether(), env, state.tether);
+  e.tether = tether::tether_energy(model.tether_of(state), env, state.tether);
   return e;
 }
 
@@ -300,6 +328,9 @@ struct SystemReport {
   /// (zero without propulsion).
   vehicle::PropulsionStep<Scalar> asv_propulsion;
   vehicle::PropulsionStep<Scalar> auv_propulsion;  ///< the AUV's; see asv_propulsion
+  /// The winch's re-meshes after the step (nodes inserted and removed, kinetic energy lost,
+  /// momentum handed to the ends); zero without a winch.
+  tether::RemeshReport<Scalar> remesh;
 };
 
 /// \brief Preallocated buffers of a system step.
@@ -309,10 +340,14 @@ struct SystemWorkspace {
   tether::TetherWorkspace<Scalar> tether;      ///< tether buffers
   /// The tether state at the start of a step, restored if the step fails.
   tether::StateBackup<Scalar> tether_backup;
+  /// With a winch: the tether buffers of every node count (tether::WinchWorkspace); `tether`
+  /// holds the current count's, swapped in and out as the winch re-meshes.
+  std::optional<tether::WinchWorkspace<Scalar>> winch;
 
   SystemWorkspace() = default;
   explicit SystemWorkspace(const SystemModel<Scalar>& model) : tether(model.tether()) {
     tether_backup.resize(model.tether().nodes());
+    if (model.winch()) winch.emplace(*model.winch());
   }
 };
 
@@ -431,7 +466,13 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
                  state.tether.time == state.time,
              "state.asv.time, state.auv.time and state.tether.time must equal state.time (use "
              "SystemState::set_time to set every clock)");
-  KELP_CHECK(ws.tether.fits(model.tether().nodes()), "workspace was built for a different system");
+  KELP_CHECK(model.winch() == nullptr || ws.winch,
+             "workspace was built for a different system (it has no winch buffers)");
+  KELP_CHECK(model.winch() != nullptr || inputs.winch_payout_rate == Scalar(0),
+             "inputs.winch_payout_rate must be 0: the system has no winch");
+  check_finite(inputs.winch_payout_rate, "inputs.winch_payout_rate");
+  const tether::TetherModel<Scalar>& line = model.tether_of(state);
+  KELP_CHECK(ws.tether.fits(line.nodes()), "workspace was built for a different system");
   vehicle::detail::check_state(state.asv);
   vehicle::detail::check_state(state.auv);
   check_all_finite(state.asv_nu_dot, "state.asv_nu_dot");
@@ -468,7 +509,10 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   tether_options.implicit = p.tether_options;
   // Everything a failure must restore.
   const detail::CouplingSnapshot<Scalar> before(state);
-  ws.tether_backup.save(state.tether);
+  // (With a winch, the backup buffers of the state's node count: no allocation.)
+  tether::StateBackup<Scalar>& backup =
+      ws.winch ? ws.winch->backup[ws.winch->slot(line.segments())] : ws.tether_backup;
+  backup.save(state.tether);
   try {
     tether::TetherBoundary<Scalar> ends;
     ends.start = detail::predicted_end(state.asv, state.asv_nu_dot, p.asv_attachment);
@@ -478,19 +522,22 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     tether::StepReport<Scalar> pass_report;
     for (int pass = 0;; ++pass) {
       try {
-        pass_report =
-            tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, tether_options);
+        pass_report = tether::advance(line, ws.tether, env, state.tether, ends, dt, tether_options);
         report.tether += pass_report;
       } catch (const kelp::numerical_error&) {
         if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
         // The failed step left the tether as it was: redo it explicitly.
-        const Scalar h = tether::estimate_stable_dt(model.tether(), tether::Integrator::rk4,
-                                                    env.water_density());
+        // (With a winch, segment 0 may be as short as r·l (r = remove_ratio): node 1's springs
+        // EA/(r l) + EA/l over its mass μ(1 + r) l/2 give a frequency 1/√r times the uniform
+        // line's, hence the factor √r.)
+        using std::sqrt;
+        const Scalar h =
+            tether::estimate_stable_dt(line, tether::Integrator::rk4, env.water_density()) *
+            (model.winch() ? sqrt(model.winch()->winch().remove_ratio) : Scalar(1));
         tether::AdvanceOptions<Scalar> fallback = tether_options;
         fallback.max_dt = std::min(p.max_tether_dt, double(value_of(h)));
         fallback.integrator = tether::Integrator::rk4;
-        pass_report =
-            tether::advance(model.tether(), ws.tether, env, state.tether, ends, dt, fallback);
+        pass_report = tether::advance(line, ws.tether, env, state.tether, ends, dt, fallback);
         report.tether += pass_report;
         ++report.tether_fallbacks;
       }
@@ -509,7 +556,7 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
       };
       reach(ends.start, state.asv.point_position(p.asv_attachment));
       reach(ends.end, state.auv.point_position(p.auv_attachment));
-      ws.tether_backup.restore(state.tether);
+      backup.restore(state.tether);
       state.asv = before.asv;
       state.auv = before.auv;
     }
@@ -517,9 +564,13 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     report.tether.failure = pass_report.failure;
   } catch (const kelp::error&) {
     before.restore(state);
-    ws.tether_backup.restore(state.tether);
+    backup.restore(state.tether);
     throw;
   }
+  // The winch, between this step and the next (it cannot fail: its inputs were checked).
+  if (model.winch())
+    report.remesh = tether::advance_winch(*model.winch(), *ws.winch, state.tether, ws.tether,
+                                          inputs.winch_payout_rate, dt);
   // The clocks in lock-step: the tether's (Kahan-summed over its sub-steps) is the system's.
   state.time = state.tether.time;
   state.asv.time = state.time;

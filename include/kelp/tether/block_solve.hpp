@@ -453,13 +453,21 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
 }
 
 /// The branch compute_forces takes for a segment of extension e = l_s − l [m] and stretch rate r
-/// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot).
+/// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot), with the
+/// segment's EA/l_s and BA/l_s (its own for segment 0 at a winch).
 template <typename Scalar>
-Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r) {
+Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r, Scalar ea_l,
+                      Scalar ba_l) {
   const bool elastic = e > Scalar(0);
-  const Scalar force = (elastic ? model.axial_spring() * e : Scalar(0)) + model.axial_damper() * r;
+  const Scalar force = (elastic ? ea_l * e : Scalar(0)) + ba_l * r;
   if (!model.parameters().compressive_damping && !(force > Scalar(0))) return Scalar(0);
   return elastic ? Scalar(2) : Scalar(1);
+}
+
+/// segment_branch with the model's uniform EA/l and BA/l.
+template <typename Scalar>
+Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r) {
+  return segment_branch(model, e, r, model.axial_spring(), model.axial_damper());
 }
 
 /// Primal–dual active set for the kinks of the axial force (semismooth Newton on
@@ -481,12 +489,13 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
                        Scalar band, int max_passes, Solve&& solve) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  const Scalar l = model.segment_length();
-  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
+  // Each segment's rest length and constants (segment 0's are its own at a winch).
+  const auto springs = [&](int s) { return segment_springs(model, ws, s); };
   // A parted segment (TetherState::parted) has no force on any branch.
   const auto true_branch = [&](int s) {
-    return ws.is_parted(s) ? Scalar(0)
-                           : segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s));
+    if (ws.is_parted(s)) return Scalar(0);
+    const SegmentSprings<Scalar> k = springs(s);
+    return segment_branch(model, ws.stretched_length(s) - k.l, ws.seg_rate(s), k.ea_l, k.ba_l);
   };
   // Updates the branches from the extension and rate predicted by ws.delta; true if any changed.
   const auto update = [&]() {
@@ -496,10 +505,11 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
       const auto u = ws.direction.col(s);
       if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
       if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
-      const Scalar now =
-          ws.is_parted(s)
-              ? Scalar(0)
-              : segment_branch(model, ws.stretched_length(s) - l + gh * w, ws.seg_rate(s) + w);
+      const SegmentSprings<Scalar> k = springs(s);
+      const Scalar now = ws.is_parted(s)
+                             ? Scalar(0)
+                             : segment_branch(model, ws.stretched_length(s) - k.l + gh * w,
+                                              ws.seg_rate(s) + w, k.ea_l, k.ba_l);
       if (now != ws.seg_branch(s)) {
         changed = true;
         ws.seg_branch(s) = now;
@@ -510,8 +520,9 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
   bool on_true_branch = true;
   for (int s = 0; s < n; ++s) {
     const Scalar bt = true_branch(s);
-    const bool banded =
-        band > Scalar(0) && ws.stretched_length(s) >= (Scalar(1) - band) * l && !ws.is_parted(s);
+    const bool banded = band > Scalar(0) &&
+                        ws.stretched_length(s) >= (Scalar(1) - band) * springs(s).l &&
+                        !ws.is_parted(s);
     ws.seg_branch(s) = banded ? Scalar(2) : bt;
     if (ws.seg_branch(s) != bt) on_true_branch = false;
   }
@@ -529,10 +540,12 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
       const Scalar b = ws.seg_branch(s);
       if (b == true_branch(s)) continue;
       // The branch's force at the current point replaces the true one.
-      const Scalar e = ws.stretched_length(s) - l, r = ws.seg_rate(s);
+      const SegmentSprings<Scalar> k = springs(s);
+      const Scalar e = ws.stretched_length(s) - k.l, r = ws.seg_rate(s);
       const Scalar tb =
-          (b == Scalar(2) ? ea_l * e : Scalar(0)) +
-          (b > Scalar(0) ? ba_l * model.dashpot_fade(ws.stretched_length(s)).value * r : Scalar(0));
+          (b == Scalar(2) ? k.ea_l * e : Scalar(0)) +
+          (b > Scalar(0) ? k.ba_l * segment_fade(model, ws, s, ws.stretched_length(s)).value * r
+                         : Scalar(0));
       const Vector3<Scalar> df = (gh * (tb - ws.tension(s))) * ws.direction.col(s);
       ws.rhs.col(s) += df;
       ws.rhs.col(s + 1) -= df;
@@ -558,8 +571,6 @@ template <typename Scalar>
 int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, Scalar gh,
                          Scalar band, int max_passes, Scalar* kept = nullptr) {
   const int n = model.segments();
-  const Scalar l = model.segment_length();
-  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
   bool saved = false;
   const int passes = segment_active_set(model, ws, gh, band, max_passes, [&](bool on_true) {
     if (!on_true) {
@@ -570,16 +581,18 @@ int active_set_direction(const TetherModel<Scalar>& model, TetherWorkspace<Scala
       }
       for (int s = 0; s < n; ++s) {
         const Scalar b = ws.seg_branch(s);
-        if (ws.is_parted(s) ||
-            b == segment_branch(model, ws.stretched_length(s) - l, ws.seg_rate(s))) {
+        const SegmentSprings<Scalar> k = segment_springs(model, ws, s);
+        if (ws.is_parted(s) || b == segment_branch(model, ws.stretched_length(s) - k.l,
+                                                   ws.seg_rate(s), k.ea_l, k.ba_l)) {
           ws.seg_k_uu(s) = ws.seg_true_k_uu(s);
           ws.seg_c_uu(s) = ws.seg_true_c_uu(s);
         } else {
-          ws.seg_k_uu(s) = (b == Scalar(2) ? ea_l : Scalar(0)) - ws.seg_k_perp(s);
+          ws.seg_k_uu(s) = (b == Scalar(2) ? k.ea_l : Scalar(0)) - ws.seg_k_perp(s);
           // (Off its true branch a segment has no fade slope in k: a clamped one has r ≤ 0, a
           // banded one is longer than the fade length.)
-          ws.seg_c_uu(s) =
-              b > Scalar(0) ? ba_l * model.dashpot_fade(ws.stretched_length(s)).value : Scalar(0);
+          ws.seg_c_uu(s) = b > Scalar(0)
+                               ? k.ba_l * segment_fade(model, ws, s, ws.stretched_length(s)).value
+                               : Scalar(0);
         }
       }
     }

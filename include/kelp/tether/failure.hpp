@@ -52,7 +52,8 @@ struct LineFailure {
 
 /// \brief Axial force T_s [N] of segment s in `state` (its positions and velocities), as
 /// compute_forces evaluates it: EA/l·max(0, l_s − l) plus the faded dashpot σ(l_s)·BA/l·u·Δv,
-/// clamped at zero unless compressive_damping; 0 for a parted segment. No check of `s`.
+/// clamped at zero unless compressive_damping; 0 for a parted segment; segment 0 at a winch with
+/// its own rest length. No check of `s`.
 template <typename Scalar>
 Scalar segment_axial_force(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
                            int s) {
@@ -60,11 +61,15 @@ Scalar segment_axial_force(const TetherModel<Scalar>& model, const TetherState<S
   if (state.parted.size() > s && state.parted(s)) return Scalar(0);
   const Vector3<Scalar> d = state.position.col(s + 1) - state.position.col(s);
   const Scalar ls = sqrt(d.squaredNorm());
-  const Scalar ext = ls - model.segment_length();
-  Scalar t = ext > Scalar(0) ? model.axial_spring() * ext : Scalar(0);
+  // Segment 0 at a winch has its own rest length l_w (TetherState::winch_length), hence EA/l_w,
+  // BA/l_w and a fade length scaled by l_w/l (as the force pass takes them).
+  const bool winch = s == 0 && state.winch_length > Scalar(0);
+  const Scalar scale = winch ? state.winch_length / model.segment_length() : Scalar(1);
+  const Scalar ext = ls - model.segment_length() * scale;
+  Scalar t = ext > Scalar(0) ? model.axial_spring() / scale * ext : Scalar(0);
   if (model.axial_damper() != Scalar(0) && ls > Scalar(0)) {
     const Scalar rate = d.dot(state.velocity.col(s + 1) - state.velocity.col(s)) / ls;
-    t += model.dashpot_fade(ls).value * model.axial_damper() * rate;
+    t += model.dashpot_fade(ls / scale).value * (model.axial_damper() / scale) * rate;
   }
   if (!model.parameters().compressive_damping && !(t > Scalar(0))) t = Scalar(0);
   return t;

@@ -50,7 +50,11 @@ struct ForcePass {
   /// Half the cable diameter [m]: a node at least this deep under the surface is wholly wet.
   Scalar half_d;
   bool clamp, damping, fade, still, bending, mass_turns;
-  NodeConstants<Scalar> kinds[3];
+  /// Segment 0 has its own rest length (a winch, TetherWorkspace::winch_length): node 0 then
+  /// takes kinds[0] and node 1 kinds[3], both built for it.
+  bool winch = false;
+  /// Node kinds: 0 start, 1 interior, 2 end, 3 node 1 next to a winch segment.
+  NodeConstants<Scalar> kinds[4];
   const Scalar* x;
   Eigen::Index xs;
   const Scalar* v;

@@ -163,7 +163,7 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
     const Scalar out = i > 0 ? ws.pass_buffer(i - 1, kSegmentForce + k) : Scalar(0);
     f(k) = in - out;
   }
-  const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
+  const int kind = i == 0 ? 0 : (i == n ? 2 : (i == 1 && c.winch ? 3 : 1));
   const Scalar li = c.kinds[kind].li;
   const Scalar z = c.X(2, i);
   const Scalar zeta = c.still ? Scalar(0) : ws.surface_elevation(i);
@@ -373,6 +373,20 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   const PackedConstants<Scalar, wide> packed(c);
   const PackedConstants<Scalar, false> single(c);
   int s = 0;
+  if (c.winch) {
+    // Segment 0 at a winch: its own rest length l_w (TetherWorkspace::winch_length), the same
+    // arithmetic with l, EA/l, BA/l and the fade length taken for l_w.
+    ForcePass<Scalar> cw = c;
+    const Scalar lw = ws.winch_length;
+    cw.l = lw;
+    cw.l2 = lw * lw;
+    cw.inv_l = Scalar(1) / lw;
+    cw.ea_l = c.ea * cw.inv_l;
+    cw.ba_l = c.ba * cw.inv_l;
+    cw.inv_fade = c.inv_fade * (c.l * cw.inv_l);
+    segment_block<WithJacobian, false>(cw, PackedConstants<Scalar, false>(cw), ws, 0);
+    s = 1;
+  }
   if constexpr (wide)
     for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, packed, ws, s);
   for (; s < n; ++s) segment_block<WithJacobian, false>(c, single, ws, s);
@@ -388,6 +402,8 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   if (c.bending) bending_forces(c, ws);
   node_general<WithJacobian>(c, ws, 0);
   int i = 1;
+  // Node 1 next to a winch segment has its own constants (kinds[3]).
+  if (c.winch && n > 1) node_general<WithJacobian>(c, ws, i++);
   if constexpr (wide)
     for (; i + lanes <= n; i += lanes)
       if (!interior_block<WithJacobian, true>(c, packed, ws, i))
@@ -477,6 +493,29 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   c.kinds[0] = node_constants(0);
   c.kinds[1] = node_constants(n > 1 ? 1 : 0);
   c.kinds[2] = node_constants(n);
+  // A winch at the start end (TetherWorkspace::winch_length): segment 0 has rest length l_w,
+  // node 0 carries l_w/2 of line and node 1 (l + l_w)/2 (l_w/2 when it is the far end).
+  c.winch = has_winch_segment(ws);
+  if (c.winch) {
+    const auto winch_node = [&](int i) {
+      const Scalar m = node_mass_at(model, ws, i), vol = node_volume_at(model, ws, i);
+      const Scalar li = node_length_at(model, ws, i);
+      return NodeConstants<Scalar>{li,
+                                   m * c.g,
+                                   (m - c.rho * vol) * c.g,
+                                   c.rho * vol,
+                                   kn_per_l * li,
+                                   kt_per_l * li,
+                                   m,
+                                   m + c.rho * vol * c.can,
+                                   c.rho * vol * (c.cat - c.can)};
+    };
+    c.kinds[0] = winch_node(0);
+    if (n > 1)
+      c.kinds[3] = winch_node(1);
+    else
+      c.kinds[2] = winch_node(1);
+  }
 
   // The passes read the coordinates through a pointer and a column stride: straight from
   // column-major storage, or from a copy of any other expression.
@@ -620,10 +659,18 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
   Scalar e(0);
   const std::uint8_t* parted =
       state.parted.size() == n && state.parted.any() ? state.parted.data() : nullptr;
+  // Segment 0 and nodes 0, 1 at a winch (TetherState::winch_length): their own rest length,
+  // spring and masses.
+  const Scalar lw = state.winch_length > Scalar(0) ? state.winch_length : l;
+  const auto node_share = [&](int i) {
+    if (i > 1 || !(state.winch_length > Scalar(0))) return Scalar(0);
+    return Scalar(0.5) * (lw - l);  // extra line lumped at node 0 and node 1 [m]
+  };
   for (int s = 0; s < n; ++s) {
     if (parted && parted[s]) continue;  // a parted segment stores no energy
     const Scalar ls = (state.position.col(s + 1) - state.position.col(s)).norm();
-    if (ls > l) e += Scalar(0.5) * model.axial_spring() * (ls - l) * (ls - l);
+    const Scalar rest = s == 0 ? lw : l;
+    if (ls > rest) e += Scalar(0.5) * (p.axial_stiffness / rest) * (ls - rest) * (ls - rest);
   }
   if (p.bending_stiffness > Scalar(0))
     for (int i = 1; i < n; ++i) {
@@ -640,13 +687,15 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
         Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
     const Scalar z = state.position(2, i);
     const Scalar phi = detail::submerged_fraction(z, zeta, p.diameter);
-    const Scalar m = model.node_mass(i), rv = phi * rho * model.node_volume(i);
+    const Scalar extra = node_share(i);
+    const Scalar m = model.node_mass(i) + p.mass_per_length * extra;
+    const Scalar vol = model.node_volume(i) + model.area() * extra;
+    const Scalar rv = phi * rho * vol;
     const Vector3<Scalar> vi = state.velocity.col(i);
     const Scalar vq = vi.dot(q);
     e += Scalar(0.5) * ((m + rv * p.normal_added_mass) * vi.squaredNorm() +
                         rv * (p.tangential_added_mass - p.normal_added_mass) * vq * vq);
-    e -= m * g * z -
-         rho * model.node_volume(i) * g * detail::submerged_depth_integral(z, zeta, p.diameter);
+    e -= m * g * z - rho * vol * g * detail::submerged_depth_integral(z, zeta, p.diameter);
   }
   return e;
 }

@@ -38,7 +38,8 @@ void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<S
   for (int i = 0; i < model.nodes(); ++i) {
     const Scalar pen = state.position(2, i) - bed;
     const Scalar ramp = pen < p.seabed_damping_depth ? pen / p.seabed_damping_depth : Scalar(1);
-    const Scalar normal = (pen * k + state.velocity(2, i) * c * ramp) * model.node_length(i);
+    const Scalar normal =
+        (pen * k + state.velocity(2, i) * c * ramp) * node_length_at(model, ws, i);
     ws.friction_normal(i) = pen > Scalar(0) && normal > Scalar(0) ? normal : Scalar(0);
   }
 }
@@ -50,11 +51,12 @@ void freeze_friction_normals(const TetherModel<Scalar>& model, TetherWorkspace<S
 template <typename Scalar>
 bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                   const VectorX<Scalar>& branch, Scalar band) {
-  const Scalar l = model.segment_length();
-  const Scalar taut_from = band > Scalar(0) ? (Scalar(1) - band) * l : l;
   const bool clamp = !model.parameters().compressive_damping;
   bool same = true;
   for (int s = 0; s < model.segments(); ++s) {
+    // The segment's rest length (segment 0's own at a winch).
+    const Scalar l = segment_springs(model, ws, s).l;
+    const Scalar taut_from = band > Scalar(0) ? (Scalar(1) - band) * l : l;
     const Scalar ls = ws.stretched_length(s);
     const bool taut = !ws.is_parted(s) && (band > Scalar(0) ? ls >= taut_from : ls > l);
     const Scalar b = ws.is_parted(s)            ? Scalar(0)

@@ -66,10 +66,12 @@ SegmentJacobian<Scalar> segment_jacobian(const TetherModel<Scalar>& model,
   if (!(ls > Scalar(0)) || ws.is_parted(s)) return out;
   const Vector3<Scalar> u = ws.direction.col(s);
   const Vector3<Scalar> e = v.col(s + 1) - v.col(s);
-  const Scalar r = u.dot(e), ext = ls - model.segment_length();
-  if (b < Scalar(0)) b = segment_branch(model, ext, r);
+  // The segment's own rest length and constants (segment 0's at a winch).
+  const SegmentSprings<Scalar> sk = segment_springs(model, ws, s);
+  const Scalar r = u.dot(e), ext = ls - sk.l;
+  const Scalar ea_l = sk.ea_l, ba_l = sk.ba_l;
+  if (b < Scalar(0)) b = segment_branch(model, ext, r, ea_l, ba_l);
   if (b == Scalar(0)) return out;
-  const Scalar ea_l = model.axial_spring(), ba_l = model.axial_damper();
   const Scalar inv_ls = Scalar(1) / ls;
   Vector3<Scalar> grad = Vector3<Scalar>::Zero();
   if (b == Scalar(2)) {
@@ -78,7 +80,7 @@ SegmentJacobian<Scalar> segment_jacobian(const TetherModel<Scalar>& model,
   }
   if (ba_l != Scalar(0)) {
     // The dashpot σ(l_s) BA/l r (TetherModel::dashpot_fade): ∂/∂d = BA/l (σ' r u + σ P e/l_s).
-    const typename TetherModel<Scalar>::Fade fade = model.dashpot_fade(ls);
+    const typename TetherModel<Scalar>::Fade fade = segment_fade(model, ws, s, ls);
     const Scalar bs = ba_l * fade.value;
     out.tension += bs * r;
     grad += (bs * inv_ls) * (e - r * u) + (ba_l * fade.slope * r) * u;
@@ -194,7 +196,7 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     const Scalar inv_c = c2 > Scalar(0) ? Scalar(1) / sqrt(c2) : Scalar(0);
     const V3 q = ws.tangent.col(i);
     // (no projector matrix: add_projector)
-    const Scalar li = model.node_length(i), vol = model.node_volume(i);
+    const Scalar li = node_length_at(model, ws, i), vol = node_volume_at(model, ws, i);
     const Scalar phi = ws.submerged(i);
     const bool wet = phi > Scalar(0);
     // ∂φ/∂z in the surface band.

@@ -114,6 +114,15 @@ struct TetherState {
   /// (a state assembled by hand may leave it empty). A re-mesh that inserts or removes nodes
   /// must carry these flags with their segments.
   SegmentFlags parted;
+  /// Unstretched length of segment 0, the segment at a winch on the start end [m]; 0 (the
+  /// default, and always without a winch): the model's segment length l. A winch
+  /// (kelp/tether/winch.hpp) changes it step by step and keeps it in [remove_ratio·l,
+  /// insert_ratio·l] by inserting and removing nodes. It lives in the state (not the model)
+  /// because it changes during a run and determines the next step.
+  Scalar winch_length = Scalar(0);
+  /// Rate at which the winch pays line out [m/s] (negative: reeling in); the winch's own state
+  /// (its speed is limited in acceleration), 0 without a winch.
+  Scalar payout_rate = Scalar(0);
 
   TetherState() = default;
   /// \brief Zero state sized for `model`, no history.
@@ -222,6 +231,7 @@ struct StateBackup {
   double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
   KeptNewtonMatrix<Scalar> newton;
   SegmentFlags parted;
+  Scalar winch_length = Scalar(0), payout_rate = Scalar(0);
 
   /// \brief Sizes the buffers for `nodes` nodes.
   /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1].
@@ -241,6 +251,8 @@ struct StateBackup {
     time = s.time;
     time_carry = s.time_carry;
     previous_dt = s.previous_dt;
+    winch_length = s.winch_length;
+    payout_rate = s.payout_rate;
     newton.factor = s.newton.factor;
     newton.branch = s.newton.branch;
     newton.gh = s.newton.gh;
@@ -258,6 +270,8 @@ struct StateBackup {
     s.time = time;
     s.time_carry = time_carry;
     s.previous_dt = previous_dt;
+    s.winch_length = winch_length;
+    s.payout_rate = payout_rate;
     s.newton.factor = newton.factor;
     s.newton.branch = newton.branch;
     s.newton.gh = newton.gh;
@@ -367,6 +381,10 @@ struct TetherWorkspace {
   /// that carries an end and receives exactly this impulse keeps the momentum of body and tether
   /// balanced whatever the integrator (kelp::system::step does so).
   EndForces<Scalar> end_impulse;
+  /// Unstretched length of segment 0 the force evaluation uses [m] (0: the model's l): the
+  /// steps copy TetherState::winch_length here before they evaluate forces (a winch at the
+  /// start end; kelp/tether/winch.hpp). Set it by hand only to call compute_forces directly.
+  Scalar winch_length = Scalar(0);
 
   TetherWorkspace() = default;
   /// \brief Buffers sized for `model`.
@@ -459,6 +477,67 @@ void load_clamps(const TetherModel<Scalar>& model, const TetherBoundary<Scalar>&
   ws.clamp_start =
       p.start_mode == EndMode::kinematic ? unit(b.start.direction) : Vector3<Scalar>::Zero();
   ws.clamp_end = p.end_mode == EndMode::kinematic ? unit(b.end.direction) : Vector3<Scalar>::Zero();
+}
+
+/// True when segment 0 has its own unstretched length (a winch at the start end, see
+/// TetherWorkspace::winch_length).
+template <typename Scalar>
+bool has_winch_segment(const TetherWorkspace<Scalar>& ws) {
+  return ws.winch_length > Scalar(0);
+}
+
+/// Unstretched length [m], axial spring EA/l_s [N/m] and damper BA/l_s [N s/m] of segment s,
+/// and the factor by which its rest length scales the dashpot's fade length (l_s/l): the
+/// model's uniform values, or segment 0's at a winch (TetherWorkspace::winch_length).
+template <typename Scalar>
+struct SegmentSprings {
+  Scalar l, ea_l, ba_l, scale;
+};
+template <typename Scalar>
+SegmentSprings<Scalar> segment_springs(const TetherModel<Scalar>& model,
+                                       const TetherWorkspace<Scalar>& ws, int s) {
+  if (s == 0 && has_winch_segment(ws)) {
+    const Scalar lw = ws.winch_length;
+    const TetherParameters<Scalar>& p = model.parameters();
+    return {lw, p.axial_stiffness / lw, p.internal_damping / lw, lw / model.segment_length()};
+  }
+  return {model.segment_length(), model.axial_spring(), model.axial_damper(), Scalar(1)};
+}
+
+/// The dashpot fade (TetherModel::dashpot_fade) of segment s at length l_s: its fade length
+/// scales with the segment's rest length (segment 0 at a winch).
+template <typename Scalar>
+typename TetherModel<Scalar>::Fade segment_fade(const TetherModel<Scalar>& model,
+                                                const TetherWorkspace<Scalar>& ws, int s,
+                                                Scalar ls) {
+  if (s != 0 || !has_winch_segment(ws)) return model.dashpot_fade(ls);
+  const Scalar scale = ws.winch_length / model.segment_length();
+  typename TetherModel<Scalar>::Fade f = model.dashpot_fade(ls / scale);
+  f.slope /= scale;
+  return f;
+}
+
+/// Length of line lumped at node i [m] (TetherModel::node_length, with segment 0 of length
+/// TetherWorkspace::winch_length at a winch: half of it at node 0 and at node 1).
+template <typename Scalar>
+Scalar node_length_at(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws, int i) {
+  if (i > 1 || !has_winch_segment(ws)) return model.node_length(i);
+  const Scalar half = Scalar(0.5) * (ws.winch_length - model.segment_length());
+  return model.node_length(i) + half;
+}
+
+/// Structural mass [kg] and displaced volume [m³] of node i (as node_length_at).
+template <typename Scalar>
+Scalar node_mass_at(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws, int i) {
+  if (i > 1 || !has_winch_segment(ws)) return model.node_mass(i);
+  return model.node_mass(i) +
+         model.parameters().mass_per_length * (node_length_at(model, ws, i) - model.node_length(i));
+}
+template <typename Scalar>
+Scalar node_volume_at(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws, int i) {
+  if (i > 1 || !has_winch_segment(ws)) return model.node_volume(i);
+  return model.node_volume(i) +
+         model.area() * (node_length_at(model, ws, i) - model.node_length(i));
 }
 
 /// Applies the prescribed end motion τ seconds into a step to the kinematic end nodes.

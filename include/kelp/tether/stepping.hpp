@@ -294,10 +294,18 @@ void check_implicit_options(const ImplicitOptions<Scalar>& o) {
 /// state assembled by hand) fitting ones and no history: nothing is changed unless all checks
 /// pass.
 template <typename Scalar>
-void check_step_inputs(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
+void check_step_inputs(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                        TetherState<Scalar>& state, const TetherBoundary<Scalar>& b, double dt) {
   check_positive(dt, "dt");
   check_workspace(model, ws);
+  // Segment 0's rest length at a winch (kelp/tether/winch.hpp): 0, or at least 1 % of l.
+  if (!(state.winch_length == Scalar(0) ||
+        (is_finite(state.winch_length) &&
+         state.winch_length >= Scalar(0.01) * model.segment_length() &&
+         state.winch_length <= limits::max_length)))
+    ::kelp::detail::throw_invalid_argument(
+        "state.winch_length must be 0 (no winch) or in [0.01 l, limits::max_length]");
+  ws.winch_length = state.winch_length;
   KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
              "state.position and state.velocity must have segments + 1 columns");
   check_boundary(b);

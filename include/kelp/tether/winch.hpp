@@ -1,0 +1,452 @@
+/// \file
+/// \brief A winch at the start end of a lumped-mass tether: the unstretched length changes with
+/// a commanded payout rate limited by the winch's speed, acceleration and pull; the segment at
+/// the winch (segment 0) grows and shrinks, and a node is inserted there when it passes
+/// `insert_ratio`·l and removed when it falls below `remove_ratio`·l, conserving the line's mass
+/// and linear momentum exactly (docs/equations.md, section "Winch").
+///
+/// The line's node count changes, so the winch keeps one TetherModel per segment count it can
+/// reach (`WinchModel`, built once) and one workspace and one spare state per count
+/// (`WinchWorkspace`, built once): a re-mesh writes the new state into the spare of the new
+/// count and swaps buffers, so nothing is allocated in a step. The time-varying part (segment 0's
+/// unstretched length, the payout rate) lives in TetherState (winch_length, payout_rate), so that
+/// the models stay constant and a saved state reproduces a run.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kelp/core/error.hpp"
+#include "kelp/core/scalar.hpp"
+#include "kelp/core/types.hpp"
+#include "kelp/tether/model.hpp"
+#include "kelp/tether/state.hpp"
+
+namespace kelp::tether {
+
+/// \brief A winch on the start end (node 0) of a tether (all magnitudes positive).
+///
+/// Defaults: a small electric ROV tether winch (0.5 m/s line speed, 0.5 m/s², 400 N pull).
+template <typename Scalar>
+struct WinchParameters {
+  /// Shortest unstretched line the winch leaves out [m] (≥ one nominal segment).
+  Scalar min_length = Scalar(5);
+  /// Longest unstretched line the winch can pay out [m]: the capacity the buffers are sized
+  /// for.
+  Scalar max_length = Scalar(60);
+  /// Largest line speed, in or out [m/s].
+  Scalar max_speed = Scalar(0.5);
+  /// Largest change of line speed [m/s²].
+  Scalar max_acceleration = Scalar(0.5);
+  /// Largest pull the winch can reel in against [N]: above it the winch stops reeling in
+  /// (its brake holds; it does not pay out by itself).
+  Scalar max_pull = Scalar(400);
+  /// A node is inserted when segment 0 is longer than insert_ratio·l (l the nominal segment
+  /// length); it then becomes (insert_ratio − 1)·l long.
+  Scalar insert_ratio = Scalar(1.5);
+  /// A node is removed when segment 0 is shorter than remove_ratio·l; it then becomes
+  /// (remove_ratio + 1)·l long.
+  Scalar remove_ratio = Scalar(0.5);
+};
+
+/// \brief Checks winch parameters for a line of nominal segment length `l` [m].
+/// \throws kelp::invalid_argument naming the field: lengths finite, min_length ≥ l,
+/// max_length ≥ min_length and ≤ limits::max_length; speeds, acceleration, pull finite and > 0;
+/// 0.1 ≤ remove_ratio < 1 < insert_ratio ≤ 3 and insert_ratio − remove_ratio ≥ 1 (so that
+/// after either re-mesh segment 0 lies inside the band and a re-mesh cannot undo itself at once).
+template <typename Scalar>
+void validate(const WinchParameters<Scalar>& w, Scalar l) {
+  check_positive(w.min_length, "winch.min_length");
+  check_at_least(w.min_length, l, "winch.min_length (at least one segment)");
+  check_at_least(w.max_length, w.min_length, "winch.max_length (at least min_length)");
+  check_at_most(w.max_length, limits::max_length, "winch.max_length");
+  check_positive(w.max_speed, "winch.max_speed");
+  check_at_most(w.max_speed, limits::max_speed, "winch.max_speed");
+  check_positive(w.max_acceleration, "winch.max_acceleration");
+  check_positive(w.max_pull, "winch.max_pull");
+  KELP_CHECK(w.remove_ratio >= Scalar(0.1) && w.remove_ratio < Scalar(1),
+             "winch.remove_ratio must be in [0.1, 1)");
+  KELP_CHECK(w.insert_ratio > Scalar(1) && w.insert_ratio <= Scalar(3),
+             "winch.insert_ratio must be in (1, 3]");
+  KELP_CHECK(w.insert_ratio - w.remove_ratio >= Scalar(1),
+             "winch.insert_ratio − winch.remove_ratio must be at least 1");
+}
+
+/// \brief What the re-meshes of a winch step did: nodes inserted and removed, the line's
+/// kinetic energy they took away (a merge of velocities loses kinetic energy, as an inelastic
+/// collision does; ≥ 0 when the ends are at rest), and the momentum [N s] they handed to each
+/// kinematic end (a removed node's share that goes to an end node whose velocity is
+/// prescribed: the vehicle carrying that end takes it).
+template <typename Scalar>
+struct RemeshReport {
+  int inserted = 0;  ///< nodes inserted
+  int removed = 0;   ///< nodes removed
+  /// Kinetic energy of the line (structural masses) before minus after [J].
+  Scalar kinetic_energy_lost = Scalar(0);
+  /// Momentum handed to the start end's body [N s] (NED).
+  Vector3<Scalar> impulse_on_start = Vector3<Scalar>::Zero();
+  /// Momentum handed to the far end's body [N s] (NED).
+  Vector3<Scalar> impulse_on_end = Vector3<Scalar>::Zero();
+  /// \brief Accumulates another report.
+  RemeshReport& operator+=(const RemeshReport& o) {
+    inserted += o.inserted;
+    removed += o.removed;
+    kinetic_energy_lost += o.kinetic_energy_lost;
+    impulse_on_start += o.impulse_on_start;
+    impulse_on_end += o.impulse_on_end;
+    return *this;
+  }
+};
+
+namespace detail {
+/// Extra line [m] lumped at node i by a winch segment of rest length state.winch_length
+/// (0 elsewhere and without a winch): (l_w − l)/2 at nodes 0 and 1.
+template <typename Scalar>
+Scalar winch_extra_length(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
+                          int i) {
+  if (i > 1 || !(state.winch_length > Scalar(0))) return Scalar(0);
+  return Scalar(0.5) * (state.winch_length - model.segment_length());
+}
+}  // namespace detail
+
+/// \brief Structural mass of node i of `state` [kg] (TetherModel::node_mass with the winch
+/// segment's share).
+template <typename Scalar>
+Scalar node_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& state, int i) {
+  return model.node_mass(i) +
+         model.parameters().mass_per_length * detail::winch_extra_length(model, state, i);
+}
+
+/// \brief Unstretched length of the line [m]: (N − 1)·l + l_w with a winch, N·l without.
+template <typename Scalar>
+Scalar unstretched_length(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  const Scalar l = model.segment_length();
+  return state.winch_length > Scalar(0) ? Scalar(model.segments() - 1) * l + state.winch_length
+                                        : Scalar(model.segments()) * l;
+}
+
+/// \brief Structural mass of the line Σ m_i [kg] (point masses of free ends included).
+template <typename Scalar>
+Scalar line_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  Scalar m(0);
+  for (int i = 0; i < model.nodes(); ++i) m += node_mass(model, state, i);
+  return m;
+}
+
+/// \brief Linear momentum of the line Σ m_i v_i [kg m/s] (structural masses, NED).
+template <typename Scalar>
+Vector3<Scalar> line_momentum(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  Vector3<Scalar> p = Vector3<Scalar>::Zero();
+  for (int i = 0; i < model.nodes(); ++i) p += node_mass(model, state, i) * state.velocity.col(i);
+  return p;
+}
+
+/// \brief Inserts a node in segment 0 of `in` (a line of N segments on `from`, segment 0 of
+/// rest length l_w > l) into `out` (a state sized for N + 1 segments: buffers reused, nothing
+/// allocated once sized). Segment 0 becomes l_w − l long, the new node 1 is at the point that
+/// splits segment 0 in those proportions, x₁' = x₀ + (l_w − l)/l_w (x₁ − x₀), with the
+/// mass-weighted velocity of the mass it takes over from nodes 0 and 1, v₁' = (l v₀ + (l_w − l)
+/// v₁)/l_w: mass and momentum are conserved exactly, kinetic energy is lost (Jensen). The
+/// integrator history restarts (see docs/equations.md: the BDF2 choice). Parted flags follow
+/// their segments.
+template <typename Scalar>
+void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar>& in,
+                       TetherState<Scalar>& out, RemeshReport<Scalar>& report) {
+  const int n = from.segments();
+  const Scalar l = from.segment_length();
+  const Scalar lw = in.winch_length > Scalar(0) ? in.winch_length : l;
+  KELP_CHECK(out.position.cols() == n + 2 && out.velocity.cols() == n + 2,
+             "insert_winch_node: out must have N + 2 columns");
+  KELP_CHECK(lw > l, "insert_winch_node: segment 0 must be longer than l");
+  const Scalar mu = from.parameters().mass_per_length;
+  const Scalar a = (lw - l) / lw;  // the new node's place along segment 0, from node 0
+  const Vector3<Scalar> x0 = in.position.col(0), x1 = in.position.col(1);
+  const Vector3<Scalar> v0 = in.velocity.col(0), v1 = in.velocity.col(1);
+  out.position.col(0) = x0;
+  out.velocity.col(0) = v0;
+  out.position.col(1) = x0 + a * (x1 - x0);
+  out.velocity.col(1) = (l * v0 + (lw - l) * v1) / lw;
+  out.position.rightCols(n) = in.position.rightCols(n);
+  out.velocity.rightCols(n) = in.velocity.rightCols(n);
+  // Kinetic energy of nodes 0..2 after minus before (nodes beyond keep theirs). Masses: before
+  // m0 = μ l_w/2, m1 = μ(l_w + l)/2 (μ l_w/2 + end point mass if node 1 is a free far end);
+  // after m0' = μ(l_w − l)/2, m1' = μ l_w/2, m2' = m1 − μ(l_w − l)/2.
+  const Scalar m0 = node_mass(from, in, 0), m1 = node_mass(from, in, 1);
+  const Scalar m0n = mu * (lw - l) / Scalar(2), m1n = mu * lw / Scalar(2);
+  const Scalar m2n = (m0 + m1) - (m0n + m1n);  // μ l (μ l/2 plus a point mass at a free far end)
+  const Vector3<Scalar> vk = out.velocity.col(1);
+  const Scalar before = m0 * v0.squaredNorm() + m1 * v1.squaredNorm();
+  const Scalar after = m0n * v0.squaredNorm() + m1n * vk.squaredNorm() + m2n * v1.squaredNorm();
+  report.kinetic_energy_lost += Scalar(0.5) * (before - after);
+  ++report.inserted;
+  out.time = in.time;
+  out.time_carry = in.time_carry;
+  out.payout_rate = in.payout_rate;
+  out.winch_length = lw - l;
+  out.previous_dt = 0.0;
+  out.newton.clear();
+  // The parted flags (TetherState::parted) follow their segments: old segment 0 is new segments
+  // 0 and 1, and a parting in it stays on the winch's side (new segment 0).
+  out.parted.setZero(n + 1);
+  if (in.parted.size() == n) {
+    out.parted(0) = in.parted(0);
+    out.parted.tail(n - 1) = in.parted.tail(n - 1);
+  }
+}
+
+/// \brief Removes node 1 of `in` (a line of N ≥ 2 segments on `from`) into `out` (sized for
+/// N − 1 segments). Segment 0 becomes l_w + l long. Node 1's mass μ(l_w + l)/2 goes to its
+/// neighbours as the new segment 0 lumps it: μ l/2 to node 0, μ l_w/2 to node 2, with its
+/// momentum in the same shares: a free node 2 gets v₂' = (m₂ v₂ + μ l_w/2 v₁)/(m₂ + μ l_w/2);
+/// the share of a kinematic node (node 0 always, node 2 when it is a kinematic far end), whose
+/// velocity is prescribed, goes to the body that carries it (report.impulse_on_start / _end).
+/// Mass and momentum (line plus those impulses) are conserved exactly. The history restarts.
+template <typename Scalar>
+void remove_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar>& in,
+                       TetherState<Scalar>& out, RemeshReport<Scalar>& report) {
+  const int n = from.segments();
+  KELP_CHECK(n >= 2, "remove_winch_node: the line must have at least two segments");
+  KELP_CHECK(out.position.cols() == n && out.velocity.cols() == n,
+             "remove_winch_node: out must have N columns");
+  const Scalar l = from.segment_length();
+  const Scalar lw = in.winch_length > Scalar(0) ? in.winch_length : l;
+  const Scalar mu = from.parameters().mass_per_length;
+  const Vector3<Scalar> v0 = in.velocity.col(0), v1 = in.velocity.col(1), v2 = in.velocity.col(2);
+  const Scalar m0 = node_mass(from, in, 0), m1 = node_mass(from, in, 1),
+               m2 = node_mass(from, in, 2);
+  const Scalar to0 = mu * l / Scalar(2), to2 = m1 - to0;  // node 1's shares (μ l/2, μ l_w/2)
+  const bool end_kinematic = n == 2 && from.parameters().end_mode == EndMode::kinematic;
+  out.position.col(0) = in.position.col(0);
+  out.velocity.col(0) = v0;
+  out.position.rightCols(n - 1) = in.position.rightCols(n - 1);
+  out.velocity.rightCols(n - 1) = in.velocity.rightCols(n - 1);
+  Vector3<Scalar> v2n = v2;
+  if (end_kinematic)
+    report.impulse_on_end += to2 * (v1 - v2);
+  else
+    v2n = (m2 * v2 + to2 * v1) / (m2 + to2);
+  out.velocity.col(1) = v2n;
+  report.impulse_on_start += to0 * (v1 - v0);
+  const Scalar before = m0 * v0.squaredNorm() + m1 * v1.squaredNorm() + m2 * v2.squaredNorm();
+  const Scalar after = (m0 + to0) * v0.squaredNorm() + (m2 + to2) * v2n.squaredNorm();
+  report.kinetic_energy_lost += Scalar(0.5) * (before - after);
+  ++report.removed;
+  out.time = in.time;
+  out.time_carry = in.time_carry;
+  out.payout_rate = in.payout_rate;
+  out.winch_length = lw + l;
+  out.previous_dt = 0.0;
+  out.newton.clear();
+  // The parted flags follow their segments: old segments 0 and 1 are new segment 0.
+  out.parted.setZero(n - 1);
+  if (in.parted.size() == n) {
+    out.parted(0) = std::uint8_t(in.parted(0) || in.parted(1));
+    out.parted.tail(n - 2) = in.parted.tail(n - 2);
+  }
+}
+
+/// \brief The winch and the line at every segment count it can reach: one TetherModel per
+/// count N in [min_segments, max_segments], all with the nominal segment length
+/// l = line.length / line.segments (the line's initial length and count). Built once; constant.
+template <typename Scalar>
+class WinchModel {
+ public:
+  /// \throws kelp::invalid_argument naming the field (validate(TetherParameters),
+  /// validate(WinchParameters)); the start end must be kinematic (the winch sits on a body), and
+  /// the line's initial length must be within [min_length, max_length].
+  WinchModel(const TetherParameters<Scalar>& line, const WinchParameters<Scalar>& w) : winch_(w) {
+    validate(line);
+    l_ = line.length / Scalar(line.segments);
+    validate(w, l_);
+    KELP_CHECK(line.start_mode == EndMode::kinematic,
+               "winch: the tether's start end (the winch) must be kinematic");
+    check_at_least(line.length, w.min_length, "tether.length (at least winch.min_length)");
+    check_at_most(line.length, w.max_length, "tether.length (at most winch.max_length)");
+    // L = (N − 1) l + l_w with l_w in [remove_ratio l, insert_ratio l].
+    const double ll = double(value_of(l_));
+    min_n_ = std::max(1, int(std::floor(double(value_of(w.min_length)) / ll + 1.0 -
+                                        double(value_of(w.insert_ratio)))));
+    max_n_ = int(
+        std::ceil(double(value_of(w.max_length)) / ll + 1.0 - double(value_of(w.remove_ratio))));
+    KELP_CHECK(max_n_ <= limits::max_segments, "winch.max_length / segment length: too many");
+    models_.reserve(std::size_t(max_n_ - min_n_ + 1));
+    for (int n = min_n_; n <= max_n_; ++n) {
+      TetherParameters<Scalar> p = line;
+      p.segments = n;
+      p.length = l_ * Scalar(n);
+      models_.emplace_back(p);
+    }
+    initial_n_ = line.segments;
+  }
+  /// \brief The winch's parameters.
+  const WinchParameters<Scalar>& winch() const { return winch_; }
+  /// \brief Nominal segment length l [m].
+  Scalar segment_length() const { return l_; }
+  /// \brief Fewest and most segments the line can have.
+  int min_segments() const { return min_n_; }
+  int max_segments() const { return max_n_; }
+  /// \brief Segment count of the line as built.
+  int initial_segments() const { return initial_n_; }
+  /// \brief The line with `segments` segments.
+  /// \throws kelp::invalid_argument outside [min_segments, max_segments].
+  const TetherModel<Scalar>& line(int segments) const {
+    KELP_CHECK(segments >= min_n_ && segments <= max_n_,
+               "WinchModel::line: segment count outside the winch's range");
+    return models_[std::size_t(segments - min_n_)];
+  }
+  /// \brief The line model that fits `state` (its column count).
+  const TetherModel<Scalar>& line_of(const TetherState<Scalar>& state) const {
+    return line(int(state.position.cols()) - 1);
+  }
+
+ private:
+  WinchParameters<Scalar> winch_;
+  Scalar l_;
+  int min_n_ = 1, max_n_ = 1, initial_n_ = 1;
+  std::vector<TetherModel<Scalar>> models_;
+};
+
+/// \brief Buffers for a winch line: one TetherWorkspace, one spare TetherState and one
+/// StateBackup per segment count of the WinchModel, built once (about 1.6 kB per node and count
+/// in double). The slot of the current count is lent out: its buffers are the caller's
+/// (kelp::system keeps them in SystemWorkspace::tether and SystemState::tether) and
+/// `lend`/`swap_count` move buffers by swapping, never by copying.
+template <typename Scalar>
+struct WinchWorkspace {
+  std::vector<TetherWorkspace<Scalar>> line;  ///< workspace per segment count
+  std::vector<TetherState<Scalar>> spare;     ///< spare state per segment count
+  std::vector<StateBackup<Scalar>> backup;    ///< state backup per segment count
+  int min_n = 1;                              ///< segment count of slot 0
+
+  WinchWorkspace() = default;
+  /// \brief Buffers for every count of `model`.
+  explicit WinchWorkspace(const WinchModel<Scalar>& model) : min_n(model.min_segments()) {
+    const int k = model.max_segments() - model.min_segments() + 1;
+    line.reserve(std::size_t(k));
+    spare.reserve(std::size_t(k));
+    backup.resize(std::size_t(k));
+    for (int n = model.min_segments(); n <= model.max_segments(); ++n) {
+      line.emplace_back(model.line(n));
+      spare.emplace_back(model.line(n));
+      backup[std::size_t(n - min_n)].resize(n + 1);
+    }
+  }
+  /// \brief Slot index of `segments`.
+  std::size_t slot(int segments) const { return std::size_t(segments - min_n); }
+};
+
+/// \brief The payout rate [m/s] the winch reaches in a step of dt [s] from `rate` towards
+/// `command`: at most max_acceleration·dt away, at most max_speed in magnitude, not reeling in
+/// while the pull at the winch is at least max_pull, and neither past max_length nor below
+/// min_length over the step from the unstretched length `length` [m].
+template <typename Scalar>
+Scalar limited_payout_rate(const WinchParameters<Scalar>& w, Scalar rate, Scalar command,
+                           Scalar pull, Scalar length, double dt) {
+  const Scalar h(dt);
+  const Scalar dv = w.max_acceleration * h;
+  Scalar r = std::min(std::max(command, rate - dv), rate + dv);
+  r = std::min(std::max(r, -w.max_speed), w.max_speed);
+  if (r < Scalar(0) && pull >= w.max_pull) r = Scalar(0);
+  r = std::min(r, (w.max_length - length) / h);
+  r = std::max(r, (w.min_length - length) / h);
+  return r;
+}
+
+/// \brief A payout rate [m/s] that brings the unstretched length from `length` to `target` [m]
+/// as fast as the winch allows and stops there: ±√(2 a |e|), at most max_speed (the
+/// time-optimal profile under the acceleration limit; limited_payout_rate limits it further).
+template <typename Scalar>
+Scalar payout_rate_for_length(const WinchParameters<Scalar>& w, Scalar length, Scalar target) {
+  using std::abs;
+  using std::sqrt;
+  const Scalar e = target - length;
+  const Scalar s = std::min(w.max_speed, sqrt(Scalar(2) * w.max_acceleration * abs(e)));
+  return e >= Scalar(0) ? s : -s;
+}
+
+/// \brief Pull of the line at the winch [N]: the elastic tension of segment 0 in `state`,
+/// EA·max(0, |x₁ − x₀| − l_w)/l_w (from the state alone, so that a restored state reproduces it).
+template <typename Scalar>
+Scalar winch_pull(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
+  const Scalar lw = state.winch_length > Scalar(0) ? state.winch_length : model.segment_length();
+  const Scalar ls = (state.position.col(1) - state.position.col(0)).norm();
+  return ls > lw ? model.parameters().axial_stiffness * (ls - lw) / lw : Scalar(0);
+}
+
+namespace detail {
+/// Moves the buffers of count `to` (spare[to] holding the new state) into `state` and `ws`, and
+/// those of count `from` back into their slots: swaps only.
+template <typename Scalar>
+void winch_switch(WinchWorkspace<Scalar>& w, TetherState<Scalar>& state,
+                  TetherWorkspace<Scalar>& ws, int from, int to) {
+  using std::swap;
+  const std::size_t a = w.slot(from), b = w.slot(to);
+  swap(state, w.spare[b]);
+  swap(w.spare[b], w.spare[a]);
+  swap(ws, w.line[b]);
+  swap(w.line[b], w.line[a]);
+}
+}  // namespace detail
+
+/// \brief One step of the winch before the line's step of dt [s]: the payout rate moves towards
+/// `command` [m/s] within the winch's limits (limited_payout_rate, with the pull winch_pull of
+/// the state), segment 0's unstretched length changes by rate·dt, and nodes are inserted or
+/// removed (insert_winch_node, remove_winch_node) until it is inside [remove_ratio·l,
+/// insert_ratio·l]. `state` and `ws` are the line's current buffers (sized for its count N, the
+/// WinchModel's line(N)); after a re-mesh they hold the buffers of the new count (swapped with
+/// `w`'s slots, nothing allocated). Segment 0's length is constant over the line's step that
+/// follows (the payout is explicit in time: the new line enters the step at rest relative to
+/// nodes 0 and 1, whose masses grow or shrink with it).
+/// \throws kelp::invalid_argument for a non-finite command or dt ≤ 0, or when the state does
+/// not fit the winch (nothing changed then).
+template <typename Scalar>
+RemeshReport<Scalar> advance_winch(const WinchModel<Scalar>& model, WinchWorkspace<Scalar>& w,
+                                   TetherState<Scalar>& state, TetherWorkspace<Scalar>& ws,
+                                   Scalar command, double dt) {
+  check_finite(command, "winch command (payout rate)");
+  check_positive(dt, "dt");
+  const int n0 = int(state.position.cols()) - 1;
+  const TetherModel<Scalar>& line0 = model.line(n0);
+  KELP_CHECK(ws.fits(line0.nodes()), "advance_winch: workspace and state of different lines");
+  const WinchParameters<Scalar>& wp = model.winch();
+  const Scalar l = model.segment_length();
+  if (!(state.winch_length > Scalar(0))) state.winch_length = l;
+  const Scalar length = unstretched_length(line0, state);
+  const Scalar rate =
+      limited_payout_rate(wp, state.payout_rate, command, winch_pull(line0, state), length, dt);
+  state.payout_rate = rate;
+  state.winch_length += rate * Scalar(dt);
+  RemeshReport<Scalar> report;
+  for (;;) {
+    const int n = int(state.position.cols()) - 1;
+    const TetherModel<Scalar>& line = model.line(n);
+    if (state.winch_length > wp.insert_ratio * l && n < model.max_segments()) {
+      insert_winch_node(line, state, w.spare[w.slot(n + 1)], report);
+      detail::winch_switch(w, state, ws, n, n + 1);
+    } else if (state.winch_length < wp.remove_ratio * l && n > std::max(1, model.min_segments())) {
+      remove_winch_node(line, state, w.spare[w.slot(n - 1)], report);
+      detail::winch_switch(w, state, ws, n, n - 1);
+    } else {
+      break;
+    }
+  }
+  return report;
+}
+
+/// \brief Double-precision aliases.
+using WinchParametersd = WinchParameters<double>;
+using WinchModeld = WinchModel<double>;
+using WinchWorkspaced = WinchWorkspace<double>;
+using RemeshReportd = RemeshReport<double>;
+/// \brief Single-precision aliases.
+using WinchParametersf = WinchParameters<float>;
+using WinchModelf = WinchModel<float>;
+using WinchWorkspacef = WinchWorkspace<float>;
+using RemeshReportf = RemeshReport<float>;
+
+}  // namespace kelp::tether
