@@ -17,81 +17,12 @@ namespace kelp_python {
 
 namespace {
 
-// The columns of timeseries.csv (kelp::sim::RunLog; examples/tethered_pair/README.md), in order.
-std::vector<std::string> column_names() {
-  std::vector<std::string> c = {"t",
-                                "asv_x",
-                                "asv_y",
-                                "asv_z",
-                                "asv_roll",
-                                "asv_pitch",
-                                "asv_yaw",
-                                "asv_u",
-                                "asv_v",
-                                "asv_r",
-                                "auv_x",
-                                "auv_y",
-                                "auv_z",
-                                "auv_roll",
-                                "auv_pitch",
-                                "auv_yaw",
-                                "auv_u",
-                                "auv_v",
-                                "auv_w",
-                                "auv_target_x",
-                                "auv_target_y",
-                                "auv_target_z",
-                                "auv_error",
-                                "asv_error",
-                                "asv_thrust_port",
-                                "asv_thrust_starboard"};
-  for (int i = 1; i <= 8; ++i) c.push_back("auv_thrust_" + std::to_string(i));
-  c.insert(c.end(), {"asv_command_port", "asv_command_starboard"});
-  for (int i = 1; i <= 8; ++i) c.push_back("auv_command_" + std::to_string(i));
-  c.insert(c.end(), {"tension_asv", "tension_auv", "asv_voltage", "asv_soc", "asv_current_port",
-                     "asv_current_starboard", "auv_voltage", "auv_soc"});
-  for (int i = 1; i <= 8; ++i) c.push_back("auv_current_" + std::to_string(i));
-  return c;
-}
+// The columns of timeseries.csv and one sample's values, appended to `out` in their order: the
+// program's own definition (kelp::sim::timeseries_columns, for_each_value), so both stay equal.
+const std::vector<std::string>& column_names() { return kelp::sim::timeseries_columns(); }
 
-// One sample's values in column_names()' order, appended to `out`.
 void append_row(const kelp::sim::LogRow& r, std::vector<double>& out) {
-  const Eigen::Vector3d ea = kelp::euler_from_quaternion(r.asv->attitude);
-  const Eigen::Vector3d eb = kelp::euler_from_quaternion(r.auv->attitude);
-  const auto& a = *r.asv;
-  const auto& b = *r.auv;
-  out.insert(out.end(), {r.t,
-                         a.position.x(),
-                         a.position.y(),
-                         a.position.z(),
-                         ea.x(),
-                         ea.y(),
-                         ea.z(),
-                         a.nu(0),
-                         a.nu(1),
-                         a.nu(5),
-                         b.position.x(),
-                         b.position.y(),
-                         b.position.z(),
-                         eb.x(),
-                         eb.y(),
-                         eb.z(),
-                         b.nu(0),
-                         b.nu(1),
-                         b.nu(2),
-                         r.auv_target.x(),
-                         r.auv_target.y(),
-                         r.auv_target.z(),
-                         r.auv_error,
-                         r.asv_error,
-                         r.asv_thrust(0),
-                         r.asv_thrust(1)});
-  for (int i = 0; i < 8; ++i) out.push_back(r.auv_thrust(i));
-  out.insert(out.end(), {r.asv_command(0), r.asv_command(1)});
-  for (int i = 0; i < 8; ++i) out.push_back(r.auv_command(i));
-  out.insert(out.end(), {r.tension_asv, r.tension_auv, r.asv_voltage, r.asv_soc, r.asv_current(0),
-                         r.asv_current(1), r.auv_voltage, r.auv_soc});
-  for (int i = 0; i < 8; ++i) out.push_back(r.auv_current(i));
+  kelp::sim::for_each_value(r, [&](double v) { out.push_back(v); });
 }
 
 }  // namespace

@@ -71,10 +71,12 @@ def test_out_writes_the_programs_files_and_timeseries_equals_the_csv(tmp_path):
     with open(tmp_path / "timeseries.csv") as f:
         rows = list(csv.reader(f))
     header, rows = rows[0], rows[1:]
-    # Every column kelp.run_scenario returns is one of the CSV's, in the CSV's order.
+    # kelp.run_scenario returns every column of the CSV, in the CSV's order (both come from
+    # kelp::sim::timeseries_columns).
     names = list(ts)
-    assert names == [h for h in header if h in ts]
-    assert {"t", "auv_x", "asv_yaw", "tension_auv", "auv_soc", "auv_current_8"} <= set(names)
+    assert names == header
+    assert {"t", "auv_x", "asv_yaw", "tension_auv", "auv_soc", "auv_current_8", "tether_turns",
+            "tether_length", "winch_pull"} <= set(names)
     n = len(rows)
     assert n == 31  # t = 0 and 10 samples a second for 3 s
     for name in names:

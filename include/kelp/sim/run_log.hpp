@@ -16,6 +16,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
@@ -67,6 +68,103 @@ struct LogRow {
   double parted_segments = none;
 };
 
+/// \brief The columns of timeseries.csv, in order (documented in
+/// examples/tethered_pair/README.md); for_each_value gives a row's values in the same order.
+inline const std::vector<std::string>& timeseries_columns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> c = {"t",
+                                  "asv_x",
+                                  "asv_y",
+                                  "asv_z",
+                                  "asv_roll",
+                                  "asv_pitch",
+                                  "asv_yaw",
+                                  "asv_u",
+                                  "asv_v",
+                                  "asv_r",
+                                  "auv_x",
+                                  "auv_y",
+                                  "auv_z",
+                                  "auv_roll",
+                                  "auv_pitch",
+                                  "auv_yaw",
+                                  "auv_u",
+                                  "auv_v",
+                                  "auv_w",
+                                  "auv_target_x",
+                                  "auv_target_y",
+                                  "auv_target_z",
+                                  "auv_error",
+                                  "asv_error",
+                                  "asv_thrust_port",
+                                  "asv_thrust_starboard"};
+    for (int i = 1; i <= 8; ++i) c.push_back("auv_thrust_" + std::to_string(i));
+    c.insert(c.end(), {"asv_command_port", "asv_command_starboard"});
+    for (int i = 1; i <= 8; ++i) c.push_back("auv_command_" + std::to_string(i));
+    c.insert(c.end(), {"tension_asv", "tension_auv"});
+    // Propulsion.
+    c.insert(c.end(), {"asv_voltage", "asv_soc", "asv_current_port", "asv_current_starboard",
+                       "auv_voltage", "auv_soc"});
+    for (int i = 1; i <= 8; ++i) c.push_back("auv_current_" + std::to_string(i));
+    // The tether: turns at the ROV, parted segments; its length out, the winch's rate and pull.
+    c.insert(c.end(), {"tether_turns", "tether_parted_segments", "tether_length", "payout_rate",
+                       "winch_pull"});
+    return c;
+  }();
+  return columns;
+}
+
+/// \brief Calls `f(value)` for each value of row `r`, in timeseries_columns()' order (what
+/// RunLog::row writes and kelp's Python package returns as columns). No allocation.
+template <typename F>
+void for_each_value(const LogRow& r, F&& f) {
+  const Eigen::Vector3d ea = kelp::euler_from_quaternion(r.asv->attitude);
+  const Eigen::Vector3d eb = kelp::euler_from_quaternion(r.auv->attitude);
+  const auto& a = *r.asv;
+  const auto& b = *r.auv;
+  for (double v : {r.t,
+                   a.position.x(),
+                   a.position.y(),
+                   a.position.z(),
+                   ea.x(),
+                   ea.y(),
+                   ea.z(),
+                   a.nu(0),
+                   a.nu(1),
+                   a.nu(5),
+                   b.position.x(),
+                   b.position.y(),
+                   b.position.z(),
+                   eb.x(),
+                   eb.y(),
+                   eb.z(),
+                   b.nu(0),
+                   b.nu(1),
+                   b.nu(2),
+                   r.auv_target.x(),
+                   r.auv_target.y(),
+                   r.auv_target.z(),
+                   r.auv_error,
+                   r.asv_error,
+                   r.asv_thrust(0),
+                   r.asv_thrust(1)})
+    f(v);
+  for (int i = 0; i < 8; ++i) f(r.auv_thrust(i));
+  f(r.asv_command(0));
+  f(r.asv_command(1));
+  for (int i = 0; i < 8; ++i) f(r.auv_command(i));
+  f(r.tension_asv);
+  f(r.tension_auv);
+  // Propulsion.
+  for (double v :
+       {r.asv_voltage, r.asv_soc, r.asv_current(0), r.asv_current(1), r.auv_voltage, r.auv_soc})
+    f(v);
+  for (int i = 0; i < 8; ++i) f(r.auv_current(i));
+  // The tether.
+  for (double v : {r.tether_turns, r.parted_segments, r.tether_length, r.payout_rate, r.winch_pull})
+    f(v);
+}
+
 /// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
 /// documented in examples/tethered_pair/README.md). Writes the header lines when constructed.
 class RunLog {
@@ -81,19 +179,8 @@ class RunLog {
     events_.open(dir / "events.csv");
     if (!ts_ || !nodes_ || !events_)
       throw kelp::error("cannot write the run's CSV files in " + dir.string());
-    ts_ << "t,asv_x,asv_y,asv_z,asv_roll,asv_pitch,asv_yaw,asv_u,asv_v,asv_r,"
-           "auv_x,auv_y,auv_z,auv_roll,auv_pitch,auv_yaw,auv_u,auv_v,auv_w,"
-           "auv_target_x,auv_target_y,auv_target_z,auv_error,asv_error,"
-           "asv_thrust_port,asv_thrust_starboard";
-    for (int i = 1; i <= 8; ++i) ts_ << ",auv_thrust_" << i;
-    ts_ << ",asv_command_port,asv_command_starboard";
-    for (int i = 1; i <= 8; ++i) ts_ << ",auv_command_" << i;
-    ts_ << ",tension_asv,tension_auv";
-    // Propulsion.
-    ts_ << ",asv_voltage,asv_soc,asv_current_port,asv_current_starboard,auv_voltage,auv_soc";
-    for (int i = 1; i <= 8; ++i) ts_ << ",auv_current_" << i;
-    // The tether: turns at the ROV, parted segments; its length out, the winch's rate and pull.
-    ts_ << ",tether_turns,tether_parted_segments,tether_length,payout_rate,winch_pull";
+    const std::vector<std::string>& columns = timeseries_columns();
+    for (std::size_t i = 0; i < columns.size(); ++i) ts_ << (i ? "," : "") << columns[i];
     ts_ << '\n';
     nodes_ << "t,node,x,y,z\n";
     events_ << "t,event,segment,x,y,z,tension\n";
@@ -101,30 +188,12 @@ class RunLog {
 
   /// \brief Appends one row to timeseries.csv.
   void row(const LogRow& r) {
-    const Eigen::Vector3d ea = kelp::euler_from_quaternion(r.asv->attitude);
-    const Eigen::Vector3d eb = kelp::euler_from_quaternion(r.auv->attitude);
-    const auto& a = *r.asv;
-    const auto& b = *r.auv;
-    ts_ << num(r.t);
-    for (double v :
-         {a.position.x(),   a.position.y(), a.position.z(), ea.x(),           ea.y(),
-          ea.z(),           a.nu(0),        a.nu(1),        a.nu(5),          b.position.x(),
-          b.position.y(),   b.position.z(), eb.x(),         eb.y(),           eb.z(),
-          b.nu(0),          b.nu(1),        b.nu(2),        r.auv_target.x(), r.auv_target.y(),
-          r.auv_target.z(), r.auv_error,    r.asv_error,    r.asv_thrust(0),  r.asv_thrust(1)})
-      ts_ << ',' << num(v);
-    for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_thrust(i));
-    ts_ << ',' << num(r.asv_command(0)) << ',' << num(r.asv_command(1));
-    for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_command(i));
-    ts_ << ',' << num(r.tension_asv) << ',' << num(r.tension_auv);
-    // Propulsion.
-    for (double v :
-         {r.asv_voltage, r.asv_soc, r.asv_current(0), r.asv_current(1), r.auv_voltage, r.auv_soc})
-      ts_ << ',' << num(v);
-    for (int i = 0; i < 8; ++i) ts_ << ',' << num(r.auv_current(i));
-    for (double v :
-         {r.tether_turns, r.parted_segments, r.tether_length, r.payout_rate, r.winch_pull})
-      ts_ << ',' << num(v);
+    bool first = true;
+    for_each_value(r, [&](double v) {
+      if (!first) ts_ << ',';
+      first = false;
+      ts_ << num(v);
+    });
     ts_ << '\n';
   }
 
