@@ -478,8 +478,8 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   const Scalar half_rho_d = Scalar(0.5) * c.rho * p.diameter;
   const Scalar kn_per_l = half_rho_d * p.normal_drag;
   const Scalar kt_per_l = half_rho_d * Scalar(kelp::pi) * p.tangential_drag;
-  const auto node_constants = [&](int i) {
-    const Scalar m = model.node_mass(i), vol = model.node_volume(i), li = model.node_length(i);
+  // Node constants from its structural mass m, displaced volume vol and lumped line length li.
+  const auto constants_of = [&](Scalar m, Scalar vol, Scalar li) {
     return NodeConstants<Scalar>{li,
                                  m * c.g,
                                  (m - c.rho * vol) * c.g,
@@ -490,6 +490,9 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
                                  m + c.rho * vol * c.can,
                                  c.rho * vol * (c.cat - c.can)};
   };
+  const auto node_constants = [&](int i) {
+    return constants_of(model.node_mass(i), model.node_volume(i), model.node_length(i));
+  };
   c.kinds[0] = node_constants(0);
   c.kinds[1] = node_constants(n > 1 ? 1 : 0);
   c.kinds[2] = node_constants(n);
@@ -498,17 +501,8 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   c.winch = has_winch_segment(ws);
   if (c.winch) {
     const auto winch_node = [&](int i) {
-      const Scalar m = node_mass_at(model, ws, i), vol = node_volume_at(model, ws, i);
-      const Scalar li = node_length_at(model, ws, i);
-      return NodeConstants<Scalar>{li,
-                                   m * c.g,
-                                   (m - c.rho * vol) * c.g,
-                                   c.rho * vol,
-                                   kn_per_l * li,
-                                   kt_per_l * li,
-                                   m,
-                                   m + c.rho * vol * c.can,
-                                   c.rho * vol * (c.cat - c.can)};
+      return constants_of(node_mass_at(model, ws, i), node_volume_at(model, ws, i),
+                          node_length_at(model, ws, i));
     };
     c.kinds[0] = winch_node(0);
     if (n > 1)
