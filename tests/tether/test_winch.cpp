@@ -78,6 +78,39 @@ TEST_CASE("1000 node insertions and removals at the winch conserve mass and mome
   CHECK_FALSE(s.has_history());
 }
 
+TEST_CASE("a re-mesh carries the parted flags with their segments", "[tether][winch][remesh]") {
+  auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
+  p.length = 10;
+  kt::WinchParameters<double> w;
+  w.min_length = 2;
+  w.max_length = 20;
+  const kt::WinchModel<double> wm(p, w);
+  kt::TetherState<double> s(wm.line(10));
+  for (int i = 0; i <= 10; ++i) s.position.col(i) = V3(i, 0, 0.5 * i);
+  s.parted(6) = 1;  // the line has parted between nodes 6 and 7
+  kt::RemeshReport<double> r;
+  // Insertion: old segment s is new segment s + 1 (s ≥ 1).
+  s.winch_length = 1.7;
+  kt::TetherState<double> grown(wm.line(11));
+  kt::insert_winch_node(wm.line(10), s, grown, r);
+  REQUIRE(grown.parted.size() == 11);
+  CHECK(grown.parted_segments() == 1);
+  CHECK(grown.parted(7) == 1);
+  // Removal: old segments 0 and 1 are new segment 0, old segment s is new s − 1 (s ≥ 2).
+  s.winch_length = 0.4;
+  kt::TetherState<double> shrunk(wm.line(9));
+  kt::remove_winch_node(wm.line(10), s, shrunk, r);
+  REQUIRE(shrunk.parted.size() == 9);
+  CHECK(shrunk.parted_segments() == 1);
+  CHECK(shrunk.parted(5) == 1);
+  // A parting in one of the two merged segments stays in the merged one.
+  s.parted.setZero();
+  s.parted(1) = 1;
+  kt::remove_winch_node(wm.line(10), s, shrunk, r);
+  CHECK(shrunk.parted(0) == 1);
+  CHECK(shrunk.parted_segments() == 1);
+}
+
 TEST_CASE("winch limits: speed, acceleration, pull and length", "[tether][winch]") {
   kt::WinchParameters<double> w;
   w.max_speed = 0.5;
