@@ -10,21 +10,13 @@
 #include <string>
 
 #include "kelp/sim.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 
 namespace {
 
-// A short calm run on a coarse tether: 5 s, samples at 5 Hz, tether snapshots at 2 Hz.
-ks::Scenario short_calm_run() {
-  ks::Scenario sc;
-  sc.sea = "calm";
-  sc.duration = 5.0;
-  sc.segment_length = 1.0;
-  sc.log_rate = 5.0;
-  sc.node_rate = 2.0;
-  return sc;
-}
+using kelp_test::short_calm_run;
 
 // The summary without what depends on the wall clock.
 nlohmann::json deterministic(nlohmann::json s) {

@@ -10,6 +10,7 @@
 
 #include "kelp/sim.hpp"
 #include "kelp/system/presets.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 namespace sp = kelp::system::presets;
@@ -31,15 +32,7 @@ struct Synthetic {
   }
 };
 
-ks::Scenario short_calm_run() {
-  ks::Scenario sc;
-  sc.sea = "calm";
-  sc.duration = 5.0;
-  sc.segment_length = 1.0;
-  sc.log_rate = 5.0;
-  sc.node_rate = 2.0;
-  return sc;
-}
+using kelp_test::short_calm_run;
 
 }  // namespace
 

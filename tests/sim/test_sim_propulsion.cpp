@@ -8,19 +8,12 @@
 #include <string>
 
 #include "kelp/sim.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 
 namespace {
-ks::Scenario short_calm_run() {
-  ks::Scenario sc;
-  sc.sea = "calm";
-  sc.duration = 5.0;
-  sc.segment_length = 1.0;
-  sc.log_rate = 5.0;
-  sc.node_rate = 2.0;
-  return sc;
-}
+using kelp_test::short_calm_run;
 }  // namespace
 
 TEST_CASE("scenario: thrusters and battery keys are parsed, echoed, checked and applied",
