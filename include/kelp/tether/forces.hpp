@@ -656,10 +656,6 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
   // Segment 0 and nodes 0, 1 at a winch (TetherState::winch_length): their own rest length,
   // spring and masses.
   const Scalar lw = state.winch_length > Scalar(0) ? state.winch_length : l;
-  const auto node_share = [&](int i) {
-    if (i > 1 || !(state.winch_length > Scalar(0))) return Scalar(0);
-    return Scalar(0.5) * (lw - l);  // extra line lumped at node 0 and node 1 [m]
-  };
   for (int s = 0; s < n; ++s) {
     if (parted && parted[s]) continue;  // a parted segment stores no energy
     const Scalar ls = (state.position.col(s + 1) - state.position.col(s)).norm();
@@ -681,7 +677,7 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
         Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
     const Scalar z = state.position(2, i);
     const Scalar phi = detail::submerged_fraction(z, zeta, p.diameter);
-    const Scalar extra = node_share(i);
+    const Scalar extra = detail::winch_extra_length(model, state.winch_length, i);
     const Scalar m = model.node_mass(i) + p.mass_per_length * extra;
     const Scalar vol = model.node_volume(i) + model.area() * extra;
     const Scalar rv = phi * rho * vol;

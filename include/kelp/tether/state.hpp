@@ -517,13 +517,20 @@ typename TetherModel<Scalar>::Fade segment_fade(const TetherModel<Scalar>& model
   return f;
 }
 
+/// Extra line [m] lumped at node i by a winch segment of rest length `winch_length`
+/// (TetherState::winch_length; 0: no winch): (l_w − l)/2 at nodes 0 and 1, 0 elsewhere.
+template <typename Scalar>
+Scalar winch_extra_length(const TetherModel<Scalar>& model, Scalar winch_length, int i) {
+  if (i > 1 || !(winch_length > Scalar(0))) return Scalar(0);
+  return Scalar(0.5) * (winch_length - model.segment_length());
+}
+
 /// Length of line lumped at node i [m] (TetherModel::node_length, with segment 0 of length
 /// TetherWorkspace::winch_length at a winch: half of it at node 0 and at node 1).
 template <typename Scalar>
 Scalar node_length_at(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws, int i) {
   if (i > 1 || !has_winch_segment(ws)) return model.node_length(i);
-  const Scalar half = Scalar(0.5) * (ws.winch_length - model.segment_length());
-  return model.node_length(i) + half;
+  return model.node_length(i) + winch_extra_length(model, ws.winch_length, i);
 }
 
 /// Structural mass [kg] and displaced volume [m³] of node i (as node_length_at).

@@ -103,23 +103,12 @@ struct RemeshReport {
   }
 };
 
-namespace detail {
-/// Extra line [m] lumped at node i by a winch segment of rest length state.winch_length
-/// (0 elsewhere and without a winch): (l_w − l)/2 at nodes 0 and 1.
-template <typename Scalar>
-Scalar winch_extra_length(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
-                          int i) {
-  if (i > 1 || !(state.winch_length > Scalar(0))) return Scalar(0);
-  return Scalar(0.5) * (state.winch_length - model.segment_length());
-}
-}  // namespace detail
-
 /// \brief Structural mass of node i of `state` [kg] (TetherModel::node_mass with the winch
 /// segment's share).
 template <typename Scalar>
 Scalar node_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& state, int i) {
-  return model.node_mass(i) +
-         model.parameters().mass_per_length * detail::winch_extra_length(model, state, i);
+  return model.node_mass(i) + model.parameters().mass_per_length *
+                                  detail::winch_extra_length(model, state.winch_length, i);
 }
 
 /// \brief Unstretched length of the line [m]: (N − 1)·l + l_w with a winch, N·l without.
