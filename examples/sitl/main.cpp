@@ -196,7 +196,7 @@ int run(const Options& o) {
       next_log = t + 1.0 / log_rate;
     }
     if (t + 1e-9 >= next_nodes) {
-      log.nodes(t, s.tether);
+      log.nodes(t, bridge.model().tether_of(s), s.tether);
       next_nodes = t + 1.0 / node_rate;
     }
   };
