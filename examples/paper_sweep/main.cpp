@@ -109,6 +109,7 @@ struct RunOptions {
   std::string shard;
   unsigned jobs = 0;
   bool quiet = false, no_plot = false;
+  bool keep_series = false;  // runs/<hash>/: timeseries.csv, nodes.csv, summary.json
 };
 
 int run(const RunOptions& o) {
@@ -137,7 +138,8 @@ int run(const RunOptions& o) {
     if (r.index % shards != shard) continue;
     ++mine;
     json stored = stored_result(out, r.hash);
-    if (stored.is_null())
+    // With --keep-series, a stored result without its series runs again (to write them).
+    if (stored.is_null() || (o.keep_series && !fs::exists(out / "runs" / r.hash / "summary.json")))
       todo.push_back(&r);
     else
       results[r.hash] = std::move(stored);
@@ -162,7 +164,14 @@ int run(const RunOptions& o) {
                      {"seed", r.seed}};
       std::string error;
       try {
-        result["summary"] = kelp::sim::simulate(r.scenario);
+        kelp::sim::SimulateOptions so;
+        // --keep-series: the run's time series in runs/<hash>/ as kelp-tethered-pair writes them
+        // (summary.json last, so a directory with one is complete: kelp-replay reads it).
+        const fs::path series = out / "runs" / r.hash;
+        if (o.keep_series) so.log_dir = series.string();
+        result["summary"] = kelp::sim::simulate(r.scenario, so);
+        if (o.keep_series)
+          write_atomically(series / "summary.json", result["summary"].dump(2) + "\n");
         write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
       } catch (const std::exception& e) {
         error = e.what();
@@ -250,6 +259,9 @@ int main(int argc, char** argv) {
   app.add_option("--shard", o.shard, "run only shard I of N (0-based, I/N); no table");
   app.add_flag("--quiet", o.quiet, "no progress bar");
   app.add_flag("--no-plot", o.no_plot, "no figure");
+  app.add_flag("--keep-series", o.keep_series,
+               "keep each run's time series in runs/<hash>/ (timeseries.csv, nodes.csv, "
+               "summary.json; kelp-replay makes its 3-D replay)");
   CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
   std::vector<std::string> dirs;
   std::string merged = "kelp-sweep-merged";

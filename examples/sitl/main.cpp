@@ -2,7 +2,8 @@
 // ArduSub (-I0, BlueROV2 Heavy) on UDP 9002 and ArduRover (-I1, BlueBoat) on UDP 9012, stepping
 // the tethered system of a kelp-tethered-pair scenario in lockstep with both (bridge.hpp says
 // how). Logs timeseries.csv and nodes.csv in kelp-tethered-pair's format (plot_run.py plots
-// them), events.log, and summary.json with the per-port counters when it stops.
+// them), events.log, summary.json with the per-port counters and the 3-D replay (replay.html)
+// when it stops.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -23,6 +24,7 @@
 
 #include "bridge.hpp"
 #include "default_world.hpp"
+#include "kelp/sim/replay.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
@@ -196,7 +198,7 @@ int run(const Options& o) {
       next_log = t + 1.0 / log_rate;
     }
     if (t + 1e-9 >= next_nodes) {
-      log.nodes(t, s.tether);
+      log.nodes(t, bridge.model().tether_of(s), s.tether);
       next_nodes = t + 1.0 / node_rate;
     }
   };
@@ -297,6 +299,21 @@ int run(const Options& o) {
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = kelp::sim::to_json(o.scenario);
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
+  // The 3-D replay (docs/replay.md): without the page's template (kelp built without three.js)
+  // the run is still complete; a replay that cannot be made is reported, not fatal.
+  const std::string replay_template = kelp::sim::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+  if (replay_template.empty()) {
+    std::fprintf(stderr, "kelp-sitl: no replay.html: %s\n",
+                 kelp::sim::replay_template_missing_note().c_str());
+  } else {
+    try {
+      kelp::sim::ReplayOptions ro;
+      ro.source = "kelp-sitl";
+      kelp::sim::write_replay(o.log, replay_template, ro);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "kelp-sitl: no replay.html: %s\n", e.what());
+    }
+  }
   std::fprintf(stderr,
                "kelp-sitl: stopped after %.2f s of physics (%llu steps) in %.1f s; malformed "
                "packets: ArduSub %llu, ArduRover %llu; summary in %s/summary.json\n",

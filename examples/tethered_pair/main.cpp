@@ -1,7 +1,7 @@
 // kelp-tethered-pair: a BlueBoat and a BlueROV2 Heavy joined by a 10 m tether in the paper's
 // moderate sea. The ROV flies a 10 m square survey at 5 m depth; the boat follows it. Writes a
-// time series (CSV), tether node positions (CSV), a JSON summary and, through plot_run.py, PNG
-// plots into the output directory.
+// time series (CSV), tether node positions (CSV), a JSON summary, the 3-D replay (replay.html)
+// and, through plot_run.py, PNG plots into the output directory.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -46,6 +46,12 @@ int run(const Options& o) {
   ro.progress = !o.quiet && isatty(2);
   ro.scenario_file = o.scenario_file;
   ro.version = KELP_VERSION_STRING;
+  // The 3-D replay's page template: installed, or this build's (KELP_REPLAY_TEMPLATE_BUILD);
+  // without one the run goes on and says once that replay.html is left out.
+  ro.replay_template = kelp::sim::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+  if (ro.replay_template.empty())
+    std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
+                 kelp::sim::replay_template_missing_note().c_str());
   const nlohmann::json summary = kelp::sim::run_scenario(o.scenario, ro);
   const double duration = summary["simulated_s"], wall = summary["wall_s"];
   const double auv_rms = summary["auv"]["rms_path_error_m"],
@@ -65,8 +71,9 @@ int run(const Options& o) {
   std::printf(
       "kelp-tethered-pair: %.0f s simulated in %.2f s (%.0fx real time); AUV path error RMS "
       "%.2f m, boat %.2f m from the AUV RMS, peak tension %.1f N; outputs in %s (timeseries.csv, "
-      "nodes.csv, summary.json%s)\n",
-      duration, wall, duration / wall, auv_rms, asv_rms, t_max, o.out.c_str(), plots.c_str());
+      "nodes.csv, summary.json%s%s)\n",
+      duration, wall, duration / wall, auv_rms, asv_rms, t_max, o.out.c_str(),
+      ro.replay_template.empty() ? "" : ", replay.html", plots.c_str());
   const nlohmann::json& ts = summary["tether_solver"];
   std::printf(
       "kelp-tethered-pair: tether solver (%s): %.2f Newton iterations per step on average, at "

@@ -11,6 +11,7 @@
 #include "kelp/sim/batch.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/pair_env.hpp"
+#include "kelp/sim/replay.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"

@@ -553,7 +553,8 @@ class ClosedLoop {
       if (options_.log) options_.log->row(row);
       if (options_.on_sample) options_.on_sample(row);
     }
-    if (options_.log && k_ % node_every_ == 0) options_.log->nodes(t, state_.tether);
+    if (options_.log && k_ % node_every_ == 0)
+      options_.log->nodes(t, model_.tether_of(state_), state_.tether);
   }
 
   Scenario scenario_;

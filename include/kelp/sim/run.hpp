@@ -18,6 +18,7 @@
 
 #include "kelp/core/error.hpp"
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/replay.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 
@@ -60,13 +61,17 @@ struct RunOptions {
   /// Called with every sample the log takes (the rows of timeseries.csv, at the scenario's log
   /// rate), whether or not a log is written; empty: nothing is called.
   std::function<void(const LogRow&)> on_sample;
+  /// The replay page's template (find_replay_template()): with `out`, replay.html is written
+  /// there at the end of the run (write_replay()); empty: no replay.html.
+  std::string replay_template;
 };
 
 /// \brief Runs a scenario as kelp-tethered-pair does: simulate() (with the CSV log in `out`),
-/// the summary's `kelp_version`, and summary.json (the summary, indented by 2) in `out`.
+/// the summary's `kelp_version`, summary.json (the summary, indented by 2) in `out` and, with a
+/// `replay_template`, replay.html (the 3-D replay, docs/replay.md) in `out`.
 /// \returns the summary (summary.json's content).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
-/// file cannot be written.
+/// file cannot be written (replay_error for replay.html).
 inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {}) {
   SimulateOptions so;
   so.log_dir = o.out;
@@ -79,6 +84,12 @@ inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {})
     std::ofstream f(std::filesystem::path(o.out) / "summary.json");
     f << summary.dump(2) << '\n';
     if (!f) throw kelp::error("cannot write summary.json in " + o.out);
+    f.close();
+    if (!o.replay_template.empty()) {
+      ReplayOptions ro;
+      ro.source = "kelp-tethered-pair";
+      write_replay(o.out, o.replay_template, ro);
+    }
   }
   return summary;
 }

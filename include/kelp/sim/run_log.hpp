@@ -1,7 +1,8 @@
 /// \file
 /// \brief The log of a run of the tethered pair: timeseries.csv (one row per sample: both
 /// vehicles, the AUV's target and errors, thrusts, commands, end tensions, the tether's turns),
-/// nodes.csv (the tether's node positions) and events.csv (the line parting).
+/// nodes.csv (the tether's node positions and segment tensions) and events.csv (the line
+/// parting).
 ///
 /// The format is shared by kelp-tethered-pair and kelp-sitl and plotted by
 /// examples/tethered_pair/plot_run.py; its columns are documented in
@@ -23,6 +24,7 @@
 #include "kelp/core/types.hpp"
 #include "kelp/tether/failure.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "kelp/tether/model.hpp"
 #include "kelp/vehicle/state.hpp"
 
 namespace kelp {
@@ -182,7 +184,7 @@ class RunLog {
     const std::vector<std::string>& columns = timeseries_columns();
     for (std::size_t i = 0; i < columns.size(); ++i) ts_ << (i ? "," : "") << columns[i];
     ts_ << '\n';
-    nodes_ << "t,node,x,y,z\n";
+    nodes_ << "t,node,x,y,z,tension\n";
     events_ << "t,event,segment,x,y,z,tension\n";
   }
 
@@ -207,11 +209,26 @@ class RunLog {
     events_.flush();
   }
 
-  /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv (one line a node).
-  void nodes(double t, const kelp::tether::TetherStated& tether) {
-    for (Eigen::Index i = 0; i < tether.position.cols(); ++i)
+  /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv, one line a node
+  /// (`t,node,x,y,z,tension`): the node's NED position [m] and the axial tension [N] of the
+  /// segment that starts at it (tether::segment_axial_force, as the step's force pass evaluates
+  /// it; 0 for the last node, which starts no segment, and for a parted segment).
+  /// \param[in] t time [s] \param[in] line the line model of `tether` (with a winch, the model
+  /// of its current node count: system::SystemModel::tether_of) \param[in] tether its state
+  /// \throws kelp::invalid_argument when `line` has not the state's node count.
+  void nodes(double t, const kelp::tether::TetherModeld& line,
+             const kelp::tether::TetherStated& tether) {
+    const Eigen::Index n = tether.position.cols();
+    KELP_CHECK(line.nodes() == n && tether.velocity.cols() == n,
+               "RunLog::nodes: the line model has " + std::to_string(line.nodes()) +
+                   " nodes, the state " + std::to_string(n));
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double tension =
+          i + 1 < n ? kelp::tether::segment_axial_force(line, tether, static_cast<int>(i)) : 0.0;
       nodes_ << num(t) << ',' << i << ',' << num(tether.position(0, i)) << ','
-             << num(tether.position(1, i)) << ',' << num(tether.position(2, i)) << '\n';
+             << num(tether.position(1, i)) << ',' << num(tether.position(2, i)) << ','
+             << num(tension) << '\n';
+    }
   }
 
   /// \brief Writes what is buffered to the files (e.g. before a status line of a long run).

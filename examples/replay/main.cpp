@@ -1,0 +1,59 @@
+// kelp-replay: the 3-D replay (replay.html, docs/replay.md) of an existing run directory:
+// kelp-tethered-pair's, kelp-sitl's, or a kelp-sweep run kept with --keep-series
+// (<sweep>/runs/<hash>/). Reads timeseries.csv, nodes.csv and summary.json; writes replay.html
+// into the directory (or --out), or with --json the replay data alone.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "kelp/sim/replay.hpp"
+
+namespace fs = std::filesystem;
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "kelp-replay: writes replay.html, the run in 3-D in any browser (one file, no network), "
+      "into a run directory of kelp-tethered-pair, kelp-sitl or kelp-sweep --keep-series"};
+  std::string dir, out, json_out, title, source;
+  app.add_option("DIR", dir, "the run directory (timeseries.csv, nodes.csv, summary.json)")
+      ->required();
+  app.add_option("--out", out, "where to write the page (default: DIR/replay.html)");
+  app.add_option("--json", json_out, "write the replay data (JSON) to this file instead of a page");
+  app.add_option("--title", title, "the page's title (default: program, scenario, duration)");
+  app.add_option("--source", source, "the program that made the run (default: told from DIR)")
+      ->check(CLI::IsMember({"kelp-tethered-pair", "kelp-sitl", "kelp-sweep"}));
+  CLI11_PARSE(app, argc, argv);
+  kelp::sim::ReplayOptions o;
+  o.title = title;
+  o.source = source;
+  try {
+    if (!json_out.empty()) {
+      std::ofstream f(json_out);
+      f << kelp::sim::replay_data(dir, o).dump() << '\n';
+      if (!f) throw kelp::error("cannot write " + json_out);
+      std::printf("kelp-replay: replay data of %s in %s\n", dir.c_str(), json_out.c_str());
+      return 0;
+    }
+    const std::string page = kelp::sim::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+    if (page.empty()) {
+      std::fprintf(stderr, "kelp-replay: %s\n", kelp::sim::replay_template_missing_note().c_str());
+      return 2;
+    }
+    fs::path written = kelp::sim::write_replay(dir, page, o);
+    if (!out.empty()) {
+      fs::rename(written, out);
+      written = out;
+    }
+    std::error_code ec;
+    const auto size = fs::file_size(written, ec);
+    std::printf("kelp-replay: %s (%.1f MB); open it in a browser: file://%s\n",
+                written.string().c_str(), static_cast<double>(size) / 1e6,
+                fs::absolute(written).string().c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "kelp-replay: %s\n", e.what());
+    return 1;
+  }
+}
