@@ -178,10 +178,11 @@
     return mul3(mul3(M, rotationNED(roll, pitch, yaw)), MT);
   }
 
-  // Tension colour map: five stops (ColorBrewer's RdYlBu, reversed: Harrower & Brewer, "Color-
-  // Brewer.org", The Cartographic Journal 40(1), 2003), interpolated linearly in sRGB like the
-  // legend's gradient. The top stop is the colour at and above the scale's maximum.
-  const STOPS = [[0x31, 0x68, 0xb0], [0x8f, 0xc3, 0xdd], [0xff, 0xf5, 0xb0], [0xf4, 0x8a, 0x4e], [0xd2, 0x18, 0x1e]];
+  // Tension colour map: ColorBrewer's five-class YlOrRd (Harrower & Brewer, "ColorBrewer.org",
+  // The Cartographic Journal 40(1), 2003; pale yellow to dark red, all of which stand out against
+  // the sea), interpolated linearly in sRGB. The top stop is the colour at and above the scale's
+  // maximum.
+  const STOPS = [[0xff, 0xff, 0xb2], [0xfe, 0xcc, 0x5c], [0xfd, 0x8d, 0x3c], [0xf0, 0x3b, 0x20], [0xbd, 0x00, 0x26]];
   function colourAt(u) {
     if (!(u > 0)) u = 0; // NaN: the bottom
     if (u > 1) u = 1;
@@ -385,10 +386,15 @@
         seaIdx.push(a, b, c, b, d, c);
       }
     seaGeom.setIndex(seaIdx);
-    const seaMat = new THREE.MeshPhongMaterial({
-      color: 0x1b6f93, specular: 0x6fa8c0, shininess: 40, transparent: true, opacity: 0.72,
-      side: THREE.DoubleSide, depthWrite: false,
+    // Unlit, with the light worked out per vertex here: per-pixel lighting of a surface that
+    // fills the screen is most of a frame's cost in software WebGL.
+    const seaCol = new Float32Array(seaN * seaN * 3);
+    seaGeom.setAttribute('color', new THREE.BufferAttribute(seaCol, 3));
+    const seaMat = new THREE.MeshBasicMaterial({
+      vertexColors: true, transparent: true, opacity: 0.6, side: THREE.DoubleSide, depthWrite: false,
     });
+    const seaBase = new THREE.Color(0x1b6f93), seaLit = new THREE.Color(0x8fd0e8);
+    const sunDir = new THREE.Vector3(-40, 80, 30).normalize();
     const sea = new THREE.Mesh(seaGeom, seaMat);
     sea.frustumCulled = false;
     sea.renderOrder = 2;
@@ -414,6 +420,16 @@
       }
       seaGeom.attributes.position.needsUpdate = true;
       seaGeom.computeVertexNormals();
+      // colour: the base, lit by the sun's angle to the surface (Lambert), in linear RGB
+      const nrm = seaGeom.attributes.normal.array;
+      for (let v = 0; v < seaN * seaN; ++v) {
+        const l = Math.max(0, nrm[3 * v] * sunDir.x + nrm[3 * v + 1] * sunDir.y + nrm[3 * v + 2] * sunDir.z);
+        const f = Math.pow(l, 8); // the bright faces turned to the sun
+        seaCol[3 * v] = seaBase.r * (0.55 + 0.45 * l) + (seaLit.r - seaBase.r) * f;
+        seaCol[3 * v + 1] = seaBase.g * (0.55 + 0.45 * l) + (seaLit.g - seaBase.g) * f;
+        seaCol[3 * v + 2] = seaBase.b * (0.55 + 0.45 * l) + (seaLit.b - seaBase.b) * f;
+      }
+      seaGeom.attributes.color.needsUpdate = true;
       seaGeom.computeBoundingSphere();
     }
 
@@ -427,6 +443,15 @@
       const grid = new THREE.GridHelper(200, 40, 0x5e513b, 0x6e604a);
       grid.position.y = -seabedDepth + 0.02;
       scene.add(grid);
+    } else {
+      // No seabed: deep water far below, so that the sea seen through its surface is dark
+      // rather than the sky's colour.
+      let deepest = 0;
+      for (const k of ['rov', 'boat']) for (const d of series[k].d) deepest = Math.max(deepest, num(d) || 0);
+      const abyss = new THREE.Mesh(new THREE.PlaneGeometry(6000, 6000), new THREE.MeshBasicMaterial({ color: 0x0b3048 }));
+      abyss.rotation.x = -Math.PI / 2;
+      abyss.position.y = -(deepest + 25);
+      scene.add(abyss);
     }
     const obstacleMat = mat(0x9b6b43);
     for (const ob of data.obstacles || []) {
@@ -473,11 +498,11 @@
     // -- waypoints and the ROV's target --
     const wps = (data.waypoints || []).map((w) => toScene(w[0], w[1], w[2]));
     if (wps.length) {
-      const wpMat = new THREE.MeshBasicMaterial({ color: 0xffd84a });
-      const sphere = new THREE.SphereGeometry(0.12, 8, 6);
+      const wpMat = new THREE.MeshBasicMaterial({ color: 0xf27ee6 });
+      const sphere = new THREE.SphereGeometry(0.08, 8, 6);
       for (const p of wps) scene.add(place(new THREE.Mesh(sphere, wpMat), p.x, p.y, p.z));
       const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(wps),
-        new THREE.LineDashedMaterial({ color: 0xffd84a, dashSize: 0.4, gapSize: 0.25 }));
+        new THREE.LineDashedMaterial({ color: 0xf27ee6, dashSize: 0.4, gapSize: 0.25 }));
       line.computeLineDistances();
       scene.add(line);
     }
@@ -487,7 +512,10 @@
     // -- tether: one cylinder per segment (instanced), unlit in its tension colour --
     let maxSegments = 1;
     for (const p of nodes.position) maxSegments = Math.max(maxSegments, p.length / 3 - 1);
-    const tetherRadius = 0.035; // drawn thicker than the 7.6 mm cable, to be seen
+    // Drawn thicker than the 7.6 mm cable, to be seen: at least 0.025 m, and wider from afar
+    // (tetherWidth scales the radius, set from the camera's distance each frame).
+    const tetherRadius = 0.025;
+    let tetherWidth = 1;
     const tether = new THREE.InstancedMesh(new THREE.CylinderGeometry(tetherRadius, tetherRadius, 1, 6, 1, true),
       new THREE.MeshBasicMaterial({ color: 0xffffff, fog: false }), maxSegments); // its colour is data: no fog
     tether.frustumCulled = false;
@@ -511,7 +539,7 @@
         tmpD.subVectors(tmpB, tmpA);
         const len = tmpD.length();
         if (len > 0) tmpQ.setFromUnitVectors(up, tmpD.divideScalar(len));
-        tmpS.set(1, Math.max(len, 1e-6), 1);
+        tmpS.set(tetherWidth, Math.max(len, 1e-6), tetherWidth);
         tmpM.compose(tmpA.add(tmpB).multiplyScalar(0.5), tmpQ, tmpS);
         tether.setMatrixAt(s, tmpM);
         const rgb = tensionColour(num(tetherNow.tension[s]));
@@ -617,7 +645,7 @@
 
     // -- one frame of state at `time` --
     let frames = 0;
-    let hudTime = -1;
+    let hudTime = -Infinity;
     function update() {
       const loc = locate(series.t, time);
       boatPose = pose(series, 'boat', loc);
@@ -628,8 +656,9 @@
       target.visible = Number.isFinite(tn) && Number.isFinite(te) && Number.isFinite(td);
       if (target.visible) target.position.copy(toScene(tn, te, td));
       target.rotation.y = time * 0.8;
-      updateTether(time);
       const look = placeCamera();
+      tetherWidth = Math.max(1, (0.004 * camera.position.distanceTo(look)) / tetherRadius);
+      updateTether(time);
       const span = cameraMode === 'underwater' ? 80 : Math.min(Math.max(4 * camera.position.distanceTo(look), 60), 500);
       updateSea(look.x, look.z, span, time);
       const below = camera.position.y < waves.elevation(camera.position.x, camera.position.z, time);
@@ -646,12 +675,15 @@
       updateHud(loc, rc);
     }
     function updateHud(loc, rc) {
+      // While playing, the text and the timeline change at most every 0.1 s of wall clock
+      // (repainting them is a good part of a frame in software rendering).
+      const now = performance.now();
+      if (playing && now - hudTime < 100) return;
+      hudTime = now;
       $('hud-time').textContent = `t = ${time.toFixed(1)} s`;
       $('time-label').textContent = `${time.toFixed(1)} / ${duration.toFixed(1)} s`;
       const tl = $('timeline');
       if (document.activeElement !== tl || playing) tl.value = String(time);
-      if (hudTime >= 0 && Math.abs(time - hudTime) < 0.05 && playing) return; // text at most 20 Hz
-      hudTime = time;
       $('hud-boat-depth').textContent = fmt(boatPose.d, 2, 'm');
       $('hud-rov-depth').textContent = fmt(rovPose.d, 2, 'm');
       $('hud-boat-tension').textContent = fmt(lerpAt(series.tension_boat, loc), 1, 'N');
@@ -683,8 +715,7 @@
         const q = project(toScene(p.n, p.e, p.d - (key === 'boat' ? 0.7 : 0.45)));
         const el = labels[key];
         el.style.display = q.inFront ? '' : 'none';
-        el.style.left = `${q.x}px`;
-        el.style.top = `${q.y}px`;
+        el.style.transform = `translate(${q.x.toFixed(1)}px, ${q.y.toFixed(1)}px) translate(-50%, -130%)`;
       }
     }
 
@@ -875,9 +906,14 @@
         const p = tetherNow.position;
         const count = p.length / 3;
         const mid = Math.floor(count / 2);
+        // the vehicles where they are drawn: their models' origins (the body frame's origin)
+        const drawn = (obj) => {
+          const m = obj.matrix.elements; // column-major: the translation is 12, 13, 14
+          return one(m[12], m[14], -m[13]);
+        };
         return {
-          boat: one(boatPose.n, boatPose.e, boatPose.d),
-          rov: one(rovPose.n, rovPose.e, rovPose.d),
+          boat: drawn(boat),
+          rov: drawn(rov),
           midNode: count ? Object.assign(one(p[3 * mid], p[3 * mid + 1], p[3 * mid + 2]), { index: mid }) : null,
         };
       },

@@ -137,7 +137,8 @@ async function decodeScript(page, pngs, body, arg) {
 }
 
 /// Compares two screenshots: the fraction of pixels that differ (any channel by more than 8),
-/// and for each point [x, y] the distance [px] to the nearest differing pixel (Infinity: none).
+/// and for each point [x, y] the distance [px] to the nearest differing pixel (null: none within
+/// 40 px) and the bounding box [x0, y0, x1, y1] of the differing pixels within 40 px of it.
 export function screenshotDiff(page, a, b, points = []) {
   return decodeScript(page, [a, b], `
     const [A, B] = images;
@@ -149,15 +150,22 @@ export function screenshotDiff(page, a, b, points = []) {
       if (Math.abs(A.px[k] - B.px[k]) > 8 || Math.abs(A.px[k + 1] - B.px[k + 1]) > 8 ||
           Math.abs(A.px[k + 2] - B.px[k + 2]) > 8) { diff[i] = 1; count++; }
     }
+    const boxes = [];
     const nearest = arg.map(([x, y]) => {
       let best = Infinity;
+      const box = [Infinity, Infinity, -Infinity, -Infinity];
       const r = 40;
       for (let j = Math.max(0, Math.round(y) - r); j <= Math.min(A.h - 1, Math.round(y) + r); ++j)
         for (let i = Math.max(0, Math.round(x) - r); i <= Math.min(A.w - 1, Math.round(x) + r); ++i)
-          if (diff[j * A.w + i]) best = Math.min(best, Math.hypot(i + 0.5 - x, j + 0.5 - y));
+          if (diff[j * A.w + i]) {
+            best = Math.min(best, Math.hypot(i + 0.5 - x, j + 0.5 - y));
+            box[0] = Math.min(box[0], i); box[1] = Math.min(box[1], j);
+            box[2] = Math.max(box[2], i + 1); box[3] = Math.max(box[3], j + 1);
+          }
+      boxes.push(best === Infinity ? null : box);
       return best === Infinity ? null : best;
     });
-    return { fraction: count / (A.w * A.h), nearest };`, points);
+    return { fraction: count / (A.w * A.h), nearest, boxes };`, points);
 }
 
 /// The pixel of a screenshot within `radius` px of [x, y] whose colour is closest to `hex`

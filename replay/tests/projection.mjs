@@ -2,7 +2,8 @@
 // and between samples (the test interpolates the log itself), for the follow and underwater
 // cameras, the logged boat, ROV and middle tether node, projected here with the camera the page
 // reports, land within 2 px of the page's own projections; and hiding each of them changes the
-// screenshot within 3 px of that point (it is drawn there).
+// screenshot around that point (a vehicle's changed pixels surround it; the tether's pass within
+// 3 px of the mid node): it is drawn there.
 // usage: node projection.mjs path/to/replay.html
 import { launch, open, checkClean, check, fail, replayFile, projectNED, interp, screenshotDiff } from './lib.mjs';
 
@@ -50,8 +51,14 @@ try {
           const without = await page.screenshot({ type: 'png' });
           await page.evaluate((l) => window.kelpReplay.setLayers({ [l]: true }), layer);
           const d = await screenshotDiff(page, all, without, [points[k]]);
-          const near = d.nearest[0];
-          check(near !== null && near <= 3, `${camera} camera: hiding the ${layer} changes the screenshot ${near === null ? 'nowhere near' : `${near.toFixed(1)} px from`} its projected point`);
+          const near = d.nearest[0], box = d.boxes[0];
+          if (layer === 'tether') { // a line through the node: drawn within 3 px of it
+            check(near !== null && near <= 3, `${camera} camera: hiding the tether changes the screenshot ${near === null ? 'nowhere near' : `${near.toFixed(1)} px from`} the mid node's projected point`);
+          } else { // a body around its origin (which may lie between its parts, as the boat's)
+            const inside = box && x >= box[0] - 2 && x <= box[2] + 2 && y >= box[1] - 2 && y <= box[3] + 2;
+            check(inside, `${camera} camera: hiding the ${layer} changes the screenshot around its projected point ` +
+              `(${x.toFixed(1)}, ${y.toFixed(1)}) px: changed pixels ${box ? `[${box[0]}, ${box[2]}] x [${box[1]}, ${box[3]}]` : 'none near'}`);
+          }
         }
       }
       checkClean(problems, `${camera} camera at t = ${t} s`);
