@@ -614,7 +614,8 @@
       let look, dist, az, el;
       if (cameraMode === 'follow') {
         look = b.clone().add(r).multiplyScalar(0.5);
-        dist = Math.max(6, 0.9 * b.distanceTo(r) + 4) * followOffset.zoom;
+        // both in the picture: the half-separation within the half-height's 27.5° view
+        dist = Math.max(6, 1.25 * b.distanceTo(r) + 4) * followOffset.zoom;
         az = followOffset.azimuth;
         el = followOffset.elevation;
       } else if (cameraMode === 'underwater') {

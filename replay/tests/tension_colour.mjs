@@ -30,6 +30,8 @@ try {
   const p = nodes.position[at];
   const midpoint = [0, 1, 2].map((k) => (p[3 * seg + k] + p[3 * seg + 3 + k]) / 2);
   const px = projectNED(cam, midpoint);
+  check(px[0] >= 0 && px[1] >= 0 && px[0] < cam.width && px[1] < cam.height,
+    `the segment's midpoint is in the follow camera's picture, at (${px.map((v) => v.toFixed(1))}) px`);
   const shot = await page.screenshot({ type: 'png' });
   const c = await closestColourNear(page, shot, px, 3, r.top);
   check(c.distance <= 3, `the screenshot shows ${c.colour && c.colour.join(',')} at (${c.at}) near the segment's midpoint (${px.map((v) => v.toFixed(1))}) px: the legend's top colour ${r.top} within 3/255`);
