@@ -224,7 +224,8 @@
     document.title = `kelp replay: ${data.title || data.source || 'run'}`;
     document.getElementById('title').textContent = data.title || data.source || 'kelp run';
 
-    // Query: ?t=SECONDS, ?paused=1, ?speed=X, ?camera=follow|underwater|orbit, ?sea=N (grid).
+    // Query: ?t=SECONDS, ?paused=1, ?speed=X, ?camera=follow|underwater|orbit, ?sea=N (grid),
+    // ?aa=0|1 (antialiasing), ?playres=R (pixel ratio while playing; below).
     const query = new URLSearchParams(window.location.search);
     const qt = parseFloat(query.get('t'));
     let time = Number.isFinite(qt) ? Math.min(Math.max(qt, tmin), duration) : tmin;
@@ -256,7 +257,13 @@
     } catch (e) {
       return showMessage(`WebGL is not available in this browser (${e.message}).`);
     }
-    renderer.setPixelRatio(software ? 1 : Math.min(window.devicePixelRatio || 1, 2));
+    // Pixels per CSS pixel: paused, the screen's (at most 2; 1 in software WebGL); playing in
+    // software WebGL, fewer (?playres=, default 0.6), since filling pixels is most of a frame's
+    // cost there; pausing draws the frame again at full resolution.
+    const fullRatio = software ? 1 : Math.min(window.devicePixelRatio || 1, 2);
+    const qr = parseFloat(query.get('playres'));
+    const playRatio = qr > 0 && qr <= 2 ? qr : software ? 0.6 : fullRatio;
+    renderer.setPixelRatio(fullRatio);
     view.appendChild(renderer.domElement);
     const scene = new THREE.Scene();
     const camera = new THREE.PerspectiveCamera(55, 1, 0.05, 3000);
@@ -750,6 +757,12 @@
     function setPlaying(on) {
       playing = !!on;
       if (playing && time >= duration) time = tmin;
+      const ratio = playing ? playRatio : fullRatio;
+      if (renderer.getPixelRatio() !== ratio) {
+        renderer.setPixelRatio(ratio);
+        resize();
+      }
+      dirty = true;
       syncControls();
     }
     function setCamera(mode) {
@@ -839,6 +852,7 @@
       }
     }
 
+    renderer.setPixelRatio(playing ? playRatio : fullRatio);
     resize();
     syncControls();
     setTime(time);
@@ -868,7 +882,8 @@
     //   seaVertex(i, j)        the sea mesh's vertex (i, j), 0 < i, j < seaGrid, as [n, e, ζ]
     //                          (float32; the outermost ring is the flat skirt to the horizon)
     //   measureFps(seconds)    plays for `seconds` of wall-clock time and resolves to {fps,
-    //                          frames, seconds, workMs (mean JS update + render call per frame)};
+    //                          frames, seconds, workMs (mean JS update + render call per frame),
+    //                          pixelRatio (drawing-buffer pixels per CSS pixel while playing)};
     //                          restores the play state afterwards
     const members = {
       data,
@@ -953,7 +968,7 @@
             const p = fpsProbe;
             fpsProbe = null;
             setPlaying(wasPlaying);
-            resolve({ fps: p.frames / elapsed, frames: p.frames, seconds: elapsed, workMs: p.frames ? p.work / p.frames : NaN });
+            resolve({ fps: p.frames / elapsed, frames: p.frames, seconds: elapsed, workMs: p.frames ? p.work / p.frames : NaN, pixelRatio: playRatio });
           }, seconds * 1000);
         });
       },

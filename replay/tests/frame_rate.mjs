@@ -57,7 +57,7 @@ try {
   console.log(`replay frame rate (headless Chromium, SwiftShader software WebGL, 960x600, this machine under its current load):`);
   console.log(`  run: ${info.duration} s, ${info.samples} log samples, ${info.nodeSamples} node samples, up to ${info.nodes} nodes, ${info.components} wave components; replay.html ${(size / 1e6).toFixed(2)} MB`);
   for (const [camera, m] of Object.entries(r))
-    console.log(`  ${camera} camera: ${m.fps.toFixed(1)} frames/s (${m.frames} frames in ${m.seconds.toFixed(1)} s; ` +
+    console.log(`  ${camera} camera: ${m.fps.toFixed(1)} frames/s drawn at ${m.pixelRatio} x 960x600 (${m.frames} frames in ${m.seconds.toFixed(1)} s; ` +
       `${m.workMs.toFixed(1)} ms of JS update + render call and ${m.cpuMs.toFixed(0)} ms of CPU in all of Chromium's processes per frame)`);
   try {
     console.log(`  load average ${readFileSync('/proc/loadavg', 'utf8').split(' ').slice(0, 3).join(' ')}`);
