@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "kelp/sim/replay.hpp"
@@ -41,9 +42,18 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "kelp-replay: %s\n", kelp::sim::replay_template_missing_note().c_str());
       return 2;
     }
-    fs::path written = kelp::sim::write_replay(dir, page, o);
-    if (!out.empty()) {
-      fs::rename(written, out);
+    fs::path written;
+    if (out.empty()) {
+      written = kelp::sim::write_replay(dir, page, o);
+    } else {  // elsewhere (perhaps another file system): written in place
+      std::ifstream in(page, std::ios::binary);
+      if (!in) throw kelp::error("cannot read the replay template " + page);
+      const std::string text((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+      const std::string html = kelp::sim::replay_html(text, kelp::sim::replay_data(dir, o));
+      std::ofstream f(out, std::ios::binary);
+      f << html;
+      if (!f) throw kelp::error("cannot write " + out);
       written = out;
     }
     std::error_code ec;

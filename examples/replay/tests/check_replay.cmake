@@ -103,3 +103,17 @@ if(SWEEP)
     message(FATAL_ERROR "kelp-replay on a kept sweep run: rc ${rc}, source found at ${at}:\n${err}")
   endif()
 endif()
+
+# --out: the page elsewhere; nothing written for a directory that is not a run.
+set(ENV{KELP_REPLAY_TEMPLATE} "${TEMPLATE}")
+execute_process(COMMAND "${REPLAY}" "${OUT}/run" --out "${OUT}/elsewhere.html" RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+file(SHA256 "${OUT}/elsewhere.html" third)
+if(NOT rc EQUAL 0 OR NOT third STREQUAL first)
+  message(FATAL_ERROR "kelp-replay --out: rc ${rc}, another page than the run's:\n${err}")
+endif()
+execute_process(COMMAND "${REPLAY}" "${OUT}/not-a-run" --out "${OUT}/nothing.html"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR EXISTS "${OUT}/nothing.html")
+  message(FATAL_ERROR "kelp-replay --out on a directory that is not a run: rc ${rc}:\n${err}")
+endif()
