@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run.hpp"
 
 namespace {
@@ -34,10 +35,18 @@ TEST_CASE("run_scenario writes run.mcap beside the log; reference.csv for the np
   for (const char* c : {"du", "dv", "dw", "dp", "dq", "dr"}) std::fprintf(ref, ",rov_nu_dot_%s", c);
   std::fprintf(ref, ",gravity\n");
   long samples = 0;
+  // The same samples in a second bag of small chunks (many chunks, each indexed).
+  const std::filesystem::path chunked = "ros2_bag_chunks";
+  std::filesystem::remove_all(chunked);
+  std::filesystem::create_directories(chunked);
+  kelp::ros2::McapOptions small;
+  small.chunk_size = 8192;
+  kelp::sim::BagRecorder second(chunked / "run.mcap", sc.node_rate, small);
   kelp::sim::RunOptions o;
   o.out = dir.string();
   o.on_sample = [&](const kelp::sim::LogRow& r) {
     ++samples;
+    second.record(r);
     std::fprintf(ref, "%.17g", r.t);
     const auto& p = r.tether->position;
     const kelp::vehicle::VehicleStated* x[2] = {r.asv, r.auv};
@@ -62,6 +71,9 @@ TEST_CASE("run_scenario writes run.mcap beside the log; reference.csv for the np
   };
   kelp::sim::run_scenario(sc, o);
   std::fclose(ref);
+  second.close();
+  std::filesystem::copy_file(dir / "reference.csv", chunked / "reference.csv");
+  CHECK(second.bag().mcap().bytes_written() > 10000);
   CHECK(samples == 61);
   REQUIRE(std::filesystem::exists(dir / "run.mcap"));
   CHECK(std::filesystem::file_size(dir / "run.mcap") > 10000);
@@ -77,7 +89,8 @@ TEST_CASE("run_scenario writes run.mcap beside the log; reference.csv for the np
     kelp::sim::run_scenario(q, oo);
     CHECK(std::filesystem::exists(off / "timeseries.csv"));
     CHECK_FALSE(std::filesystem::exists(off / "run.mcap"));
-    // The scenario key round-trips through JSON.
+    // The scenario key round-trips through JSON; on (the default) it is left out.
     CHECK(kelp::sim::parse_scenario(kelp::sim::to_json(q).dump(), "q").mcap == false);
+    CHECK_FALSE(kelp::sim::to_json(sc).at("output").contains("mcap"));
   }
 }

@@ -71,11 +71,13 @@ class Ros2Sampler {
 /// a bag: at the node rate it costs a tenth of what it would at the log rate).
 class BagRecorder {
  public:
-  /// \brief Creates the bag at `path`; markers at most `marker_rate` times a second (> 0).
+  /// \brief Creates the bag at `path`; markers at most `marker_rate` times a second (> 0);
+  /// `options` of the MCAP file (chunk size).
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument for a rate
   /// that is not > 0.
-  BagRecorder(const std::filesystem::path& path, double marker_rate)
-      : bag_(path), marker_period_(1.0 / marker_rate) {
+  BagRecorder(const std::filesystem::path& path, double marker_rate,
+              const ros2::McapOptions& options = {})
+      : bag_(path, options), marker_period_(1.0 / marker_rate) {
     KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
                "BagRecorder: the marker rate must be > 0");
   }

@@ -705,7 +705,10 @@ inline nlohmann::json to_json(const Scenario& s) {
   for (const auto& w : s.waypoints) wp.push_back(v3(w));
   j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
   if (!s.waypoints.empty()) j["mission"]["waypoints"] = wp;
-  j["output"] = {{"log_rate", s.log_rate}, {"node_rate", s.node_rate}, {"mcap", s.mcap}};
+  j["output"] = {{"log_rate", s.log_rate}, {"node_rate", s.node_rate}};
+  // Only when off: writing a bag does not change the run, so the default leaves the JSON (and the
+  // run hashes of kelp-sweep, which key stored results) as they were.
+  if (!s.mcap) j["output"]["mcap"] = false;
   // Only when pinned: the default leaves the JSON (and kelp-sweep's run hashes) as they were.
   if (s.kernel != "auto") j["kernel"] = s.kernel;
   // Navigation: likewise only when it differs from the default (perfect navigation).

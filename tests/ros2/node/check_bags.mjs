@@ -214,8 +214,19 @@ async function checkBag(file) {
     }
     if (compared === 0) fail(file, "reference.csv: nothing compared");
   } else if (fs.existsSync(path.join(dir, "timeseries.csv"))) {
+    // The CSV's times have 6 significant digits too: each row takes the nearest stamp within that.
+    const stamps = [...(byTopic.get("/rov/odom")?.keys() ?? [])];
     for (const r of readCsv(path.join(dir, "timeseries.csv"))) {
-      const ns = stampNs(r.t);
+      let ns = stampNs(r.t);
+      let best = Infinity;
+      for (const s of stamps) {
+        const d = Math.abs(Number(s) * 1e-9 - r.t);
+        if (d < best) [best, ns] = [d, s];
+      }
+      if (!(best <= 6e-6 * Math.max(1, Math.abs(r.t)))) {
+        fail(file, `no sample at t = ${r.t} (nearest ${best} s away)`);
+        continue;
+      }
       for (const [who, col] of [["boat", "asv"], ["rov", "auv"]]) {
         const odom = one(`/${who}/odom`, ns);
         if (!odom) {
