@@ -10,12 +10,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/ros2.hpp"
 #include "sweep.hpp"
 
 namespace fs = std::filesystem;
@@ -109,6 +111,7 @@ struct RunOptions {
   std::string shard;
   unsigned jobs = 0;
   bool quiet = false, no_plot = false;
+  bool mcap = false;  // each run's ROS 2 bag, runs/<hash>.mcap
 };
 
 int run(const RunOptions& o) {
@@ -162,7 +165,16 @@ int run(const RunOptions& o) {
                      {"seed", r.seed}};
       std::string error;
       try {
-        result["summary"] = kelp::sim::simulate(r.scenario);
+        // With --mcap, each run's ROS 2 bag beside its result (runs/<hash>.mcap).
+        kelp::sim::SimulateOptions so;
+        std::unique_ptr<kelp::sim::BagRecorder> bag;
+        if (o.mcap) {
+          bag = std::make_unique<kelp::sim::BagRecorder>(out / "runs" / (r.hash + ".mcap"),
+                                                         r.scenario.node_rate);
+          so.on_sample = [&bag](const kelp::sim::LogRow& row) { bag->record(row); };
+        }
+        result["summary"] = kelp::sim::simulate(r.scenario, so);
+        if (bag) bag->close();
         write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
       } catch (const std::exception& e) {
         error = e.what();
@@ -250,6 +262,9 @@ int main(int argc, char** argv) {
   app.add_option("--shard", o.shard, "run only shard I of N (0-based, I/N); no table");
   app.add_flag("--quiet", o.quiet, "no progress bar");
   app.add_flag("--no-plot", o.no_plot, "no figure");
+  app.add_flag("--mcap", o.mcap,
+               "also write each run as a ROS 2 bag, runs/<hash>.mcap (off by default: a bag is "
+               "a few MB a simulated minute, a sweep has many runs)");
   CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
   std::vector<std::string> dirs;
   std::string merged = "kelp-sweep-merged";
