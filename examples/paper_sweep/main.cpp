@@ -10,12 +10,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/ros2.hpp"
 #include "sweep.hpp"
 
 namespace fs = std::filesystem;
@@ -110,6 +112,7 @@ struct RunOptions {
   unsigned jobs = 0;
   bool quiet = false, no_plot = false;
   bool keep_series = false;  // runs/<hash>/: timeseries.csv, nodes.csv, summary.json
+  bool mcap = false;  // each run's ROS 2 bag, runs/<hash>.mcap
 };
 
 int run(const RunOptions& o) {
@@ -169,7 +172,15 @@ int run(const RunOptions& o) {
         // (summary.json last, so a directory with one is complete: kelp-replay reads it).
         const fs::path series = out / "runs" / r.hash;
         if (o.keep_series) so.log_dir = series.string();
+        // With --mcap, each run's ROS 2 bag beside its result (runs/<hash>.mcap).
+        std::unique_ptr<kelp::sim::BagRecorder> bag;
+        if (o.mcap) {
+          bag = std::make_unique<kelp::sim::BagRecorder>(out / "runs" / (r.hash + ".mcap"),
+                                                         r.scenario.node_rate);
+          so.on_sample = [&bag](const kelp::sim::LogRow& row) { bag->record(row); };
+        }
         result["summary"] = kelp::sim::simulate(r.scenario, so);
+        if (bag) bag->close();
         if (o.keep_series)
           write_atomically(series / "summary.json", result["summary"].dump(2) + "\n");
         write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
@@ -262,6 +273,9 @@ int main(int argc, char** argv) {
   app.add_flag("--keep-series", o.keep_series,
                "keep each run's time series in runs/<hash>/ (timeseries.csv, nodes.csv, "
                "summary.json; kelp-replay makes its 3-D replay)");
+  app.add_flag("--mcap", o.mcap,
+               "also write each run as a ROS 2 bag, runs/<hash>.mcap (off by default: a bag is "
+               "a few MB a simulated minute, a sweep has many runs)");
   CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
   std::vector<std::string> dirs;
   std::string merged = "kelp-sweep-merged";

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "bridge.hpp"
 #include "default_world.hpp"
 #include "kelp/sim/replay.hpp"
+#include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
@@ -51,6 +53,7 @@ struct Options {
   double duration = 0;  // physics seconds; 0: until interrupted
   double status_interval = 10;
   bool quiet = false;
+  int mcap = -1;  // run.mcap: 1 on, 0 off, -1 the scenario's output.mcap
 };
 
 // A UDP socket bound to address:port; throws with the reason.
@@ -136,6 +139,9 @@ int run(const Options& o) {
   fs::create_directories(o.log);
   kelp::sim::RunLog log(o.log);
   std::ofstream events(fs::path(o.log) / "events.log");
+  // The run as a ROS 2 bag (run.mcap), the markers at the node rate.
+  const bool mcap = o.mcap >= 0 ? o.mcap != 0 : o.scenario.mcap;
+  std::unique_ptr<kelp::sim::BagRecorder> bag;
   const double wall0 = wall_now();
   bridge.on_event = [&](const std::string& s) {
     char stamp[32];
@@ -152,6 +158,7 @@ int run(const Options& o) {
 
   const double log_rate = o.log_rate > 0 ? o.log_rate : o.scenario.log_rate;
   const double node_rate = o.node_rate > 0 ? o.node_rate : o.scenario.node_rate;
+  if (mcap) bag = std::make_unique<kelp::sim::BagRecorder>(fs::path(o.log) / "run.mcap", node_rate);
   double next_log = 0, next_nodes = 0, next_status = wall0 + o.status_interval;
   // The ROV's turns about the tether and the line's partings, at every step (as kelp::sim's
   // ClosedLoop keeps them).
@@ -179,6 +186,12 @@ int run(const Options& o) {
       row.tension_auv = bridge.last_report().force_on_auv.norm();
       row.tether_turns = turns.turns();
       row.parted_segments = s.tether.parted_segments();
+      row.force_on_asv = bridge.last_report().force_on_asv;
+      row.force_on_auv = bridge.last_report().force_on_auv;
+      row.auv_nu_dot = s.auv_nu_dot;
+      row.gravity = bridge.model().environment().gravity();
+      row.tether_model = &bridge.model().tether_of(s);
+      row.tether = &s.tether;
       // Propulsion: thrust as delivered (lagged), currents, batteries.
       if (const auto* pm = bridge.model().asv_propulsion()) {
         row.asv_thrust = s.asv_propulsion.thrust.head<2>();
@@ -195,6 +208,7 @@ int run(const Options& o) {
             kelp::vehicle::state_of_charge(pm->parameters().battery, s.auv_propulsion.battery);
       }
       log.row(row);
+      if (bag) bag->record(row);
       next_log = t + 1.0 / log_rate;
     }
     if (t + 1e-9 >= next_nodes) {
@@ -258,6 +272,7 @@ int run(const Options& o) {
     }
   }
   log.close();
+  if (bag) bag->close();
   const double wall = wall_now() - wall0;
   nlohmann::json summary;
   summary["kelp_version"] = KELP_VERSION_STRING;
@@ -365,9 +380,14 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1e7));
   app.add_option("--status-interval", o.status_interval, "wall seconds between status lines")
       ->check(CLI::Range(0.1, 1e6));
+  bool with_mcap = false, no_mcap = false;
+  app.add_flag("--mcap", with_mcap,
+               "write run.mcap, the run as a ROS 2 bag (the default; the scenario's output.mcap)");
+  app.add_flag("--no-mcap", no_mcap, "do not write run.mcap");
   app.add_flag("--quiet", o.quiet,
                "no status lines or events on stderr (events.log still has them)");
   CLI11_PARSE(app, argc, argv);
+  if (with_mcap || no_mcap) o.mcap = with_mcap && !no_mcap ? 1 : 0;
   try {
     kelp::simd::kernel_policy();  // a bad KELP_KERNEL stops here, named
   } catch (const kelp::invalid_argument& e) {

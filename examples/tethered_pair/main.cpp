@@ -71,9 +71,10 @@ int run(const Options& o) {
   std::printf(
       "kelp-tethered-pair: %.0f s simulated in %.2f s (%.0fx real time); AUV path error RMS "
       "%.2f m, boat %.2f m from the AUV RMS, peak tension %.1f N; outputs in %s (timeseries.csv, "
-      "nodes.csv, summary.json%s%s)\n",
+      "nodes.csv, summary.json%s%s%s)\n",
       duration, wall, duration / wall, auv_rms, asv_rms, t_max, o.out.c_str(),
-      ro.replay_template.empty() ? "" : ", replay.html", plots.c_str());
+      o.scenario.mcap ? ", run.mcap" : "", ro.replay_template.empty() ? "" : ", replay.html",
+      plots.c_str());
   const nlohmann::json& ts = summary["tether_solver"];
   std::printf(
       "kelp-tethered-pair: tether solver (%s): %.2f Newton iterations per step on average, at "
@@ -110,6 +111,10 @@ int main(int argc, char** argv) {
                  "instruction path of the wave kernel (overrides the scenario; portable: the "
                  "same numbers on every CPU)")
       ->check(CLI::IsMember({"auto", "portable", "avx2", "avx512"}));
+  bool mcap = false, no_mcap = false;
+  app.add_flag("--mcap", mcap,
+               "write run.mcap, the run as a ROS 2 bag (the default; the scenario's output.mcap)");
+  app.add_flag("--no-mcap", no_mcap, "do not write run.mcap");
   app.add_flag("--deterministic", deterministic,
                "the same numbers on every CPU: --kernel portable (see docs/deterministic.md)");
   CLI11_PARSE(app, argc, argv);
@@ -134,6 +139,7 @@ int main(int argc, char** argv) {
     overrides.seed = seed;
     overrides.kernel = kernel;
     overrides.deterministic = deterministic;
+    if (mcap || no_mcap) overrides.mcap = mcap && !no_mcap ? 1 : 0;
     o.scenario = kelp::sim::apply_overrides(o.scenario, overrides);
     return run(o);
   } catch (const kelp::sim::scenario_error& e) {

@@ -13,12 +13,14 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "kelp/core/error.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/replay.hpp"
+#include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 
@@ -33,6 +35,7 @@ struct ScenarioOverrides {
   std::string
       kernel;  ///< wave kernel path ("auto", "portable", "avx2", "avx512"); non-empty overrides
   bool deterministic = false;  ///< true: the kernel "portable" (the same numbers on every CPU)
+  int mcap = -1;  ///< run.mcap (the scenario's `output.mcap`): 1 on, 0 off, -1 the scenario's
 };
 
 /// \brief The scenario with the overrides applied.
@@ -47,6 +50,7 @@ inline Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o) {
   if (o.seed >= 0) sc.seed = static_cast<std::uint64_t>(o.seed);
   if (!o.kernel.empty()) sc.kernel = o.kernel;
   if (o.deterministic) sc.kernel = "portable";
+  if (o.mcap >= 0) sc.mcap = o.mcap != 0;
   return sc;
 }
 
@@ -67,8 +71,10 @@ struct RunOptions {
 };
 
 /// \brief Runs a scenario as kelp-tethered-pair does: simulate() (with the CSV log in `out`),
-/// the summary's `kelp_version`, summary.json (the summary, indented by 2) in `out` and, with a
-/// `replay_template`, replay.html (the 3-D replay, docs/replay.md) in `out`.
+/// the summary's `kelp_version`, summary.json (the summary, indented by 2) in `out`; with the
+/// scenario's `output.mcap` (the default) also run.mcap, the run as a ROS 2 bag (BagRecorder:
+/// every sample, the markers at the node rate), and with a `replay_template`, replay.html (the
+/// 3-D replay, docs/replay.md) in `out`.
 /// \returns the summary (summary.json's content).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
 /// file cannot be written (replay_error for replay.html).
@@ -78,7 +84,18 @@ inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {})
   so.progress = o.progress;
   so.scenario_file = o.scenario_file;
   so.on_sample = o.on_sample;
+  // The ROS 2 bag: every sample's messages, the markers at the node rate.
+  std::unique_ptr<BagRecorder> bag;
+  if (sc.mcap && !o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    bag = std::make_unique<BagRecorder>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
+    so.on_sample = [&bag, user = o.on_sample](const LogRow& r) {
+      bag->record(r);
+      if (user) user(r);
+    };
+  }
   nlohmann::json summary = simulate(sc, so);
+  if (bag) bag->close();
   if (!o.version.empty()) summary["kelp_version"] = o.version;
   if (!o.out.empty()) {
     std::ofstream f(std::filesystem::path(o.out) / "summary.json");

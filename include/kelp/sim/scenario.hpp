@@ -153,6 +153,8 @@ struct Scenario {
   /// \name Output: rows of timeseries.csv and snapshots of nodes.csv per simulated second [Hz].
   ///@{
   double log_rate = 10.0, node_rate = 1.0;
+  /// Write run.mcap, a ROS 2 bag of the run (kelp/sim/ros2.hpp), beside the CSV log.
+  bool mcap = true;
   ///@}
   /// Instruction path of the wave kernel (kelp/core/kernel_path.hpp): "auto" (the process'
   /// policy, i.e. `KELP_KERNEL`, else the widest the CPU runs), "portable" (the deterministic
@@ -577,9 +579,10 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   if (j.contains("output")) {
     const auto& o = j.at("output");
-    r.object(o, "/output", {"log_rate", "node_rate"});
+    r.object(o, "/output", {"log_rate", "node_rate", "mcap"});
     r.number(o, "/output", "log_rate", s.log_rate, 0.01, 100);
     r.number(o, "/output", "node_rate", s.node_rate, 0.001, 100);
+    r.boolean(o, "/output", "mcap", s.mcap);
   }
   if (j.contains("navigation")) detail::parse_navigation(j.at("navigation"), r, s.navigation);
   // Propulsion (thrusters' lag, batteries).
@@ -703,6 +706,9 @@ inline nlohmann::json to_json(const Scenario& s) {
   j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
   if (!s.waypoints.empty()) j["mission"]["waypoints"] = wp;
   j["output"] = {{"log_rate", s.log_rate}, {"node_rate", s.node_rate}};
+  // Only when off: writing a bag does not change the run, so the default leaves the JSON (and the
+  // run hashes of kelp-sweep, which key stored results) as they were.
+  if (!s.mcap) j["output"]["mcap"] = false;
   // Only when pinned: the default leaves the JSON (and kelp-sweep's run hashes) as they were.
   if (s.kernel != "auto") j["kernel"] = s.kernel;
   // Navigation: likewise only when it differs from the default (perfect navigation).
