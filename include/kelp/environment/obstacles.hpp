@@ -307,11 +307,17 @@ Proximity<Scalar> point_box(const Vector3<Scalar>& p, const Box& box) {
 /// breakpoints the squared outside distance is a quadratic in t (its minimiser is a candidate),
 /// and the inside distance the least of three linear functions (their crossings are
 /// candidates); the least over all candidates and breakpoints is the exact minimum.
+///
+/// With `rounding` r > 0 the box's edges and corners are rounded by r (the distance to the box
+/// shrunk by r on every side, less r): the same faces, but a normal that turns continuously
+/// round an edge, also for a segment a little inside (up to r deep), which a contact law needs.
 template <typename Scalar>
-Proximity<Scalar> segment_box(const Vector3<Scalar>& a, const Vector3<Scalar>& b, const Box& box) {
+Proximity<Scalar> segment_box(const Vector3<Scalar>& a, const Vector3<Scalar>& b, const Box& box,
+                              double rounding = 0.0) {
   using std::abs;
   const Matrix3<Scalar> R = box.rotation().cast<Scalar>();
-  const Vector3<Scalar> c = box.center.cast<Scalar>(), h = box.half_extents.cast<Scalar>();
+  const Vector3<Scalar> c = box.center.cast<Scalar>(),
+                        h = (box.half_extents.array() - rounding).matrix().cast<Scalar>();
   const Vector3<Scalar> o = R.transpose() * (a - c), d = R.transpose() * (b - a);
   const Scalar zero(0), one(1);
   // Breakpoints: 0, 1 and the crossings of the planes −h, 0, +h of each axis (at most 11).
@@ -377,10 +383,11 @@ Proximity<Scalar> segment_box(const Vector3<Scalar>& a, const Vector3<Scalar>& b
       best.distance = dist;
       best.t = cand[i];
       best.on_query = a + cand[i] * (b - a);
-      best.on_obstacle = c + R * s;
+      best.on_obstacle = c + R * (s + Scalar(rounding) * n);
       best.normal = R * n;
     }
   }
+  best.distance -= Scalar(rounding);
   return best;
 }
 
@@ -661,13 +668,22 @@ class ObstacleSet {
       }
   }
 
-  /// \brief Proximity of the segment a→b (a point when a = b) to one obstacle.
+  /// \brief Proximity of the segment a→b (a point when a = b) to one obstacle, as contact sees
+  /// it: a cylinder as a capsule, a box with its edges rounded by box_rounding().
   template <typename Scalar>
   Proximity<Scalar> proximity(ObstacleRef r, const Vector3<Scalar>& a,
                               const Vector3<Scalar>& b) const {
-    return r.kind == ObstacleRef::cylinder
-               ? segment_capsule<Scalar>(a, b, cylinders_[std::size_t(r.index)])
-               : segment_box<Scalar>(a, b, boxes_[std::size_t(r.index)]);
+    if (r.kind == ObstacleRef::cylinder)
+      return segment_capsule<Scalar>(a, b, cylinders_[std::size_t(r.index)]);
+    const Box& box = boxes_[std::size_t(r.index)];
+    return segment_box<Scalar>(a, b, box, box_rounding(box));
+  }
+  /// \brief Rounding of a box's edges for contact [m]: min(5 cm, ¼ of its least half extent).
+  /// A sharp edge turns the contact normal abruptly from one face to the next as a line slides
+  /// over it, a force that jumps and that Newton's method cannot converge on; rounded, the normal
+  /// turns over the rounding as the line wraps the edge.
+  static double box_rounding(const Box& box) {
+    return std::min(0.05, 0.25 * box.half_extents.minCoeff());
   }
 
  private:

@@ -95,7 +95,9 @@ bool contact_law(Scalar pen, const Vector3<Scalar>& n, const Vector3<Scalar>& vp
 }
 
 /// Contact of obstacle `r` with segment xa→xb: the forces on its two nodes, the normal force,
-/// the barycentric t and the normal of the closest point, and the law's terms.
+/// node b's share t (contact_share), the normal of the closest point and the law's terms. The
+/// law is evaluated at the closest point (its penetration and normal) with the velocity
+/// (1 − t) v_a + t v_b; the force goes (1 − t) to node a, t to node b.
 template <typename Scalar>
 struct SegmentContact {
   Vector3<Scalar> fa = Vector3<Scalar>::Zero(), fb = Vector3<Scalar>::Zero();
@@ -103,6 +105,37 @@ struct SegmentContact {
   Scalar t = Scalar(0);
   ContactLaw<Scalar> law;
 };
+/// ∫ max(0, p(t)) dt and ∫ t max(0, p(t)) dt over [t0, t1] for p linear from p0 to p1, added
+/// to m0 and m1.
+template <typename Scalar>
+void positive_moments(Scalar t0, Scalar p0, Scalar t1, Scalar p1, Scalar& m0, Scalar& m1) {
+  if (!(t1 > t0) || (p0 <= Scalar(0) && p1 <= Scalar(0))) return;
+  if (p0 < Scalar(0)) {
+    t0 = t0 + (t1 - t0) * (-p0) / (p1 - p0);
+    p0 = Scalar(0);
+  } else if (p1 < Scalar(0)) {
+    t1 = t0 + (t1 - t0) * p0 / (p0 - p1);
+    p1 = Scalar(0);
+  }
+  const Scalar w = t1 - t0;
+  m0 += Scalar(0.5) * (p0 + p1) * w;
+  m1 += w / Scalar(6) * (p0 * (Scalar(2) * t0 + t1) + p1 * (t0 + Scalar(2) * t1));
+}
+
+/// The share of a segment's contact force carried by its far node b: the centroid of the
+/// positive part of the penetration profile through (0, p_a), (t, p_c), (1, p_b) — p_a, p_b the
+/// penetrations of the nodes, p_c that of the closest point at t. For a short contact this is
+/// about t; for a segment lying along a face (p_a = p_c = p_b) it is ½ wherever the closest
+/// point falls, so the load does not jump from node to node as the closest point does when the
+/// segment is parallel to the surface.
+template <typename Scalar>
+Scalar contact_share(Scalar pa, Scalar t, Scalar pc, Scalar pb) {
+  Scalar m0(0), m1(0);
+  positive_moments(Scalar(0), pa, t, pc, m0, m1);
+  positive_moments(t, pc, Scalar(1), pb, m0, m1);
+  return m0 > Scalar(0) ? m1 / m0 : t;
+}
+
 template <typename Scalar>
 bool segment_contact(const environment::ObstacleSet& set, environment::ObstacleRef r,
                      const Vector3<Scalar>& xa, const Vector3<Scalar>& xb,
@@ -112,7 +145,9 @@ bool segment_contact(const environment::ObstacleSet& set, environment::ObstacleR
   const Scalar pen = radius - pr.distance;
   if (!(pen > Scalar(0))) return false;
   const environment::ContactProperties& cp = set.contact(r);
-  const Scalar t = pr.t, one(1);
+  const Scalar pa = radius - set.proximity<Scalar>(r, xa, xa).distance;
+  const Scalar pb = radius - set.proximity<Scalar>(r, xb, xb).distance;
+  const Scalar t = contact_share(pa, pr.t, pen, pb), one(1);
   const Vector3<Scalar> vp = (one - t) * va + t * vb;
   if (!contact_law(pen, pr.normal, vp, Scalar(cp.stiffness) * dl, Scalar(cp.damping) * dl,
                    Scalar(cp.damping_depth), Scalar(cp.friction), Scalar(cp.friction_velocity),
