@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -39,6 +40,7 @@
 #include "kelp/core/types.hpp"
 #include "kelp/environment/current.hpp"
 #include "kelp/environment/limits.hpp"
+#include "kelp/environment/obstacles.hpp"
 #include "kelp/environment/waves.hpp"
 #include "kelp/environment/wind.hpp"
 
@@ -133,6 +135,17 @@ class Environment {
     KELP_CHECK(!std::isnan(value_of(depth)) && value_of(depth) > 0.0,
                "seabed_depth must be > 0 (or +infinity for no seabed)");
     seabed_depth_ = depth;
+    return *this;
+  }
+  /// \brief The obstacles (cylinders, boxes, a height-field seabed) the tether and the vehicles
+  /// touch, or null when there are none (the contact passes then cost nothing).
+  const ObstacleSet* obstacles() const {
+    return obstacles_ && !obstacles_->empty() ? obstacles_.get() : nullptr;
+  }
+  /// \brief Sets the obstacles (copied once; copies of this environment share them, read-only).
+  /// An empty set removes them. Allocates: call it at setup or between steps.
+  Environment& set_obstacles(const ObstacleSet& obstacles) {
+    obstacles_ = obstacles.empty() ? nullptr : std::make_shared<const ObstacleSet>(obstacles);
     return *this;
   }
   /// \brief Sets a constant, depth-uniform current velocity, NED [m/s].
@@ -353,6 +366,7 @@ class Environment {
   CurrentModel<Scalar> current_;
   WaveField<Scalar> waves_;
   WindField<Scalar> wind_;
+  std::shared_ptr<const ObstacleSet> obstacles_;
 };
 
 /// \brief Throws `kelp::invalid_argument` unless a model's water density and gravity are those of
