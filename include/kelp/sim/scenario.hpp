@@ -25,6 +25,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/nav/pair.hpp"
+#include "kelp/sim/entanglement.hpp"
 
 namespace kelp {
 namespace sim {
@@ -172,6 +173,10 @@ struct Scenario {
   BatteryScenario asv_battery{31.2, 4, 0.02, 1.0, 0.0};
   BatteryScenario auv_battery{15.6, 4, 0.04, 1.0, 0.0};
   ///@}
+  /// The thresholds of the tether's entanglement events (`"entanglement": {"wrap_threshold":
+  /// rad, "wrap_hysteresis": rad, "contact_margin": m, "pin_slip_speed": m/s,
+  /// "pin_tension_difference": N, "pin_hold_time": s}`; kelp/sim/entanglement.hpp).
+  EntanglementSettings entanglement;
 };
 
 /// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
@@ -442,9 +447,10 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.fail("", std::string("not valid JSON: ") + e.what());
   }
   Scenario s;
-  r.object(j, "",
-           {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission",
-            "output", "kernel", "deterministic", "navigation", "thrusters", "battery"});
+  r.object(
+      j, "",
+      {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission", "output",
+       "kernel", "deterministic", "navigation", "thrusters", "battery", "entanglement"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -610,6 +616,22 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
       r.number(o, path, "hotel_current", x.hotel_current, 0.0, 1000.0);
     }
   }
+  if (j.contains("entanglement")) {
+    const auto& e = j.at("entanglement");
+    const std::string p = "/entanglement";
+    r.object(e, p,
+             {"wrap_threshold", "wrap_hysteresis", "contact_margin", "pin_slip_speed",
+              "pin_tension_difference", "pin_hold_time"});
+    EntanglementSettings& x = s.entanglement;
+    r.number(e, p, "wrap_threshold", x.wrap_threshold, 1e-3, 1e3);
+    r.number(e, p, "wrap_hysteresis", x.wrap_hysteresis, 0, 1e3);
+    r.number(e, p, "contact_margin", x.contact_margin, 0, 10);
+    r.number(e, p, "pin_slip_speed", x.pin_slip_speed, 1e-6, 10);
+    r.number(e, p, "pin_tension_difference", x.pin_tension_difference, 1e-3, 1e6);
+    r.number(e, p, "pin_hold_time", x.pin_hold_time, 0, 1e4);
+    if (x.wrap_hysteresis > x.wrap_threshold)
+      r.fail(p + "/wrap_hysteresis", "expected at most wrap_threshold");
+  }
   r.choice(j, "", "kernel", s.kernel, {"auto", "portable", "avx2", "avx512"});
   bool deterministic = false;
   r.boolean(j, "", "deterministic", deterministic);
@@ -720,6 +742,21 @@ inline nlohmann::json to_json(const Scenario& s) {
                           {"hotel_current", b.hotel_current}};
   };
   j["battery"] = {{"asv", battery(s.asv_battery)}, {"auv", battery(s.auv_battery)}};
+  // Entanglement thresholds: only when they differ from the defaults (the JSON of a scenario
+  // without them, and kelp-sweep's run hashes, stay as they were).
+  {
+    const EntanglementSettings& e = s.entanglement;
+    const EntanglementSettings d;
+    if (e.wrap_threshold != d.wrap_threshold || e.wrap_hysteresis != d.wrap_hysteresis ||
+        e.contact_margin != d.contact_margin || e.pin_slip_speed != d.pin_slip_speed ||
+        e.pin_tension_difference != d.pin_tension_difference || e.pin_hold_time != d.pin_hold_time)
+      j["entanglement"] = {{"wrap_threshold", e.wrap_threshold},
+                           {"wrap_hysteresis", e.wrap_hysteresis},
+                           {"contact_margin", e.contact_margin},
+                           {"pin_slip_speed", e.pin_slip_speed},
+                           {"pin_tension_difference", e.pin_tension_difference},
+                           {"pin_hold_time", e.pin_hold_time}};
+  }
   return j;
 }
 

@@ -7,6 +7,7 @@
 /// optional `kelp::sim` component.
 #pragma once
 
+#include <cmath>
 #include <string>
 
 #include "kelp/core/kernel_path.hpp"
@@ -126,6 +127,12 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     env.set_waves(waves);
   }
   env.waves().active_kernel();
+  // The hulls against the seabed and the obstacles (kelp/system/hull_contact.hpp), when there is
+  // something to touch: in open water without a seabed a run is as it was.
+  if (env.obstacles() != nullptr || std::isfinite(env.seabed_depth())) {
+    params.asv_hull = kelp::system::blueboat_hull<double>();
+    params.auv_hull = kelp::system::bluerov2_heavy_hull<double>();
+  }
   return {params, env, start};
 }
 
