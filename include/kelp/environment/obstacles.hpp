@@ -326,7 +326,8 @@ Proximity<Scalar> segment_box(const Vector3<Scalar>& a, const Vector3<Scalar>& b
       if (t > zero && t < one) bp[nb++] = t;
     }
   }
-  std::sort(bp, bp + nb);
+  for (int i = 1; i < nb; ++i)  // insertion sort of at most 11 values
+    for (int j = i; j > 0 && bp[j] < bp[j - 1]; --j) std::swap(bp[j], bp[j - 1]);
   Scalar cand[64];
   int nc = 0;
   for (int i = 0; i < nb; ++i) cand[nc++] = bp[i];

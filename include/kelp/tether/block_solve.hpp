@@ -291,6 +291,15 @@ void factor_solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWork
       base.zy = bz * qy + c_v * lanes_row(ws.node_dv, 4, i0, i1);
       base.zz =
           a + bz * qz + c_v * lanes_row(ws.node_dv, 5, i0, i1) + c_x * lanes(ws.node_kz, i0, i1);
+      if (ws.any_contact) {
+        // Obstacle contacts' normal stiffness (kelp/tether/contact.hpp).
+        base.xx += c_x * lanes_row(ws.node_kc, 0, i0, i1);
+        base.yx += c_x * lanes_row(ws.node_kc, 1, i0, i1);
+        base.zx += c_x * lanes_row(ws.node_kc, 2, i0, i1);
+        base.yy += c_x * lanes_row(ws.node_kc, 3, i0, i1);
+        base.zy += c_x * lanes_row(ws.node_kc, 4, i0, i1);
+        base.zz += c_x * lanes_row(ws.node_kc, 5, i0, i1);
+      }
       r0 = lanes_row(ws.rhs, 0, i0, i1) + cr0;
       r1 = lanes_row(ws.rhs, 1, i0, i1) + cr1;
       r2 = lanes_row(ws.rhs, 2, i0, i1) + cr2;

@@ -12,6 +12,7 @@
 
 #include "kelp/core/simd.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/obstacles.hpp"
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/state.hpp"
 
@@ -63,6 +64,8 @@ struct ForcePass {
   Scalar* acc = nullptr;
   /// One flag per segment when the line has parted (TetherWorkspace::parted), else null.
   const std::uint8_t* parted = nullptr;
+  /// The environment's obstacles (environment::ObstacleSet), or null: no contact pass at all.
+  const environment::ObstacleSet* obstacles = nullptr;
   Scalar X(int k, int i) const { return x[i * xs + k]; }
   Scalar V(int k, int i) const { return v[i * vs + k]; }
   /// The positions as a 3 × (N+1) matrix.

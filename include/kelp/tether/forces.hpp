@@ -17,6 +17,7 @@
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/simd.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/tether/contact.hpp"
 #include "kelp/tether/force_kernels.hpp"
 #include "kelp/tether/model.hpp"
 #include "kelp/tether/state.hpp"
@@ -396,6 +397,7 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
     parted_segments<WithJacobian>(c, ws);
     if (c.bending) bending_forces(c, ws);
     for (int i = 0; i <= n; ++i) node_general<WithJacobian>(c, ws, i);
+    if (c.obstacles) contact_pass<WithJacobian>(c, ws);
     for (int i = 0; i <= n; ++i) finish_block<false>(c, ws, i);
     return;
   }
@@ -414,6 +416,8 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
     if (!interior_block<WithJacobian, false>(c, single, ws, i))
       node_general<WithJacobian>(c, ws, i);
   if (n > 0) node_general<WithJacobian>(c, ws, n);
+  // Obstacles (kelp/tether/contact.hpp): none in most environments, and then no pass at all.
+  if (c.obstacles) contact_pass<WithJacobian>(c, ws);
   finish_block<false>(c, ws, 0);
   i = 1;
   if constexpr (wide)
@@ -458,6 +462,8 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   // MoorDyn's line model (TetherModel::added_mass_rate_terms).
   c.mass_turns = model.added_mass_rate_terms();
   c.parted = ws.any_parted ? ws.parted.data() : nullptr;
+  c.obstacles = obstacles_of(env);
+  if (!c.obstacles) ws.any_contact = false;
 
   // Water velocity and acceleration at the nodes; a still environment (no waves, no current)
   // gives zeros everywhere, which the buffers keep from the last time they were zeroed.

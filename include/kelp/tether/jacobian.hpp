@@ -339,6 +339,10 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     sink.xvm(i, hi, fc, gdc, mc, one);
     sink.xvm(i, lo, fc, gdc, mc, -one);
   }
+
+  // Obstacles (kelp/tether/contact.hpp): segments against cylinders and boxes, nodes against a
+  // height-field seabed.
+  contact_jacobian_blocks(model, ws, env, x, v, sink);
 }
 
 /// Index of block (i, j), |i − j| ≤ 2, in a 9 × 5(N+1) block store: column 5i + (j − i + 2)

@@ -321,6 +321,20 @@ struct TetherWorkspace {
   /// −∂F_i/∂v_i from drag and seabed, symmetric (xx, yx, zx, yy, zy, zz) [N s/m]
   Eigen::Matrix<Scalar, 6, Eigen::Dynamic> node_dv;
   VectorX<Scalar> node_kz;  ///< −∂F_z/∂z from the seabed [N/m]
+  /// −∂F_i/∂x_i of the obstacle contacts' normal stiffness, symmetric (xx, yx, zx, yy, zy, zz)
+  /// [N/m]; meaningful only while `any_contact` (kelp/tether/contact.hpp)
+  Eigen::Matrix<Scalar, 6, Eigen::Dynamic> node_kc;
+  // --- obstacle contact (kelp/tether/contact.hpp), filled when the environment has obstacles ---
+  /// Force of the obstacles (cylinders, boxes, a height-field seabed) on each node, NED [N]
+  /// (zero without obstacles)
+  Matrix3X<Scalar> contact_force;
+  /// Normal contact force of the cylinders and boxes on each segment [N] (≥ 0)
+  VectorX<Scalar> segment_contact;
+  /// The obstacle pressing hardest on each segment: ObstacleSet index (cylinders first, then
+  /// boxes), or −1 when it touches none
+  Eigen::VectorXi segment_obstacle;
+  /// True when the last force evaluation found a contact with an obstacle
+  bool any_contact = false;
   // --- linear solver and integrator buffers ----------------------------------------------------
   /// What the block elimination of the Newton solve keeps for its back substitution, two
   /// columns per elimination step (detail::solve_block_tridiagonal)
@@ -401,6 +415,8 @@ struct TetherWorkspace {
     retry_backup.resize(nodes);
     water_is_zero = true;
     any_parted = false;
+    any_contact = false;
+    segment_obstacle.setConstant(-1);
     clamp_start.setZero();
     clamp_end.setZero();
   }
@@ -423,7 +439,7 @@ struct TetherWorkspace {
     const Eigen::Index n = nodes, s = nodes - 1;
     for (auto* m : {&w.force, &w.bending, &w.acceleration, &w.tangent, &w.water_velocity,
                     &w.water_acceleration, &w.rhs, &w.rhs_true, &w.delta, &w.x0, &w.v0, &w.x1,
-                    &w.v1, &w.xs, &w.vs, &w.x_eval, &w.v_eval})
+                    &w.v1, &w.xs, &w.vs, &w.x_eval, &w.v_eval, &w.contact_force})
       f(*m, 3, n);
     for (auto* v : {&w.mass_iso, &w.mass_tan, &w.mass_iso_inv, &w.mass_tan_ratio, &w.seabed_force,
                     &w.friction_normal, &w.submerged, &w.node_kz, &w.surface_elevation})
@@ -433,6 +449,9 @@ struct TetherWorkspace {
                     &w.seg_true_k_uu, &w.seg_true_c_uu, &w.seg_rate, &w.seg_branch})
       f(*v, s, 1);
     f(w.node_dv, 6, n);
+    f(w.node_kc, 6, n);
+    f(w.segment_contact, s, 1);
+    f(w.segment_obstacle, s, 1);
     f(w.pass_buffer, n, 9);
     f(w.block_inv, 17, n);
     f(w.newton_lu, 9, 5 * n);
