@@ -155,7 +155,12 @@ class ClosedLoop {
                     s0 + kelp::Vector3<double>(0, a, 0), s0};
     }
     auv_.follow(waypoints_);
-    asv_.follow_auv();
+    if (sc.asv_station) {
+      const kelp::Matrix3<double> r = state_.asv.attitude.toRotationMatrix();
+      asv_.station(state_.asv.position, std::atan2(r(1, 0), r(0, 0)));
+    } else {
+      asv_.follow_auv();
+    }
     // At most one parting per segment: no allocation in a step when the line parts.
     failures_.reserve(std::size_t(model_.tether().segments()));
     if (sc.winch.enabled) {

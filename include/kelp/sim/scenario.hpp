@@ -141,6 +141,10 @@ struct Scenario {
   bool compensation = false;
   Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
   double asv_thrust_clip = 25.0, asv_rate = 10.0;
+  /// The boat keeps station at its start position and heading (`"control": {"asv":
+  /// {"station": true}}`) instead of following the ROV (e.g. a ROV working round a pile while
+  /// its boat waits off it).
+  bool asv_station = false;
   double auv_rate = 50.0;
   Gains auv_surge{40.0, 4.0, 56.0}, auv_sway{40.0, 4.0, 56.0}, auv_heave{60.0, 8.0, 88.0},
       auv_yaw{5.0, 0.2, 3.4};
@@ -551,7 +555,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.boolean(c, "/control", "compensation", s.compensation);
     if (c.contains("asv")) {
       const auto& a = c.at("asv");
-      r.object(a, "/control/asv", {"linear", "angular", "yaw", "thrust_clip", "rate"});
+      r.object(a, "/control/asv", {"linear", "angular", "yaw", "thrust_clip", "rate", "station"});
+      r.boolean(a, "/control/asv", "station", s.asv_station);
       r.gains(a, "/control/asv", "linear", s.asv_linear);
       r.gains(a, "/control/asv", "angular", s.asv_angular);
       r.gains(a, "/control/asv", "yaw", s.asv_yaw);
@@ -720,6 +725,7 @@ inline nlohmann::json to_json(const Scenario& s) {
                     {"heave", g(s.auv_heave)},
                     {"yaw", g(s.auv_yaw)},
                     {"rate", s.auv_rate}}}};
+  if (s.asv_station) j["control"]["asv"]["station"] = true;
   nlohmann::json wp = nlohmann::json::array();
   for (const auto& w : s.waypoints) wp.push_back(v3(w));
   j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
