@@ -560,3 +560,80 @@ TEST_CASE("capstan: a line sliding over a cylinder has T1/T2 = exp(mu theta) wit
   // Frictionless: the tension passes over unchanged.
   CHECK(capstan_ratio(0.0, kelp::pi) == Approx(1.0).epsilon(0.01));
 }
+
+TEST_CASE("steps with obstacles allocate nothing, with the symmetric and the whole Jacobian",
+          "[obstacles]") {
+  // A slack line lying across a capsule and a box onto a sloping height field.
+  kt::TetherParameters<double> p = jacobian_line();
+  p.segments = 20;
+  p.length = 4.0;
+  p.mass_per_length = 1.0;  // sinks (the Jacobian line is slightly buoyant)
+  const kt::TetherModel<double> model(p);
+  ke::ObstacleSet set;
+  set.add(cylinder(Vector3d(-1, -2, 5.3), Vector3d(-1, 2, 5.3), 0.3, 0.4));
+  ke::Box b;
+  b.center = Vector3d(0.5, 0, 5.6);
+  b.half_extents = Vector3d(0.3, 1, 0.3);
+  b.contact.friction = 0.2;
+  set.add(b);
+  ke::HeightField hf;
+  hf.origin = Eigen::Vector2d(-5, -5);
+  hf.spacing = Eigen::Vector2d(5, 5);
+  hf.rows = hf.cols = 3;
+  hf.depth = {5.8, 5.9, 6.0, 5.9, 5.95, 6.0, 6.0, 6.05, 6.1};
+  set.set_seabed(hf);
+  ke::Environment<double> env;
+  env.set_obstacles(set);
+  for (kt::JacobianKind kind : {kt::JacobianKind::adaptive, kt::JacobianKind::whole}) {
+    kt::TetherWorkspace<double> ws(model);
+    kt::TetherState<double> st(model);
+    for (int i = 0; i <= 20; ++i) st.position.col(i) = Vector3d(-1.8 + 0.18 * i, 0, 4.99);
+    const kt::TetherBoundary<double> bnd =
+        kt::TetherBoundary<double>::fixed(st.position.col(0), st.position.col(20));
+    kt::ImplicitOptions<double> io;
+    io.jacobian = kind;
+    const kt::StepOptions<double> options(kt::Integrator::bdf2, io);
+    kt::step(model, ws, env, st, bnd, 0.01, options);  // first step: BDF2 starts with Euler
+    Eigen::internal::set_is_malloc_allowed(false);
+    for (int k = 0; k < 100; ++k) kt::step(model, ws, env, st, bnd, 0.01, options);
+    Eigen::internal::set_is_malloc_allowed(true);
+    CHECK(ws.any_contact);
+    CHECK(st.position.allFinite());
+    // The node over the box (top at z 5.3) rests on it, not in it.
+    CHECK(st.position(2, 12) < 5.3 + 0.005);
+  }
+}
+
+TEST_CASE("contact forces of a float tether agree with the double one", "[obstacles]") {
+  ke::ObstacleSet set;
+  ke::Cylinder c = cylinder(Vector3d(0.13, -2, 5.3), Vector3d(0.1, 2, 5.3), 0.3, 0.5);
+  c.contact.damping = 1e3;
+  set.add(c);
+  ke::Box b;
+  b.center = Vector3d(0.7, 0, 5.5);
+  b.half_extents = Vector3d(0.2, 0.5, 0.5);
+  set.add(b);
+  ke::Environment<double> env;
+  ke::Environment<float> envf;
+  env.set_obstacles(set);
+  envf.set_obstacles(set);
+  Matrix3X<double> x, v;
+  line_state(5.005, 1, x, v);
+  const kt::TetherModel<double> model(jacobian_line());
+  kt::TetherParameters<float> pf;
+  const kt::TetherParameters<double> pd = jacobian_line();
+  pf.segments = pd.segments;
+  pf.length = float(pd.length);
+  pf.diameter = float(pd.diameter);
+  pf.mass_per_length = float(pd.mass_per_length);
+  pf.axial_stiffness = float(pd.axial_stiffness);
+  const kt::TetherModel<float> mf(pf);
+  kt::TetherWorkspace<double> ws(model);
+  kt::TetherWorkspace<float> wsf(mf);
+  kt::compute_forces(model, ws, env, 0.0, x, v);
+  kt::compute_forces(mf, wsf, envf, 0.0, x.cast<float>().eval(), v.cast<float>().eval());
+  REQUIRE(ws.any_contact);
+  REQUIRE(wsf.any_contact);
+  const double scale = ws.contact_force.cwiseAbs().maxCoeff();
+  CHECK((wsf.contact_force.cast<double>() - ws.contact_force).cwiseAbs().maxCoeff() < 1e-3 * scale);
+}

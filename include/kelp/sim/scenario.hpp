@@ -24,6 +24,7 @@
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/environment/obstacles.hpp"
 #include "kelp/nav/pair.hpp"
 #include "kelp/sim/entanglement.hpp"
 
@@ -177,11 +178,43 @@ struct Scenario {
   BatteryScenario asv_battery{31.2, 4, 0.02, 1.0, 0.0};
   BatteryScenario auv_battery{15.6, 4, 0.04, 1.0, 0.0};
   ///@}
+  /// \name Obstacles and seabed (`"obstacles": [...]`, `"seabed": {...}`; none by default).
+  ///@{
+  /// Cylinders (`{"type": "cylinder", "name", "from", "to", "radius"}`), in file order.
+  std::vector<kelp::environment::Cylinder> cylinders;
+  /// Boxes (`{"type": "box", "name", "center", "half_extents", "yaw"}`, optional `roll`,
+  /// `pitch`), in file order. Every obstacle may set `friction` (μ), `stiffness` [Pa/m],
+  /// `damping` [Pa s/m] (kelp::environment::ContactProperties).
+  std::vector<kelp::environment::Box> boxes;
+  /// NED z of a flat seabed [m] (`"seabed": {"depth": m}`); +∞: none.
+  double seabed_depth = std::numeric_limits<double>::infinity();
+  /// A height-field seabed (`"seabed": {"heightfield": "file"}` in MoorDyn's seafloor format,
+  /// kelp::environment::load_heightfield, a path relative to the scenario file; or inline,
+  /// `{"origin": [n, e], "spacing": [dn, de], "size": [rows, cols], "depth": [...]}`).
+  bool has_heightfield = false;
+  kelp::environment::HeightField heightfield;
+  /// The height field's file as the scenario names it (empty: given inline).
+  std::string heightfield_file;
+  /// Seabed Coulomb friction μ of the tether on the seabed, flat or height field
+  /// (`"seabed": {"friction": μ}`; tether::TetherParameters::seabed_friction); -1: the tether's.
+  double seabed_friction = -1;
+  ///@}
   /// The thresholds of the tether's entanglement events (`"entanglement": {"wrap_threshold":
   /// rad, "wrap_hysteresis": rad, "contact_margin": m, "pin_slip_speed": m/s,
   /// "pin_tension_difference": N, "pin_hold_time": s}`; kelp/sim/entanglement.hpp).
   EntanglementSettings entanglement;
 };
+
+/// \brief The scenario's obstacles (cylinders, boxes, height-field seabed) as an ObstacleSet
+/// (cylinders first, then boxes: the set's flat indices). Empty when the scenario has none.
+/// \throws kelp::invalid_argument for an obstacle the set refuses (parse_scenario checks them).
+inline kelp::environment::ObstacleSet obstacle_set(const Scenario& s) {
+  kelp::environment::ObstacleSet set;
+  for (const auto& c : s.cylinders) set.add(c);
+  for (const auto& b : s.boxes) set.add(b);
+  if (s.has_heightfield) set.set_seabed(s.heightfield);
+  return set;
+}
 
 /// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
 /// needs 4. nlohmann-json parses iteratively but copies, compares and dumps recursively, so a file
@@ -434,6 +467,219 @@ inline nlohmann::json navigation_json(const NavigationSettings& n) {
 
 }  // namespace detail
 
+namespace detail {
+
+/// An inline height field (`origin`, `spacing`, `size`, `depth`: the replay's shape).
+inline kelp::environment::HeightField parse_heightfield_object(const nlohmann::json& h,
+                                                               const Reader& r,
+                                                               const std::string& p,
+                                                               bool with_type) {
+  std::set<std::string> keys{"origin", "spacing", "size", "depth"};
+  if (with_type) keys.insert("type");
+  r.object(h, p, keys);
+  for (const char* k : {"origin", "spacing", "size", "depth"})
+    if (!h.contains(k)) r.fail(p, std::string("missing \"") + k + "\"");
+  const auto pair = [&](const char* k, double lo, double hi) {
+    const auto& v = h.at(k);
+    if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+      r.fail(p + "/" + k, "expected an array of 2 numbers, got " + v.dump());
+    const double a = v[0].get<double>(), b = v[1].get<double>();
+    if (!(a >= lo && a <= hi && b >= lo && b <= hi))
+      r.fail(p + "/" + k, "expected numbers in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                              "], got " + v.dump());
+    return std::pair<double, double>(a, b);
+  };
+  kelp::environment::HeightField hf;
+  const auto o = pair("origin", -1e6, 1e6);
+  const auto sp = pair("spacing", 1e-6, 1e6);
+  const auto sz = pair("size", 2, 100000);
+  hf.origin = Eigen::Vector2d(o.first, o.second);
+  hf.spacing = Eigen::Vector2d(sp.first, sp.second);
+  if (sz.first != std::floor(sz.first) || sz.second != std::floor(sz.second))
+    r.fail(p + "/size", "expected whole numbers [rows, cols]");
+  hf.rows = int(sz.first);
+  hf.cols = int(sz.second);
+  const auto& d = h.at("depth");
+  if (!d.is_array() || d.size() != std::size_t(hf.rows) * std::size_t(hf.cols))
+    r.fail(p + "/depth", "expected an array of rows x cols = " +
+                             std::to_string(std::size_t(hf.rows) * std::size_t(hf.cols)) +
+                             " depths (row-major)");
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (!d[i].is_number() || !(std::abs(d[i].get<double>()) <= 1e5))
+      r.fail(p + "/depth/" + std::to_string(i),
+             "expected a depth within 1e5 m, got " + d[i].dump());
+    hf.depth.push_back(d[i].get<double>());
+  }
+  return hf;
+}
+
+/// The contact keys an obstacle may set (`friction`, `stiffness`, `damping`).
+inline void parse_contact(const nlohmann::json& o, const Reader& r, const std::string& p,
+                          kelp::environment::ContactProperties& c) {
+  r.number(o, p, "friction", c.friction, 0, 100);
+  r.number(o, p, "stiffness", c.stiffness, 1e-6, 1e13);
+  r.number(o, p, "damping", c.damping, 0, 1e13);
+}
+
+/// `"obstacles": [...]` into s.cylinders, s.boxes (and an inline height field).
+inline void parse_obstacles(const nlohmann::json& list, const Reader& r, const std::string& file,
+                            Scenario& s) {
+  (void)file;
+  if (!list.is_array()) r.fail("/obstacles", "expected an array of obstacles");
+  if (list.size() > 100000) r.fail("/obstacles", "at most 100000 obstacles");
+  std::set<std::string> names;
+  kelp::environment::ObstacleSet check;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const auto& o = list[i];
+    const std::string p = "/obstacles/" + std::to_string(i);
+    if (!o.is_object() || !o.contains("type") || !o.at("type").is_string())
+      r.fail(p, "expected an object with \"type\": \"cylinder\", \"box\" or \"heightfield\"");
+    const std::string type = o.at("type").get<std::string>();
+    std::string name = type + " " + std::to_string(i);
+    if (o.contains("name")) {
+      if (!o.at("name").is_string() || o.at("name").get<std::string>().empty())
+        r.fail(p + "/name", "expected a non-empty string");
+      name = o.at("name").get<std::string>();
+    }
+    if (type != "heightfield" && !names.insert(name).second)
+      r.fail(p + "/name", "\"" + name + "\" names another obstacle already");
+    try {
+      if (type == "cylinder") {
+        r.object(o, p,
+                 {"type", "name", "from", "to", "radius", "friction", "stiffness", "damping"});
+        for (const char* k : {"from", "to", "radius"})
+          if (!o.contains(k)) r.fail(p, std::string("missing \"") + k + "\"");
+        kelp::environment::Cylinder c;
+        c.name = name;
+        c.from = r.vec3(o.at("from"), p + "/from");
+        c.to = r.vec3(o.at("to"), p + "/to");
+        c.radius = -1;
+        r.number(o, p, "radius", c.radius, 1e-6, 1e4);
+        parse_contact(o, r, p, c.contact);
+        check.add(c);
+        s.cylinders.push_back(c);
+      } else if (type == "box") {
+        r.object(o, p,
+                 {"type", "name", "center", "half_extents", "yaw", "roll", "pitch", "friction",
+                  "stiffness", "damping"});
+        for (const char* k : {"center", "half_extents"})
+          if (!o.contains(k)) r.fail(p, std::string("missing \"") + k + "\"");
+        kelp::environment::Box b;
+        b.name = name;
+        b.center = r.vec3(o.at("center"), p + "/center");
+        b.half_extents = r.vec3(o.at("half_extents"), p + "/half_extents");
+        r.number(o, p, "yaw", b.yaw, -100, 100);
+        r.number(o, p, "roll", b.roll, -100, 100);
+        r.number(o, p, "pitch", b.pitch, -100, 100);
+        parse_contact(o, r, p, b.contact);
+        check.add(b);
+        s.boxes.push_back(b);
+      } else if (type == "heightfield") {
+        if (s.has_heightfield) r.fail(p, "a second height field (one seabed per scenario)");
+        s.heightfield = parse_heightfield_object(o, r, p, true);
+        kelp::environment::validate(s.heightfield);
+        s.has_heightfield = true;
+        s.heightfield_file.clear();
+      } else {
+        r.fail(p + "/type",
+               "expected \"cylinder\", \"box\" or \"heightfield\", got \"" + type + "\"");
+      }
+    } catch (const scenario_error&) {
+      throw;
+    } catch (const kelp::invalid_argument& e) {
+      r.fail(p, e.what());
+    }
+  }
+}
+
+/// `"seabed": {"depth": m}` or `{"heightfield": "file" | {...}}`, optional `"friction"`.
+inline void parse_seabed(const nlohmann::json& b, const Reader& r, const std::string& file,
+                         Scenario& s) {
+  r.object(b, "/seabed", {"depth", "heightfield", "friction"});
+  if (b.contains("depth") && b.contains("heightfield"))
+    r.fail("/seabed", "expected \"depth\" (flat) or \"heightfield\", not both");
+  r.number(b, "/seabed", "depth", s.seabed_depth, 0.1, 1e5);
+  r.number(b, "/seabed", "friction", s.seabed_friction, 0, 100);
+  if (!b.contains("heightfield")) return;
+  if (s.has_heightfield)
+    r.fail("/seabed/heightfield", "a second height field (one seabed per scenario)");
+  const auto& h = b.at("heightfield");
+  try {
+    if (h.is_string()) {
+      const std::string name = h.get<std::string>();
+      std::string path = name;
+      // Relative to the scenario file's directory (when the scenario is a file).
+      const auto slash = file.find_last_of('/');
+      if (!name.empty() && name[0] != '/' && slash != std::string::npos) {
+        const std::string beside = file.substr(0, slash + 1) + name;
+        if (std::ifstream(beside).good()) path = beside;
+      }
+      s.heightfield = kelp::environment::load_heightfield(path);
+      s.heightfield_file = name;
+    } else {
+      s.heightfield = parse_heightfield_object(h, r, "/seabed/heightfield", false);
+      kelp::environment::validate(s.heightfield);
+      s.heightfield_file.clear();
+    }
+  } catch (const scenario_error&) {
+    throw;
+  } catch (const kelp::invalid_argument& e) {
+    r.fail("/seabed/heightfield", e.what());
+  }
+  s.has_heightfield = true;
+}
+
+/// The obstacles and the seabed as JSON (to_json).
+inline void obstacles_json(const Scenario& s, nlohmann::json& j) {
+  const auto v3 = [](const Eigen::Vector3d& v) {
+    return nlohmann::json::array({v(0), v(1), v(2)});
+  };
+  const auto contact = [](const kelp::environment::ContactProperties& c, nlohmann::json& o) {
+    o["friction"] = c.friction;
+    o["stiffness"] = c.stiffness;
+    o["damping"] = c.damping;
+  };
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& c : s.cylinders) {
+    nlohmann::json o = {{"type", "cylinder"},
+                        {"name", c.name},
+                        {"from", v3(c.from)},
+                        {"to", v3(c.to)},
+                        {"radius", c.radius}};
+    contact(c.contact, o);
+    list.push_back(o);
+  }
+  for (const auto& b : s.boxes) {
+    nlohmann::json o = {{"type", "box"},
+                        {"name", b.name},
+                        {"center", v3(b.center)},
+                        {"half_extents", v3(b.half_extents)},
+                        {"yaw", b.yaw}};
+    if (b.roll != 0) o["roll"] = b.roll;
+    if (b.pitch != 0) o["pitch"] = b.pitch;
+    contact(b.contact, o);
+    list.push_back(o);
+  }
+  if (!list.empty()) j["obstacles"] = list;
+  nlohmann::json bed = nlohmann::json::object();
+  if (std::isfinite(s.seabed_depth)) bed["depth"] = s.seabed_depth;
+  if (s.has_heightfield) {
+    if (!s.heightfield_file.empty()) {
+      bed["heightfield"] = s.heightfield_file;
+    } else {
+      const auto& h = s.heightfield;
+      bed["heightfield"] = {{"origin", {h.origin.x(), h.origin.y()}},
+                            {"spacing", {h.spacing.x(), h.spacing.y()}},
+                            {"size", {h.rows, h.cols}},
+                            {"depth", h.depth}};
+    }
+  }
+  if (s.seabed_friction >= 0) bed["friction"] = s.seabed_friction;
+  if (!bed.empty()) j["seabed"] = bed;
+}
+
+}  // namespace detail
+
 /// \brief Reads and validates a scenario from JSON text.
 /// \param[in] text the JSON text \param[in] file names the scenario in error messages
 /// \throws scenario_error naming the file, the JSON path and what was expected.
@@ -451,10 +697,10 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.fail("", std::string("not valid JSON: ") + e.what());
   }
   Scenario s;
-  r.object(
-      j, "",
-      {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission", "output",
-       "kernel", "deterministic", "navigation", "thrusters", "battery", "entanglement"});
+  r.object(j, "",
+           {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission",
+            "output", "kernel", "deterministic", "navigation", "thrusters", "battery", "obstacles",
+            "seabed", "entanglement"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -621,6 +867,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
       r.number(o, path, "hotel_current", x.hotel_current, 0.0, 1000.0);
     }
   }
+  if (j.contains("obstacles")) detail::parse_obstacles(j.at("obstacles"), r, file, s);
+  if (j.contains("seabed")) detail::parse_seabed(j.at("seabed"), r, file, s);
   if (j.contains("entanglement")) {
     const auto& e = j.at("entanglement");
     const std::string p = "/entanglement";
@@ -748,6 +996,8 @@ inline nlohmann::json to_json(const Scenario& s) {
                           {"hotel_current", b.hotel_current}};
   };
   j["battery"] = {{"asv", battery(s.asv_battery)}, {"auv", battery(s.auv_battery)}};
+  // Obstacles and seabed: only when the scenario has them.
+  detail::obstacles_json(s, j);
   // Entanglement thresholds: only when they differ from the defaults (the JSON of a scenario
   // without them, and kelp-sweep's run hashes, stay as they were).
   {

@@ -127,6 +127,11 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     env.set_waves(waves);
   }
   env.waves().active_kernel();
+  // Seabed and obstacles (kelp/environment/obstacles.hpp; the tether touches them through the
+  // environment, kelp/tether/contact.hpp).
+  if (std::isfinite(sc.seabed_depth)) env.set_seabed_depth(sc.seabed_depth);
+  if (sc.seabed_friction >= 0) tp.seabed_friction = sc.seabed_friction;
+  env.set_obstacles(obstacle_set(sc));
   // The hulls against the seabed and the obstacles (kelp/system/hull_contact.hpp), when there is
   // something to touch: in open water without a seabed a run is as it was.
   if (env.obstacles() != nullptr || std::isfinite(env.seabed_depth())) {
