@@ -41,30 +41,11 @@ struct Loaded {
 
 Loaded load(const std::string& name) {
   const std::string file = scenario_path(name);
-  std::ifstream in(file);
-  nlohmann::json j = nlohmann::json::parse(in);
-  const nlohmann::json obstacles = j["obstacles"];
-  const double bed = j["seabed"]["depth"].get<double>();
-  j.erase("obstacles");
-  j.erase("seabed");
-  Loaded l{ksim::parse_scenario(j.dump(), file), {}};
+  Loaded l{ksim::load_scenario(file), {}};
   l.world = ksim::world_setup(l.scenario, file);
-  kelp::environment::ObstacleSet set;
-  for (const auto& o : obstacles) {
-    kelp::environment::Cylinder c;
-    c.name = o["name"].get<std::string>();
-    for (int i = 0; i < 3; ++i) {
-      c.from(i) = o["from"][std::size_t(i)].get<double>();
-      c.to(i) = o["to"][std::size_t(i)].get<double>();
-    }
-    c.radius = o["radius"].get<double>();
-    c.contact.friction = o["friction"].get<double>();
-    set.add(c);
-  }
-  l.world.environment.set_obstacles(set);
-  l.world.environment.set_seabed_depth(bed);
-  l.world.parameters.asv_hull = kelp::system::blueboat_hull<double>();
-  l.world.parameters.auv_hull = kelp::system::bluerov2_heavy_hull<double>();
+  // kelp::sim gives the vehicles their hulls when the world has a seabed or obstacles.
+  REQUIRE(l.world.parameters.auv_hull.has_value());
+  REQUIRE(l.world.parameters.asv_hull.has_value());
   return l;
 }
 
@@ -130,6 +111,8 @@ TEST_CASE("scenario pile_wrap: the tether wraps once and `entangled` fires on ti
   CHECK(o["name"] == "pile");
   CHECK(o["entangled_s"].get<double>() == e.time);
   CHECK(std::abs(o["max_abs_winding_rad"].get<double>() - 2 * kelp::pi) < 0.05);
+  // The scenario echo keeps the obstacles (the replay draws them from it).
+  CHECK(s["scenario"]["obstacles"][0]["name"] == "pile");
 }
 
 TEST_CASE("scenario mooring_flyby: the tether snags with friction and slides without",
