@@ -209,3 +209,21 @@ TEST_CASE("hull contact in system::step: the ROV rests on the seabed only with i
     CHECK(r.auv_contact.points == 0);
   }
 }
+
+TEST_CASE("hull contact: float gives the double's resting force", "[system][contact]") {
+  ke::Environmentf envf;
+  envf.set_seabed_depth(10.0f);
+  ke::Environmentd envd;
+  envd.set_seabed_depth(10.0);
+  kv::VehicleStatef xf;
+  xf.position = kelp::Vector3<float>(0, 0, 10.0f - 0.127f + 0.005f);
+  kv::VehicleStated xd;
+  xd.position = xf.position.cast<double>();
+  const auto lf = ks::hull_contact(ks::bluerov2_heavy_hull<float>(), envf, xf);
+  const auto ld = ks::hull_contact(ks::bluerov2_heavy_hull<double>(), envd, xd);
+  CHECK(lf.points == 4);
+  CHECK(ld.points == 4);
+  // 4 corners 5 mm deep: 4 k p = 400 N up.
+  CHECK(ld.force.z() == Approx(-400.0).epsilon(1e-4));
+  CHECK(double(lf.force.z()) == Approx(ld.force.z()).epsilon(1e-3));
+}
