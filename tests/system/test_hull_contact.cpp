@@ -218,7 +218,7 @@ TEST_CASE("hull contact: float gives the double's resting force", "[system][cont
   kv::VehicleStatef xf;
   xf.position = kelp::Vector3<float>(0, 0, 10.0f - 0.127f + 0.005f);
   kv::VehicleStated xd;
-  xd.position = xf.position.cast<double>();
+  xd.position = V3(0, 0, 10.0 - 0.127 + 0.005);
   const auto lf = ks::hull_contact(ks::bluerov2_heavy_hull<float>(), envf, xf);
   const auto ld = ks::hull_contact(ks::bluerov2_heavy_hull<double>(), envd, xd);
   CHECK(lf.points == 4);
