@@ -138,7 +138,7 @@ TEST_CASE("a line with a low breaking strength parts in a run, which reports it"
   std::ifstream ev(dir / "events.csv");
   std::string header, row;
   std::getline(ev, header);
-  CHECK(header == "t,event,segment,x,y,z,tension");
+  CHECK(header == "t,event,segment,x,y,z,tension,obstacle,winding");
   REQUIRE(std::getline(ev, row));
   CHECK(row.find(",line_parted," + std::to_string(seg) + ",") != std::string::npos);
   std::ifstream ts(dir / "timeseries.csv");

@@ -27,6 +27,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/nav/pair.hpp"
+#include "kelp/sim/entanglement.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/solver_report.hpp"
@@ -143,7 +144,9 @@ class ClosedLoop {
         start_(state_.auv.position),
         steps_(std::lround(sc.duration / dt)),
         log_every_(std::max(1L, std::lround(1.0 / (sc.log_rate * dt)))),
-        node_every_(std::max(1L, std::lround(1.0 / (sc.node_rate * dt)))) {
+        node_every_(std::max(1L, std::lround(1.0 / (sc.node_rate * dt)))),
+        entanglement_(entanglement_axes(model_), sc.entanglement,
+                      0.5 * model_.tether().parameters().diameter) {
     waypoints_ = sc.waypoints;
     if (waypoints_.empty()) {
       const kelp::Vector3<double> s0(start_.x(), start_.y(), sc.depth);
@@ -152,7 +155,12 @@ class ClosedLoop {
                     s0 + kelp::Vector3<double>(0, a, 0), s0};
     }
     auv_.follow(waypoints_);
-    asv_.follow_auv();
+    if (sc.asv_station) {
+      const kelp::Matrix3<double> r = state_.asv.attitude.toRotationMatrix();
+      asv_.station(state_.asv.position, std::atan2(r(1, 0), r(0, 0)));
+    } else {
+      asv_.follow_auv();
+    }
     // At most one parting per segment: no allocation in a step when the line parts.
     failures_.reserve(std::size_t(model_.tether().segments()));
     if (sc.winch.enabled) {
@@ -290,6 +298,9 @@ class ClosedLoop {
   const kelp::system::SolverStatsd& solver_stats() const { return solver_stats_; }
   /// \brief The AUV's turns about the tether at its attachment (updated at every step).
   const TurnCounter& turn_counter() const { return turns_; }
+  /// \brief The tether's winding about each cylinder of the environment and its entanglement
+  /// events (updated at every step; kelp/sim/entanglement.hpp).
+  const EntanglementMonitor& entanglement() const { return entanglement_; }
   /// \brief The tether's partings so far (at most one per step; kelp/tether/failure.hpp).
   const std::vector<kelp::tether::LineFailured>& line_failures() const { return failures_; }
   /// \brief The sensors and filters when the scenario's navigation mode is "sensors", else null.
@@ -321,6 +332,56 @@ class ClosedLoop {
                       {"water", v.dvl_pings(kelp::nav::DvlMode::water)},
                       {"none", v.dvl_pings(kelp::nav::DvlMode::none)}};
     return n;
+  }
+
+  /// \brief The summary's `entanglement` object: the thresholds, every cylinder's winding
+  /// (`obstacles`: name, index, `max_abs_winding_rad`, `final_winding_rad`, the times of its
+  /// first `entangled` and `pinned` events or null, its events) and all events in time order
+  /// (`events`: event, time_s, obstacle, position_m, winding_rad or tension_difference_n).
+  nlohmann::json entanglement_summary() const {
+    const EntanglementMonitor& m = entanglement_;
+    const EntanglementSettings& x = m.settings();
+    nlohmann::json e;
+    e["settings"] = {{"wrap_threshold_rad", x.wrap_threshold},
+                     {"wrap_hysteresis_rad", x.wrap_hysteresis},
+                     {"contact_margin_m", x.contact_margin},
+                     {"pin_slip_speed_m_s", x.pin_slip_speed},
+                     {"pin_tension_difference_n", x.pin_tension_difference},
+                     {"pin_hold_time_s", x.pin_hold_time}};
+    const auto time_or_null = [](double t) {
+      return std::isnan(t) ? nlohmann::json() : nlohmann::json(t);
+    };
+    const auto event_json = [&](const EntanglementEvent& v) {
+      nlohmann::json j = {{"event", event_name(v.kind)},
+                          {"time_s", v.time},
+                          {"obstacle", m.axes()[std::size_t(v.obstacle)].name},
+                          {"position_m", {v.position.x(), v.position.y(), v.position.z()}}};
+      if (v.kind == EntanglementEvent::Kind::entangled)
+        j["winding_rad"] = v.value;
+      else
+        j["tension_difference_n"] = v.value;
+      return j;
+    };
+    nlohmann::json obstacles = nlohmann::json::array();
+    for (std::size_t k = 0; k < m.axes().size(); ++k) {
+      const ObstacleWinding& w = m.obstacle(k);
+      nlohmann::json events = nlohmann::json::array();
+      for (const EntanglementEvent& v : m.events())
+        if (std::size_t(v.obstacle) == k) events.push_back(event_json(v));
+      obstacles.push_back({{"name", m.axes()[k].name},
+                           {"index", m.axes()[k].index},
+                           {"max_abs_winding_rad", w.max_abs_winding},
+                           {"final_winding_rad", w.winding},
+                           {"entangled_s", time_or_null(w.first_entangled)},
+                           {"pinned_s", time_or_null(w.first_pinned)},
+                           {"events", events}});
+    }
+    e["obstacles"] = obstacles;
+    nlohmann::json all = nlohmann::json::array();
+    for (const EntanglementEvent& v : m.events()) all.push_back(event_json(v));
+    e["events"] = all;
+    e["dropped_events"] = m.dropped_events();
+    return e;
   }
 
   /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
@@ -387,12 +448,30 @@ class ClosedLoop {
     s["kernel"] = kelp::simd::kernel_name(model_.environment().waves().active_kernel());
     s["math_library"] = kelp::simd::math_library_fingerprint();
     s["navigation"] = navigation_summary();
+    s["entanglement"] = entanglement_summary();
     s["scenario_file"] = options_.scenario_file;
     s["scenario"] = to_json(scenario_);
     return s;
   }
 
  private:
+  // The environment's cylinders as the entanglement monitor's axes.
+  static std::vector<EntanglementAxis> entanglement_axes(const kelp::system::SystemModeld& model) {
+    std::vector<EntanglementAxis> axes;
+    if (const kelp::environment::ObstacleSet* o = model.environment().obstacles()) {
+      for (std::size_t k = 0; k < o->cylinders().size(); ++k) {
+        const kelp::environment::Cylinder& c = o->cylinders()[k];
+        EntanglementAxis a;
+        a.name = c.name.empty() ? "cylinder " + std::to_string(k) : c.name;
+        a.index = int(k);
+        a.from = c.from;
+        a.to = c.to;
+        a.radius = c.radius;
+        axes.push_back(a);
+      }
+    }
+    return axes;
+  }
   static kelp::vehicle::ThrusterAllocationd rov_allocation() {
     const auto rov = kelp::vehicle::bluerov2_heavy<double>();
     return {rov.thruster_positions, rov.thruster_directions};
@@ -500,6 +579,30 @@ class ClosedLoop {
     turns_.update(state_.auv, state_.tether, int(state_.tether.position.cols()) - 1);
     row.tether_turns = turns_.turns();
     row.parted_segments = state_.tether.parted_segments();
+    // The tether's winding about each cylinder and its entanglement events (the segments' axial
+    // forces of the last force evaluation, when the workspace holds this node count's).
+    {
+      const Eigen::Index segments = state_.tether.position.cols() - 1;
+      const auto& tension = workspace_.tether.tension;
+      const int raised = entanglement_.update(
+          t, state_.tether.position, state_.tether.velocity,
+          tension.head(tension.size() == segments ? segments : Eigen::Index(0)));
+      if (options_.log)
+        for (std::size_t k = entanglement_.events().size() - std::size_t(raised);
+             k < entanglement_.events().size(); ++k) {
+          const EntanglementEvent& e = entanglement_.events()[k];
+          options_.log->entanglement(
+              e.time, event_name(e.kind), e.position,
+              e.kind == EntanglementEvent::Kind::pinned ? e.value : LogRow::none,
+              entanglement_.axes()[std::size_t(e.obstacle)].name,
+              entanglement_.obstacle(std::size_t(e.obstacle)).winding);
+        }
+      const int most = entanglement_.most_wound();
+      row.tether_winding =
+          most < 0 ? LogRow::none : entanglement_.obstacle(std::size_t(most)).winding;
+      row.winding_obstacle =
+          most < 0 ? LogRow::none : double(entanglement_.axes()[std::size_t(most)].index);
+    }
     // The line out, and with a winch its payout rate, its pull and the next command.
     {
       const auto& line = model_.tether_of(state_);
@@ -593,6 +696,8 @@ class ClosedLoop {
   kelp::tether::RemeshReport<double> remesh_;
   double line_mass_start_ = 0, length_start_ = 0;
   double min_length_ = std::numeric_limits<double>::infinity(), max_length_ = 0;
+  // The tether's winding about the environment's cylinders, and its entanglement events.
+  EntanglementMonitor entanglement_;
 };
 
 /// \brief Options of simulate().

@@ -2,7 +2,7 @@
 /// \brief The log of a run of the tethered pair: timeseries.csv (one row per sample: both
 /// vehicles, the AUV's target and errors, thrusts, commands, end tensions, the tether's turns),
 /// nodes.csv (the tether's node positions and segment tensions) and events.csv (the line
-/// parting).
+/// parting, the tether's entanglement with obstacles).
 ///
 /// The format is shared by kelp-tethered-pair and kelp-sitl and plotted by
 /// examples/tethered_pair/plot_run.py; its columns are documented in
@@ -68,6 +68,10 @@ struct LogRow {
   double tether_turns = none;
   /// Segments of the tether that have parted (TetherState::parted) [-].
   double parted_segments = none;
+  /// The tether's winding angle [rad] about the obstacle it is most wound round now (the
+  /// largest |winding|; kelp/sim/entanglement.hpp), and that obstacle's index among the
+  /// scenario's cylinders (NaN without cylinders).
+  double tether_winding = none, winding_obstacle = none;
   /// \name For the ROS 2 messages (kelp/sim/ros2.hpp; not in timeseries.csv): the tether's force
   /// on each vehicle (NED [N], system::SystemReport), the AUV's last acceleration ν̇ (body, its
   /// IMU's specific force), gravity [m/s²], and the tether's line model and state (pointed to:
@@ -123,6 +127,8 @@ inline const std::vector<std::string>& timeseries_columns() {
     // The tether: turns at the ROV, parted segments; its length out, the winch's rate and pull.
     c.insert(c.end(), {"tether_turns", "tether_parted_segments", "tether_length", "payout_rate",
                        "winch_pull"});
+    // Entanglement: the largest winding about an obstacle now, and which obstacle.
+    c.insert(c.end(), {"tether_winding", "tether_winding_obstacle"});
     return c;
   }();
   return columns;
@@ -177,6 +183,8 @@ void for_each_value(const LogRow& r, F&& f) {
   // The tether.
   for (double v : {r.tether_turns, r.parted_segments, r.tether_length, r.payout_rate, r.winch_pull})
     f(v);
+  f(r.tether_winding);
+  f(r.winding_obstacle);
 }
 
 /// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
@@ -197,7 +205,7 @@ class RunLog {
     for (std::size_t i = 0; i < columns.size(); ++i) ts_ << (i ? "," : "") << columns[i];
     ts_ << '\n';
     nodes_ << "t,node,x,y,z,tension\n";
-    events_ << "t,event,segment,x,y,z,tension\n";
+    events_ << "t,event,segment,x,y,z,tension,obstacle,winding\n";
   }
 
   /// \brief Appends one row to timeseries.csv.
@@ -211,13 +219,27 @@ class RunLog {
     ts_ << '\n';
   }
 
-  /// \brief Appends the tether's parting to events.csv (`t,event,segment,x,y,z,tension`, event
-  /// `line_parted`): its time [s], segment, position NED [m] and axial force [N].
+  /// \brief Appends the tether's parting to events.csv
+  /// (`t,event,segment,x,y,z,tension,obstacle,winding`, event `line_parted`): its time [s],
+  /// segment, position NED [m] and axial force [N] (no obstacle, winding `nan`).
   void line_parted(const kelp::tether::LineFailured& f) {
     events_ << num(f.time) << ",line_parted," << f.segment;
     for (double v : {f.position.x(), f.position.y(), f.position.z(), f.tension})
       events_ << ',' << num(v);
-    events_ << '\n';
+    events_ << ",," << num(std::numeric_limits<double>::quiet_NaN()) << '\n';
+    events_.flush();
+  }
+
+  /// \brief Appends an entanglement event to events.csv (kelp/sim/entanglement.hpp): `entangled`
+  /// (the winding about obstacle `obstacle` passed the threshold; `tension` nan) or `pinned`
+  /// (`tension`: the axial force on the ROV's side of the contact less the boat's [N]); its
+  /// time [s], no segment (`nan`), the contact's position NED [m], the obstacle's name and the
+  /// winding about it then [rad].
+  void entanglement(double t, const char* event, const kelp::Vector3<double>& position,
+                    double tension, const std::string& obstacle, double winding) {
+    events_ << num(t) << ',' << event << ',' << num(std::numeric_limits<double>::quiet_NaN());
+    for (double v : {position.x(), position.y(), position.z(), tension}) events_ << ',' << num(v);
+    events_ << ',' << obstacle << ',' << num(winding) << '\n';
     events_.flush();
   }
 

@@ -26,6 +26,7 @@
 #include "kelp/core/types.hpp"
 #include "kelp/environment/obstacles.hpp"
 #include "kelp/nav/pair.hpp"
+#include "kelp/sim/entanglement.hpp"
 
 namespace kelp {
 namespace sim {
@@ -141,6 +142,10 @@ struct Scenario {
   bool compensation = false;
   Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
   double asv_thrust_clip = 25.0, asv_rate = 10.0;
+  /// The boat keeps station at its start position and heading (`"control": {"asv":
+  /// {"station": true}}`) instead of following the ROV (e.g. a ROV working round a pile while
+  /// its boat waits off it).
+  bool asv_station = false;
   double auv_rate = 50.0;
   Gains auv_surge{40.0, 4.0, 56.0}, auv_sway{40.0, 4.0, 56.0}, auv_heave{60.0, 8.0, 88.0},
       auv_yaw{5.0, 0.2, 3.4};
@@ -196,6 +201,10 @@ struct Scenario {
   /// (`"seabed": {"friction": μ}`; tether::TetherParameters::seabed_friction); -1: the tether's.
   double seabed_friction = -1;
   ///@}
+  /// The thresholds of the tether's entanglement events (`"entanglement": {"wrap_threshold":
+  /// rad, "wrap_hysteresis": rad, "contact_margin": m, "pin_slip_speed": m/s,
+  /// "pin_tension_difference": N, "pin_hold_time": s}`; kelp/sim/entanglement.hpp).
+  EntanglementSettings entanglement;
 };
 
 /// \brief The scenario's obstacles (cylinders, boxes, height-field seabed) as an ObstacleSet
@@ -690,10 +699,10 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.fail("", std::string("not valid JSON: ") + e.what());
   }
   Scenario s;
-  r.object(
-      j, "",
-      {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission", "output",
-       "kernel", "deterministic", "navigation", "thrusters", "battery", "obstacles", "seabed"});
+  r.object(j, "",
+           {"duration", "seed", "sea", "tether", "vehicles", "start", "control", "mission",
+            "output", "kernel", "deterministic", "navigation", "thrusters", "battery", "obstacles",
+            "seabed", "entanglement"});
   r.number(j, "", "duration", s.duration, 1e-3, 1e7);
   r.integer(j, "", "seed", s.seed, 0, 1e18);
   if (j.contains("sea")) {
@@ -794,7 +803,8 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
     r.boolean(c, "/control", "compensation", s.compensation);
     if (c.contains("asv")) {
       const auto& a = c.at("asv");
-      r.object(a, "/control/asv", {"linear", "angular", "yaw", "thrust_clip", "rate"});
+      r.object(a, "/control/asv", {"linear", "angular", "yaw", "thrust_clip", "rate", "station"});
+      r.boolean(a, "/control/asv", "station", s.asv_station);
       r.gains(a, "/control/asv", "linear", s.asv_linear);
       r.gains(a, "/control/asv", "angular", s.asv_angular);
       r.gains(a, "/control/asv", "yaw", s.asv_yaw);
@@ -862,6 +872,22 @@ inline Scenario parse_scenario(const std::string& text, const std::string& file)
   }
   if (j.contains("obstacles")) detail::parse_obstacles(j.at("obstacles"), r, file, s);
   if (j.contains("seabed")) detail::parse_seabed(j.at("seabed"), r, file, s);
+  if (j.contains("entanglement")) {
+    const auto& e = j.at("entanglement");
+    const std::string p = "/entanglement";
+    r.object(e, p,
+             {"wrap_threshold", "wrap_hysteresis", "contact_margin", "pin_slip_speed",
+              "pin_tension_difference", "pin_hold_time"});
+    EntanglementSettings& x = s.entanglement;
+    r.number(e, p, "wrap_threshold", x.wrap_threshold, 1e-3, 1e3);
+    r.number(e, p, "wrap_hysteresis", x.wrap_hysteresis, 0, 1e3);
+    r.number(e, p, "contact_margin", x.contact_margin, 0, 10);
+    r.number(e, p, "pin_slip_speed", x.pin_slip_speed, 1e-6, 10);
+    r.number(e, p, "pin_tension_difference", x.pin_tension_difference, 1e-3, 1e6);
+    r.number(e, p, "pin_hold_time", x.pin_hold_time, 0, 1e4);
+    if (x.wrap_hysteresis > x.wrap_threshold)
+      r.fail(p + "/wrap_hysteresis", "expected at most wrap_threshold");
+  }
   r.choice(j, "", "kernel", s.kernel, {"auto", "portable", "avx2", "avx512"});
   bool deterministic = false;
   r.boolean(j, "", "deterministic", deterministic);
@@ -950,6 +976,7 @@ inline nlohmann::json to_json(const Scenario& s) {
                     {"heave", g(s.auv_heave)},
                     {"yaw", g(s.auv_yaw)},
                     {"rate", s.auv_rate}}}};
+  if (s.asv_station) j["control"]["asv"]["station"] = true;
   nlohmann::json wp = nlohmann::json::array();
   for (const auto& w : s.waypoints) wp.push_back(v3(w));
   j["mission"] = {{"depth", s.depth}, {"square_side", s.square_side}};
@@ -977,6 +1004,21 @@ inline nlohmann::json to_json(const Scenario& s) {
   j["battery"] = {{"asv", battery(s.asv_battery)}, {"auv", battery(s.auv_battery)}};
   // Obstacles and seabed: only when the scenario has them.
   detail::obstacles_json(s, j);
+  // Entanglement thresholds: only when they differ from the defaults (the JSON of a scenario
+  // without them, and kelp-sweep's run hashes, stay as they were).
+  {
+    const EntanglementSettings& e = s.entanglement;
+    const EntanglementSettings d;
+    if (e.wrap_threshold != d.wrap_threshold || e.wrap_hysteresis != d.wrap_hysteresis ||
+        e.contact_margin != d.contact_margin || e.pin_slip_speed != d.pin_slip_speed ||
+        e.pin_tension_difference != d.pin_tension_difference || e.pin_hold_time != d.pin_hold_time)
+      j["entanglement"] = {{"wrap_threshold", e.wrap_threshold},
+                           {"wrap_hysteresis", e.wrap_hysteresis},
+                           {"contact_margin", e.contact_margin},
+                           {"pin_slip_speed", e.pin_slip_speed},
+                           {"pin_tension_difference", e.pin_tension_difference},
+                           {"pin_hold_time", e.pin_hold_time}};
+  }
   return j;
 }
 

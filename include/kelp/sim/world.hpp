@@ -132,6 +132,12 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (std::isfinite(sc.seabed_depth)) env.set_seabed_depth(sc.seabed_depth);
   if (sc.seabed_friction >= 0) tp.seabed_friction = sc.seabed_friction;
   env.set_obstacles(obstacle_set(sc));
+  // The hulls against the seabed and the obstacles (kelp/system/hull_contact.hpp), when there is
+  // something to touch: in open water without a seabed a run is as it was.
+  if (env.obstacles() != nullptr || std::isfinite(env.seabed_depth())) {
+    params.asv_hull = kelp::system::blueboat_hull<double>();
+    params.auv_hull = kelp::system::bluerov2_heavy_hull<double>();
+  }
   return {params, env, start};
 }
 

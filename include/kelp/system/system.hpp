@@ -71,6 +71,7 @@
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/environment.hpp"
+#include "kelp/system/hull_contact.hpp"
 #include "kelp/system/tether_attachment.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
@@ -129,6 +130,12 @@ struct SystemParameters {
   /// (kelp/tether/winch.hpp; commanded by SystemInputs::winch_payout_rate). Empty (the default):
   /// the tether keeps its length and node count.
   std::optional<tether::WinchParameters<Scalar>> winch;
+  /// The ASV's hull against the seabed (flat or height field) and the environment's obstacles
+  /// (kelp/system/hull_contact.hpp: e.g. blueboat_hull()); its contact wrench is added to the
+  /// vehicle's external wrench at every RK4 stage. Empty (the default): no hull contact.
+  std::optional<HullContact<Scalar>> asv_hull;
+  /// The AUV's hull (e.g. bluerov2_heavy_hull()); see asv_hull.
+  std::optional<HullContact<Scalar>> auv_hull;
 };
 
 /// \brief Checks system parameters (the parts' own checks, kinematic tether ends, attachment
@@ -150,6 +157,8 @@ void validate(const SystemParameters<Scalar>& p) {
              "coupling_corrections must be in [0, 16]");
   if (p.asv_propulsion) vehicle::validate(*p.asv_propulsion);
   if (p.auv_propulsion) vehicle::validate(*p.auv_propulsion);
+  if (p.asv_hull) validate(*p.asv_hull);
+  if (p.auv_hull) validate(*p.auv_hull);
 }
 
 /// \brief A system built once from SystemParameters and an environment (copied; it is the one
@@ -331,6 +340,9 @@ struct SystemReport {
   /// The winch's re-meshes after the step (nodes inserted and removed, kinetic energy lost,
   /// momentum handed to the ends); zero without a winch.
   tether::RemeshReport<Scalar> remesh;
+  /// The ASV's hull contact at the end of the step (SystemParameters::asv_hull; zero without).
+  HullContactLoad<Scalar> asv_contact;
+  HullContactLoad<Scalar> auv_contact;  ///< the AUV's; see asv_contact
 };
 
 /// \brief Preallocated buffers of a system step.
@@ -390,7 +402,8 @@ vehicle::Surroundings<Scalar> lerp(const vehicle::Surroundings<Scalar>& a,
 /// One RK4 step of a vehicle in the environment under constant body wrenches `tau` and a
 /// constant force `f_ned` fixed in NED at the body point r (its wrench follows the stage
 /// attitudes). Returns the last stage's ν̇ (the predictor of the next step); commits only a
-/// finite state.
+/// finite state. With a hull (`hull` not null), its contact wrench with the environment's seabed
+/// and obstacles (hull_contact()) is added at every stage, from the stage's state.
 ///
 /// The surroundings (water, free surface, wind) are sampled twice per step, at the vehicle's
 /// position at t and at its predicted position p + R v h at t + h, and taken linearly in time
@@ -403,7 +416,8 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
                              vehicle::VehicleWorkspace<Scalar>& ws,
                              vehicle::VehicleState<Scalar>& x, const Env& env, double t, double dt,
                              const vehicle::VehicleInputs<Scalar>& in, const Vector3<Scalar>& r,
-                             const Vector3<Scalar>& f_ned) {
+                             const Vector3<Scalar>& f_ned,
+                             const HullContact<Scalar>* hull = nullptr) {
   const vehicle::Surroundings<Scalar> s0 = vehicle::surroundings(model, env, x, t);
   vehicle::VehicleState<Scalar> ahead = x;
   ahead.position += x.attitude * Vector3<Scalar>(x.nu.template head<3>()) * Scalar(dt);
@@ -413,7 +427,8 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
              [&](const vehicle::VehicleState<Scalar>& s, double c) {
                vehicle::StateDerivative<Scalar> d;
                d.pose = vehicle::pose_rate(s.attitude, s.nu);
-               const Vector6<Scalar> tau_ext = in.tau_ext + wrench_of_force(s, r, f_ned);
+               Vector6<Scalar> tau_ext = in.tau_ext + wrench_of_force(s, r, f_ned);
+               if (hull) tau_ext += hull_contact(*hull, env, s).wrench;
                d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.tau, tau_ext,
                                                     lerp(s0, s1, Scalar(c)));
                return d;
@@ -544,10 +559,12 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
       // The impulse the tether's integrator delivered to its ends, as a mean force.
       report.force_on_asv = ws.tether.end_impulse.on_start / Scalar(dt);
       report.force_on_auv = ws.tether.end_impulse.on_end / Scalar(dt);
-      state.asv_nu_dot = detail::step_vehicle(model.asv(), ws.asv, state.asv, env, t, dt, asv_in,
-                                              p.asv_attachment, report.force_on_asv);
-      state.auv_nu_dot = detail::step_vehicle(model.auv(), ws.auv, state.auv, env, t, dt, auv_in,
-                                              p.auv_attachment, report.force_on_auv);
+      state.asv_nu_dot =
+          detail::step_vehicle(model.asv(), ws.asv, state.asv, env, t, dt, asv_in, p.asv_attachment,
+                               report.force_on_asv, p.asv_hull ? &*p.asv_hull : nullptr);
+      state.auv_nu_dot =
+          detail::step_vehicle(model.auv(), ws.auv, state.auv, env, t, dt, auv_in, p.auv_attachment,
+                               report.force_on_auv, p.auv_hull ? &*p.auv_hull : nullptr);
       if (pass >= p.coupling_corrections) break;
       // Corrector: the end paths that start as before and reach the actual attachment points.
       const Scalar h(dt);
@@ -577,6 +594,8 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   state.auv.time = state.time;
   state.asv_propulsion = asv_prop;
   state.auv_propulsion = auv_prop;
+  if (p.asv_hull) report.asv_contact = hull_contact(*p.asv_hull, env, state.asv);
+  if (p.auv_hull) report.auv_contact = hull_contact(*p.auv_hull, env, state.auv);
   if (options.with_energy) report.energy = energy(model, state);
   return report;
 }
