@@ -496,6 +496,12 @@ class ClosedLoop {
     row.auv_command = (auv_override_ ? auv_override_ : auv_command_)->command;
     row.tension_asv = ta;
     row.tension_auv = tb;
+    row.force_on_asv = report_.force_on_asv;
+    row.force_on_auv = report_.force_on_auv;
+    row.auv_nu_dot = state_.auv_nu_dot;
+    row.gravity = model_.environment().gravity();
+    row.tether_model = &model_.tether_of(state_);
+    row.tether = &state_.tether;
     // The AUV's turns about the tether (its attachment is the tether's last node).
     turns_.update(state_.auv, state_.tether, int(state_.tether.position.cols()) - 1);
     row.tether_turns = turns_.turns();

@@ -66,6 +66,18 @@ struct LogRow {
   double tether_turns = none;
   /// Segments of the tether that have parted (TetherState::parted) [-].
   double parted_segments = none;
+  /// \name For the ROS 2 messages (kelp/sim/ros2.hpp; not in timeseries.csv): the tether's force
+  /// on each vehicle (NED [N], system::SystemReport), the AUV's last acceleration ν̇ (body, its
+  /// IMU's specific force), gravity [m/s²], and the tether's line model and state (pointed to:
+  /// they must outlive the call). NaN / null when the program does not give them.
+  ///@{
+  kelp::Vector3<double> force_on_asv = kelp::Vector3<double>::Constant(none);
+  kelp::Vector3<double> force_on_auv = kelp::Vector3<double>::Constant(none);
+  kelp::Vector6<double> auv_nu_dot = kelp::Vector6<double>::Constant(none);
+  double gravity = none;
+  const kelp::tether::TetherModeld* tether_model = nullptr;
+  const kelp::tether::TetherStated* tether = nullptr;
+  ///@}
 };
 
 /// \brief The columns of timeseries.csv, in order (documented in
