@@ -8,8 +8,8 @@
 //                                /rov/cmd_wrench from 4 s to 9 s, and write <dir>/odom.csv (the
 //                                /rov/odom samples received) and <dir>/peer.json (checks,
 //                                latencies); exit 1 when a check fails
-//   fastdds_peer refusals <dir>  publish bad commands (NaN, absurd) and a few good ones to kelp
-//                                running paced; the test then reads kelp's summary.json
+//   fastdds_peer refusals <dir>  publish bad commands (NaN, absurd) to kelp running paced; the
+//                                test then reads kelp's summary.json
 //   fastdds_peer check <dir>     compare <dir>/odom.csv with kelp's <dir>/run/timeseries.csv
 //
 // DDS: domain ROS_DOMAIN_ID; UDPv4 on 127.0.0.1 only, discovery by unicast to 127.0.0.1 (so the
@@ -406,29 +406,30 @@ int refusals() {
     w.torque().z(tz);
     wrench->write(&w);
   };
-  // 4 not finite, 3 absurd (far beyond eight T200s), 2 good.
-  send_wrench(NAN, 0, 0);
-  send_wrench(0, INFINITY, 0);
-  send_wrench(0, 0, NAN);
-  send_wrench(-INFINITY, 0, 0);
-  send_wrench(1e6, 0, 0);
-  send_wrench(0, 5000, 0);
-  send_wrench(0, 0, 1e4);
-  send_wrench(10, 0, 0);
-  send_wrench(0, 0, 1);
-  // 2 not finite ROV velocities, 1 absurd boat velocity, 1 payout without a winch.
-  geometry_msgs::msg::dds_::Twist_ v;
-  v.linear().x(NAN);
-  rov_vel->write(&v);
-  v.linear().x(0);
-  v.angular().z(INFINITY);
-  rov_vel->write(&v);
-  geometry_msgs::msg::dds_::Twist_ b;
-  b.linear().x(100.0);
-  boat_vel->write(&b);
+  // A barrage at 20 Hz for 3 s, every message bad: 4 not finite and 3 absurd wrenches (far
+  // beyond eight T200s), 2 not finite ROV velocities, 1 absurd boat velocity, 1 payout rate
+  // without a winch. Repeated because a volatile reader may skip what a writer sent before it
+  // matched that writer (`ros2 topic pub --once` loses its message the same way).
+  geometry_msgs::msg::dds_::Twist_ v_nan, v_inf, b_fast;
+  v_nan.linear().x(NAN);
+  v_inf.angular().z(INFINITY);
+  b_fast.linear().x(100.0);
   std_msgs::msg::dds_::Float64_ p;
   p.data(0.1);
-  payout->write(&p);
+  for (int i = 0; i < 60; ++i) {
+    send_wrench(NAN, 0, 0);
+    send_wrench(0, INFINITY, 0);
+    send_wrench(0, 0, NAN);
+    send_wrench(-INFINITY, 0, 0);
+    send_wrench(1e6, 0, 0);
+    send_wrench(0, 5000, 0);
+    send_wrench(0, 0, 1e4);
+    rov_vel->write(&v_nan);
+    rov_vel->write(&v_inf);
+    boat_vel->write(&b_fast);
+    payout->write(&p);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
   // Until every sample is acknowledged by kelp's readers (reliable), then a little longer.
   const eprosima::fastrtps::Duration_t ten(10, 0);
   for (DataWriter* w : {wrench, rov_vel, boat_vel, payout})

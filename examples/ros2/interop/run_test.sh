@@ -31,6 +31,8 @@ summary_check() {  # python3 expressions over the summary `s`, each must hold
   python3 - "$out/run/summary.json" "$@" <<'PY'
 import json, math, sys
 s = json.load(open(sys.argv[1]))
+sub = s["ros2"]["subscriptions"]
+w, v, b, p = (sub[k] for k in ("/rov/cmd_wrench", "/rov/cmd_vel", "/boat/cmd_vel", "/tether/cmd_payout"))
 bad = 0
 for expr in sys.argv[2:]:
     ok = bool(eval(expr))
@@ -67,10 +69,10 @@ case "$mode" in
     kelp_pid=
     cat "$out/kelp.log"
     summary_check 's["ros2"]["mode"] == "paced"' \
-      's["ros2"]["subscriptions"]["/rov/cmd_wrench"] == {"received": 9, "accepted": 2, "refused": 7, "refused_not_finite": 4, "refused_out_of_range": 3, "refused_unavailable": 0}' \
-      's["ros2"]["subscriptions"]["/rov/cmd_vel"]["refused_not_finite"] == 2 and s["ros2"]["subscriptions"]["/rov/cmd_vel"]["accepted"] == 0' \
-      's["ros2"]["subscriptions"]["/boat/cmd_vel"]["refused_out_of_range"] == 1 and s["ros2"]["subscriptions"]["/boat/cmd_vel"]["accepted"] == 0' \
-      's["ros2"]["subscriptions"]["/tether/cmd_payout"]["refused_unavailable"] == 1' \
+      'w["received"] >= 70 and w["accepted"] == 0 and w["refused_not_finite"] >= 40 and w["refused_out_of_range"] >= 30 and w["received"] == w["refused"]' \
+      'v["received"] >= 20 and v["refused_not_finite"] == v["received"]' \
+      'b["received"] >= 10 and b["refused_out_of_range"] == b["received"]' \
+      'p["received"] >= 10 and p["refused_unavailable"] == p["received"]' \
       's["ros2"]["published"]["/clock"] == 2000' \
       'math.isfinite(s["energy_j"]) and s["auv"]["second_half_max_depth_error_m"] < 0.3' \
       's["auv"]["max_path_error_m"] < 0.5'
