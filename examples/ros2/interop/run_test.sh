@@ -9,12 +9,13 @@
 set -euo pipefail
 mode=$1 program=$2 peer=$3 scenario=$4 out=$5
 
-if [ -z "${KELP_ROS2_NETNS:-}" ] && command -v unshare >/dev/null && command -v ip >/dev/null &&
+# KELP_ROS2_NO_NETNS=1 skips the namespace (loopback only, as where unshare is not allowed).
+if [ -z "${KELP_ROS2_IN_NETNS:-}" ] && [ -z "${KELP_ROS2_NO_NETNS:-}" ] && command -v unshare >/dev/null && command -v ip >/dev/null &&
   unshare -n true 2>/dev/null; then
-  exec env KELP_ROS2_NETNS=1 unshare -n bash -c 'ip link set lo up && exec bash "$0" "$@"' \
+  exec env KELP_ROS2_IN_NETNS=1 unshare -n bash -c 'ip link set lo up && exec bash "$0" "$@"' \
     "$0" "$@"
 fi
-echo "run_test: $mode, $([ -n "${KELP_ROS2_NETNS:-}" ] && echo "own network namespace" || echo "host network, loopback only")"
+echo "run_test: $mode, $([ -n "${KELP_ROS2_IN_NETNS:-}" ] && echo "own network namespace" || echo "host network, loopback only")"
 
 ROS_DOMAIN_ID=$(((RANDOM % 200) + 1))
 export ROS_DOMAIN_ID
