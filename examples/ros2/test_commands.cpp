@@ -118,3 +118,28 @@ TEST_CASE("ROS 2 velocity commands drive the ROV through its velocity loop") {
   }
   CHECK(loop.state().auv.nu(0) == Approx(0.3).margin(0.1));
 }
+
+TEST_CASE("/tether/cmd_payout drives the winch through ClosedLoop's override, within its limits") {
+  kelp::sim::Scenario sc = calm();
+  sc.winch.enabled = true;  // the scenario file's defaults (e.g. max_speed 0.5 m/s)
+  kelp::sim::ClosedLoop loop(sc);
+  kelp_ros2::PairCommander cmd(loop);
+  const double top = loop.model().winch()->winch().max_speed;
+  CHECK(cmd.payout(3 * top) == kelp_ros2::Refusal::out_of_range);
+  const double length0 = loop.sample().tether_length;
+  for (int i = 0; i < 200; ++i) {  // 2 s paying out at 0.2 m/s, commanded at 100 Hz
+    REQUIRE(cmd.payout(0.2) == kelp_ros2::Refusal::none);
+    cmd.apply();
+    loop.step();
+  }
+  CHECK(cmd.payout_commanded());
+  CHECK(loop.state().tether.payout_rate == Approx(0.2).margin(1e-9));
+  CHECK(loop.sample().tether_length > length0 + 0.25);
+  // 1.5 × the top speed is accepted (within the margin) and limited by the winch.
+  for (int i = 0; i < 300; ++i) {
+    REQUIRE(cmd.payout(1.5 * top) == kelp_ros2::Refusal::none);
+    cmd.apply();
+    loop.step();
+  }
+  CHECK(loop.state().tether.payout_rate == Approx(top).margin(1e-9));
+}
