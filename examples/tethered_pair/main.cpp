@@ -12,6 +12,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#ifdef KELP_WITH_ROS2
+#include "bridge.hpp"
+#endif
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 
@@ -25,6 +28,10 @@ struct Options {
   std::string out = "kelp-run";
   bool quiet = false;
   bool no_plots = false;
+  bool ros2 = false;  // --ros2: live ROS 2 topics over DDS (examples/ros2/)
+#ifdef KELP_WITH_ROS2
+  kelp_ros2::Ros2Options ros2_options;
+#endif
 };
 
 std::string plot_script() {
@@ -52,7 +59,12 @@ int run(const Options& o) {
   if (ro.replay_template.empty())
     std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
                  kelp::sim::replay_template_missing_note().c_str());
+#ifdef KELP_WITH_ROS2
+  const nlohmann::json summary = o.ros2 ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)
+                                        : kelp::sim::run_scenario(o.scenario, ro);
+#else
   const nlohmann::json summary = kelp::sim::run_scenario(o.scenario, ro);
+#endif
   const double duration = summary["simulated_s"], wall = summary["wall_s"];
   const double auv_rms = summary["auv"]["rms_path_error_m"],
                asv_rms = summary["asv"]["rms_distance_to_auv_m"],
@@ -117,7 +129,35 @@ int main(int argc, char** argv) {
   app.add_flag("--no-mcap", no_mcap, "do not write run.mcap");
   app.add_flag("--deterministic", deterministic,
                "the same numbers on every CPU: --kernel portable (see docs/deterministic.md)");
+  bool lockstep = false;
+  double ros2_speed = 1.0, clock_timeout = 10.0;
+  app.add_flag("--ros2", o.ros2,
+               "publish the run live as ROS 2 topics over DDS and take commands from ROS 2 "
+               "(paced to real time; see README, \"With ROS 2\")");
+  app.add_flag("--ros2-lockstep", lockstep,
+               "with --ros2: step in lockstep with /clock (each rosgraph_msgs/Clock received is a "
+               "time to simulate to) instead of real time");
+  app.add_option("--ros2-speed", ros2_speed, "with --ros2: simulated seconds per second")
+      ->check(CLI::Range(1e-3, 1e3));
+  app.add_option("--ros2-clock-timeout", clock_timeout,
+                 "with --ros2-lockstep: end the run after this long without /clock [s]")
+      ->check(CLI::Range(1e-3, 1e6));
   CLI11_PARSE(app, argc, argv);
+  if (lockstep && !o.ros2) o.ros2 = true;
+#ifdef KELP_WITH_ROS2
+  o.ros2_options.lockstep = lockstep;
+  o.ros2_options.speed = ros2_speed;
+  o.ros2_options.clock_timeout = clock_timeout;
+#else
+  if (o.ros2) {
+    std::fprintf(stderr,
+                 "kelp-tethered-pair: built without ROS 2 topics (configure with "
+                 "-DKELP_BUILD_ROS2=ON; needs Cyclone DDS)\n");
+    return 3;
+  }
+  (void)ros2_speed;
+  (void)clock_timeout;
+#endif
   if (deterministic && !kernel.empty() && kernel != "portable") {
     std::fprintf(stderr, "kelp-tethered-pair: --deterministic pins --kernel portable, not %s\n",
                  kernel.c_str());

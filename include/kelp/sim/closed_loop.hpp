@@ -217,6 +217,7 @@ class ClosedLoop {
       to_vehicle(*pm, asv.command, inputs_.asv_commands);
     else
       inputs_.asv.tau = asv.wrench;
+    if (winch_override_ && model_.winch()) inputs_.winch_payout_rate = *winch_override_;
     report_ = kelp::system::step(model_, workspace_, state_, inputs_, dt);
     solver_stats_ += report_;
     if (report_.tether.partings > 0) {
@@ -287,6 +288,11 @@ class ClosedLoop {
   void set_asv_override(const kelp::control::AsvCommand* command) { asv_override_ = command; }
   /// \brief The command overriding the ASV's controller, or null.
   const kelp::control::AsvCommand* asv_override() const { return asv_override_; }
+  /// \brief Commands the winch's payout rate [m/s] by `*rate` instead of its strategy from the
+  /// next step on (e.g. a ROS 2 node's /tether/cmd_payout); the winch still limits it
+  /// (tether::limited_payout_rate). Ignored without a winch. Not owned, read at every step.
+  /// Null: the strategy commands it again.
+  void set_winch_override(const double* rate) { winch_override_ = rate; }
   /// \brief The ASV's command for the next step.
   const kelp::control::AsvCommand& asv_command() const { return *asv_command_; }
   /// \brief The sample of the current state (what a log row holds; its vehicle states point into
@@ -683,6 +689,7 @@ class ClosedLoop {
   const kelp::control::AsvCommand* asv_command_ = nullptr;
   const kelp::control::AuvCommand* auv_override_ = nullptr;  // set_auv_override()
   const kelp::control::AsvCommand* asv_override_ = nullptr;  // set_asv_override()
+  const double* winch_override_ = nullptr;                   // set_winch_override()
   LogRow sample_;
   RunMetrics metrics_;
   kelp::system::SolverStatsd solver_stats_;
