@@ -230,6 +230,10 @@ nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::Run
   kelp::sim::ClosedLoopOptions lo;
   lo.scenario_file = run.scenario_file;
   lo.log = log.get();
+  lo.on_sample = run.on_sample;
+  // The same files as every run: run.mcap (the scenario's output.mcap), and at the end
+  // summary.json and replay.html (finish_run).
+  std::unique_ptr<kelp::sim::BagRecorder> bag = kelp::sim::open_run_bag(sc, run, lo.on_sample);
   kelp::sim::ClosedLoop loop(sc, setup, lo);
   PairCommander commander(loop);
 
@@ -272,11 +276,11 @@ nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::Run
   }
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
   if (log) log->close();
+  if (bag) bag->close();
 
   nlohmann::json summary = loop.summary();
   summary["wall_s"] = wall;
   summary["realtime_factor"] = loop.time() / wall;
-  if (!run.version.empty()) summary["kelp_version"] = run.version;
   nlohmann::json r;
   r["mode"] = o.lockstep ? "lockstep" : "paced";
   if (!o.lockstep) r["speed"] = o.speed;
@@ -294,11 +298,7 @@ nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::Run
     r["subscriptions"]["/clock"] = {{"received", subs.clock_received},
                                     {"refused", subs.clock_refused}};
   summary["ros2"] = r;
-  if (!run.out.empty()) {
-    std::ofstream f(std::filesystem::path(run.out) / "summary.json");
-    f << summary.dump(2) << '\n';
-    if (!f) throw kelp::error("cannot write summary.json in " + run.out);
-  }
+  kelp::sim::finish_run(summary, run);
   return summary;
 }
 

@@ -70,11 +70,47 @@ struct RunOptions {
   std::string replay_template;
 };
 
+/// \brief The run's ROS 2 bag, run.mcap in `o.out`, when the scenario asks for one
+/// (`output.mcap`, the default) and there is an output directory: `on_sample` is wrapped so that
+/// every sample is recorded before it is passed on. Close the recorder after the run.
+/// \returns the recorder, or null when no bag is written.
+inline std::unique_ptr<BagRecorder> open_run_bag(const Scenario& sc, const RunOptions& o,
+                                                 std::function<void(const LogRow&)>& on_sample) {
+  if (!sc.mcap || o.out.empty()) return nullptr;
+  std::filesystem::create_directories(o.out);
+  auto bag = std::make_unique<BagRecorder>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
+  on_sample = [b = bag.get(), user = on_sample](const LogRow& r) {
+    b->record(r);
+    if (user) user(r);
+  };
+  return bag;
+}
+
+/// \brief What a run leaves after its last step: the summary's `kelp_version`, summary.json
+/// (indented by 2) in `o.out` and, with a `replay_template`, replay.html there (write_replay(),
+/// `source` named in it). run_scenario() calls it, and so does a program that runs its own loop
+/// (kelp-tethered-pair --ros2), so that every run directory has the same files.
+/// \throws kelp::error when a file cannot be written (replay_error for replay.html).
+inline void finish_run(nlohmann::json& summary, const RunOptions& o,
+                       const std::string& source = "kelp-tethered-pair") {
+  if (!o.version.empty()) summary["kelp_version"] = o.version;
+  if (o.out.empty()) return;
+  std::ofstream f(std::filesystem::path(o.out) / "summary.json");
+  f << summary.dump(2) << '\n';
+  if (!f) throw kelp::error("cannot write summary.json in " + o.out);
+  f.close();
+  if (!o.replay_template.empty()) {
+    ReplayOptions ro;
+    ro.source = source;
+    write_replay(o.out, o.replay_template, ro);
+  }
+}
+
 /// \brief Runs a scenario as kelp-tethered-pair does: simulate() (with the CSV log in `out`),
-/// the summary's `kelp_version`, summary.json (the summary, indented by 2) in `out`; with the
-/// scenario's `output.mcap` (the default) also run.mcap, the run as a ROS 2 bag (BagRecorder:
-/// every sample, the markers at the node rate), and with a `replay_template`, replay.html (the
-/// 3-D replay, docs/replay.md) in `out`.
+/// then finish_run(): the summary's `kelp_version`, summary.json in `out` and, with a
+/// `replay_template`, replay.html (the 3-D replay, docs/replay.md); with the scenario's
+/// `output.mcap` (the default) also run.mcap, the run as a ROS 2 bag (open_run_bag(): every
+/// sample, the markers at the node rate).
 /// \returns the summary (summary.json's content).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
 /// file cannot be written (replay_error for replay.html).
@@ -84,30 +120,10 @@ inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {})
   so.progress = o.progress;
   so.scenario_file = o.scenario_file;
   so.on_sample = o.on_sample;
-  // The ROS 2 bag: every sample's messages, the markers at the node rate.
-  std::unique_ptr<BagRecorder> bag;
-  if (sc.mcap && !o.out.empty()) {
-    std::filesystem::create_directories(o.out);
-    bag = std::make_unique<BagRecorder>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
-    so.on_sample = [&bag, user = o.on_sample](const LogRow& r) {
-      bag->record(r);
-      if (user) user(r);
-    };
-  }
+  std::unique_ptr<BagRecorder> bag = open_run_bag(sc, o, so.on_sample);
   nlohmann::json summary = simulate(sc, so);
   if (bag) bag->close();
-  if (!o.version.empty()) summary["kelp_version"] = o.version;
-  if (!o.out.empty()) {
-    std::ofstream f(std::filesystem::path(o.out) / "summary.json");
-    f << summary.dump(2) << '\n';
-    if (!f) throw kelp::error("cannot write summary.json in " + o.out);
-    f.close();
-    if (!o.replay_template.empty()) {
-      ReplayOptions ro;
-      ro.source = "kelp-tethered-pair";
-      write_replay(o.out, o.replay_template, ro);
-    }
-  }
+  finish_run(summary, o);
   return summary;
 }
 
