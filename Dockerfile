@@ -13,11 +13,11 @@ ARG BASE=debian:bookworm
 FROM ${BASE} AS build
 ENV DEBIAN_FRONTEND=noninteractive
 WORKDIR /src
-# The build dependencies have one home, scripts/install-deps (the demo's packages + the Python
-# package's: pybind11, Python's headers, numpy).
-COPY scripts/install-deps scripts/install-deps
-RUN scripts/install-deps python
 COPY . .
+# The build dependencies have one home, scripts/install-deps (the demo's packages + the Python
+# package's: pybind11, Python's headers, numpy), run on the whole tree (.dockerignore keeps the
+# docs, tests and build trees out of it), since a profile may install from files in it.
+RUN scripts/install-deps python
 # Release, no tests or benchmarks; the examples and the Python package on (a missing dependency
 # is an error). The Python package goes where Debian's python3 looks in /usr/local.
 RUN cmake -S . -B build/image -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr/local \
@@ -41,8 +41,8 @@ ENV DEBIAN_FRONTEND=noninteractive
 RUN apt-get update \
     && apt-get install -y --no-install-recommends python3 python3-numpy python3-matplotlib \
        libstdc++6 libgcc-s1 \
-    && apt-get clean && rm -rf /var/lib/apt/lists/* /usr/share/doc/* /usr/share/man/* \
-    && find /usr/lib/python3 -name __pycache__ -prune -exec rm -rf {} +
+    && apt-get clean && rm -rf /var/lib/apt/lists/* /usr/share/man/* \
+    && find /usr/share/doc -type f ! -name copyright -delete
 # The installed tree: /usr/local/bin/kelp-*, /usr/local/share/kelp (plot_run.py, plot_sweep.py,
 # the scenarios, sitl/params and sitl/scenarios, the sweeps; share/kelp/replay when built) and
 # the Python package in /usr/local/lib/python3/dist-packages/kelp.
