@@ -19,10 +19,12 @@ COPY . .
 # docs, tests and build trees out of it), since a profile may install from files in it.
 RUN scripts/install-deps python
 # Release, no tests or benchmarks; the examples and the Python package on (a missing dependency
-# is an error). The Python package goes where Debian's python3 looks in /usr/local.
+# is an error). The Python package goes where Debian's python3 looks in /usr/local
+# (/usr/local/lib/python3.X/dist-packages; site-packages is not on its path).
 RUN cmake -S . -B build/image -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr/local \
       -DKELP_BUILD_TESTS=OFF -DKELP_BUILD_BENCHMARKS=OFF -DKELP_BUILD_EXAMPLES=ON \
-      -DKELP_BUILD_PYTHON=ON -DKELP_PYTHON_INSTALL_DIR=lib/python3/dist-packages
+      -DKELP_BUILD_PYTHON=ON -DKELP_PYTHON_INSTALL_DIR="lib/python3.$(python3 -c \
+        'import sys; print(sys.version_info.minor)')/dist-packages"
 # Only what `cmake --install` installs (not the hello examples): the programs present in this
 # tree and the Python module; the install below fails if any other installed target is unbuilt.
 RUN targets=$(cmake --build build/image --target help | sed -n 's/^\.\.\. //p' | cut -d' ' -f1 \
@@ -45,7 +47,7 @@ RUN apt-get update \
     && find /usr/share/doc -type f ! -name copyright -delete
 # The installed tree: /usr/local/bin/kelp-*, /usr/local/share/kelp (plot_run.py, plot_sweep.py,
 # the scenarios, sitl/params and sitl/scenarios, the sweeps; share/kelp/replay when built) and
-# the Python package in /usr/local/lib/python3/dist-packages/kelp.
+# the Python package in /usr/local/lib/python3.X/dist-packages/kelp.
 COPY --from=build /staging/usr/local/ /usr/local/
 # A non-root user; any --user uid works too (matplotlib's cache goes to /tmp).
 RUN useradd --create-home --uid 1000 --shell /bin/bash kelp \
