@@ -129,7 +129,8 @@ def main(image, outdir, seconds, run_opts):
     p = docker("run", "--rm", *run_opts, "-v", "%s:/out" % os.path.abspath(outdir), image,
                "python3", "/usr/local/share/kelp/plot_run.py", "/out/run")
     check(p.returncode == 0, "plot_run.py in the image failed on the SITL log: " + p.stderr[-500:])
-    check(os.path.getsize(os.path.join(log, "trajectories.png")) > 10000, "no trajectories.png")
+    png = os.path.join(log, "trajectories.png")
+    check(os.path.exists(png) and os.path.getsize(png) > 10000, "no trajectories.png")
 
     if fake_sitl.failures:
         print("%d check(s) failed" % len(fake_sitl.failures))
