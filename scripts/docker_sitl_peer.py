@@ -21,6 +21,7 @@ import subprocess
 import sys
 import time
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples",
                                 "sitl", "tests", "bridge"))
 import fake_sitl  # noqa: E402  (the fake peer: packets, reply validation, lockstep)
