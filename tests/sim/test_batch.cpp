@@ -12,7 +12,7 @@ namespace ks = kelp::sim;
 
 namespace {
 
-ks::Scenario short_run() {
+ks::Scenario short_batch_run() {
   ks::Scenario sc;
   sc.duration = 2.0;
   return sc;
@@ -39,7 +39,7 @@ std::vector<double> actions(std::size_t n, int call) {
 std::vector<double> run(unsigned threads) {
   ks::BatchOptions o;
   o.threads = threads;
-  ks::Batch b(short_run(), 5, 11, o);
+  ks::Batch b(short_batch_run(), 5, 11, o);
   CHECK(b.threads() == threads);
   std::vector<double> out = snapshot(b);
   b.step(3);  // the controllers
@@ -64,13 +64,13 @@ TEST_CASE("a batch's numbers do not depend on the thread count", "[sim][batch]")
 TEST_CASE("world i of a batch is the scenario with seed + i", "[sim][batch]") {
   ks::BatchOptions o;
   o.threads = 2;
-  ks::Batch b(short_run(), 3, 20, o);
+  ks::Batch b(short_batch_run(), 3, 20, o);
   CHECK(b.size() == 3);
   CHECK(b.action_size() == 6);
   // The controllers fly: world i is the ClosedLoop of seed 20 + i.
   b.step(5);
   for (std::size_t i = 0; i < 3; ++i) {
-    ks::Scenario sc = short_run();
+    ks::Scenario sc = short_batch_run();
     sc.seed = 20 + i;
     ks::ClosedLoop loop(sc);
     loop.run_for(0.5);
@@ -87,7 +87,7 @@ TEST_CASE("world i of a batch is the scenario with seed + i", "[sim][batch]") {
   const std::vector<double> a = actions(3, 0);
   b.step(4, a.data());
   for (std::size_t i = 0; i < 3; ++i) {
-    ks::Scenario sc = short_run();
+    ks::Scenario sc = short_batch_run();
     sc.seed = 20 + i;
     ks::TetheredPairEnv env(sc);
     env.fly_by_controllers(true);
@@ -105,7 +105,7 @@ TEST_CASE("world i of a batch is the scenario with seed + i", "[sim][batch]") {
 TEST_CASE("a batch ends, resets, and refuses bad actions", "[sim][batch]") {
   ks::BatchOptions o;
   o.threads = 2;
-  ks::Batch b(short_run(), 2, 1, o);
+  ks::Batch b(short_batch_run(), 2, 1, o);
   const double* address = b.auv_position().data();
   std::vector<double> a = actions(2, 0);
   a[7] = std::nan("");
@@ -125,13 +125,13 @@ TEST_CASE("a batch ends, resets, and refuses bad actions", "[sim][batch]") {
   CHECK(b.ended()(0, 1) == 0);
   CHECK(b.time()(0, 0) == 0.0);
   CHECK(b.auv_position().data() == address);  // the arrays stay put
-  CHECK_THROWS_AS(ks::Batch(short_run(), 0, 1), kelp::invalid_argument);
+  CHECK_THROWS_AS(ks::Batch(short_batch_run(), 0, 1), kelp::invalid_argument);
 }
 
 TEST_CASE("a batch step allocates nothing", "[sim][batch][malloc]") {
   ks::BatchOptions o;
   o.threads = 1;  // Eigen's malloc check is one flag for the process
-  ks::Batch b(short_run(), 2, 1, o);
+  ks::Batch b(short_batch_run(), 2, 1, o);
   const std::vector<double> a = actions(2, 0);
   b.step(1, a.data());
   Eigen::internal::set_is_malloc_allowed(false);

@@ -1,6 +1,8 @@
 // Smallest program a downstream user writes: include the umbrella header and use it.
-#include <cstdio>
+// kelp/kelp.hpp first: this file is where the packaging test compiles it on its own.
 #include <kelp/kelp.hpp>
+
+#include <cstdio>
 
 int main() {
   const auto R = kelp::rotation_zyx(0.0, 0.0, kelp::pi / 2);

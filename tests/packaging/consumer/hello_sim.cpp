@@ -1,13 +1,14 @@
 // A downstream program on kelp::sim, built against the installed package: it writes a scenario
 // file, loads it, runs 10 s of the closed loop with a CSV log through the public API and checks
 // what the run must show. Exit status 0 when every check holds.
+// kelp/sim.hpp first: this file is where the packaging test compiles it on its own.
+#include "kelp/sim.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
-
-#include "kelp/sim.hpp"
 
 namespace {
 
