@@ -233,7 +233,7 @@ nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::Run
   lo.on_sample = run.on_sample;
   // The same files as every run: run.mcap (the scenario's output.mcap), and at the end
   // summary.json and replay.html (finish_run).
-  std::unique_ptr<kelp::sim::BagRecorder> bag = kelp::sim::open_run_bag(sc, run, lo.on_sample);
+  std::unique_ptr<kelp::sim::RunBag> bag = kelp::sim::open_run_bag(sc, run, lo.on_sample);
   kelp::sim::ClosedLoop loop(sc, setup, lo);
   PairCommander commander(loop);
 

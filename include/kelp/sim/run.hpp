@@ -16,6 +16,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "kelp/core/error.hpp"
 #include "kelp/sim/closed_loop.hpp"
@@ -70,15 +71,42 @@ struct RunOptions {
   std::string replay_template;
 };
 
+/// \brief A run's ROS 2 bag (BagRecorder), opened at the run's first sample (t = 0, taken when
+/// the loop is built), so that a scenario which fails before it, e.g. with a tether too short
+/// for its attachment points, leaves no file behind.
+class RunBag {
+ public:
+  /// \brief The bag `file` (its directory created when it opens), markers at `marker_rate` [Hz].
+  RunBag(std::filesystem::path file, double marker_rate)
+      : file_(std::move(file)), marker_rate_(marker_rate) {}
+  /// \brief Records sample `r`, opening the bag first if it is not open yet.
+  /// \throws kelp::error when the file cannot be written.
+  void record(const LogRow& r) {
+    if (!bag_) {
+      if (file_.has_parent_path()) std::filesystem::create_directories(file_.parent_path());
+      bag_ = std::make_unique<BagRecorder>(file_, marker_rate_);
+    }
+    bag_->record(r);
+  }
+  /// \brief Finishes the bag if it was opened.
+  void close() {
+    if (bag_) bag_->close();
+  }
+
+ private:
+  std::filesystem::path file_;
+  double marker_rate_;
+  std::unique_ptr<BagRecorder> bag_;
+};
+
 /// \brief The run's ROS 2 bag, run.mcap in `o.out`, when the scenario asks for one
 /// (`output.mcap`, the default) and there is an output directory: `on_sample` is wrapped so that
-/// every sample is recorded before it is passed on. Close the recorder after the run.
-/// \returns the recorder, or null when no bag is written.
-inline std::unique_ptr<BagRecorder> open_run_bag(const Scenario& sc, const RunOptions& o,
-                                                 std::function<void(const LogRow&)>& on_sample) {
+/// every sample is recorded before it is passed on. Close the bag after the run.
+/// \returns the bag, or null when none is written.
+inline std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
+                                            std::function<void(const LogRow&)>& on_sample) {
   if (!sc.mcap || o.out.empty()) return nullptr;
-  std::filesystem::create_directories(o.out);
-  auto bag = std::make_unique<BagRecorder>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
+  auto bag = std::make_unique<RunBag>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
   on_sample = [b = bag.get(), user = on_sample](const LogRow& r) {
     b->record(r);
     if (user) user(r);
@@ -120,7 +148,7 @@ inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {})
   so.progress = o.progress;
   so.scenario_file = o.scenario_file;
   so.on_sample = o.on_sample;
-  std::unique_ptr<BagRecorder> bag = open_run_bag(sc, o, so.on_sample);
+  std::unique_ptr<RunBag> bag = open_run_bag(sc, o, so.on_sample);
   nlohmann::json summary = simulate(sc, so);
   if (bag) bag->close();
   finish_run(summary, o);
