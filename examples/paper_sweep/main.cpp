@@ -112,7 +112,7 @@ struct RunOptions {
   unsigned jobs = 0;
   bool quiet = false, no_plot = false;
   bool keep_series = false;  // runs/<hash>/: timeseries.csv, nodes.csv, summary.json
-  bool mcap = false;  // each run's ROS 2 bag, runs/<hash>.mcap
+  bool mcap = false;         // each run's ROS 2 bag, runs/<hash>.mcap
 };
 
 int run(const RunOptions& o) {
