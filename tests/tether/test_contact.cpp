@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
@@ -36,8 +37,26 @@ ke::Cylinder cylinder(const Vector3d& a, const Vector3d& b, double r, double mu 
   return c;
 }
 
+// The height-field files, in a directory of their own under the system's temporary directory
+// (removed when the test process ends), not in the working directory.
+const std::filesystem::path& scratch_dir() {
+  static const struct Dir {
+    std::filesystem::path path;
+    Dir()
+        : path(std::filesystem::temp_directory_path() /
+               ("kelp_test_contact_" + std::to_string(std::random_device{}()))) {
+      std::filesystem::create_directories(path);
+    }
+    ~Dir() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  } dir;
+  return dir.path;
+}
+
 std::string write_file(const std::string& name, const std::string& text) {
-  const std::string path = "kelp_test_" + name + ".txt";
+  const std::string path = (scratch_dir() / (name + ".txt")).string();
   std::ofstream(path) << text;
   return path;
 }
