@@ -14,8 +14,10 @@
 //   - beside a reference.csv (the samples in kelp's own frames, NED/FRD, at full precision, from
 //     tests/ros2/test_ros2_bag.cpp) poses, velocities, the IMU and the end wrenches are recomputed
 //     here in ROS's frames (REP 103: ENU world, FLU body) and compared to 1e-9;
-//   - beside a timeseries.csv only (kelp-tethered-pair's runs) the odometry positions are compared
-//     with the CSV's 6 significant digits.
+//   - beside a timeseries.csv only (kelp-tethered-pair's and kelp-sitl's runs) each logged sample is
+//     compared with the CSV's 6 significant digits: both odometries' positions, attitudes (from
+//     the CSV's Euler angles) and logged body velocities, the magnitude of the tether's force at
+//     each end (the CSV's tensions) and every thruster's command and thrust.
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { parse } from "@foxglove/rosmsg";
 import { MessageReader } from "@foxglove/rosmsg2-serialization";
@@ -85,6 +87,25 @@ function near(file, what, got, want, tol) {
   return true;
 }
 const v3 = (m) => [m.x, m.y, m.z];
+// A value against the CSV's 6 significant digits (absolute 6e-6 below 1).
+function csvNear(file, what, got, want) {
+  for (let i = 0; i < want.length; i++) {
+    if (!(Math.abs(got[i] - want[i]) <= 6e-6 * Math.max(1, Math.abs(want[i])))) {
+      fail(file, `${what}[${i}]: ${got[i]} vs CSV ${want[i]}`);
+      return;
+    }
+  }
+}
+// Rotation matrix body → NED of zyx Euler angles (Fossen 2021, eq. 2.18: R = Rz(ψ) Ry(θ) Rx(φ)).
+function rotZYX(phi, theta, psi) {
+  const [cf, sf, ct, st, cp, sp] = [Math.cos(phi), Math.sin(phi), Math.cos(theta), Math.sin(theta),
+    Math.cos(psi), Math.sin(psi)];
+  return [
+    [cp * ct, -sp * cf + cp * st * sf, sp * sf + cp * cf * st],
+    [sp * ct, cp * cf + sf * st * sp, -cp * sf + st * sp * cf],
+    [-st, ct * sf, ct * cf],
+  ];
+}
 
 async function checkBag(file) {
   const buf = fs.readFileSync(file);
@@ -227,19 +248,49 @@ async function checkBag(file) {
         fail(file, `no sample at t = ${r.t} (nearest ${best} s away)`);
         continue;
       }
+      const forces = one("/tether/end_forces", ns) ?? [];
       for (const [who, col] of [["boat", "asv"], ["rov", "auv"]]) {
         const odom = one(`/${who}/odom`, ns);
         if (!odom) {
           fail(file, `/${who}/odom: nothing at t = ${r.t}`);
           continue;
         }
-        const want = enu([r[`${col}_x`], r[`${col}_y`], r[`${col}_z`]]);
-        const got = v3(odom[0].pose.pose.position);
-        // The CSV has 6 significant digits.
-        for (let i = 0; i < 3; i++) {
-          if (!(Math.abs(got[i] - want[i]) <= 6e-6 * Math.max(1, Math.abs(want[i])))) {
-            fail(file, `/${who}/odom position[${i}] ${got[i]} vs CSV ${want[i]} at t = ${r.t}`);
-          }
+        const at = `at t = ${r.t}`;
+        const o = odom[0];
+        csvNear(file, `/${who}/odom position ${at}`, v3(o.pose.pose.position),
+          enu([r[`${col}_x`], r[`${col}_y`], r[`${col}_z`]]));
+        // Attitude: the CSV's zyx Euler angles (6 digits, so ~1e-5 rad) as ROS's rotation.
+        const R = rotZYX(r[`${col}_roll`], r[`${col}_pitch`], r[`${col}_yaw`]);
+        const q = o.pose.pose.orientation;
+        near(file, `/${who}/odom orientation ${at}`, rot(q.w, q.x, q.y, q.z).flat(),
+          mul(mul(ENU_NED, R), FRD_FLU).flat(), 3e-5);
+        // Body velocities, FRD → FLU: the boat logs u, v and r, the ROV u, v and w.
+        const lin = v3(o.twist.twist.linear);
+        if (who === "boat") {
+          csvNear(file, `/boat/odom twist ${at}`, [lin[0], lin[1], o.twist.twist.angular.z],
+            [r.asv_u, -r.asv_v, -r.asv_r]);
+        } else {
+          csvNear(file, `/rov/odom twist ${at}`, lin, flu([r.auv_u, r.auv_v, r.auv_w]));
+        }
+        // The tether's force on each vehicle: its magnitude is the CSV's tension at that end.
+        const w = forces.find((x) => x.header.frame_id === `${who}/base_link`);
+        if (!w) {
+          fail(file, `/tether/end_forces: no ${who} end ${at}`);
+        } else {
+          const F = v3(w.wrench.force);
+          csvNear(file, `/tether/end_forces ${who} |force| ${at}`, [Math.hypot(...F)],
+            [r[`tension_${col}`]]);
+        }
+        // Thrusters: velocity = the normalised command, effort = the thrust [N], motor order.
+        const th = one(`/${who}/thrusters`, ns);
+        const names = who === "boat" ? ["port", "starboard"] : [1, 2, 3, 4, 5, 6, 7, 8];
+        if (!th || th[0].effort.length !== names.length) {
+          fail(file, `/${who}/thrusters: no ${names.length} thrusters ${at}`);
+        } else {
+          csvNear(file, `/${who}/thrusters effort ${at}`, Array.from(th[0].effort),
+            names.map((n) => r[`${col}_thrust_${n}`]));
+          csvNear(file, `/${who}/thrusters velocity ${at}`, Array.from(th[0].velocity),
+            names.map((n) => r[`${col}_command_${n}`]));
         }
       }
       compared++;
