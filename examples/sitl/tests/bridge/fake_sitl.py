@@ -345,6 +345,17 @@ def main(program, outdir):
         rows = f.readlines()
     check("tension_auv" in header and "auv_thrust_8" in header and len(rows) > 100,
           "timeseries.csv: %d rows" % len(rows))
+    # The run's 3-D replay (its data marked as kelp-sitl's) and its ROS 2 bag, whose contents
+    # tests/ros2's ros2_mcap_node_check compares with timeseries.csv.
+    replay = os.path.join(log, "replay.html")
+    check(os.path.exists(replay), "no replay.html in the SITL log")
+    if os.path.exists(replay):
+        with open(replay, encoding="utf-8") as f:
+            page = f.read()
+        check(re.search(r'"source"\s*:\s*"kelp-sitl"', page) is not None,
+              "replay.html does not hold kelp-sitl's run")
+    mcap = os.path.join(log, "run.mcap")
+    check(os.path.exists(mcap) and os.path.getsize(mcap) > 1000, "no run.mcap in the SITL log")
     plot = os.path.join(here, "..", "..", "..", "tethered_pair", "plot_run.py")
     python = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
     check(subprocess.call([python, plot, log]) == 0, "plot_run.py failed on the SITL log")
