@@ -1,0 +1,9 @@
+#include "kelp/sim/version.hpp"
+
+namespace kelp {
+namespace sim {
+
+const char* version() noexcept { return KELP_VERSION_STRING; }
+
+}  // namespace sim
+}  // namespace kelp
