@@ -18,12 +18,12 @@ COPY . .
 # package's: pybind11, Python's headers, numpy), run on the whole tree (.dockerignore keeps the
 # docs, tests and build trees out of it), since a profile may install from files in it.
 RUN scripts/install-deps python
-# Release, no tests or benchmarks; the examples and the Python package on (a missing dependency
-# is an error). The Python package goes where Debian's python3 looks in /usr/local
+# Release, no tests or benchmarks; the examples, the programs (apps/) and the Python package on
+# (a missing dependency is an error). The Python package goes where Debian's python3 looks in /usr/local
 # (/usr/local/lib/python3.X/dist-packages; site-packages is not on its path).
 RUN cmake -S . -B build/image -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr/local \
       -DKELP_BUILD_TESTS=OFF -DKELP_BUILD_BENCHMARKS=OFF -DKELP_BUILD_EXAMPLES=ON \
-      -DKELP_BUILD_PYTHON=ON -DKELP_PYTHON_INSTALL_DIR="lib/python3.$(python3 -c \
+      -DKELP_BUILD_APPS=ON -DKELP_BUILD_PYTHON=ON -DKELP_PYTHON_INSTALL_DIR="lib/python3.$(python3 -c \
         'import sys; print(sys.version_info.minor)')/dist-packages"
 # Only what `cmake --install` installs (not the hello examples): the programs present in this
 # tree and the Python module; the install below fails if any other installed target is unbuilt.

@@ -1,5 +1,5 @@
 // libFuzzer target: kelp-sitl's lockstep bridge fed arbitrary datagrams from both autopilots
-// (examples/sitl/bridge.hpp: Bridge::receive and check_timeouts over parse_servo_packet), with
+// (apps/sitl/bridge.hpp: Bridge::receive and check_timeouts over parse_servo_packet), with
 // the calm default world of kelp::sim (its tether in two segments).
 //
 // Input: byte 0 = settings (bit 0: start_together), then records, at most 48:

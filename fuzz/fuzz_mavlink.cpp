@@ -1,5 +1,5 @@
 // libFuzzer target: the MAVLink v1/v2 byte-stream parser and the payload codec
-// (examples/sitl/mavlink/frame.hpp, messages.hpp, wire.hpp, enums.hpp).
+// (apps/sitl/mavlink/frame.hpp, messages.hpp, wire.hpp, enums.hpp).
 //
 // Input: byte 0 seeds the chunking (0: one feed() call; otherwise chunks of 1..64 bytes from a
 // small generator), the rest is the TCP stream.

@@ -1,5 +1,5 @@
 // libFuzzer target: ArduPilot SITL's JSON-interface servo packet parser and the reply writer
-// (examples/sitl/protocol.hpp).
+// (apps/sitl/protocol.hpp).
 //
 // Oracle:
 // - parse_servo_packet(input) accepts exactly the 40-byte packets with the 16-channel magic and

@@ -1,4 +1,4 @@
-// libFuzzer target: kelp-sweep's sweep reader and expansion (examples/paper_sweep/sweep.hpp).
+// libFuzzer target: kelp-sweep's sweep reader and expansion (apps/sweep/sweep.hpp).
 //
 // Oracle: parse_sweep(input) either throws paper_sweep::sweep_error (the documented error, whose
 // message names the file) or returns a sweep with points = the product of the axes' sizes,

@@ -6,7 +6,7 @@ docker_sitl_peer.py IMAGE OUTDIR SECONDS [DOCKER RUN OPTIONS...]
 
 Starts `kelp-sitl --bind 0.0.0.0` in a container of IMAGE with its two JSON ports (9002, 9012)
 published on the host's loopback at two free ephemeral UDP ports, and OUTDIR mounted as /out.
-Plays the two SITL instances from the host the way examples/sitl/tests/bridge/fake_sitl.py does
+Plays the two SITL instances from the host the way apps/sitl/tests/bridge/fake_sitl.py does
 (its packets, its reply checks as ArduPilot's SIM_JSON parser reads them, its lockstep), for
 SECONDS of physics at 1200 Hz: thrusters neutral, then two seconds of the ROV's vertical
 thrusters up and the boat's throttle ahead (the ROV must rise, the boat move forward), then
@@ -22,7 +22,7 @@ import sys
 import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples",
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "apps",
                                 "sitl", "tests", "bridge"))
 import fake_sitl  # noqa: E402  (the fake peer: packets, reply validation, lockstep)
 

@@ -6,7 +6,7 @@
 
 int main(int argc, char** argv) {
   namespace sim = kelp::sim;
-  // A scenario file (schema: examples/tethered_pair/README.md), or the embedded default run.
+  // A scenario file (schema: apps/tethered_pair/README.md), or the embedded default run.
   sim::Scenario sc = argc > 1 ? sim::load_scenario(argv[1]) : sim::Scenario{};
   sc.duration = 30.0;                // [s]
   sim::RunLog log("hello-sim-run");  // timeseries.csv and nodes.csv, at the scenario's rates

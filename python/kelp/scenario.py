@@ -20,7 +20,7 @@ def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseri
     Parameters
     ----------
     path_or_dict : str, os.PathLike, dict or None
-        A scenario file (JSON; its schema is in examples/tethered_pair/README.md), a scenario as a
+        A scenario file (JSON; its schema is in apps/tethered_pair/README.md), a scenario as a
         dict of the same keys, or None for the embedded default run. Errors in a dict name
         ``(dict)`` and the JSON path of the offending key.
     duration : float, optional

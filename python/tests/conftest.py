@@ -10,10 +10,10 @@ import pytest
 
 @pytest.fixture(scope="session")
 def scenarios_dir():
-    """examples/tethered_pair/scenarios of the source tree."""
+    """apps/tethered_pair/scenarios of the source tree."""
     d = os.environ.get("KELP_TEST_SCENARIOS")
     if d is None:
-        d = pathlib.Path(__file__).resolve().parents[2] / "examples" / "tethered_pair" / "scenarios"
+        d = pathlib.Path(__file__).resolve().parents[2] / "apps" / "tethered_pair" / "scenarios"
     return pathlib.Path(d)
 
 
@@ -22,5 +22,5 @@ def tethered_pair_cli():
     """The kelp-tethered-pair program of this build (skips when it was not built)."""
     p = os.environ.get("KELP_TETHERED_PAIR")
     if not p or not os.path.exists(p):
-        pytest.skip("kelp-tethered-pair is not built (KELP_BUILD_EXAMPLES=OFF)")
+        pytest.skip("kelp-tethered-pair is not built (KELP_BUILD_APPS=OFF)")
     return p

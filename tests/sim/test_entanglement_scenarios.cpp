@@ -1,4 +1,4 @@
-// The entanglement scenarios of kelp-tethered-pair (examples/tethered_pair/scenarios/):
+// The entanglement scenarios of kelp-tethered-pair (apps/tethered_pair/scenarios/):
 // - pile_wrap.json: a ROV circles a pile once on its tether while its boat keeps station; the
 //   tether wraps, and `entangled` fires when the chord between the tether's ends leaves the
 //   pile's shadow past the half orbit (computed here from the vehicles' attachment points), and
@@ -24,7 +24,7 @@ namespace ksim = kelp::sim;
 using V3 = kelp::Vector3<double>;
 
 #ifndef KELP_SCENARIO_DIR
-#error "KELP_SCENARIO_DIR must name examples/tethered_pair/scenarios"
+#error "KELP_SCENARIO_DIR must name apps/tethered_pair/scenarios"
 #endif
 
 namespace {

@@ -1,11 +1,11 @@
 #!/usr/bin/env node
-// Assembles the replay page's template (docs/replay.md): replay/page/replay.html with its markers
+// Assembles the replay page's template (docs/replay.md): page/replay.html with its markers
 // /*@KELP_STYLE@*/, /*@KELP_THREE@*/ and /*@KELP_APP@*/ replaced by replay.css, three.js and
 // replay.js. The data marker /*@KELP_DATA@*/ is left for the programs (kelp::sim::write_replay).
 //
 // three.js r160+ ships no UMD build and its three.cjs (r187) only re-exports the ES module, and
 // ES modules do not load from file://. So the ES build (three.core.js, three.module.js; the
-// exact files npm installed from replay/package-lock.json) is turned into one classic script
+// exact files npm installed from package-lock.json) is turned into one classic script
 // that defines window.THREE: each file's body runs in its own function scope (as a module's
 // does, strict mode), its `import {...} from './three.core.js'` becomes a destructuring of the
 // core's exports, and its `export {...}` a returned object. The two files are checked to have
@@ -17,7 +17,7 @@ const fs = require('fs');
 const path = require('path');
 
 function fail(message) {
-  process.stderr.write(`replay/assemble.js: ${message}\n`);
+  process.stderr.write(`apps/replay/page/assemble.js: ${message}\n`);
   process.exit(1);
 }
 
@@ -93,7 +93,7 @@ const core = wrapModule(path.join(threeDir, 'three.core.js'), {});
 const main = wrapModule(path.join(threeDir, 'three.module.js'), { './three.core.js': '__kelpThreeCore' });
 const three = checkScript(
   `// three.js ${pkg.version} (MIT, https://threejs.org; see its LICENSE in node_modules/three), ` +
-    `its ES build wrapped as a classic script by kelp's replay/assemble.js\n` +
+    `its ES build wrapped as a classic script by kelp's apps/replay/page/assemble.js\n` +
     `(function () {\n'use strict';\nconst __kelpThreeCore = ${core};\nconst __kelpThreeMain = ${main};\n` +
     `window.THREE = Object.freeze(Object.assign({}, __kelpThreeCore, __kelpThreeMain));\n})();\n`,
   'three.js'

@@ -11,8 +11,8 @@ try {
   puppeteer = (await import('puppeteer-core')).default;
 } catch (e) {
   console.error(
-    'replay tests: puppeteer-core is not installed in replay/node_modules; run scripts/install-deps\n' +
-      `(or: cd replay && npm ci). (${e.message})`);
+    'replay tests: puppeteer-core is not installed in apps/replay/page/node_modules; run\n' +
+      `scripts/install-deps (or: cd apps/replay/page && npm ci). (${e.message})`);
   process.exit(1);
 }
 

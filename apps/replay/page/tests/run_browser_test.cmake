@@ -6,7 +6,7 @@ endif()
 get_filename_component(replay_dir "${SCRIPT}" DIRECTORY)
 if(NOT EXISTS "${replay_dir}/../node_modules/puppeteer-core/package.json")
   message(FATAL_ERROR "puppeteer-core is not installed in ${replay_dir}/../node_modules: "
-                      "run scripts/install-deps test (or npm ci in replay/)")
+                      "run scripts/install-deps test (or npm ci in apps/replay/page/)")
 endif()
 execute_process(COMMAND "${NODE}" "${SCRIPT}" "${HTML}" RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Follows examples/sitl/README.md's launch lines as a newcomer would, with fake autopilots.
+"""Follows apps/sitl/README.md's launch lines as a newcomer would, with fake autopilots.
 
 Usage: readme_launch.py README BUILD_DIR FAKE_ARDUPILOT WORK_DIR [CMAKE]
 

@@ -9,8 +9,9 @@ if(NOT rc EQUAL 0)
 endif()
 if(NOT EXISTS "${OUT}/replay.html")
   message(FATAL_ERROR "kelp-tethered-pair wrote no ${OUT}/replay.html: the replay page's template "
-                      "was not built (it needs Node.js and three.js in replay/node_modules: run "
-                      "scripts/install-deps test, or npm ci in replay/, then cmake again)")
+                      "was not built (it needs Node.js and three.js in apps/replay/page/node_modules: "
+                      "run scripts/install-deps test, or npm ci in apps/replay/page/, then cmake "
+                      "again)")
 endif()
 file(SIZE "${OUT}/replay.html" size)
 message(STATUS "replay.html: ${size} bytes")

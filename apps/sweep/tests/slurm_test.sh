@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end test of examples/paper_sweep/slurm/ on a real, single-node Slurm started here:
+# End-to-end test of apps/sweep/slurm/ on a real, single-node Slurm started here:
 #
 #   slurm_test.sh PROGRAM SWEEP.json WORKDIR
 #
@@ -152,7 +152,7 @@ say "munged up (pid $munged_pid, socket $socket)"
 
 # --- slurmctld + slurmd ---------------------------------------------------------------------------
 cat >"$conf" <<EOF
-# Single-node test cluster of examples/paper_sweep/tests/slurm_test.sh
+# Single-node test cluster of apps/sweep/tests/slurm_test.sh
 ClusterName=kelptest
 SlurmctldHost=$node(127.0.0.1)
 SlurmctldPort=$ctld_port
