@@ -9,12 +9,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <string>
 
 #ifdef KELP_WITH_ROS2
 #include "bridge.hpp"
 #endif
+#include "common/progress.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 
@@ -50,7 +50,8 @@ int run(const Options& o) {
   // What kelp.run_scenario (Python) runs too: the same summary from the same scenario.
   kelp::sim::RunOptions ro;
   ro.out = o.out;
-  ro.progress = !o.quiet && isatty(2);
+  const bool progress = !o.quiet && isatty(2);
+  if (progress) ro.on_progress = kelp_apps::progress_bar(o.scenario.duration);
   ro.scenario_file = o.scenario_file;
   ro.version = KELP_VERSION_STRING;
   // The 3-D replay's page template: installed, or this build's (KELP_REPLAY_TEMPLATE_BUILD);
@@ -60,15 +61,17 @@ int run(const Options& o) {
     std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
                  kelp::sim::replay_template_missing_note().c_str());
 #ifdef KELP_WITH_ROS2
-  const nlohmann::json summary = o.ros2 ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)
-                                        : kelp::sim::run_scenario(o.scenario, ro);
+  const kelp::sim::RunSummary summary = o.ros2
+                                            ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)
+                                            : kelp::sim::run_scenario(o.scenario, ro);
 #else
-  const nlohmann::json summary = kelp::sim::run_scenario(o.scenario, ro);
+  const kelp::sim::RunSummary summary = kelp::sim::run_scenario(o.scenario, ro);
 #endif
-  const double duration = summary["simulated_s"], wall = summary["wall_s"];
-  const double auv_rms = summary["auv"]["rms_path_error_m"],
-               asv_rms = summary["asv"]["rms_distance_to_auv_m"],
-               t_max = summary["tether"]["max_tension_n"];
+  if (progress) kelp_apps::progress_done();
+  const double duration = summary.simulated_s, wall = summary.wall_s.value_or(0.0);
+  const double auv_rms = summary.auv.rms_path_error_m,
+               asv_rms = summary.asv.rms_distance_to_auv_m,
+               t_max = summary.tether.max_tension_n;
 
   std::string plots;
   if (!o.no_plots) {
@@ -87,14 +90,12 @@ int run(const Options& o) {
       duration, wall, duration / wall, auv_rms, asv_rms, t_max, o.out.c_str(),
       o.scenario.mcap ? ", run.mcap" : "", ro.replay_template.empty() ? "" : ", replay.html",
       plots.c_str());
-  const nlohmann::json& ts = summary["tether_solver"];
+  const kelp::sim::SolverSummary& ts = summary.tether_solver;
   std::printf(
       "kelp-tethered-pair: tether solver (%s): %.2f Newton iterations per step on average, at "
       "most %d in one step; %ld retried steps, %ld explicit fallbacks\n",
-      ts["integrator"].get<std::string>().c_str(),
-      ts["newton_iterations_per_step_mean"].get<double>(),
-      ts["newton_iterations_per_step_max"].get<int>(), ts["retried_steps"].get<long>(),
-      ts["explicit_fallbacks"].get<long>());
+      ts.integrator.c_str(), ts.newton_iterations_per_step_mean, ts.newton_iterations_per_step_max,
+      ts.retried_steps, ts.explicit_fallbacks);
   return 0;
 }
 

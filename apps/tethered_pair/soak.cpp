@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
     // Between two observations only the controllers and the step run: no allocation allowed.
     Eigen::internal::set_is_malloc_allowed(v.step < warm_up);
   };
-  nlohmann::json summary;
+  kelp::sim::RunSummary summary;
   try {
     summary = kelp::sim::simulate(sc, o);
   } catch (const std::exception& e) {
@@ -232,23 +232,23 @@ int main(int argc, char** argv) {
                  std::to_string(lo) + ", " + std::to_string(hi) + "] J by more than their spread");
   }
   expect(fallbacks == 0, std::to_string(fallbacks) + " tether steps redone explicitly");
-  const nlohmann::json& solver = summary["tether_solver"];
-  expect(solver["explicit_fallbacks"] == fallbacks && solver["retried_steps"] == retries,
-         "summary's tether_solver disagrees with the steps' reports: " + solver.dump());
-  const double late_auv = summary["auv"]["second_half_max_path_error_m"];
-  const double late_asv = summary["asv"]["second_half_max_distance_to_auv_m"];
+  const kelp::sim::SolverSummary& solver = summary.tether_solver;
+  expect(solver.explicit_fallbacks == fallbacks && solver.retried_steps == retries,
+         "summary's tether_solver disagrees with the steps' reports: " +
+             kelp::sim::solver_summary_json(solver));
+  const double late_auv = summary.auv.second_half_max_path_error_m;
+  const double late_asv = summary.asv.second_half_max_distance_to_auv_m;
   expect(late_auv < 20.0, "ROV " + std::to_string(late_auv) + " m off its path");
   expect(late_asv < 25.0, "boat " + std::to_string(late_asv) + " m from the ROV");
   std::printf("soak: %.2f h simulated in %.1f s wall, %.0fx real time\n", hours,
-              summary["wall_s"].get<double>(), summary["realtime_factor"].get<double>());
+              summary.wall_s.value_or(0.0), summary.realtime_factor.value_or(0.0));
   std::printf(
       "soak: worst tether residual %.3g x tolerance, %ld retried steps, %ld explicit "
       "fallbacks\n",
       worst_residual_ratio, retries, fallbacks);
   std::printf("soak: Newton iterations per step %.3f on average, at most %d (budget %d)\n",
-              solver["newton_iterations_per_step_mean"].get<double>(),
-              solver["newton_iterations_per_step_max"].get<int>(),
-              solver["newton_budget"].get<int>());
+              solver.newton_iterations_per_step_mean, solver.newton_iterations_per_step_max,
+              solver.newton_budget);
   std::printf("soak: clock drift %.3g s, wave elevation error %.3g m\n", worst_clock, worst_wave);
   std::printf("soak: %ld heap allocations after the first minute, resident memory %+ld KiB%s\n",
               allocations_after_warm_up, rss_growth,

@@ -1,16 +1,18 @@
 /// \file
-/// \brief kelp::sim, the optional component the programs sit on: scenario files, the world a
-/// scenario builds, the closed loop (kelp's controllers flying the tethered pair), the run log,
-/// a gym-style environment's core (pair_env.hpp) and a batch of worlds on a thread pool
-/// (batch.hpp: a program that uses it links Threads::Threads).
+/// \brief kelp::sim, the compiled library the programs sit on: scenario files, the world a
+/// scenario builds, the closed loop (kelp's controllers flying the tethered pair), its typed
+/// summary, the run's outputs (CSV log, run.mcap, replay.html), a gym-style environment's core
+/// (pair_env.hpp) and a batch of worlds on a thread pool (batch.hpp).
 ///
-/// Needs nlohmann-json besides Eigen: link the target kelp::sim, found with
-/// `find_package(kelp CONFIG REQUIRED COMPONENTS sim)`. Not included by kelp/kelp.hpp.
+/// Link the target kelp::sim, found with `find_package(kelp CONFIG REQUIRED COMPONENTS sim)`; its
+/// headers declare, the library (built once, src/) defines, so a program on it compiles in
+/// seconds. Not included by kelp/kelp.hpp.
 #pragma once
 
 #include "kelp/sim/batch.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/entanglement.hpp"
+#include "kelp/sim/navigation.hpp"
 #include "kelp/sim/pair_env.hpp"
 #include "kelp/sim/replay.hpp"
 #include "kelp/sim/ros2.hpp"
@@ -18,6 +20,7 @@
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/scenario_reader.hpp"
-#include "kelp/sim/solver_report.hpp"
+#include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"
+#include "kelp/sim/version.hpp"
 #include "kelp/sim/world.hpp"

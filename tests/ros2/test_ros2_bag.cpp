@@ -9,6 +9,7 @@
 
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run.hpp"
+#include "../sim/sim_test_support.hpp"
 
 namespace {
 void put(std::FILE* f, double v) { std::fprintf(f, ",%.17g", v); }
@@ -90,7 +91,7 @@ TEST_CASE("run_scenario writes run.mcap beside the log; reference.csv for the np
     CHECK(std::filesystem::exists(off / "timeseries.csv"));
     CHECK_FALSE(std::filesystem::exists(off / "run.mcap"));
     // The scenario key round-trips through JSON; on (the default) it is left out.
-    CHECK(kelp::sim::parse_scenario(kelp::sim::to_json(q).dump(), "q").mcap == false);
-    CHECK_FALSE(kelp::sim::to_json(sc).at("output").contains("mcap"));
+    CHECK(kelp::sim::parse_scenario(kelp_test::json_of(q).dump(), "q").mcap == false);
+    CHECK_FALSE(kelp_test::json_of(sc).at("output").contains("mcap"));
   }
 }

@@ -19,6 +19,7 @@
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/world.hpp"
+#include "sim_test_support.hpp"
 
 namespace ksim = kelp::sim;
 using V3 = kelp::Vector3<double>;
@@ -106,7 +107,7 @@ TEST_CASE("scenario pile_wrap: the tether wraps once and `entangled` fires on ti
   // One wrap, and it stays wound: |W| = 2π at the end (the chord is clear of the pile).
   CHECK(std::abs(std::abs(m.obstacle(0).winding) - 2 * kelp::pi) < 0.05);
   // The summary carries it.
-  const nlohmann::json s = loop.summary();
+  const nlohmann::json s = kelp_test::json_of(loop.summary());
   const auto& o = s["entanglement"]["obstacles"][0];
   CHECK(o["name"] == "pile");
   CHECK(o["entangled_s"].get<double>() == e.time);

@@ -14,6 +14,7 @@
 #include "kelp/sim/replay.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/tether/failure.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 namespace fs = std::filesystem;
@@ -75,7 +76,7 @@ LoggedRun logged_run(const fs::path& dir) {
     if (loop.steps_taken() % 50 == 0) snap();  // 2 Hz: every 50 steps of 10 ms
   }
   log.close();
-  std::ofstream(dir / "summary.json") << loop.summary().dump(2) << '\n';
+  std::ofstream(dir / "summary.json") << kelp_test::json_of(loop.summary()).dump(2) << '\n';
   return r;
 }
 
@@ -294,7 +295,7 @@ TEST_CASE("a 10-minute run with 40 nodes at the default rates makes under 10 MB"
       }
     }
   }
-  json summary = {{"scenario", ks::to_json(sc)}, {"scenario_file", "synthetic"}};
+  json summary = {{"scenario", kelp_test::json_of(sc)}, {"scenario_file", "synthetic"}};
   std::ofstream(dir / "summary.json") << summary.dump(2);
   const std::string script = ks::replay_script(ks::replay_data(dir));
   const double mb = static_cast<double>(script.size()) / 1e6;

@@ -36,19 +36,19 @@ std::size_t lines_of(const std::filesystem::path& p) {
 
 TEST_CASE("a ClosedLoop stepped by hand runs what simulate() runs, bit for bit", "[sim]") {
   const ks::Scenario sc = short_calm_run();
-  const nlohmann::json reference = deterministic(ks::simulate(sc));
+  const nlohmann::json reference = deterministic(kelp_test::json_of(ks::simulate(sc)));
 
   ks::ClosedLoop loop(sc);
   CHECK(loop.total_steps() == 500);
   while (!loop.done()) loop.step();
-  CHECK(loop.summary() == reference);
+  CHECK(kelp_test::json_of(loop.summary()) == reference);
 
   // In chunks of simulated time: the same run.
   ks::ClosedLoop chunked(sc);
   CHECK(chunked.run_for(1.234) == 123);
   CHECK(chunked.run_for(100.0) == 377);  // up to the end, not beyond
   CHECK(chunked.done());
-  CHECK(chunked.summary() == reference);
+  CHECK(kelp_test::json_of(chunked.summary()) == reference);
   CHECK(chunked.state().time == loop.state().time);
   CHECK(chunked.state().auv.position == loop.state().auv.position);
 }
@@ -69,7 +69,7 @@ TEST_CASE("the closed loop samples at the log rate and flies the survey", "[sim]
   CHECK(sc.square_side == 8.0);
   CHECK(d1 < d0 - 1.0);
   CHECK(loop.metrics().max_tension > 0.0);
-  CHECK(std::isfinite(loop.summary()["energy_j"].get<double>()));
+  CHECK(std::isfinite(kelp_test::json_of(loop.summary())["energy_j"].get<double>()));
 }
 
 TEST_CASE("a ClosedLoop with a RunLog writes a row per sample and a snapshot per node tick",
@@ -128,7 +128,7 @@ TEST_CASE("the closed loop counts the tether solver's work of every step and rep
   CHECK(st.force_evaluations == evaluations);
   CHECK(st.explicit_fallbacks == 0);
   CHECK(st.mean_step_newton_iterations() == Approx(newton / 50.0));
-  const nlohmann::json j = loop.summary()["tether_solver"];
+  const nlohmann::json j = kelp_test::json_of(loop.summary())["tether_solver"];
   INFO(j.dump());
   CHECK(j["steps"] == 50);
   CHECK(j["integrator"] == "bdf2");
@@ -148,8 +148,8 @@ TEST_CASE("a scenario's tether.explicit_fallback is off unless set, and reaches 
   CHECK(on.explicit_fallback);
   CHECK(ks::world_setup(on, "on.json").parameters.explicit_fallback);
   // The summary's echo reads back to the same setting.
-  CHECK(ks::parse_scenario(ks::to_json(on).dump(), "echo").explicit_fallback);
-  CHECK_FALSE(ks::parse_scenario(ks::to_json(ks::Scenario{}).dump(), "echo").explicit_fallback);
+  CHECK(ks::parse_scenario(kelp_test::json_of(on).dump(), "echo").explicit_fallback);
+  CHECK_FALSE(ks::parse_scenario(kelp_test::json_of(ks::Scenario{}).dump(), "echo").explicit_fallback);
   CHECK_THROWS_WITH(ks::parse_scenario(R"({"tether": {"explicit_fallback": 1}})", "bad.json"),
                     Catch::Contains("/tether/explicit_fallback"));
 }
@@ -173,14 +173,14 @@ TEST_CASE("the tether's line_model: parsed, written back, passed to the tether, 
   // Default: kelp's line, and to_json leaves the key out.
   const ks::Scenario plain = ks::parse_scenario(R"({"tether": {"length": 10}})", "a.json");
   CHECK(plain.line_model == "kelp");
-  CHECK_FALSE(ks::to_json(plain).at("tether").contains("line_model"));
+  CHECK_FALSE(kelp_test::json_of(plain).at("tether").contains("line_model"));
   CHECK(ks::world_setup(plain, "a.json").parameters.tether.line_model ==
         kelp::tether::LineModel::kelp);
   // "moordyn": parsed, round-tripped through to_json, and reaching the tether's parameters.
   const ks::Scenario md =
       ks::parse_scenario(R"({"tether": {"length": 10, "line_model": "moordyn"}})", "b.json");
   CHECK(md.line_model == "moordyn");
-  CHECK(ks::parse_scenario(ks::to_json(md).dump(), "c.json").line_model == "moordyn");
+  CHECK(ks::parse_scenario(kelp_test::json_of(md).dump(), "c.json").line_model == "moordyn");
   CHECK(ks::world_setup(md, "b.json").parameters.tether.line_model ==
         kelp::tether::LineModel::moordyn);
   // Anything else is refused with the path, in the file and in a Scenario built by hand.

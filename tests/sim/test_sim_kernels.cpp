@@ -12,6 +12,7 @@
 
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/sim.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 namespace simd = kelp::simd;
@@ -46,7 +47,7 @@ Run run_with_policy(const ks::Scenario& sc, KernelPath p, const std::string& dir
   ks::SimulateOptions o;
   o.log_dir = dir;
   Run r;
-  r.summary = ks::simulate(sc, o);
+  r.summary = kelp_test::json_of(ks::simulate(sc, o));
   r.summary.erase("wall_s");
   r.summary.erase("realtime_factor");
   r.timeseries = read(std::filesystem::path(dir) / "timeseries.csv");
@@ -129,7 +130,7 @@ TEST_CASE("deterministic runs give the same summary and logs, bit for bit, on ev
 TEST_CASE("a scenario's kernel and deterministic fields: parsing, echo and errors",
           "[sim][kernel]") {
   CHECK(ks::parse_scenario("{}", "s.json").kernel == "auto");
-  CHECK(!ks::to_json(ks::parse_scenario("{}", "s.json")).contains("kernel"));
+  CHECK(!kelp_test::json_of(ks::parse_scenario("{}", "s.json")).contains("kernel"));
   CHECK(ks::parse_scenario(R"({"deterministic": true})", "s.json").kernel == "portable");
   CHECK(ks::parse_scenario(R"({"deterministic": false})", "s.json").kernel == "auto");
   CHECK(ks::parse_scenario(R"({"deterministic": true, "kernel": "portable"})", "s.json").kernel ==
@@ -138,7 +139,7 @@ TEST_CASE("a scenario's kernel and deterministic fields: parsing, echo and error
     const ks::Scenario s = ks::parse_scenario(std::string(R"({"kernel": ")") + k + "\"}", "s.json");
     CHECK(s.kernel == k);
     // The echo reads back to the same scenario.
-    CHECK(ks::parse_scenario(ks::to_json(s).dump(), "echo").kernel == k);
+    CHECK(ks::parse_scenario(kelp_test::json_of(s).dump(), "echo").kernel == k);
   }
   CHECK_THROWS_WITH(ks::parse_scenario(R"({"kernel": "sse2"})", "s.json"),
                     Catch::Contains("s.json: /kernel: expected one of"));

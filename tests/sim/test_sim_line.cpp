@@ -122,7 +122,7 @@ TEST_CASE("a line with a low breaking strength parts in a run, which reports it"
   ks::SimulateOptions o;
   o.log_dir = dir.string();
   nlohmann::json s;
-  REQUIRE_NOTHROW(s = ks::simulate(sc, o));
+  REQUIRE_NOTHROW(s = kelp_test::json_of(ks::simulate(sc, o)));
   INFO(s["tether"].dump());
   const auto& failures = s["tether"]["line_failures"];
   REQUIRE(failures.is_array());
@@ -146,7 +146,7 @@ TEST_CASE("a line with a low breaking strength parts in a run, which reports it"
   CHECK(header.find(",tether_turns,tether_parted_segments") != std::string::npos);
 
   // The default line (the Fathom tether's 1557 N) holds.
-  const nlohmann::json d = ks::simulate(short_calm_run());
+  const nlohmann::json d = kelp_test::json_of(ks::simulate(short_calm_run()));
   CHECK(d["tether"]["line_failures"].empty());
   CHECK(std::abs(d["tether"]["net_turns"].get<double>()) < 1.0);
 }

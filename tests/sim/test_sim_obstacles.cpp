@@ -8,6 +8,7 @@
 
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/world.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 
@@ -40,9 +41,9 @@ TEST_CASE("scenario obstacles and seabed: parsed, echoed and handed to the envir
   CHECK(s.heightfield.at(2, 2) == 32);
   CHECK(s.seabed_friction == 0.4);
   // to_json reads back to the same scenario.
-  const nlohmann::json j = ks::to_json(s);
+  const nlohmann::json j = kelp_test::json_of(s);
   const ks::Scenario back = ks::parse_scenario(j.dump(), "echo.json");
-  CHECK(ks::to_json(back) == j);
+  CHECK(kelp_test::json_of(back) == j);
   CHECK(back.cylinders[1].to == s.cylinders[1].to);
   CHECK(back.heightfield.depth == s.heightfield.depth);
   // The world's environment carries them; the tether's seabed friction is the scenario's.
@@ -54,8 +55,8 @@ TEST_CASE("scenario obstacles and seabed: parsed, echoed and handed to the envir
   // Without obstacles: none in the environment, none in the echo.
   const ks::Scenario plain = ks::parse_scenario("{}", "plain.json");
   CHECK(ks::world_setup(plain, "plain.json").environment.obstacles() == nullptr);
-  CHECK(!ks::to_json(plain).contains("obstacles"));
-  CHECK(!ks::to_json(plain).contains("seabed"));
+  CHECK(!kelp_test::json_of(plain).contains("obstacles"));
+  CHECK(!kelp_test::json_of(plain).contains("seabed"));
   const ks::Scenario flat = ks::parse_scenario(R"({"seabed": {"depth": 40}})", "flat.json");
   CHECK(ks::world_setup(flat, "flat.json").environment.seabed_depth() == 40);
 }
@@ -68,7 +69,7 @@ TEST_CASE("scenario seabed from a grid file beside the scenario", "[sim][obstacl
   const ks::Scenario s = ks::load_scenario("kelp_test_scenario_hf.json");
   CHECK(s.has_heightfield);
   CHECK(s.heightfield.at(1, 1) == 23);
-  CHECK(ks::to_json(s)["seabed"]["heightfield"] == "kelp_test_bathymetry.txt");
+  CHECK(kelp_test::json_of(s)["seabed"]["heightfield"] == "kelp_test_bathymetry.txt");
 }
 
 TEST_CASE("scenario obstacles: errors name the JSON path", "[sim][obstacles]") {

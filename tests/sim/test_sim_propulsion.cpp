@@ -43,7 +43,7 @@ TEST_CASE("scenario: thrusters and battery keys are parsed, echoed, checked and 
   CHECK(p.auv_propulsion->battery.hotel_current == 1.5);
   CHECK(p.asv_propulsion->battery.internal_resistance == 0.03);
   // The echo reads back to the same scenario.
-  const ks::Scenario e = ks::parse_scenario(ks::to_json(s).dump(), "echo");
+  const ks::Scenario e = ks::parse_scenario(kelp_test::json_of(s).dump(), "echo");
   CHECK(e.thruster_time_constant == 0.05);
   CHECK(e.auv_battery.hotel_current == 1.5);
   CHECK(e.asv_battery.internal_resistance == 0.03);
@@ -72,7 +72,7 @@ TEST_CASE(
   std::filesystem::remove_all(dir);
   ks::SimulateOptions o;
   o.log_dir = dir.string();
-  const nlohmann::json s = ks::simulate(short_calm_run(), o);
+  const nlohmann::json s = kelp_test::json_of(ks::simulate(short_calm_run(), o));
   CHECK(s.at("auv").at("energy_wh").get<double>() > 0.0);
   CHECK(s.at("asv").at("energy_wh").get<double>() > 0.0);
   const double soc = s.at("auv").at("final_soc").get<double>();
@@ -107,7 +107,7 @@ TEST_CASE(
   // Without propulsion, the summary has no battery and the run differs.
   ks::Scenario off = short_calm_run();
   off.propulsion = false;
-  const nlohmann::json s_off = ks::simulate(off);
+  const nlohmann::json s_off = kelp_test::json_of(ks::simulate(off));
   CHECK_FALSE(s_off.at("auv").contains("energy_wh"));
   CHECK(s_off.at("auv").at("rms_path_error_m") != s.at("auv").at("rms_path_error_m"));
 

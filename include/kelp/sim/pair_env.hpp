@@ -19,6 +19,7 @@
 
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/sim/export.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/scenario.hpp"
@@ -74,7 +75,7 @@ struct PairEnvOptions {
 ///
 /// No heap allocation in step(). The environment holds references into itself: it can be
 /// neither copied nor moved.
-class TetheredPairEnv {
+class KELP_SIM_API TetheredPairEnv {
  public:
   /// Observation entries.
   static constexpr int observation_size = 20;
@@ -88,24 +89,7 @@ class TetheredPairEnv {
   /// \throws kelp::invalid_argument for a control period that is not a positive multiple of
   /// 10 ms, non-positive weights or max_path_error; scenario_error, kelp::invalid_argument from
   /// the world (world_setup()).
-  explicit TetheredPairEnv(const Scenario& scenario, const PairEnvOptions& options = {})
-      : scenario_(scenario), options_(options) {
-    check_positive(options.control_period, "control_period");
-    const double k = options.control_period / ClosedLoop::dt;
-    KELP_CHECK(std::abs(k - std::round(k)) < 1e-9 && std::round(k) >= 1,
-               "control_period must be a positive multiple of 0.01 s, got " +
-                   std::to_string(options.control_period));
-    substeps_ = std::lround(k);
-    check_positive(options.max_path_error, "max_path_error");
-    check_non_negative(options.path_weight, "path_weight");
-    check_non_negative(options.energy_weight, "energy_weight");
-    const Eigen::Index n = 8;  // the BlueROV2 Heavy's thrusters
-    force_ = Eigen::VectorXd::Zero(n);
-    scratch_ = Eigen::VectorXd::Zero(n);
-    rov_.thrust = Eigen::VectorXd::Zero(n);
-    rov_.command = Eigen::VectorXd::Zero(n);
-    reset(scenario.seed);
-  }
+  explicit TetheredPairEnv(const Scenario& scenario, const PairEnvOptions& options = {});
 
   TetheredPairEnv(const TetheredPairEnv&) = delete;
   TetheredPairEnv& operator=(const TetheredPairEnv&) = delete;
@@ -120,56 +104,17 @@ class TetheredPairEnv {
   /// \brief Starts a new episode: the scenario's world with `seed` as its sea's seed, at rest
   /// (the scenario's start), the action zero. Allocates (it builds the world).
   /// \throws as the constructor; the environment is then as it was.
-  void reset(std::uint64_t seed) {
-    // The new world is built aside: if that throws, the environment is as it was.
-    Scenario sc = scenario_;
-    sc.seed = seed;
-    auto loop = std::make_unique<ClosedLoop>(sc);
-    scenario_.seed = seed;
-    loop_ = std::move(loop);
-    fly_by_controllers(controllers_);
-    error_.clear();
-    terminated_ = false;
-    reward_ = 0.0;
-    const std::array<double, 8> zero{};
-    apply(zero.data());
-    observe(obs_.data());
-  }
+  void reset(std::uint64_t seed);
 
   /// \brief Sets the action held from the next step on: `action` points to action_size()
   /// entries, each clipped to [−1, 1]. No allocation.
   /// \throws kelp::invalid_argument for a non-finite entry (the action is then unchanged).
-  void apply(const double* action) {
-    for (int i = 0; i < action_size(); ++i)
-      KELP_CHECK(std::isfinite(action[i]), "action[" + std::to_string(i) + "] is not finite");
-    const auto clip = [](double a) { return a < -1.0 ? -1.0 : (a > 1.0 ? 1.0 : a); };
-    Vector6<double> tau;
-    for (int i = 0; i < 6; ++i) tau(i) = clip(action[i]) * action_scale[static_cast<size_t>(i)];
-    const auto& chain = loop_->auv_controller().thruster_chain();
-    const control::AllocationScales s =
-        control::allocate_wrench(chain, tau, max_thrust_, true, force_, scratch_);
-    chain.commands_for(force_, rov_.command, rov_.thrust);
-    rov_.wrench = chain.wrench(rov_.thrust);
-    rov_.saturated = s.saturated();
-    if (options_.boat_action) {
-      const auto& boat = loop_->asv_controller().thruster_chain();
-      const double c = scenario_.asv_thrust_clip;
-      const Eigen::Vector2d wanted(clip(action[6]) * c, clip(action[7]) * c);
-      boat_.left = wanted(0);
-      boat_.right = wanted(1);
-      boat.commands_for(wanted, boat_.command, boat_thrust_);
-      boat_.wrench = boat.wrench(boat_thrust_);
-    }
-  }
+  void apply(const double* action);
 
   /// \brief Lets the scenario's controllers fly the vehicles (true) or the action (false, the
   /// default) from the next step on; the controllers run all along, so switching is seamless.
   /// kelp::sim::Batch flies by the controllers when it is given no actions.
-  void fly_by_controllers(bool yes) {
-    controllers_ = yes;
-    loop_->set_auv_override(yes ? nullptr : &rov_);
-    loop_->set_asv_override(yes || !options_.boat_action ? nullptr : &boat_);
-  }
+  void fly_by_controllers(bool yes);
   /// \brief True when the scenario's controllers fly the vehicles (fly_by_controllers()).
   bool flown_by_controllers() const { return controllers_; }
 
@@ -178,46 +123,13 @@ class TetheredPairEnv {
   /// (terminated() or truncated()) but return 0. No allocation.
   /// \returns the reward of the step (see the class).
   /// \throws kelp::invalid_argument for a bad action (nothing is stepped).
-  double step(const double* action) {
-    if (terminated_ || truncated()) return 0.0;
-    apply(action);
-    return advance();
-  }
+  double step(const double* action);
 
   /// \brief As step() with the action set earlier (apply()), e.g. by kelp::sim::Batch.
-  double advance() {
-    if (terminated_ || truncated()) return 0.0;
-    const double e0 = energy_drawn();
-    try {
-      for (long i = 0; i < substeps_ && !loop_->done(); ++i) loop_->step();
-    } catch (const kelp::error& e) {
-      error_ = e.what();
-      terminated_ = true;
-    }
-    observe(obs_.data());
-    const double path_error = obs_[19];
-    if (!(path_error <= options_.max_path_error)) terminated_ = true;
-    reward_ = -options_.path_weight * path_error - options_.energy_weight * (energy_drawn() - e0);
-    return reward_;
-  }
+  double advance();
 
   /// \brief Writes the observation of the current state (observation_size entries) to `out`.
-  void observe(double* out) const {
-    const auto& s = loop_->state();
-    const Vector3<double> rel = s.auv.position - loop_->auv_controller().target();
-    const Vector3<double> rpy = euler_from_quaternion(s.auv.attitude);
-    const Vector3<double> boat = s.asv.position - s.auv.position;
-    const Vector3<double>& f = loop_->last_report().force_on_auv;
-    for (int i = 0; i < 3; ++i) {
-      out[i] = rel(i);
-      out[3 + i] = rpy(i);
-      out[12 + i] = boat(i);
-      out[16 + i] = f(i);
-    }
-    for (int i = 0; i < 6; ++i) out[6 + i] = s.auv.nu(i);
-    out[15] = euler_from_quaternion(s.asv.attitude).z();
-    out[19] = loop_->sample().auv_error;
-  }
+  void observe(double* out) const;
 
   /// \brief The observation after the last reset() or step().
   const std::array<double, observation_size>& observation() const { return obs_; }
@@ -234,10 +146,7 @@ class TetheredPairEnv {
   /// \brief The ROV's command of the current action (thrusts, commands, wrench, saturation).
   const control::AuvCommand& rov_command() const { return rov_; }
   /// \brief The energy the ROV's battery has delivered since reset() [J] (0 without propulsion).
-  double energy_drawn() const {
-    return loop_->model().auv_propulsion() ? loop_->state().auv_propulsion.battery.energy_drawn
-                                           : 0.0;
-  }
+  double energy_drawn() const;
 
  private:
   Scenario scenario_;

@@ -8,25 +8,22 @@
 /// `kelp::sim` component.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
-#include <utility>
 
-#include "kelp/core/error.hpp"
 #include "kelp/sim/closed_loop.hpp"
-#include "kelp/sim/replay.hpp"
-#include "kelp/sim/ros2.hpp"
+#include "kelp/sim/export.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/summary.hpp"
 
 namespace kelp {
 namespace sim {
+
+class BagRecorder;
 
 /// \brief What a run may change in its scenario (kelp-tethered-pair's `--duration`, `--seed`,
 /// `--kernel`, `--deterministic`); an unset field keeps the scenario's value.
@@ -42,18 +39,7 @@ struct ScenarioOverrides {
 /// \brief The scenario with the overrides applied.
 /// \throws kelp::invalid_argument for a non-finite duration, or `deterministic` with a kernel
 /// other than "portable".
-inline Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o) {
-  KELP_CHECK(!std::isnan(o.duration), "ScenarioOverrides::duration must not be NaN");
-  KELP_CHECK(
-      !o.deterministic || o.kernel.empty() || o.kernel == "portable",
-      "ScenarioOverrides: deterministic pins the kernel \"portable\", not \"" + o.kernel + "\"");
-  if (o.duration > 0) sc.duration = o.duration;
-  if (o.seed >= 0) sc.seed = static_cast<std::uint64_t>(o.seed);
-  if (!o.kernel.empty()) sc.kernel = o.kernel;
-  if (o.deterministic) sc.kernel = "portable";
-  if (o.mcap >= 0) sc.mcap = o.mcap != 0;
-  return sc;
-}
+KELP_SIM_API Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o);
 
 /// \brief Options of run_scenario().
 struct RunOptions {
@@ -61,7 +47,9 @@ struct RunOptions {
   /// created if needed; empty: nothing is written.
   std::string out;
   std::string scenario_file = "(embedded default)";  ///< named in errors and in the summary
-  bool progress = false;                             ///< a progress bar on stderr
+  /// Called after every step with the steps taken, the run's steps and the simulation time
+  /// (SimulateOptions::on_progress, e.g. a program's progress bar); empty: nothing is called.
+  std::function<void(long steps_taken, long total_steps, double time)> on_progress;
   std::string version;  ///< the summary's `kelp_version` (empty: the field is left out)
   /// Called with every sample the log takes (the rows of timeseries.csv, at the scenario's log
   /// rate), whether or not a log is written; empty: nothing is called.
@@ -74,24 +62,18 @@ struct RunOptions {
 /// \brief A run's ROS 2 bag (BagRecorder), opened at the run's first sample (t = 0, taken when
 /// the loop is built), so that a scenario which fails before it, e.g. with a tether too short
 /// for its attachment points, leaves no file behind.
-class RunBag {
+class KELP_SIM_API RunBag {
  public:
   /// \brief The bag `file` (its directory created when it opens), markers at `marker_rate` [Hz].
-  RunBag(std::filesystem::path file, double marker_rate)
-      : file_(std::move(file)), marker_rate_(marker_rate) {}
+  RunBag(std::filesystem::path file, double marker_rate);
+  ~RunBag();
+  RunBag(const RunBag&) = delete;
+  RunBag& operator=(const RunBag&) = delete;
   /// \brief Records sample `r`, opening the bag first if it is not open yet.
   /// \throws kelp::error when the file cannot be written.
-  void record(const LogRow& r) {
-    if (!bag_) {
-      if (file_.has_parent_path()) std::filesystem::create_directories(file_.parent_path());
-      bag_ = std::make_unique<BagRecorder>(file_, marker_rate_);
-    }
-    bag_->record(r);
-  }
+  void record(const LogRow& r);
   /// \brief Finishes the bag if it was opened.
-  void close() {
-    if (bag_) bag_->close();
-  }
+  void close();
 
  private:
   std::filesystem::path file_;
@@ -103,57 +85,33 @@ class RunBag {
 /// (`output.mcap`, the default) and there is an output directory: `on_sample` is wrapped so that
 /// every sample is recorded before it is passed on. Close the bag after the run.
 /// \returns the bag, or null when none is written.
-inline std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
-                                            std::function<void(const LogRow&)>& on_sample) {
-  if (!sc.mcap || o.out.empty()) return nullptr;
-  auto bag = std::make_unique<RunBag>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
-  on_sample = [b = bag.get(), user = on_sample](const LogRow& r) {
-    b->record(r);
-    if (user) user(r);
-  };
-  return bag;
-}
+KELP_SIM_API std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
+                                                 std::function<void(const LogRow&)>& on_sample);
 
 /// \brief What a run leaves after its last step: the summary's `kelp_version`, summary.json
 /// (indented by 2) in `o.out` and, with a `replay_template`, replay.html there (write_replay(),
 /// `source` named in it). run_scenario() calls it, and so does a program that runs its own loop
 /// (kelp-tethered-pair --ros2), so that every run directory has the same files.
 /// \throws kelp::error when a file cannot be written (replay_error for replay.html).
-inline void finish_run(nlohmann::json& summary, const RunOptions& o,
-                       const std::string& source = "kelp-tethered-pair") {
-  if (!o.version.empty()) summary["kelp_version"] = o.version;
-  if (o.out.empty()) return;
-  std::ofstream f(std::filesystem::path(o.out) / "summary.json");
-  f << summary.dump(2) << '\n';
-  if (!f) throw kelp::error("cannot write summary.json in " + o.out);
-  f.close();
-  if (!o.replay_template.empty()) {
-    ReplayOptions ro;
-    ro.source = source;
-    write_replay(o.out, o.replay_template, ro);
-  }
-}
+KELP_SIM_API void finish_run(RunSummary& summary, const RunOptions& o,
+                             const std::string& source = "kelp-tethered-pair");
+
+/// \brief finish_run() for a program whose summary holds more than RunSummary (e.g. the live
+/// ROS 2 run's `ros2` object): `summary_text` is written as summary.json as it is (no
+/// `kelp_version` is added), then replay.html as finish_run() writes it.
+/// \throws kelp::error when a file cannot be written (replay_error for replay.html).
+KELP_SIM_API void finish_run_with(const std::string& summary_text, const RunOptions& o,
+                                  const std::string& source = "kelp-tethered-pair");
 
 /// \brief Runs a scenario as kelp-tethered-pair does: simulate() (with the CSV log in `out`),
 /// then finish_run(): the summary's `kelp_version`, summary.json in `out` and, with a
 /// `replay_template`, replay.html (the 3-D replay, docs/replay.md); with the scenario's
 /// `output.mcap` (the default) also run.mcap, the run as a ROS 2 bag (open_run_bag(): every
 /// sample, the markers at the node rate).
-/// \returns the summary (summary.json's content).
+/// \returns the summary (summary.json's content: summary_json()).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
 /// file cannot be written (replay_error for replay.html).
-inline nlohmann::json run_scenario(const Scenario& sc, const RunOptions& o = {}) {
-  SimulateOptions so;
-  so.log_dir = o.out;
-  so.progress = o.progress;
-  so.scenario_file = o.scenario_file;
-  so.on_sample = o.on_sample;
-  std::unique_ptr<RunBag> bag = open_run_bag(sc, o, so.on_sample);
-  nlohmann::json summary = simulate(sc, so);
-  if (bag) bag->close();
-  finish_run(summary, o);
-  return summary;
-}
+KELP_SIM_API RunSummary run_scenario(const Scenario& sc, const RunOptions& o = {});
 
 }  // namespace sim
 }  // namespace kelp

@@ -7,17 +7,13 @@
 /// optional `kelp::sim` component.
 #pragma once
 
-#include <cmath>
 #include <string>
 
-#include "kelp/core/kernel_path.hpp"
-#include "kelp/environment/sea_state.hpp"
+#include "kelp/environment/environment.hpp"
+#include "kelp/sim/export.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
-#include "kelp/tether/initial_state.hpp"
-#include "kelp/tether/presets.hpp"
-#include "kelp/vehicle/surroundings.hpp"
 
 namespace kelp {
 namespace sim {
@@ -35,111 +31,7 @@ struct WorldSetup {
 /// \throws scenario_error when the tether cannot span the start poses or the scenario's kernel
 /// path is one this CPU lacks; kelp::invalid_argument from the library for parameters it refuses
 /// and for a bad `KELP_KERNEL` environment variable.
-inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
-  namespace sp = kelp::system::presets;
-  namespace ke = kelp::environment;
-  const sp::TetherKind kind =
-      sc.tether_kind == "bead_chain" ? sp::TetherKind::bead_chain : sp::TetherKind::rov_tether;
-  kelp::system::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
-  if (kind == sp::TetherKind::rov_tether)
-    params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
-  auto& tp = params.tether;
-  if (sc.diameter > 0) tp.diameter = sc.diameter;
-  if (sc.mass_per_length > 0) tp.mass_per_length = sc.mass_per_length;
-  if (sc.axial_stiffness > 0) tp.axial_stiffness = sc.axial_stiffness;
-  if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
-  if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
-  if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
-  if (sc.breaking_strength >= 0) tp.breaking_strength = sc.breaking_strength;
-  params.explicit_fallback = sc.explicit_fallback;
-  if (sc.line_model != "kelp" && sc.line_model != "moordyn")
-    throw scenario_error(file + ": /tether/line_model: expected \"kelp\" or \"moordyn\", got \"" +
-                         sc.line_model + "\"");
-  if (sc.line_model == "moordyn") tp.line_model = kelp::tether::LineModel::moordyn;
-  if (sc.winch.enabled) {
-    kelp::tether::WinchParameters<double> w;
-    w.max_speed = sc.winch.max_speed;
-    w.max_acceleration = sc.winch.max_acceleration;
-    w.max_pull = sc.winch.max_pull;
-    w.min_length = sc.winch.min_length;
-    w.max_length = sc.winch.max_length;
-    params.winch = w;
-  }
-  params.asv_attachment = sc.asv_attachment;
-  params.auv_attachment = sc.auv_attachment;
-  // Propulsion: the paper preset's (thrusters, batteries) with the scenario's lag and batteries,
-  // or none.
-  if (!sc.propulsion) {
-    params.asv_propulsion.reset();
-    params.auv_propulsion.reset();
-  } else {
-    const auto apply = [&](kelp::vehicle::PropulsionParametersd& p, const BatteryScenario& b) {
-      p.time_constant = sc.thruster_lag ? sc.thruster_time_constant : 0.0;
-      p.battery.capacity_ah = b.capacity_ah;
-      p.battery.cells_in_series = b.cells_in_series;
-      p.battery.internal_resistance = b.internal_resistance;
-      p.battery.initial_soc = b.initial_soc;
-      p.battery.hotel_current = b.hotel_current;
-    };
-    apply(*params.asv_propulsion, sc.asv_battery);
-    apply(*params.auv_propulsion, sc.auv_battery);
-  }
-  ke::SeaStateOptions sea_options;
-  sea_options.seed = sc.seed;
-  sea_options.wave_components = sc.wave_components;
-  sea_options.ramp = sc.start_ramp;
-  ke::SeaState sea = ke::presets::calm();
-  if (sc.sea == "moderate") sea = ke::presets::moderate();
-  if (sc.sea == "rough") sea = ke::presets::rough();
-  if (sc.sea == "custom") {
-    sea = ke::SeaState{};  // no waves unless a height is given
-    sea.significant_height = sc.significant_height;
-    sea.peak_period = sc.peak_period;
-    if (sc.significant_height > 0)
-      sea.peak_enhancement = ke::dnv_peak_enhancement(sc.significant_height, sc.peak_period);
-    sea.wind_speed = sc.wind_speed;
-    sea.current_speed = sc.current_speed;
-    sea.wave_direction = sc.wave_direction;
-    sea.wind_direction = sc.wind_direction;
-    sea.current_direction = sc.current_direction;
-  }
-  sp::StartPoses<double> start = sp::paper_start(sc.tether_length);
-  if (!sc.auv_start.empty())
-    start.auv.position = kelp::Vector3<double>(sc.auv_start[0], sc.auv_start[1], sc.auv_start[2]);
-  const double span = (start.auv.point_position(params.auv_attachment) -
-                       start.asv.point_position(params.asv_attachment))
-                          .norm();
-  if (span > sc.tether_length)
-    throw scenario_error(file + ": /tether/length: " + std::to_string(sc.tether_length) +
-                         " m is shorter than the initial distance between its ends (" +
-                         std::to_string(span) + " m)");
-  ke::Environmentd env = ke::make_environment<double>(sea, sea_options);
-  // The wave kernel's instruction path: pinned by the scenario (a path this CPU lacks is named
-  // as the file's error), else the process' policy (a bad KELP_KERNEL throws
-  // kelp::invalid_argument naming it); resolved here, before the run's first step.
-  if (sc.kernel != "auto") {
-    ke::WaveFieldd waves = env.waves();
-    try {
-      waves.set_kernel(kelp::simd::parse_kernel_path(sc.kernel));
-    } catch (const kelp::invalid_argument& e) {
-      throw scenario_error(file + ": /kernel: " + e.what());
-    }
-    env.set_waves(waves);
-  }
-  env.waves().active_kernel();
-  // Seabed and obstacles (kelp/environment/obstacles.hpp; the tether touches them through the
-  // environment, kelp/tether/contact.hpp).
-  if (std::isfinite(sc.seabed_depth)) env.set_seabed_depth(sc.seabed_depth);
-  if (sc.seabed_friction >= 0) tp.seabed_friction = sc.seabed_friction;
-  env.set_obstacles(obstacle_set(sc));
-  // The hulls against the seabed and the obstacles (kelp/system/hull_contact.hpp), when there is
-  // something to touch: in open water without a seabed a run is as it was.
-  if (env.obstacles() != nullptr || std::isfinite(env.seabed_depth())) {
-    params.asv_hull = kelp::system::blueboat_hull<double>();
-    params.auv_hull = kelp::system::bluerov2_heavy_hull<double>();
-  }
-  return {params, env, start};
-}
+KELP_SIM_API WorldSetup world_setup(const Scenario& sc, const std::string& file);
 
 /// \brief The state a run of the scenario starts from: `system::initial_state` (the vehicles at
 /// their start poses, the tether's static shape between them) at t = 0 and, with the scenario's
@@ -149,22 +41,9 @@ inline WorldSetup world_setup(const Scenario& sc, const std::string& file) {
 /// ramp) that velocity is zero. Every program on kelp::sim starts here (kelp-tethered-pair,
 /// kelp-sweep, kelp-sitl), so a run flown by kelp's controllers and one flown by SITL start alike.
 /// \throws kelp::numerical_error when the tether's static shape does not converge.
-inline kelp::system::SystemStated start_state(const kelp::system::SystemModeld& model,
-                                              kelp::system::SystemWorkspaced& ws,
-                                              const WorldSetup& world, const Scenario& sc) {
-  kelp::system::SystemStated s =
-      kelp::system::initial_state(model, ws, world.start.asv, world.start.auv);
-  if (sc.start_with_water) {
-    const auto& env = model.environment();
-    for (kelp::vehicle::VehicleState<double>* v : {&s.asv, &s.auv}) {
-      const auto e = env.sample(v->position, s.time, false);
-      v->nu.head<3>() = v->attitude.conjugate() * (e.current + e.wave_velocity);
-      v->nu.tail<3>().setZero();
-    }
-    kelp::tether::move_with_water(model.tether(), env, s.tether);
-  }
-  return s;
-}
+KELP_SIM_API kelp::system::SystemStated start_state(const kelp::system::SystemModeld& model,
+                                                   kelp::system::SystemWorkspaced& ws,
+                                                   const WorldSetup& world, const Scenario& sc);
 
 }  // namespace sim
 }  // namespace kelp

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "kelp/sim.hpp"
+#include "sim_test_support.hpp"
 
 namespace ks = kelp::sim;
 
@@ -22,7 +23,7 @@ std::string sensors_run(double duration, int seed, const std::string& extra = ""
 TEST_CASE("scenario navigation: perfect by default, every sensor's key read", "[nav][scenario]") {
   const ks::Scenario d = ks::parse_scenario("{}", "t.json");
   CHECK(d.navigation.mode == "perfect");
-  CHECK_FALSE(ks::to_json(d).contains("navigation"));  // the default leaves the echo as it was
+  CHECK_FALSE(kelp_test::json_of(d).contains("navigation"));  // the default leaves the echo as it was
   const ks::Scenario s = ks::parse_scenario(R"({"navigation": {"mode": "sensors", "seed": 9,
       "imu": {"rate": 50, "gyro_noise_density": 1e-4, "gyro_bias_walk": 2e-5,
               "gyro_bias_initial": 0.01, "accel_noise_density": 2e-3, "accel_bias_walk": 1e-3,
@@ -49,8 +50,8 @@ TEST_CASE("scenario navigation: perfect by default, every sensor's key read", "[
   CHECK(n.sensors.usbl.latency == 1);
   CHECK(n.sensors.usbl.max_range == 50);
   // The echo reads back to the same settings.
-  const ks::Scenario back = ks::parse_scenario(ks::to_json(s).dump(), "echo");
-  CHECK(ks::to_json(back) == ks::to_json(s));
+  const ks::Scenario back = ks::parse_scenario(kelp_test::json_of(s).dump(), "echo");
+  CHECK(kelp_test::json_of(back) == kelp_test::json_of(s));
 }
 
 TEST_CASE("scenario navigation: bad values name their JSON path", "[nav][scenario][errors]") {
@@ -91,7 +92,7 @@ TEST_CASE("closed loop on sensors: the estimates converge and stay bounded in th
           std::max(late_asv, (n->asv().position - loop.state().asv.position).head<2>().norm());
     }
   }
-  const nlohmann::json s = loop.summary()["navigation"];
+  const nlohmann::json s = kelp_test::json_of(loop.summary())["navigation"];
   INFO(s.dump(1));
   CHECK(s["mode"] == "sensors");
   CHECK(s["dvl_pings"]["water"].get<long>() > 100);
@@ -111,7 +112,7 @@ TEST_CASE("closed loop on sensors: the same seed gives the same run, another see
   const auto run = [](int seed) {
     ks::ClosedLoop loop(ks::parse_scenario(sensors_run(5, seed), "t"));
     loop.run();
-    return std::make_pair(loop.summary()["navigation"], loop.state().auv.position);
+    return std::make_pair(kelp_test::json_of(loop.summary())["navigation"], loop.state().auv.position);
   };
   const auto a = run(3), b = run(3), c = run(4);
   CHECK(a.first == b.first);
@@ -124,7 +125,7 @@ TEST_CASE("closed loop, perfect navigation: no sensors, the summary says so", "[
   ks::ClosedLoop loop(ks::parse_scenario(R"({"duration": 1})", "t"));
   CHECK(loop.navigation() == nullptr);
   loop.run();
-  CHECK(loop.summary()["navigation"] == nlohmann::json{{"mode", "perfect"}});
+  CHECK(kelp_test::json_of(loop.summary())["navigation"] == nlohmann::json{{"mode", "perfect"}});
 }
 
 TEST_CASE("closed loop on sensors: a step allocates nothing", "[nav][sim][malloc]") {

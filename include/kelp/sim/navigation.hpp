@@ -1,0 +1,128 @@
+/// \file
+/// \brief Navigation of the tethered pair from its sensors: the ROV fuses IMU, depth, DVL,
+/// compass and USBL fixes (made on the boat from its own estimate); the boat fuses IMU, compass
+/// and GPS. One call per simulation step samples every sensor that is due from the system's true
+/// state and updates both filters; what the controllers see is read back as nav::Navigation.
+///
+/// Each sensor draws from its own stream of the run's seed (kelp/nav/random.hpp), so the same
+/// seed gives the same numbers, and changing one sensor's rate leaves the others' noise as it
+/// was. No heap allocation in update().
+///
+/// Part of the compiled kelp::sim layer (it reads the coupled system's state); the sensors and
+/// filters it is made of are kelp::nav's (header-only).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "kelp/core/types.hpp"
+#include "kelp/nav/filter.hpp"
+#include "kelp/nav/sensors.hpp"
+#include "kelp/sim/export.hpp"
+#include "kelp/system/system.hpp"
+
+namespace kelp {
+namespace sim {
+
+
+/// \brief The sensors of the pair (one IMU and compass model for both vehicles: each carries a
+/// Navigator) and the filters' settings.
+struct PairSensors {
+  nav::ImuParameters imu;          ///< on both vehicles
+  nav::DepthParameters depth;      ///< on the ROV
+  nav::DvlParameters dvl;          ///< on the ROV
+  nav::CompassParameters compass;  ///< on both vehicles
+  nav::GpsParameters gps;          ///< on the boat
+  nav::UsblParameters usbl;        ///< transceiver on the boat, locator on the ROV
+  /// The ROV's filter (estimates the current when its DVL water-tracks).
+  nav::FilterSettings auv_filter = [] {
+    nav::FilterSettings s;
+    s.estimate_current = true;
+    return s;
+  }();
+  nav::FilterSettings asv_filter;  ///< the boat's filter
+  /// σ of the boat's "at the surface" depth pseudo-measurement (its heave in waves) [m].
+  double asv_heave_sigma = 1.0;
+};
+
+/// \brief Checks every sensor's and filter's parameters. \throws kelp::invalid_argument naming
+/// the field.
+KELP_SIM_API void validate(const PairSensors& p);
+
+/// \brief Running error statistics of one vehicle's estimate against the truth.
+struct EstimateErrors {
+  long samples = 0;                   ///< steps accumulated
+  double position_squared_sum = 0;    ///< Σ |p̂ − p|² [m²]
+  double heading_squared_sum = 0;     ///< Σ (ψ̂ − ψ)² [rad²]
+  double velocity_squared_sum = 0;    ///< Σ |ν̂₁ − ν₁|² [m²/s²]
+  double horizontal_squared_sum = 0;  ///< Σ |p̂ − p|² of the north and east parts [m²]
+  double max_position = 0;            ///< largest |p̂ − p| [m]
+  /// \brief RMS position error [m].
+  double rms_position() const { return std::sqrt(position_squared_sum / count()); }
+  /// \brief RMS horizontal position error [m].
+  double rms_horizontal() const { return std::sqrt(horizontal_squared_sum / count()); }
+  /// \brief RMS heading error [rad].
+  double rms_heading() const { return std::sqrt(heading_squared_sum / count()); }
+  /// \brief RMS body-velocity error [m/s].
+  double rms_velocity() const { return std::sqrt(velocity_squared_sum / count()); }
+
+ private:
+  double count() const { return samples > 0 ? static_cast<double>(samples) : 1.0; }
+};
+
+/// \brief The pair's sensors and filters (see the file comment).
+class KELP_SIM_API PairNavigation {
+ public:
+  /// \param[in] p sensors and filters \param[in] seed the run's navigation seed
+  /// \param[in] model the system \param[in] state its initial state (the filters start at the
+  /// vehicles' launch positions and velocities, with the attitude from the first IMU and
+  /// compass samples) \throws kelp::invalid_argument for bad parameters.
+  PairNavigation(const PairSensors& p, std::uint64_t seed, const system::SystemModeld& model,
+                 const system::SystemStated& state);
+
+  /// per step, after the step). Errors against the truth are accumulated for t > 0.
+  void update(const system::SystemModeld& model, const system::SystemStated& state);
+
+
+  /// \brief The ROV's estimate.
+  const nav::Navigation& auv() const { return auv_.navigation(); }
+  /// \brief The boat's estimate.
+  const nav::Navigation& asv() const { return asv_.navigation(); }
+  /// \brief The ROV's filter.
+  const nav::NavigationFilter& auv_filter() const { return auv_; }
+  /// \brief The boat's filter.
+  const nav::NavigationFilter& asv_filter() const { return asv_; }
+  /// \brief Error statistics of the ROV's estimate.
+  const EstimateErrors& auv_errors() const { return auv_errors_; }
+  /// \brief Error statistics of the boat's estimate.
+  const EstimateErrors& asv_errors() const { return asv_errors_; }
+  /// \brief USBL pings, lost pings and fixes used so far.
+  long usbl_pings() const { return usbl_.pings(); }
+  long usbl_dropouts() const { return usbl_.dropouts(); }  ///< see usbl_pings()
+  long usbl_fixes() const { return usbl_fixes_; }          ///< see usbl_pings()
+  /// \brief DVL pings so far in a mode.
+  long dvl_pings(nav::DvlMode m) const { return dvl_counts_[static_cast<int>(m)]; }
+  /// \brief The parameters.
+  const PairSensors& parameters() const { return p_; }
+
+ private:
+  static void accumulate(const nav::Navigation& est, const vehicle::VehicleStated& x,
+                         EstimateErrors& e);
+
+
+  PairSensors p_;
+  nav::ImuSensor auv_imu_, asv_imu_;
+  nav::DepthSensor depth_;
+  nav::Dvl dvl_;
+  nav::Compass auv_compass_, asv_compass_;
+  nav::Gps gps_;
+  nav::Usbl usbl_;
+  nav::NavigationFilter auv_, asv_;
+  double last_ = 0.0;
+  long usbl_fixes_ = 0;
+  long dvl_counts_[3] = {0, 0, 0};
+  EstimateErrors auv_errors_, asv_errors_;
+};
+
+}  // namespace sim
+}  // namespace kelp
