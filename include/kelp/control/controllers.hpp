@@ -15,8 +15,12 @@
 /// and feeds −d̂ forward. Everything it cannot explain with its model (current, waves, wind,
 /// tether pull) ends up in d̂.
 ///
-/// Controllers run at their own period (zero-order hold between updates) in double precision and
-/// allocate nothing after construction.
+/// Controllers run at their own period (zero-order hold between updates) and allocate nothing
+/// after construction. Every class and function here is a template on the scalar of the vehicle
+/// model, navigation and thrust (`AuvControllerT<Scalar>`, …; the names without the T are the
+/// double ones), so that a translation unit that includes this header but flies no controller
+/// instantiates none of their Eigen code. The settings, the PIDs, time and the scalar
+/// intermediate quantities (errors, distances, gains) are double for every Scalar.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,47 +30,37 @@
 #include <vector>
 
 #include "kelp/control/pid.hpp"
+#include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/nav/estimate.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/state.hpp"
 #include "kelp/vehicle/thrusters.hpp"
 
 namespace kelp::control {
 
-/// \brief What a vehicle knows of itself.
-struct Navigation {
-  Vector3<double> position = Vector3<double>::Zero();            ///< NED [m]
-  Quaternion<double> attitude = Quaternion<double>::Identity();  ///< body → NED
-  Vector6<double> nu = Vector6<double>::Zero();  ///< body velocity over ground [m/s, rad/s]
-};
-
-/// \brief A perfect navigation solution from a simulated state.
-inline Navigation navigation_of(const vehicle::VehicleState<double>& x) {
-  return {x.position, x.attitude, x.nu};
-}
-
-/// \brief Heading ψ [rad] of an attitude (yaw of the ZYX Euler angles).
-inline double heading_of(const Quaternion<double>& q) { return euler_from_quaternion(q).z(); }
-
-/// \brief Angle wrapped to (−π, π].
-inline double wrap_angle(double a) {
-  a = std::fmod(a + kelp::pi, 2.0 * kelp::pi);
-  if (a <= 0.0) a += 2.0 * kelp::pi;
-  return a - kelp::pi;
-}
+// What a controller sees: kelp::nav's estimate (kelp/nav/estimate.hpp), under its old names.
+using nav::Navigation;
+using nav::navigation_of;
+using nav::NavigationT;
+// The heading of an attitude and the controllers' angle wrap (kelp/core/angles.hpp).
+using kelp::heading_of;
+using kelp::wrap_angle;
 
 /// \brief When a controller of period T runs: at its first call, then every T (zero-order hold
 /// in between; a late call runs at once and the schedule restarts from it).
-class SampleClock {
+/// \tparam Time the clock's type (double).
+template <typename Time>
+class SampleClockT {
  public:
   /// \brief True when an update is due at time t [s]; `dt` is then the time since the last one
   /// (T on the first).
-  bool due(double t, double period, double& dt) {
+  bool due(Time t, Time period, Time& dt) {
     if (started_ && t < next_ - 1e-9) return false;
-    dt = started_ ? std::max(t - last_, 1e-6) : period;
+    dt = started_ ? std::max(t - last_, Time(1e-6)) : period;
     next_ = (started_ ? next_ : t) + period;
     if (next_ <= t) next_ = t + period;
     last_ = t;
@@ -75,50 +69,67 @@ class SampleClock {
   }
 
  private:
-  double last_ = 0.0, next_ = 0.0;
+  Time last_ = Time(0), next_ = Time(0);
   bool started_ = false;
 };
 
+/// \brief The controllers' clock (double seconds).
+using SampleClock = SampleClockT<double>;
+
 /// \brief Momentum-based disturbance observer (see the file comment).
-class DisturbanceObserver {
+/// \tparam Scalar the model's and the navigation's scalar (double or float).
+template <typename Scalar>
+class DisturbanceObserverT {
  public:
-  DisturbanceObserver() = default;
+  DisturbanceObserverT() = default;
   /// \param[in] model the vehicle's own model \param[in] time_constant of the low-pass [s]
-  DisturbanceObserver(const vehicle::VehicleModel<double>& model, double time_constant)
+  DisturbanceObserverT(const vehicle::VehicleModel<Scalar>& model, double time_constant)
       : model_(&model), tau_(time_constant) {
     check_positive(time_constant, "observer time_constant");
   }
   /// \brief Updates the estimate from the navigation at this update, the wrench applied since
   /// the last one and the time since [s]. Returns d̂ (body wrench [N, N m]).
-  const Vector6<double>& update(const Navigation& nav, const Vector6<double>& applied, double dt) {
+  const Vector6<Scalar>& update(const NavigationT<Scalar>& nav, const Vector6<Scalar>& applied,
+                                double dt) {
     if (model_ == nullptr) return estimate_;
     if (has_last_) {
-      vehicle::VehicleState<double> x;
+      vehicle::VehicleState<Scalar> x;
       x.position = last_.position;
       x.attitude = last_.attitude;
       x.nu = last_.nu;
-      const Vector6<double> predicted =
-          vehicle::forward_dynamics(*model_, ws_, x, applied, Vector6<double>::Zero());
-      const Vector6<double> measured = (nav.nu - last_.nu) / dt;
-      const Vector6<double> d = model_->mass_matrix() * (measured - predicted);
+      const Vector6<Scalar> predicted =
+          vehicle::forward_dynamics(*model_, ws_, x, applied, Vector6<Scalar>::Zero());
+      const Vector6<Scalar> measured = (nav.nu - last_.nu) / Scalar(dt);
+      const Vector6<Scalar> d = model_->mass_matrix() * (measured - predicted);
       const double a = dt / (tau_ + dt);
-      estimate_ += a * (d - estimate_);
+      estimate_ += Scalar(a) * (d - estimate_);
     }
     last_ = nav;
     has_last_ = true;
     return estimate_;
   }
   /// \brief The current estimate d̂.
-  const Vector6<double>& estimate() const { return estimate_; }
+  const Vector6<Scalar>& estimate() const { return estimate_; }
 
  private:
-  const vehicle::VehicleModel<double>* model_ = nullptr;
-  vehicle::VehicleWorkspace<double> ws_;
+  const vehicle::VehicleModel<Scalar>* model_ = nullptr;
+  vehicle::VehicleWorkspace<Scalar> ws_;
   double tau_ = 1.0;
-  Navigation last_;
+  NavigationT<Scalar> last_;
   bool has_last_ = false;
-  Vector6<double> estimate_ = Vector6<double>::Zero();
+  Vector6<Scalar> estimate_ = Vector6<Scalar>::Zero();
 };
+
+/// \brief The observer in double precision.
+using DisturbanceObserver = DisturbanceObserverT<double>;
+
+namespace detail {
+/// `T` in a parameter that takes no part in template argument deduction (std::type_identity).
+template <typename T>
+struct NonDeduced {
+  using type = T;
+};
+}  // namespace detail
 
 /// \brief The factors (each in (0, 1]) by which allocate_wrench() scaled the thrust down to keep
 /// every thruster within its limit; all 1 when nothing saturated.
@@ -144,13 +155,15 @@ struct AllocationScales {
 /// \param[out] scratch a buffer of the same size (the vertical part's forces)
 /// \returns the scale factors applied.
 /// \throws kelp::invalid_argument for a non-finite `tau` or wrongly sized buffers.
-inline AllocationScales allocate_wrench(const vehicle::ThrusterChain<double>& chain,
-                                        const Vector6<double>& tau, double max_thrust,
-                                        bool split_saturation, Eigen::VectorXd& force,
-                                        Eigen::VectorXd& scratch) {
+/// \tparam Scalar the chain's scalar (deduced from `chain` only).
+template <typename Scalar>
+AllocationScales allocate_wrench(const vehicle::ThrusterChain<Scalar>& chain,
+                                 const typename detail::NonDeduced<Vector6<Scalar>>::type& tau,
+                                 double max_thrust, bool split_saturation, VectorX<Scalar>& force,
+                                 VectorX<Scalar>& scratch) {
   KELP_CHECK(scratch.size() == force.size(), "allocate_wrench: scratch must be sized as force");
   // fit(f) is the largest factor ≤ 1 that keeps every thruster of f within its limit.
-  const auto fit = [&](const Eigen::VectorXd& f) {
+  const auto fit = [&](const VectorX<Scalar>& f) {
     double scale = 1.0;
     for (Eigen::Index i = 0; i < f.size(); ++i) {
       const double l = std::min(
@@ -164,22 +177,22 @@ inline AllocationScales allocate_wrench(const vehicle::ThrusterChain<double>& ch
     // A depth correction that saturates the vertical thrusters does not shrink the horizontal
     // thrust (on a vehicle whose thrusters split so, e.g. the BlueROV2 Heavy, the groups are
     // independent).
-    Vector6<double> part = tau;
+    Vector6<Scalar> part = tau;
     part(2) = part(3) = part(4) = 0.0;
     chain.allocation().distribute(part, force);
     s.horizontal = fit(force);
-    force *= s.horizontal;
+    force *= Scalar(s.horizontal);
     part = tau - part;
     chain.allocation().distribute(part, scratch);
     s.vertical = fit(scratch);
-    scratch *= s.vertical;
+    scratch *= Scalar(s.vertical);
     force += scratch;
     s.total = fit(force);
-    force *= s.total;
+    force *= Scalar(s.total);
   } else {
     chain.allocation().distribute(tau, force);
     s.total = fit(force);
-    if (s.total < 1.0) force *= s.total;
+    if (s.total < 1.0) force *= Scalar(s.total);
   }
   return s;
 }
@@ -229,26 +242,34 @@ struct AuvControllerSettings {
 };
 
 /// \brief One AUV controller output.
-struct AuvCommand {
-  Vector6<double> wrench = Vector6<double>::Zero();  ///< body wrench the thrusters deliver
-  Eigen::VectorXd thrust;                            ///< per thruster [N], after saturation
-  Eigen::VectorXd command;  ///< normalised commands (the thruster model's inverse of thrust)
-  Vector3<double> position_error = Vector3<double>::Zero();  ///< target − position, NED [m]
+/// \tparam Scalar the controller's scalar (double or float).
+template <typename Scalar>
+struct AuvCommandT {
+  Vector6<Scalar> wrench = Vector6<Scalar>::Zero();  ///< body wrench the thrusters deliver
+  VectorX<Scalar> thrust;                            ///< per thruster [N], after saturation
+  VectorX<Scalar> command;  ///< normalised commands (the thruster model's inverse of thrust)
+  Vector3<Scalar> position_error = Vector3<Scalar>::Zero();  ///< target − position, NED [m]
   double heading_error = 0.0;                                ///< [rad]
   bool saturated = false;  ///< the allocation had to scale the thrust down
 };
 
+/// \brief An AUV controller output in double precision.
+using AuvCommand = AuvCommandT<double>;
+
 /// \brief Depth, heading and position hold and waypoint following for an AUV with a fully
 /// actuated thruster set (e.g. vehicle::bluerov2_heavy).
-class AuvController {
+/// \tparam Scalar the scalar of the model, the navigation, the thrust and the wrench (double or
+/// float); the settings, the PIDs and the errors are double.
+template <typename Scalar>
+class AuvControllerT {
  public:
   /// \param[in] model the AUV's own model (for the disturbance observer; kept by reference)
   /// \param[in] thrusters its allocation \param[in] s settings
-  AuvController(const vehicle::VehicleModel<double>& model,
-                const vehicle::ThrusterAllocation<double>& thrusters,
-                const AuvControllerSettings& s = {})
+  AuvControllerT(const vehicle::VehicleModel<Scalar>& model,
+                 const vehicle::ThrusterAllocation<Scalar>& thrusters,
+                 const AuvControllerSettings& s = {})
       : settings_(s),
-        thrusters_(thrusters, s.thruster_model, vehicle::PwmMapping<double>(), s.thruster_facing,
+        thrusters_(thrusters, s.thruster_model, vehicle::PwmMapping<Scalar>(), s.thruster_facing,
                    s.voltage),
         surge_(s.surge, "surge"),
         sway_(s.sway, "sway"),
@@ -261,14 +282,14 @@ class AuvController {
     check_positive(s.max_thrust, "max_thrust");
     check_positive(s.max_horizontal_error, "max_horizontal_error");
     check_positive(s.acceptance_radius, "acceptance_radius");
-    command_.thrust = Eigen::VectorXd::Zero(thrusters.size());
-    command_.command = Eigen::VectorXd::Zero(thrusters.size());
-    force_ = Eigen::VectorXd::Zero(thrusters.size());
-    vertical_ = Eigen::VectorXd::Zero(thrusters.size());
+    command_.thrust = VectorX<Scalar>::Zero(thrusters.size());
+    command_.command = VectorX<Scalar>::Zero(thrusters.size());
+    force_ = VectorX<Scalar>::Zero(thrusters.size());
+    vertical_ = VectorX<Scalar>::Zero(thrusters.size());
   }
 
   /// \brief Hold this NED position and heading [rad].
-  void hold(const Vector3<double>& position, double heading) {
+  void hold(const Vector3<Scalar>& position, double heading) {
     check_all_finite(position, "hold position");
     check_finite(heading, "hold heading");
     waypoints_.clear();
@@ -277,7 +298,7 @@ class AuvController {
   }
   /// \brief Follow these NED waypoints in order, facing the direction of travel; hold the last.
   /// \throws kelp::invalid_argument for an empty list or a non-finite point.
-  void follow(const std::vector<Vector3<double>>& waypoints) {
+  void follow(const std::vector<Vector3<Scalar>>& waypoints) {
     KELP_CHECK(!waypoints.empty(), "follow: the waypoint list is empty");
     for (const auto& w : waypoints) check_all_finite(w, "waypoint");
     waypoints_ = waypoints;
@@ -289,17 +310,17 @@ class AuvController {
   /// \brief Index of the waypoint being flown to (== count when all are reached).
   std::size_t next_waypoint() const { return waypoints_.empty() ? 0 : next_; }
   /// \brief The current target position, NED [m].
-  const Vector3<double>& target() const { return target_; }
+  const Vector3<Scalar>& target() const { return target_; }
 
   /// \brief The command at time t [s] for navigation `nav`: recomputed every `period`, held in
   /// between. No allocation.
-  const AuvCommand& update(const Navigation& nav, double t) {
+  const AuvCommandT<Scalar>& update(const NavigationT<Scalar>& nav, double t) {
     double dt = 0.0;
     if (!clock_.due(t, settings_.period, dt)) return command_;
     if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
     // Waypoints: advance when within the acceptance radius; face the direction of travel.
-    Vector3<double> aim = target_;                           // where the PIDs steer to
-    Vector3<double> aim_velocity = Vector3<double>::Zero();  // its velocity, NED
+    Vector3<Scalar> aim = target_;                           // where the PIDs steer to
+    Vector3<Scalar> aim_velocity = Vector3<Scalar>::Zero();  // its velocity, NED
     bool held = false;  // the reference waits for the vehicle (max_horizontal_error ahead)
     if (!waypoints_.empty()) {
       if (!has_leg_start_) {
@@ -311,15 +332,15 @@ class AuvController {
         ++next_;
       target_ = waypoints_[std::min(next_, waypoints_.size() - 1)];
       aim = target_;
-      const Vector3<double> d = target_ - nav.position;
-      const Vector3<double> a =
+      const Vector3<Scalar> d = target_ - nav.position;
+      const Vector3<Scalar> a =
           next_ == 0 ? leg_start_ : waypoints_[std::min(next_, waypoints_.size()) - 1];
-      const Vector3<double> leg = target_ - a;
+      const Vector3<Scalar> leg = target_ - a;
       const double length = leg.norm();
       if (settings_.follow_legs && next_ < waypoints_.size() &&
           length > settings_.acceptance_radius) {
-        const Vector3<double> u = leg / length;
-        const double along = std::clamp((nav.position - a).dot(u), 0.0, length);
+        const Vector3<Scalar> u = leg / Scalar(length);
+        const double along = std::clamp(double((nav.position - a).dot(u)), 0.0, length);
         if (leg_ != next_) {  // a new leg: the reference starts level with the vehicle
           leg_ = next_;
           progress_ = along;
@@ -329,33 +350,34 @@ class AuvController {
         held = wanted > ahead;
         progress_ = std::min({wanted, ahead, length});
         progress_ = std::max(progress_, 0.0);
-        aim = a + progress_ * u;
-        if (!held && progress_ < length) aim_velocity = settings_.leg_speed * u;
-        if (leg.head<2>().norm() > 2.0 * settings_.acceptance_radius)
+        aim = a + Scalar(progress_) * u;
+        if (!held && progress_ < length) aim_velocity = Scalar(settings_.leg_speed) * u;
+        if (leg.template head<2>().norm() > 2.0 * settings_.acceptance_radius)
           heading_ = std::atan2(leg.y(), leg.x());
-      } else if (d.head<2>().norm() > 2.0 * settings_.acceptance_radius) {
+      } else if (d.template head<2>().norm() > 2.0 * settings_.acceptance_radius) {
         heading_ = std::atan2(d.y(), d.x());
       }
     }
     const double psi = heading_of(nav.attitude);
-    Vector3<double> e = aim - nav.position;
+    Vector3<Scalar> e = aim - nav.position;
     command_.position_error = target_ - nav.position;
-    const double h = e.head<2>().norm();
+    const double h = e.template head<2>().norm();
     // Capped (a far waypoint); following legs, the reference is already near, and its
     // cross-track part is kept whole up to twice the cap.
     const double cap = (settings_.follow_legs ? 2.0 : 1.0) * settings_.max_horizontal_error;
-    if (h > cap) e.head<2>() *= cap / h;
+    if (h > cap) e.template head<2>() *= Scalar(cap / h);
     // Error in the heading frame (yaw only); its rate is minus the body velocity (level flight).
     const double c = std::cos(psi), s = std::sin(psi);
-    const Vector3<double> eb(c * e.x() + s * e.y(), -s * e.x() + c * e.y(), e.z());
-    const Vector3<double> vb(c * aim_velocity.x() + s * aim_velocity.y(),
-                             -s * aim_velocity.x() + c * aim_velocity.y(), aim_velocity.z());
-    const Vector3<double> rpy = euler_from_quaternion(nav.attitude);
+    const Vector3<Scalar> eb(Scalar(c * e.x() + s * e.y()), Scalar(-s * e.x() + c * e.y()), e.z());
+    const Vector3<Scalar> vb(Scalar(c * aim_velocity.x() + s * aim_velocity.y()),
+                             Scalar(-s * aim_velocity.x() + c * aim_velocity.y()),
+                             aim_velocity.z());
+    const Vector3<Scalar> rpy = euler_from_quaternion(nav.attitude);
     const double e_psi = wrap_angle(heading_ - psi);
     command_.heading_error = e_psi;
     const double i_saved[4] = {surge_.integral(), sway_.integral(), heave_.integral(),
                                yaw_.integral()};
-    Vector6<double> tau;
+    Vector6<Scalar> tau;
     tau << surge_.update(eb.x(), dt, vb.x() - nav.nu(0)),
         sway_.update(eb.y(), dt, vb.y() - nav.nu(1)), heave_.update(eb.z(), dt, vb.z() - nav.nu(2)),
         roll_.update(-rpy(0), dt, -nav.nu(3)), pitch_.update(-rpy(1), dt, -nav.nu(4)),
@@ -385,7 +407,7 @@ class AuvController {
     return command_;
   }
   /// \brief The last command.
-  const AuvCommand& command() const { return command_; }
+  const AuvCommandT<Scalar>& command() const { return command_; }
   /// \brief Sets the thrusters' supply voltage [V] (e.g. the battery's, each step): the inverse
   /// and the saturation use it from the next update on.
   /// \throws kelp::invalid_argument outside [0, 20] V or not finite (nothing changes).
@@ -393,27 +415,30 @@ class AuvController {
   /// \brief The thrusters' supply voltage [V].
   double voltage() const { return thrusters_.voltage(); }
   /// \brief The thruster chain (curve, facing, voltage) the inverse uses.
-  const vehicle::ThrusterChain<double>& thruster_chain() const { return thrusters_; }
+  const vehicle::ThrusterChain<Scalar>& thruster_chain() const { return thrusters_; }
   /// \brief The disturbance estimate (zero unless compensating).
-  const Vector6<double>& disturbance_estimate() const { return observer_.estimate(); }
+  const Vector6<Scalar>& disturbance_estimate() const { return observer_.estimate(); }
 
  private:
   AuvControllerSettings settings_;
-  vehicle::ThrusterChain<double> thrusters_;
+  vehicle::ThrusterChain<Scalar> thrusters_;
   Pid surge_, sway_, heave_, roll_, pitch_, yaw_;
-  DisturbanceObserver observer_;
-  std::vector<Vector3<double>> waypoints_;
+  DisturbanceObserverT<Scalar> observer_;
+  std::vector<Vector3<Scalar>> waypoints_;
   std::size_t next_ = 0;
-  Vector3<double> target_ = Vector3<double>::Zero();
-  Vector3<double> leg_start_ = Vector3<double>::Zero();  // where the first leg begins
+  Vector3<Scalar> target_ = Vector3<Scalar>::Zero();
+  Vector3<Scalar> leg_start_ = Vector3<Scalar>::Zero();  // where the first leg begins
   bool has_leg_start_ = false;
   std::size_t leg_ = static_cast<std::size_t>(-1);  // the leg `progress_` belongs to
   double progress_ = 0.0;                           // the reference's distance along its leg [m]
   double heading_ = 0.0;
-  AuvCommand command_;
-  Eigen::VectorXd force_, vertical_;
+  AuvCommandT<Scalar> command_;
+  VectorX<Scalar> force_, vertical_;
   SampleClock clock_;
 };
+
+/// \brief The AUV controller in double precision.
+using AuvController = AuvControllerT<double>;
 
 /// \brief How the ASV follows its target.
 enum class AsvLaw {
@@ -472,24 +497,32 @@ struct AsvControllerSettings {
 };
 
 /// \brief One ASV controller output.
-struct AsvCommand {
+/// \tparam Scalar the controller's scalar (double or float).
+template <typename Scalar>
+struct AsvCommandT {
   double left = 0.0, right = 0.0;  ///< thrust of the port and starboard thrusters [N]
-  Eigen::Vector2d command = Eigen::Vector2d::Zero();         ///< normalised commands
-  Vector6<double> wrench = Vector6<double>::Zero();          ///< body wrench delivered
-  Vector3<double> position_error = Vector3<double>::Zero();  ///< target − position, NED [m]
+  Eigen::Matrix<Scalar, 2, 1> command = Eigen::Matrix<Scalar, 2, 1>::Zero();  ///< normalised
+  Vector6<Scalar> wrench = Vector6<Scalar>::Zero();          ///< body wrench delivered
+  Vector3<Scalar> position_error = Vector3<Scalar>::Zero();  ///< target − position, NED [m]
   double heading_error = 0.0;  ///< bearing (or heading, once there) error [rad]
 };
 
+/// \brief An ASV controller output in double precision.
+using AsvCommand = AsvCommandT<double>;
+
 /// \brief Station keeping and follow-the-AUV for a skid-steered ASV (vehicle::blueboat).
-class AsvController {
+/// \tparam Scalar the scalar of the model, the navigation, the thrust and the wrench (double or
+/// float); the settings, the PIDs and the errors are double.
+template <typename Scalar>
+class AsvControllerT {
  public:
   /// \param[in] model the ASV's own model (for the observer; kept by reference)
   /// \param[in] thrusters its two thrusters (port first) \param[in] s settings
-  AsvController(const vehicle::VehicleModel<double>& model,
-                const vehicle::ThrusterAllocation<double>& thrusters,
-                const AsvControllerSettings& s = {})
+  AsvControllerT(const vehicle::VehicleModel<Scalar>& model,
+                 const vehicle::ThrusterAllocation<Scalar>& thrusters,
+                 const AsvControllerSettings& s = {})
       : settings_(s),
-        thrusters_(thrusters, s.thruster_model, vehicle::PwmMapping<double>(), s.thruster_facing,
+        thrusters_(thrusters, s.thruster_model, vehicle::PwmMapping<Scalar>(), s.thruster_facing,
                    s.voltage),
         linear_(s.linear, "linear"),
         angular_(s.angular, "angular"),
@@ -512,7 +545,7 @@ class AsvController {
   }
 
   /// \brief Keep station at this NED point (z ignored) and heading [rad].
-  void station(const Vector3<double>& point, double heading) {
+  void station(const Vector3<Scalar>& point, double heading) {
     check_all_finite(point, "station point");
     check_finite(heading, "station heading");
     follow_ = false;
@@ -523,17 +556,18 @@ class AsvController {
   void follow_auv() { follow_ = true; }
 
   /// \brief The command at time t [s] from the boat's navigation and the AUV's position (USBL).
-  const AsvCommand& update(const Navigation& nav, const Vector3<double>& auv_position, double t) {
+  const AsvCommandT<Scalar>& update(const NavigationT<Scalar>& nav,
+                                    const Vector3<Scalar>& auv_position, double t) {
     double dt = 0.0;
     if (!clock_.due(t, settings_.period, dt)) return command_;
     if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
     if (follow_) {
-      target_ = auv_position + settings_.follow_offset;
+      target_ = auv_position + settings_.follow_offset.template cast<Scalar>();
       heading_ = heading_of(nav.attitude);  // hold whatever heading it arrives with
     }
     const double psi = heading_of(nav.attitude);
-    Vector3<double> e = target_ - nav.position;
-    e.z() = 0.0;
+    Vector3<Scalar> e = target_ - nav.position;
+    e.z() = Scalar(0);
     command_.position_error = e;
     const double distance = e.norm();
     double common = 0.0, differential = 0.0;
@@ -555,7 +589,7 @@ class AsvController {
     }
     if (settings_.compensate) {
       // Feed forward −d̂ through the same mix: surge and yaw moment.
-      const Vector6<double>& d = observer_.estimate();
+      const Vector6<Scalar>& d = observer_.estimate();
       common -= 0.5 * d(0);
       differential -= 0.5 * d(5) / half_track_;
     }
@@ -563,14 +597,14 @@ class AsvController {
     // More thrust on the port side turns the bow to starboard (positive yaw, NED).
     command_.left = std::clamp(common + differential, -clip, clip);
     command_.right = std::clamp(common - differential, -clip, clip);
-    const Eigen::Vector2d wanted(command_.left, command_.right);
-    Eigen::Vector2d f;
+    const Eigen::Matrix<Scalar, 2, 1> wanted(Scalar(command_.left), Scalar(command_.right));
+    Eigen::Matrix<Scalar, 2, 1> f;
     thrusters_.commands_for(wanted, command_.command, f);
     command_.wrench = thrusters_.wrench(f);
     return command_;
   }
   /// \brief The last command.
-  const AsvCommand& command() const { return command_; }
+  const AsvCommandT<Scalar>& command() const { return command_; }
   /// \brief Sets the thrusters' supply voltage [V] (e.g. the battery's, each step): the inverse
   /// uses it from the next update on.
   /// \throws kelp::invalid_argument outside [0, 20] V or not finite (nothing changes).
@@ -578,31 +612,31 @@ class AsvController {
   /// \brief The thrusters' supply voltage [V].
   double voltage() const { return thrusters_.voltage(); }
   /// \brief The thruster chain (curve, facing, voltage) the inverse uses.
-  const vehicle::ThrusterChain<double>& thruster_chain() const { return thrusters_; }
+  const vehicle::ThrusterChain<Scalar>& thruster_chain() const { return thrusters_; }
   /// \brief The current target position, NED [m].
-  const Vector3<double>& target() const { return target_; }
+  const Vector3<Scalar>& target() const { return target_; }
   /// \brief The target's estimated velocity over ground (AsvLaw::track; zero until two updates
   /// have seen it), NED [m/s].
-  const Vector3<double>& target_velocity() const { return target_velocity_; }
+  const Vector3<Scalar>& target_velocity() const { return target_velocity_; }
 
  private:
   // AsvLaw::track: velocity command from the target's velocity and the position error, heading
   // to it, surge speed along the bow.
-  void track(const Navigation& nav, const Vector3<double>& e, double psi, double dt, double& common,
-             double& differential) {
+  void track(const NavigationT<Scalar>& nav, const Vector3<Scalar>& e, double psi, double dt,
+             double& common, double& differential) {
     if (has_last_target_) {
-      const Vector3<double> v = (target_ - last_target_) / dt;
+      const Vector3<Scalar> v = (target_ - last_target_) / Scalar(dt);
       const double a = dt / (settings_.target_velocity_time_constant + dt);
-      target_velocity_ += a * (v - target_velocity_);
-      target_velocity_.z() = 0.0;
+      target_velocity_ += Scalar(a) * (v - target_velocity_);
+      target_velocity_.z() = Scalar(0);
     }
     last_target_ = target_;
     has_last_target_ = true;
-    Vector3<double> v_cmd = target_velocity_ + settings_.position_gain * e;
+    Vector3<Scalar> v_cmd = target_velocity_ + Scalar(settings_.position_gain) * e;
     const double speed = v_cmd.norm();
-    if (speed > settings_.max_speed) v_cmd *= settings_.max_speed / speed;
+    if (speed > settings_.max_speed) v_cmd *= Scalar(settings_.max_speed / speed);
     if (speed > settings_.turn_speed || !has_course_) {
-      course_ = speed > settings_.turn_speed ? std::atan2(v_cmd.y(), v_cmd.x()) : psi;
+      course_ = speed > settings_.turn_speed ? double(std::atan2(v_cmd.y(), v_cmd.x())) : psi;
       has_course_ = true;
     }
     const double e_psi = wrap_angle(course_ - psi);
@@ -617,18 +651,21 @@ class AsvController {
   }
 
   AsvControllerSettings settings_;
-  vehicle::ThrusterChain<double> thrusters_;
+  vehicle::ThrusterChain<Scalar> thrusters_;
   Pid linear_, angular_, yaw_, speed_, heading_pid_;
-  Vector3<double> last_target_ = Vector3<double>::Zero();
-  Vector3<double> target_velocity_ = Vector3<double>::Zero();
+  Vector3<Scalar> last_target_ = Vector3<Scalar>::Zero();
+  Vector3<Scalar> target_velocity_ = Vector3<Scalar>::Zero();
   double course_ = 0.0;
   bool has_last_target_ = false, has_course_ = false;
-  DisturbanceObserver observer_;
-  Vector3<double> target_ = Vector3<double>::Zero();
+  DisturbanceObserverT<Scalar> observer_;
+  Vector3<Scalar> target_ = Vector3<Scalar>::Zero();
   double heading_ = 0.0, half_track_ = 0.0;
   bool follow_ = false;
-  AsvCommand command_;
+  AsvCommandT<Scalar> command_;
   SampleClock clock_;
 };
+
+/// \brief The ASV controller in double precision.
+using AsvController = AsvControllerT<double>;
 
 }  // namespace kelp::control

@@ -1,7 +1,9 @@
 /// \file
 /// \brief A navigation filter for one vehicle: the IMU drives it, aiding sensors (depth, DVL,
 /// compass, GPS or USBL fixes, the latter possibly late) correct it, and it gives the
-/// controllers a control::Navigation.
+/// controllers a nav::Navigation (kelp/nav/estimate.hpp). The filter is a template on its scalar
+/// (`NavigationFilterT<Scalar>`; `NavigationFilter` is the double one), so that a unit that
+/// includes this header but runs no filter instantiates none of its Eigen code.
 ///
 /// **Choice: a cascade of a complementary attitude filter and a linear Kalman filter.**
 /// - Attitude: the explicit complementary filter on SO(3) of Mahony, Hamel and Pflimlin
@@ -37,11 +39,12 @@
 #include <cmath>
 #include <vector>
 
-#include "kelp/control/controllers.hpp"
+#include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/nav/estimate.hpp"
 #include "kelp/nav/sensors.hpp"
 
 namespace kelp::nav {
@@ -87,16 +90,19 @@ inline void validate(const FilterSettings& s) {
 }
 
 /// \brief The navigation filter of one vehicle (see the file comment).
-class NavigationFilter {
+/// \tparam Scalar the scalar of the estimate (double or float); the sensors' samples, the
+/// settings and time are double.
+template <typename Scalar>
+class NavigationFilterT {
  public:
   static constexpr int n = 11;                      ///< Kalman states
-  using StateVector = Eigen::Matrix<double, n, 1>;  ///< (p, v, b_a, c)
-  using Covariance = Eigen::Matrix<double, n, n>;   ///< its covariance
+  using StateVector = Eigen::Matrix<Scalar, n, 1>;  ///< (p, v, b_a, c)
+  using Covariance = Eigen::Matrix<Scalar, n, n>;   ///< its covariance
 
   /// \param[in] imu the IMU it integrates (its rate and noise) \param[in] s settings
   /// \param[in] gravity g [m/s²] \throws kelp::invalid_argument for bad parameters.
-  NavigationFilter(const ImuParameters& imu, const FilterSettings& s = {},
-                   double gravity = kelp::standard_gravity)
+  NavigationFilterT(const ImuParameters& imu, const FilterSettings& s = {},
+                    double gravity = kelp::standard_gravity)
       : imu_((validate(imu), imu)), s_((validate(s), s)), g_(gravity) {
     check_positive(gravity, "gravity");
     history_.resize(static_cast<std::size_t>(std::ceil(s.history * imu.rate)) + 2);
@@ -104,7 +110,7 @@ class NavigationFilter {
 
   /// \brief Starts the filter at a known NED position and velocity [m, m/s], with the attitude
   /// from an IMU sample at rest-like conditions (roll and pitch from gravity) and a heading [rad].
-  void initialize(const Vector3<double>& position, const Vector3<double>& velocity, double heading,
+  void initialize(const Vector3<Scalar>& position, const Vector3<Scalar>& velocity, double heading,
                   const ImuSample& imu) {
     check_all_finite(position, "initialize: position");
     check_all_finite(velocity, "initialize: velocity");
@@ -112,19 +118,19 @@ class NavigationFilter {
     const Vector3<double>& f = imu.accel;
     const double roll = std::atan2(-f.y(), -f.z());
     const double pitch = std::atan2(f.x(), std::hypot(f.y(), f.z()));
-    q_ = quaternion_from_euler(roll, pitch, heading);
+    q_ = quaternion_from_euler(Scalar(roll), Scalar(pitch), Scalar(heading));
     x_.setZero();
-    x_.segment<3>(0) = position;
-    x_.segment<3>(3) = velocity;
+    x_.template segment<3>(0) = position;
+    x_.template segment<3>(3) = velocity;
     P_.setZero();
-    P_.diagonal().segment<3>(0).setConstant(sq(s_.initial_position_sigma));
-    P_.diagonal().segment<3>(3).setConstant(sq(s_.initial_velocity_sigma));
-    P_.diagonal().segment<3>(6).setConstant(sq(s_.initial_accel_bias_sigma));
-    P_.diagonal().segment<2>(9).setConstant(s_.estimate_current ? sq(s_.initial_current_sigma)
-                                                                : 0.0);
+    P_.diagonal().template segment<3>(0).setConstant(Scalar(sq(s_.initial_position_sigma)));
+    P_.diagonal().template segment<3>(3).setConstant(Scalar(sq(s_.initial_velocity_sigma)));
+    P_.diagonal().template segment<3>(6).setConstant(Scalar(sq(s_.initial_accel_bias_sigma)));
+    P_.diagonal().template segment<2>(9).setConstant(
+        Scalar(s_.estimate_current ? sq(s_.initial_current_sigma) : 0.0));
     gyro_bias_.setZero();
     t_ = imu.t;
-    omega_ = imu.gyro;
+    omega_ = imu.gyro.template cast<Scalar>();
     count_ = 0;
     head_ = 0;
     shift_.setZero();
@@ -141,115 +147,121 @@ class NavigationFilter {
     KELP_CHECK(initialized_, "NavigationFilter::predict: call initialize() first");
     const double dt = m.t - t_;
     t_ = m.t;
-    omega_ = m.gyro;
+    omega_ = m.gyro.template cast<Scalar>();
     if (!(dt > 0)) return;
     // Attitude: gyro less bias, corrected towards gravity when the accelerometer sees about g.
-    Vector3<double> w = m.gyro - gyro_bias_;
+    Vector3<Scalar> w = m.gyro.template cast<Scalar>() - gyro_bias_;
     const double fn = m.accel.norm();
     if (s_.tilt_gain > 0 && std::abs(fn - g_) < 0.2 * g_) {
-      const Vector3<double> measured = -m.accel / fn;
-      const Vector3<double> predicted = q_.conjugate() * Vector3<double>::UnitZ();
-      const Vector3<double> e = measured.cross(predicted);
-      w += s_.tilt_gain * e;
-      gyro_bias_ -= s_.gyro_bias_gain * e * dt;
+      const Vector3<Scalar> measured = (-m.accel / fn).template cast<Scalar>();
+      const Vector3<Scalar> predicted = q_.conjugate() * Vector3<Scalar>::UnitZ();
+      const Vector3<Scalar> e = measured.cross(predicted);
+      w += Scalar(s_.tilt_gain) * e;
+      gyro_bias_ -= Scalar(s_.gyro_bias_gain) * e * Scalar(dt);
     }
-    rotate(w * dt);
+    rotate(w * Scalar(dt));
     // Translation: the Kalman prediction with the new attitude.
-    const Matrix3<double> R = q_.toRotationMatrix();
-    const Vector3<double> a = R * (m.accel - x_.segment<3>(6)) + Vector3<double>(0.0, 0.0, g_);
-    x_.segment<3>(0) += x_.segment<3>(3) * dt + 0.5 * a * dt * dt;
-    x_.segment<3>(3) += a * dt;
+    const Matrix3<Scalar> R = q_.toRotationMatrix();
+    const Vector3<Scalar> a = R * (m.accel.template cast<Scalar>() - x_.template segment<3>(6)) +
+                              Vector3<Scalar>(Scalar(0), Scalar(0), Scalar(g_));
+    x_.template segment<3>(0) +=
+        x_.template segment<3>(3) * Scalar(dt) + Scalar(0.5) * a * Scalar(dt) * Scalar(dt);
+    x_.template segment<3>(3) += a * Scalar(dt);
     // P ← F P Fᵀ with F = I + [0 dt·I A; 0 0 B; 0 0 0] on (p, v, b_a) (A = −½dt² R̂,
     // B = −dt R̂), written out by blocks: a few hundred flops instead of two dense 11³ products.
-    const Matrix3<double> A = -0.5 * dt * dt * R, B = -dt * R;
-    P_.middleRows<3>(0) += dt * P_.middleRows<3>(3) + A * P_.middleRows<3>(6);
-    P_.middleRows<3>(3) += B * P_.middleRows<3>(6);
-    P_.middleCols<3>(0) += dt * P_.middleCols<3>(3) + P_.middleCols<3>(6) * A.transpose();
-    P_.middleCols<3>(3) += P_.middleCols<3>(6) * B.transpose();
+    const Matrix3<Scalar> A = Scalar(-0.5 * dt * dt) * R, B = Scalar(-dt) * R;
+    P_.template middleRows<3>(0) +=
+        Scalar(dt) * P_.template middleRows<3>(3) + A * P_.template middleRows<3>(6);
+    P_.template middleRows<3>(3) += B * P_.template middleRows<3>(6);
+    P_.template middleCols<3>(0) +=
+        Scalar(dt) * P_.template middleCols<3>(3) + P_.template middleCols<3>(6) * A.transpose();
+    P_.template middleCols<3>(3) += P_.template middleCols<3>(6) * B.transpose();
     const double qv = (sq(s_.acceleration_noise) + sq(imu_.accel_noise_density)) * dt;
-    P_.diagonal().segment<3>(0).array() += qv * dt * dt / 3.0;
-    P_.diagonal().segment<3>(3).array() += qv;
-    P_.diagonal().segment<3>(6).array() += sq(s_.accel_bias_walk) * dt;
-    if (s_.estimate_current) P_.diagonal().segment<2>(9).array() += sq(s_.current_walk) * dt;
+    P_.diagonal().template segment<3>(0).array() += Scalar(qv * dt * dt / 3.0);
+    P_.diagonal().template segment<3>(3).array() += Scalar(qv);
+    P_.diagonal().template segment<3>(6).array() += Scalar(sq(s_.accel_bias_walk) * dt);
+    if (s_.estimate_current)
+      P_.diagonal().template segment<2>(9).array() += Scalar(sq(s_.current_walk) * dt);
     push_history();
     refresh();
   }
 
   /// \brief A depth fix z [m] of noise σ [m].
   void update_depth(double z, double sigma) {
-    Eigen::Matrix<double, 1, n> H = Eigen::Matrix<double, 1, n>::Zero();
-    H(0, 2) = 1.0;
-    Eigen::Matrix<double, 1, 1> y, R;
-    y(0) = z - x_(2);
-    R(0) = sq(std::max(sigma, 1e-4));
+    Eigen::Matrix<Scalar, 1, n> H = Eigen::Matrix<Scalar, 1, n>::Zero();
+    H(0, 2) = Scalar(1);
+    Eigen::Matrix<Scalar, 1, 1> y, R;
+    y(0) = Scalar(z - x_(2));
+    R(0) = Scalar(sq(std::max(sigma, 1e-4)));
     correct<1>(y, H, R);
   }
 
   /// \brief A bottom-lock velocity (body axes, over ground) [m/s] of noise σ [m/s] per axis.
-  void update_body_velocity(const Vector3<double>& v, double sigma) {
-    const Matrix3<double> Rt = q_.toRotationMatrix().transpose();
-    Eigen::Matrix<double, 3, n> H = Eigen::Matrix<double, 3, n>::Zero();
-    H.block<3, 3>(0, 3) = Rt;
-    const Vector3<double> y = v - Rt * x_.segment<3>(3);
-    correct<3>(y, H, Matrix3<double>::Identity() * sq(std::max(sigma, 1e-4)));
+  void update_body_velocity(const Vector3<Scalar>& v, double sigma) {
+    const Matrix3<Scalar> Rt = q_.toRotationMatrix().transpose();
+    Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
+    H.template block<3, 3>(0, 3) = Rt;
+    const Vector3<Scalar> y = v - Rt * x_.template segment<3>(3);
+    correct<3>(y, H, Matrix3<Scalar>::Identity() * Scalar(sq(std::max(sigma, 1e-4))));
   }
 
   /// \brief A water-track velocity (body axes, relative to the water) [m/s] of noise σ [m/s]
   /// (the filter adds its `water_track_noise`). Used only when the filter estimates the current.
-  void update_water_velocity(const Vector3<double>& v, double sigma) {
+  void update_water_velocity(const Vector3<Scalar>& v, double sigma) {
     if (!s_.estimate_current) return;
-    const Matrix3<double> Rt = q_.toRotationMatrix().transpose();
-    Eigen::Matrix<double, 3, n> H = Eigen::Matrix<double, 3, n>::Zero();
-    H.block<3, 3>(0, 3) = Rt;
-    H.block<3, 2>(0, 9) = -Rt.leftCols<2>();
-    const Vector3<double> c(x_(9), x_(10), 0.0);
-    const Vector3<double> y = v - Rt * (x_.segment<3>(3) - c);
+    const Matrix3<Scalar> Rt = q_.toRotationMatrix().transpose();
+    Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
+    H.template block<3, 3>(0, 3) = Rt;
+    H.template block<3, 2>(0, 9) = -Rt.template leftCols<2>();
+    const Vector3<Scalar> c(x_(9), x_(10), Scalar(0));
+    const Vector3<Scalar> y = v - Rt * (x_.template segment<3>(3) - c);
     const double s2 = sq(sigma) + sq(s_.water_track_noise);
-    correct<3>(y, H, Matrix3<double>::Identity() * std::max(s2, 1e-8));
+    correct<3>(y, H, Matrix3<Scalar>::Identity() * Scalar(std::max(s2, 1e-8)));
   }
 
   /// \brief A compass heading ψ [rad]; `dt` [s] is the time since the last one (the correction
   /// is a rate).
   void update_heading(double psi, double dt) {
-    const double e = control::wrap_angle(psi - control::heading_of(q_));
-    const Vector3<double> axis = q_.conjugate() * Vector3<double>::UnitZ();  // NED z in body
-    rotate(s_.heading_gain * e * dt * axis);
-    gyro_bias_ -= s_.gyro_bias_gain * e * dt * axis;
+    const double e = kelp::wrap_angle(psi - kelp::heading_of(q_));
+    const Vector3<Scalar> axis = q_.conjugate() * Vector3<Scalar>::UnitZ();  // NED z in body
+    rotate(Scalar(s_.heading_gain * e * dt) * axis);
+    gyro_bias_ -= Scalar(s_.gyro_bias_gain * e * dt) * axis;
     refresh();
   }
 
   /// \brief A horizontal position fix (north, east) [m] of noise σ per axis [m] (e.g. a GPS fix,
   /// whose altitude is much worse than its horizontal position).
-  void update_horizontal_position(const Eigen::Vector2d& p, double sigma, double measured_at) {
-    Eigen::Matrix<double, 2, n> H = Eigen::Matrix<double, 2, n>::Zero();
-    H.block<2, 2>(0, 0).setIdentity();
-    const Eigen::Vector2d y = p - position_at(measured_at).head<2>();
-    correct<2>(y, H, Eigen::Matrix2d::Identity() * sq(std::max(sigma, 1e-4)));
+  void update_horizontal_position(const Eigen::Matrix<Scalar, 2, 1>& p, double sigma,
+                                  double measured_at) {
+    Eigen::Matrix<Scalar, 2, n> H = Eigen::Matrix<Scalar, 2, n>::Zero();
+    H.template block<2, 2>(0, 0).setIdentity();
+    const Eigen::Matrix<Scalar, 2, 1> y = p - position_at(measured_at).template head<2>();
+    correct<2>(y, H, Eigen::Matrix<Scalar, 2, 2>::Identity() * Scalar(sq(std::max(sigma, 1e-4))));
   }
 
   /// \brief A position fix (NED) [m] of noise σ per axis [m], measured at time `measured_at`
   /// [s] (earlier than now for a late fix; compared with the estimate of then).
-  void update_position(const Vector3<double>& p, const Vector3<double>& sigma, double measured_at) {
-    Eigen::Matrix<double, 3, n> H = Eigen::Matrix<double, 3, n>::Zero();
-    H.block<3, 3>(0, 0).setIdentity();
-    const Vector3<double> y = p - position_at(measured_at);
-    Matrix3<double> R = Matrix3<double>::Zero();
-    for (int i = 0; i < 3; ++i) R(i, i) = sq(std::max(sigma(i), 1e-4));
+  void update_position(const Vector3<Scalar>& p, const Vector3<Scalar>& sigma, double measured_at) {
+    Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
+    H.template block<3, 3>(0, 0).setIdentity();
+    const Vector3<Scalar> y = p - position_at(measured_at);
+    Matrix3<Scalar> R = Matrix3<Scalar>::Zero();
+    for (int i = 0; i < 3; ++i) R(i, i) = Scalar(sq(std::max(double(sigma(i)), 1e-4)));
     correct<3>(y, H, R);
   }
 
   /// \brief The estimate as the controllers take it: NED position, attitude, body velocity
   /// over ground (linear from the Kalman velocity, angular from the gyroscope less its bias).
-  const control::Navigation& navigation() const { return nav_; }
+  const NavigationT<Scalar>& navigation() const { return nav_; }
   /// \brief The Kalman state (p, v, b_a, c).
   const StateVector& state() const { return x_; }
   /// \brief Its covariance.
   const Covariance& covariance() const { return P_; }
   /// \brief The gyroscope bias estimate [rad/s].
-  const Vector3<double>& gyro_bias() const { return gyro_bias_; }
+  const Vector3<Scalar>& gyro_bias() const { return gyro_bias_; }
   /// \brief The position estimate at time t [s] (within the kept history; clamped to it).
-  Vector3<double> position_at(double t) const {
-    if (count_ == 0) return x_.segment<3>(0);
+  Vector3<Scalar> position_at(double t) const {
+    if (count_ == 0) return x_.template segment<3>(0);
     const std::size_t cap = history_.size();
     const std::size_t kept = std::min(count_, cap);
     // Newest first: find the first entry at or before t.
@@ -259,7 +271,7 @@ class NavigationFilter {
         if (i == 0) return e.p + shift_;
         const Entry& later = history_[(head_ + cap - i) % cap];
         const double s = later.t > e.t ? (t - e.t) / (later.t - e.t) : 0.0;
-        return e.p + s * (later.p - e.p) + shift_;
+        return e.p + Scalar(s) * (later.p - e.p) + shift_;
       }
     }
     return history_[(head_ + cap - kept) % cap].p + shift_;  // older than the history: its oldest
@@ -268,41 +280,39 @@ class NavigationFilter {
  private:
   struct Entry {
     double t = 0.0;
-    Vector3<double> p = Vector3<double>::Zero();
+    Vector3<Scalar> p = Vector3<Scalar>::Zero();
   };
   static double sq(double x) { return x * x; }
 
-  void rotate(const Vector3<double>& phi) {
-    const double a = phi.norm();
-    if (a > 0) q_ = q_ * Quaternion<double>(Eigen::AngleAxisd(a, phi / a));
+  void rotate(const Vector3<Scalar>& phi) {
+    const Scalar a = phi.norm();
+    if (a > 0) q_ = q_ * Quaternion<Scalar>(Eigen::AngleAxis<Scalar>(a, phi / a));
     q_.normalize();
   }
   void push_history() {
-    history_[head_] = Entry{t_, x_.segment<3>(0) - shift_};
+    history_[head_] = Entry{t_, x_.template segment<3>(0) - shift_};
     head_ = (head_ + 1) % history_.size();
     ++count_;
   }
   void refresh() {
-    nav_.position = x_.segment<3>(0);
+    nav_.position = x_.template segment<3>(0);
     nav_.attitude = q_;
-    nav_.nu.head<3>() = q_.conjugate() * Vector3<double>(x_.segment<3>(3));
-    nav_.nu.tail<3>() = omega_ - gyro_bias_;
+    nav_.nu.template head<3>() = q_.conjugate() * Vector3<Scalar>(x_.template segment<3>(3));
+    nav_.nu.template tail<3>() = omega_ - gyro_bias_;
   }
   template <int M>
-  void correct(const Eigen::Matrix<double, M, 1>& y, const Eigen::Matrix<double, M, n>& H,
-               const Eigen::Matrix<double, M, M>& R) {
+  void correct(const Eigen::Matrix<Scalar, M, 1>& y, const Eigen::Matrix<Scalar, M, n>& H,
+               const Eigen::Matrix<Scalar, M, M>& R) {
     if (!initialized_) return;
     // Coefficient-wise products and the closed-form inverse of the (at most 3×3) innovation
     // covariance S, rather than Eigen's general product kernels and an LLT solve (the same
-    // result up to rounding): this class is not a template, so every translation unit that
-    // includes this header instantiates correct<1..3>; with those, the header alone took
-    // ~19 CPU s of GCC 12 to compile, with these ~10 s.
-    const Eigen::Matrix<double, n, M> PHt = P_.lazyProduct(H.transpose());
-    const Eigen::Matrix<double, M, M> S = H.lazyProduct(PHt) + R;
-    const Eigen::Matrix<double, n, M> K = (S.inverse() * PHt.transpose()).transpose();
+    // result up to rounding; cheaper to compile too, now only where a filter is used).
+    const Eigen::Matrix<Scalar, n, M> PHt = P_.lazyProduct(H.transpose());
+    const Eigen::Matrix<Scalar, M, M> S = H.lazyProduct(PHt) + R;
+    const Eigen::Matrix<Scalar, n, M> K = (S.inverse() * PHt.transpose()).transpose();
     const StateVector dx = K.lazyProduct(y);
     x_ += dx;
-    shift_ += dx.segment<3>(0);  // the kept estimates move with the correction
+    shift_ += dx.template segment<3>(0);  // the kept estimates move with the correction
     // P ← (I − K H) P, kept symmetric (cheaper than Joseph's form: n·M·n flops).
     P_.noalias() -= K.lazyProduct(PHt.transpose());
     P_ = (0.5 * (P_ + P_.transpose())).eval();
@@ -312,8 +322,8 @@ class NavigationFilter {
   ImuParameters imu_;
   FilterSettings s_;
   double g_;
-  Quaternion<double> q_ = Quaternion<double>::Identity();
-  Vector3<double> gyro_bias_ = Vector3<double>::Zero(), omega_ = Vector3<double>::Zero();
+  Quaternion<Scalar> q_ = Quaternion<Scalar>::Identity();
+  Vector3<Scalar> gyro_bias_ = Vector3<Scalar>::Zero(), omega_ = Vector3<Scalar>::Zero();
   StateVector x_ = StateVector::Zero();
   Covariance P_ = Covariance::Identity();
   double t_ = 0.0;
@@ -321,10 +331,13 @@ class NavigationFilter {
   // Kept positions are stored less the corrections applied so far (`shift_`), so that every
   // correction moves all of them at once: a late fix is compared with the estimate of its time
   // as corrected since.
-  Vector3<double> shift_ = Vector3<double>::Zero();
+  Vector3<Scalar> shift_ = Vector3<Scalar>::Zero();
   std::size_t head_ = 0, count_ = 0;
   bool initialized_ = false;
-  control::Navigation nav_;
+  NavigationT<Scalar> nav_;
 };
+
+/// \brief The navigation filter in double precision.
+using NavigationFilter = NavigationFilterT<double>;
 
 }  // namespace kelp::nav

@@ -68,6 +68,7 @@
 #include <cstdint>
 #include <string>
 
+#include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
@@ -369,7 +370,7 @@ class Compass {
   /// \brief Samples the heading of attitude `q` when due at time t: true and `out` [rad].
   bool sample(const Quaternion<double>& q, double t, double& out) {
     if (!schedule_.due(t)) return false;
-    out = measure(euler_from_quaternion(q).z());
+    out = measure(heading_of(q));
     return true;
   }
   /// \brief One reading of heading ψ [rad], regardless of the schedule.

@@ -41,6 +41,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/types.hpp"
@@ -54,14 +55,6 @@ struct Winding {
   double chord = 0;           ///< C: the chord's angle, start → end, in (−π, π]
   double chord_distance = 0;  ///< d_c: distance of the chord's projection from the axis [m]
 };
-
-namespace detail {
-/// An angle wrapped to (−π, π].
-inline double wrap_angle(double a) {
-  a = std::remainder(a, 2.0 * kelp::pi);
-  return a <= -kelp::pi ? a + 2.0 * kelp::pi : a;
-}
-}  // namespace detail
 
 /// \brief The winding angle of the line with nodes `nodes` (3×n, NED [m], start end first) about
 /// the axis through `from` and `to` (see the file's definition). No allocation.
@@ -108,7 +101,7 @@ Winding winding_angle(const Eigen::MatrixBase<Derived>& nodes, const Vector3<dou
       first = q;
       have = true;
     } else {
-      w.swept += detail::wrap_angle(t - theta);
+      w.swept += kelp::wrap_angle_exact(t - theta);
     }
     theta = t;
     last = q;
