@@ -36,10 +36,10 @@ Scalar wrap_angle_exact(Scalar a) {
 template <typename Scalar>
 Scalar wrap_angle(Scalar a) {
   using std::fmod;
-  const Scalar pi = Scalar(kelp::pi), two_pi = Scalar(2.0 * kelp::pi);
-  a = fmod(a + pi, two_pi);
+  const Scalar half_turn = Scalar(kelp::pi), two_pi = Scalar(2.0 * kelp::pi);
+  a = fmod(a + half_turn, two_pi);
   if (a <= Scalar(0)) a += two_pi;
-  return a - pi;
+  return a - half_turn;
 }
 
 /// \brief Heading ψ [rad] of an attitude (body → NED): the yaw of its ZYX Euler angles
