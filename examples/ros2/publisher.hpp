@@ -16,7 +16,7 @@
 
 #include "builtin_interfaces.h"
 #include "geometry_msgs.h"
-#include "kelp/ros2/messages.hpp"
+#include "kelp/sim/ros2/messages.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/ros2.hpp"
 #include "nav_msgs.h"

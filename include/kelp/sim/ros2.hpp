@@ -1,6 +1,6 @@
 /// \file
 /// \brief A sample of a kelp::sim run (LogRow) as ROS 2 messages: the one adapter the MCAP bag
-/// (kelp/ros2/mcap.hpp) and the live DDS topics both use, so that both carry the same values.
+/// (kelp/sim/ros2/mcap.hpp) and the live DDS topics both use, so that both carry the same values.
 /// Part of the optional `kelp::sim` component.
 #pragma once
 
@@ -8,8 +8,8 @@
 #include <filesystem>
 
 #include "kelp/core/error.hpp"
-#include "kelp/ros2/mcap.hpp"
-#include "kelp/ros2/messages.hpp"
+#include "kelp/sim/ros2/mcap.hpp"
+#include "kelp/sim/ros2/messages.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/tether/failure.hpp"
 
