@@ -26,6 +26,7 @@
 #include "bridge.hpp"
 #include "default_world.hpp"
 #include "kelp/sim/replay.hpp"
+#include "kelp/sim/replay_template.hpp"
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"

@@ -15,6 +15,7 @@
 #ifdef KELP_WITH_ROS2
 #include "bridge.hpp"
 #endif
+#include "kelp/sim/replay_template.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 
