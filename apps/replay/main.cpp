@@ -10,6 +10,7 @@
 #include <string>
 
 #include "kelp/sim/replay.hpp"
+#include "common/replay_template.hpp"
 
 namespace fs = std::filesystem;
 
@@ -32,14 +33,14 @@ int main(int argc, char** argv) {
   try {
     if (!json_out.empty()) {
       std::ofstream f(json_out);
-      f << kelp::sim::replay_data(dir, o).dump() << '\n';
+      f << kelp::sim::replay_data_json(dir, o) << '\n';
       if (!f) throw kelp::error("cannot write " + json_out);
       std::printf("kelp-replay: replay data of %s in %s\n", dir.c_str(), json_out.c_str());
       return 0;
     }
-    const std::string page = kelp::sim::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+    const std::string page = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
     if (page.empty()) {
-      std::fprintf(stderr, "kelp-replay: %s\n", kelp::sim::replay_template_missing_note().c_str());
+      std::fprintf(stderr, "kelp-replay: %s\n", kelp_apps::replay_template_missing_note().c_str());
       return 2;
     }
     fs::path written;
@@ -50,7 +51,7 @@ int main(int argc, char** argv) {
       if (!in) throw kelp::error("cannot read the replay template " + page);
       const std::string text((std::istreambuf_iterator<char>(in)),
                              std::istreambuf_iterator<char>());
-      const std::string html = kelp::sim::replay_html(text, kelp::sim::replay_data(dir, o));
+      const std::string html = kelp::sim::replay_html(text, kelp::sim::replay_data_json(dir, o));
       std::ofstream f(out, std::ios::binary);
       f << html;
       if (!f) throw kelp::error("cannot write " + out);

@@ -1,6 +1,6 @@
 // kelp-tethered-pair --ros2: the tethered pair's run with live ROS 2 topics over DDS (Eclipse
 // Cyclone DDS, the middleware of ROS 2 Humble's default rmw_cyclonedds_cpp), without ROS 2: the
-// same messages as the run's MCAP bag (kelp/ros2/messages.hpp), published with ROS 2's names,
+// same messages as the run's MCAP bag (kelp/sim/ros2/messages.hpp), published with ROS 2's names,
 // types and QoS, and subscriptions through which a ROS 2 node flies the pair (commands.hpp).
 // The DDS side lives in bridge.cpp, so that no Cyclone header reaches the program.
 #pragma once

@@ -16,9 +16,9 @@
 
 #include "builtin_interfaces.h"
 #include "geometry_msgs.h"
-#include "kelp/ros2/messages.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/ros2.hpp"
+#include "kelp/sim/ros2/messages.hpp"
 #include "nav_msgs.h"
 #include "rosgraph_msgs.h"
 #include "sensor_msgs.h"

@@ -26,6 +26,7 @@
 #include "bridge.hpp"
 #include "default_world.hpp"
 #include "kelp/sim/replay.hpp"
+#include "common/replay_template.hpp"
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
@@ -316,10 +317,10 @@ int run(const Options& o) {
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
   // The 3-D replay (docs/replay.md): without the page's template (kelp built without three.js)
   // the run is still complete; a replay that cannot be made is reported, not fatal.
-  const std::string replay_template = kelp::sim::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+  const std::string replay_template = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
   if (replay_template.empty()) {
     std::fprintf(stderr, "kelp-sitl: no replay.html: %s\n",
-                 kelp::sim::replay_template_missing_note().c_str());
+                 kelp_apps::replay_template_missing_note().c_str());
   } else {
     try {
       kelp::sim::ReplayOptions ro;

@@ -15,6 +15,7 @@
 #include "bridge.hpp"
 #endif
 #include "common/progress.hpp"
+#include "common/replay_template.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 
@@ -56,10 +57,10 @@ int run(const Options& o) {
   ro.version = KELP_VERSION_STRING;
   // The 3-D replay's page template: installed, or this build's (KELP_REPLAY_TEMPLATE_BUILD);
   // without one the run goes on and says once that replay.html is left out.
-  ro.replay_template = kelp::sim::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+  ro.replay_template = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
   if (ro.replay_template.empty())
     std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
-                 kelp::sim::replay_template_missing_note().c_str());
+                 kelp_apps::replay_template_missing_note().c_str());
 #ifdef KELP_WITH_ROS2
   const kelp::sim::RunSummary summary = o.ros2
                                             ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)

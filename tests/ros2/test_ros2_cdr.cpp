@@ -2,7 +2,7 @@
 #include <catch2/catch.hpp>
 #include <cstring>
 
-#include "kelp/ros2/cdr.hpp"
+#include "kelp/sim/ros2/cdr.hpp"
 
 namespace r2 = kelp::ros2;
 

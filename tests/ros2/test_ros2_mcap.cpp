@@ -8,7 +8,7 @@
 #include <iterator>
 #include <map>
 
-#include "kelp/ros2/mcap.hpp"
+#include "kelp/sim/ros2/mcap.hpp"
 
 namespace r2 = kelp::ros2;
 

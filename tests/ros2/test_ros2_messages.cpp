@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "kelp/core/rotation.hpp"
-#include "kelp/ros2/messages.hpp"
+#include "kelp/sim/ros2/messages.hpp"
 
 namespace r2 = kelp::ros2;
 using Catch::Matchers::WithinAbs;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -80,6 +81,11 @@ LoggedRun logged_run(const fs::path& dir) {
   return r;
 }
 
+// The replay data of the run in `dir` (kelp::sim gives it as JSON text).
+json replay_data(const fs::path& dir, const ks::ReplayOptions& o = {}) {
+  return json::parse(ks::replay_data_json(dir, o));
+}
+
 // The JSON inside the script a page gets.
 json parse_script(const std::string& script) {
   const std::string prefix = "window.KELP_REPLAY_DATA = ";
@@ -106,7 +112,7 @@ double page_elevation(const json& waves, double x, double y, double t) {
 TEST_CASE("a run's replay data holds the logged poses, nodes and segment tensions", "[replay]") {
   const fs::path dir = fresh_dir("test_replay_run");
   const LoggedRun run = logged_run(dir);
-  const json d = ks::replay_data(dir);
+  const json d = replay_data(dir);
   CHECK(d["format"] == "kelp-replay");
   CHECK(d["version"] == 1);
   CHECK(d["source"] == "kelp-tethered-pair");
@@ -169,7 +175,7 @@ TEST_CASE("a run's replay data holds the logged poses, nodes and segment tension
 TEST_CASE("the replay's sea is kelp's: elevation_check and the exported formula", "[replay]") {
   const fs::path dir = fresh_dir("test_replay_sea");
   const LoggedRun run = logged_run(dir);
-  const json d = ks::replay_data(dir);
+  const json d = replay_data(dir);
   const ks::WorldSetup world = ks::world_setup(run.sc, "test");
   const auto& env = world.environment;
   const json& w = d["waves"];
@@ -196,20 +202,20 @@ TEST_CASE("the replay's sea is kelp's: elevation_check and the exported formula"
     CHECK(ks::replay_ramp(t, 4.0) == env.ramp_factor(t, rate));
 
   // Through the page's script, every wave number and check value comes back bit for bit.
-  const json back = parse_script(ks::replay_script(d));
+  const json back = parse_script(ks::replay_script(d.dump()));
   CHECK(back["waves"] == d["waves"]);
   CHECK(back["elevation_check"] == d["elevation_check"]);
   CHECK(back["nodes"] == d["nodes"]);
   // A NaN (the ROV's target when an autopilot flies it) is written as null.
   json nan = {{"x", std::numeric_limits<double>::quiet_NaN()}};
-  CHECK(parse_script(ks::replay_script(nan))["x"].is_null());
+  CHECK(parse_script(ks::replay_script(nan.dump()))["x"].is_null());
 }
 
 TEST_CASE("no string of the data can end the page's script element", "[replay]") {
   const std::string evil = "</script><script>alert(1)</script><!-- </SCRIPT ";
   json d = {{"title", evil}, {"obstacles", {{{"type", "box"}, {"name", evil}}}}};
   const std::string tmpl = "<html><script>/*@KELP_DATA@*/</script></html>";
-  const std::string html = ks::replay_html(tmpl, d);
+  const std::string html = ks::replay_html(tmpl, d.dump());
   // Exactly the template's one closing tag, and no comment opener.
   std::size_t closes = 0;
   for (std::size_t at = html.find("</"); at != std::string::npos; at = html.find("</", at + 1))
@@ -221,29 +227,29 @@ TEST_CASE("no string of the data can end the page's script element", "[replay]")
   CHECK(parse_script(script)["obstacles"][0]["name"] == evil);
 
   // A template without the marker, or with two, is refused.
-  CHECK_THROWS_AS(ks::replay_html("<html></html>", d), ks::replay_error);
-  CHECK_THROWS_AS(ks::replay_html(tmpl + tmpl, d), ks::replay_error);
+  CHECK_THROWS_AS(ks::replay_html("<html></html>", d.dump()), ks::replay_error);
+  CHECK_THROWS_AS(ks::replay_html(tmpl + tmpl, d.dump()), ks::replay_error);
 }
 
 TEST_CASE("a directory that is not a run is refused, naming what it lacks", "[replay]") {
   const fs::path dir = fresh_dir("test_replay_not_a_run");
-  CHECK_THROWS_WITH(ks::replay_data(dir / "missing"), Catch::Contains("is not a directory"));
+  CHECK_THROWS_WITH(replay_data(dir / "missing"), Catch::Contains("is not a directory"));
   std::ofstream(dir / "notes.txt") << "hello\n";
-  CHECK_THROWS_WITH(ks::replay_data(dir),
+  CHECK_THROWS_WITH(replay_data(dir),
                     Catch::Contains("is not a kelp run directory: it has no timeseries.csv"));
   // The CSV files without a summary, then a summary without the scenario, then bad CSV.
   const fs::path run = fresh_dir("test_replay_partial");
   std::ofstream(run / "timeseries.csv") << "t\n0\n";
   std::ofstream(run / "nodes.csv") << "t,node,x,y,z\n0,0,0,0,0\n";
-  CHECK_THROWS_WITH(ks::replay_data(run), Catch::Contains("it has no summary.json"));
+  CHECK_THROWS_WITH(replay_data(run), Catch::Contains("it has no summary.json"));
   std::ofstream(run / "summary.json") << "{\"wall_s\": 1}";
-  CHECK_THROWS_WITH(ks::replay_data(run), Catch::Contains("no \"scenario\""));
+  CHECK_THROWS_WITH(replay_data(run), Catch::Contains("no \"scenario\""));
   std::ofstream(run / "summary.json") << "{\"scenario\": {\"sea\": \"calm\"}}";
-  CHECK_THROWS_WITH(ks::replay_data(run), Catch::Contains("no column asv_x"));
+  CHECK_THROWS_WITH(replay_data(run), Catch::Contains("no column asv_x"));
   std::ofstream(run / "timeseries.csv") << "t,a\n0,zz\n";
-  CHECK_THROWS_WITH(ks::replay_data(run), Catch::Contains("timeseries.csv:2: expected a number"));
+  CHECK_THROWS_WITH(replay_data(run), Catch::Contains("timeseries.csv:2: expected a number"));
   // Every refusal is a kelp::error.
-  CHECK_THROWS_AS(ks::replay_data(dir), kelp::error);
+  CHECK_THROWS_AS(replay_data(dir), kelp::error);
   CHECK_THROWS_AS(ks::write_replay(dir, "/no/such/template.html"), ks::replay_error);
 }
 
@@ -297,7 +303,7 @@ TEST_CASE("a 10-minute run with 40 nodes at the default rates makes under 10 MB"
   }
   json summary = {{"scenario", kelp_test::json_of(sc)}, {"scenario_file", "synthetic"}};
   std::ofstream(dir / "summary.json") << summary.dump(2);
-  const std::string script = ks::replay_script(ks::replay_data(dir));
+  const std::string script = ks::replay_script(ks::replay_data_json(dir));
   const double mb = static_cast<double>(script.size()) / 1e6;
   // The page's template (three.js ~2.1 MB, the page's own code) comes on top: the data must
   // leave it room under 10 MB.
@@ -318,12 +324,22 @@ TEST_CASE("a run kept by kelp-sweep is told from its place in the sweep", "[repl
   std::ofstream(sweep / "sweep.json") << "{}";
   fs::create_directories(sweep / "runs");
   fs::copy(src, sweep / "runs" / "0123456789abcdef");
-  CHECK(ks::replay_data(sweep / "runs" / "0123456789abcdef")["source"] == "kelp-sweep");
+  CHECK(replay_data(sweep / "runs" / "0123456789abcdef")["source"] == "kelp-sweep");
   ks::ReplayOptions o;
   o.source = "kelp-sitl";
   o.title = "given";
-  const json d = ks::replay_data(src, o);
+  const json d = replay_data(src, o);
   CHECK(d["source"] == "kelp-sitl");
   CHECK(d["title"] == "given");
   CHECK(d["waypoints"].empty());  // ArduPilot flies its own mission
+
+  // write_replay: replay.html in the run directory, the template with the same data.
+  const std::string tmpl = "<html><script>/*@KELP_DATA@*/</script></html>";
+  std::ofstream(src / "template.html") << tmpl;
+  const fs::path page = ks::write_replay(src, (src / "template.html").string(), o);
+  CHECK(page == src / "replay.html");
+  std::ifstream in(page, std::ios::binary);
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(html == ks::replay_html(tmpl, ks::replay_data_json(src, o)));
+  CHECK(parse_script(html.substr(14, html.size() - 14 - 16))["title"] == "given");
 }

@@ -1,6 +1,6 @@
 /// \file
 /// \brief A sample of a kelp::sim run (LogRow) as ROS 2 messages: the one adapter the MCAP bag
-/// (kelp/ros2/mcap.hpp) and the live DDS topics both use, so that both carry the same values.
+/// (kelp/sim/ros2/mcap.hpp) and the live DDS topics both use, so that both carry the same values.
 /// Part of the optional `kelp::sim` component.
 #pragma once
 
@@ -8,8 +8,9 @@
 #include <filesystem>
 
 #include "kelp/core/error.hpp"
-#include "kelp/ros2/mcap.hpp"
-#include "kelp/ros2/messages.hpp"
+#include "kelp/sim/export.hpp"
+#include "kelp/sim/ros2/mcap.hpp"
+#include "kelp/sim/ros2/messages.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/tether/failure.hpp"
 
@@ -18,44 +19,17 @@ namespace sim {
 
 /// \brief Turns LogRows into ros2::Messages (ros2::fill_messages), keeping its buffers: after the
 /// first sample (and after a change of the tether's node count) no heap allocation.
-class Ros2Sampler {
+class KELP_SIM_API Ros2Sampler {
  public:
   /// \brief The sample of row `r` (the segments' axial tensions evaluated from its tether by
   /// tether::segment_axial_force, as the line-failure check does).
   /// \throws kelp::invalid_argument when the row lacks what the messages need (vehicles, the
   /// tether, the end forces).
-  const ros2::RunSample& sample(const LogRow& r) {
-    KELP_CHECK(r.asv && r.auv && r.tether && r.tether_model,
-               "Ros2Sampler: the row needs both vehicles and the tether (model and state)");
-    KELP_CHECK(r.force_on_asv.allFinite() && r.force_on_auv.allFinite(),
-               "Ros2Sampler: the row needs the tether's force on each vehicle");
-    const auto& line = *r.tether_model;
-    const auto& x = *r.tether;
-    const int segments = static_cast<int>(x.position.cols()) - 1;
-    tensions_.resize(segments);
-    for (int i = 0; i < segments; ++i) tensions_(i) = kelp::tether::segment_axial_force(line, x, i);
-    s_.time = r.t;
-    s_.boat = r.asv;
-    s_.rov = r.auv;
-    s_.rov_nu_dot = r.auv_nu_dot;
-    s_.gravity = std::isfinite(r.gravity) ? r.gravity : kelp::standard_gravity;
-    s_.nodes = &x.position;
-    s_.tensions = &tensions_;
-    s_.force_on_boat = r.force_on_asv;
-    s_.force_on_rov = r.force_on_auv;
-    s_.boat_thrust = r.asv_thrust;
-    s_.boat_command = r.asv_command;
-    s_.rov_thrust = r.auv_thrust;
-    s_.rov_command = r.auv_command;
-    return s_;
-  }
+  const ros2::RunSample& sample(const LogRow& r);
 
   /// \brief The messages of row `r` (valid until the next call).
   /// \throws kelp::invalid_argument as sample() and ros2::fill_messages.
-  const ros2::Messages& messages(const LogRow& r) {
-    ros2::fill_messages(sample(r), m_);
-    return m_;
-  }
+  const ros2::Messages& messages(const LogRow& r);
 
   /// \brief The tension drawn fully red on /tether/markers [N] (default 200).
   void set_tension_scale(double newtons) { s_.tension_scale = newtons; }
@@ -69,26 +43,17 @@ class Ros2Sampler {
 /// \brief A run's ROS 2 bag (run.mcap): every sample's messages (Ros2Sampler) written by a
 /// ros2::BagWriter, /tether/markers at most at `marker_rate` (the line's drawing is the bulk of
 /// a bag: at the node rate it costs a tenth of what it would at the log rate).
-class BagRecorder {
+class KELP_SIM_API BagRecorder {
  public:
   /// \brief Creates the bag at `path`; markers at most `marker_rate` times a second (> 0);
   /// `options` of the MCAP file (chunk size).
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument for a rate
   /// that is not > 0.
   BagRecorder(const std::filesystem::path& path, double marker_rate,
-              const ros2::McapOptions& options = {})
-      : bag_(path, options), marker_period_(1.0 / marker_rate) {
-    KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
-               "BagRecorder: the marker rate must be > 0");
-  }
+              const ros2::McapOptions& options = {});
   /// \brief Writes the messages of row `r` (markers when due).
   /// \throws kelp::error on a write failure, kelp::invalid_argument as Ros2Sampler.
-  void record(const LogRow& r) {
-    const ros2::Messages& m = sampler_.messages(r);
-    const bool markers = r.t + 1e-9 >= next_marker_;
-    if (markers) next_marker_ = r.t + marker_period_;
-    bag_.write(m, markers);
-  }
+  void record(const LogRow& r);
   /// \brief Finishes the bag (summary, index, footer).
   /// \throws kelp::error on a write failure.
   void close() { bag_.close(); }

@@ -22,6 +22,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/types.hpp"
+#include "kelp/sim/export.hpp"
 #include "kelp/tether/failure.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "kelp/tether/model.hpp"
@@ -88,51 +89,7 @@ struct LogRow {
 
 /// \brief The columns of timeseries.csv, in order (documented in
 /// examples/tethered_pair/README.md); for_each_value gives a row's values in the same order.
-inline const std::vector<std::string>& timeseries_columns() {
-  static const std::vector<std::string> columns = [] {
-    std::vector<std::string> c = {"t",
-                                  "asv_x",
-                                  "asv_y",
-                                  "asv_z",
-                                  "asv_roll",
-                                  "asv_pitch",
-                                  "asv_yaw",
-                                  "asv_u",
-                                  "asv_v",
-                                  "asv_r",
-                                  "auv_x",
-                                  "auv_y",
-                                  "auv_z",
-                                  "auv_roll",
-                                  "auv_pitch",
-                                  "auv_yaw",
-                                  "auv_u",
-                                  "auv_v",
-                                  "auv_w",
-                                  "auv_target_x",
-                                  "auv_target_y",
-                                  "auv_target_z",
-                                  "auv_error",
-                                  "asv_error",
-                                  "asv_thrust_port",
-                                  "asv_thrust_starboard"};
-    for (int i = 1; i <= 8; ++i) c.push_back("auv_thrust_" + std::to_string(i));
-    c.insert(c.end(), {"asv_command_port", "asv_command_starboard"});
-    for (int i = 1; i <= 8; ++i) c.push_back("auv_command_" + std::to_string(i));
-    c.insert(c.end(), {"tension_asv", "tension_auv"});
-    // Propulsion.
-    c.insert(c.end(), {"asv_voltage", "asv_soc", "asv_current_port", "asv_current_starboard",
-                       "auv_voltage", "auv_soc"});
-    for (int i = 1; i <= 8; ++i) c.push_back("auv_current_" + std::to_string(i));
-    // The tether: turns at the ROV, parted segments; its length out, the winch's rate and pull.
-    c.insert(c.end(), {"tether_turns", "tether_parted_segments", "tether_length", "payout_rate",
-                       "winch_pull"});
-    // Entanglement: the largest winding about an obstacle now, and which obstacle.
-    c.insert(c.end(), {"tether_winding", "tether_winding_obstacle"});
-    return c;
-  }();
-  return columns;
-}
+KELP_SIM_API const std::vector<std::string>& timeseries_columns();
 
 /// \brief Calls `f(value)` for each value of row `r`, in timeseries_columns()' order (what
 /// RunLog::row writes and kelp's Python package returns as columns). No allocation.
@@ -189,46 +146,20 @@ void for_each_value(const LogRow& r, F&& f) {
 
 /// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
 /// documented in examples/tethered_pair/README.md). Writes the header lines when constructed.
-class RunLog {
+class KELP_SIM_API RunLog {
  public:
   /// \brief Creates `dir` (and its parents) and the three files in it, each with its header line.
   /// \throws kelp::error when the files cannot be opened for writing; std::filesystem's error
   /// when the directory cannot be created.
-  explicit RunLog(const std::filesystem::path& dir) {
-    std::filesystem::create_directories(dir);
-    ts_.open(dir / "timeseries.csv");
-    nodes_.open(dir / "nodes.csv");
-    events_.open(dir / "events.csv");
-    if (!ts_ || !nodes_ || !events_)
-      throw kelp::error("cannot write the run's CSV files in " + dir.string());
-    const std::vector<std::string>& columns = timeseries_columns();
-    for (std::size_t i = 0; i < columns.size(); ++i) ts_ << (i ? "," : "") << columns[i];
-    ts_ << '\n';
-    nodes_ << "t,node,x,y,z,tension\n";
-    events_ << "t,event,segment,x,y,z,tension,obstacle,winding\n";
-  }
+  explicit RunLog(const std::filesystem::path& dir);
 
   /// \brief Appends one row to timeseries.csv.
-  void row(const LogRow& r) {
-    bool first = true;
-    for_each_value(r, [&](double v) {
-      if (!first) ts_ << ',';
-      first = false;
-      ts_ << num(v);
-    });
-    ts_ << '\n';
-  }
+  void row(const LogRow& r);
 
   /// \brief Appends the tether's parting to events.csv
   /// (`t,event,segment,x,y,z,tension,obstacle,winding`, event `line_parted`): its time [s],
   /// segment, position NED [m] and axial force [N] (no obstacle, winding `nan`).
-  void line_parted(const kelp::tether::LineFailured& f) {
-    events_ << num(f.time) << ",line_parted," << f.segment;
-    for (double v : {f.position.x(), f.position.y(), f.position.z(), f.tension})
-      events_ << ',' << num(v);
-    events_ << ",," << num(std::numeric_limits<double>::quiet_NaN()) << '\n';
-    events_.flush();
-  }
+  void line_parted(const kelp::tether::LineFailured& f);
 
   /// \brief Appends an entanglement event to events.csv (kelp/sim/entanglement.hpp): `entangled`
   /// (the winding about obstacle `obstacle` passed the threshold; `tension` nan) or `pinned`
@@ -236,12 +167,7 @@ class RunLog {
   /// time [s], no segment (`nan`), the contact's position NED [m], the obstacle's name and the
   /// winding about it then [rad].
   void entanglement(double t, const char* event, const kelp::Vector3<double>& position,
-                    double tension, const std::string& obstacle, double winding) {
-    events_ << num(t) << ',' << event << ',' << num(std::numeric_limits<double>::quiet_NaN());
-    for (double v : {position.x(), position.y(), position.z(), tension}) events_ << ',' << num(v);
-    events_ << ',' << obstacle << ',' << num(winding) << '\n';
-    events_.flush();
-  }
+                    double tension, const std::string& obstacle, double winding);
 
   /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv, one line a node
   /// (`t,node,x,y,z,tension`): the node's NED position [m] and the axial tension [N] of the
@@ -251,37 +177,15 @@ class RunLog {
   /// of its current node count: system::SystemModel::tether_of) \param[in] tether its state
   /// \throws kelp::invalid_argument when `line` has not the state's node count.
   void nodes(double t, const kelp::tether::TetherModeld& line,
-             const kelp::tether::TetherStated& tether) {
-    const Eigen::Index n = tether.position.cols();
-    KELP_CHECK(line.nodes() == n && tether.velocity.cols() == n,
-               "RunLog::nodes: the line model has " + std::to_string(line.nodes()) +
-                   " nodes, the state " + std::to_string(n));
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double tension =
-          i + 1 < n ? kelp::tether::segment_axial_force(line, tether, static_cast<int>(i)) : 0.0;
-      nodes_ << num(t) << ',' << i << ',' << num(tether.position(0, i)) << ','
-             << num(tether.position(1, i)) << ',' << num(tether.position(2, i)) << ','
-             << num(tension) << '\n';
-    }
-  }
+             const kelp::tether::TetherStated& tether);
 
   /// \brief Writes what is buffered to the files (e.g. before a status line of a long run).
-  void flush() {
-    ts_.flush();
-    nodes_.flush();
-  }
+  void flush();
   /// \brief Closes both files (also done by the destructor).
-  void close() {
-    ts_.close();
-    nodes_.close();
-    events_.close();
-  }
+  void close();
 
  private:
-  const char* num(double v) {
-    std::snprintf(buf_, sizeof buf_, "%.6g", v);
-    return buf_;
-  }
+  const char* num(double v);
   std::ofstream ts_, nodes_, events_;
   char buf_[64] = {};
 };

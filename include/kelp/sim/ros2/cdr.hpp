@@ -1,5 +1,5 @@
 /// \file
-/// \brief CDR serialisation of the ROS 2 messages (kelp/ros2/messages.hpp): the bytes a ROS 2
+/// \brief CDR serialisation of the ROS 2 messages (kelp/sim/ros2/messages.hpp): the bytes a ROS 2
 /// node puts on the wire and rosbag2 stores, XCDR1 little endian.
 ///
 /// The rules (OMG DDS-XTypes 1.3, §7.4.3 "Extended CDR representation (encoding version 1)",
@@ -22,7 +22,8 @@
 #include <vector>
 
 #include "kelp/core/error.hpp"
-#include "kelp/ros2/messages.hpp"
+#include "kelp/sim/export.hpp"
+#include "kelp/sim/ros2/messages.hpp"
 
 namespace kelp {
 namespace ros2 {
@@ -32,13 +33,10 @@ inline constexpr std::array<std::uint8_t, 4> cdr_le_header = {0x00, 0x01, 0x00, 
 
 /// \brief Appends a message's CDR bytes to a byte buffer (kept by the caller, so that its
 /// capacity is reused from message to message).
-class CdrWriter {
+class KELP_SIM_API CdrWriter {
  public:
   /// \brief Starts a message in `out` (cleared, then the encapsulation header).
-  explicit CdrWriter(std::vector<std::uint8_t>& out) : out_(out) {
-    out_.clear();
-    out_.insert(out_.end(), cdr_le_header.begin(), cdr_le_header.end());
-  }
+  explicit CdrWriter(std::vector<std::uint8_t>& out);
 
   /// \brief Writes a primitive, string, sequence, fixed array or message.
   template <class T>
@@ -67,29 +65,17 @@ class CdrWriter {
   struct is_std_array : std::false_type {};
   template <class T, std::size_t N>
   struct is_std_array<std::array<T, N>> : std::true_type {};
-  void align(std::size_t a) {
-    const std::size_t offset = out_.size() - cdr_le_header.size();
-    const std::size_t pad = (a - offset % a) % a;
-    out_.insert(out_.end(), pad, std::uint8_t{0});
-  }
-  void put(const void* p, std::size_t n) {
-    static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary32/64 expected");
-    const auto* b = static_cast<const std::uint8_t*>(p);
-    out_.insert(out_.end(), b, b + n);  // the host is little endian (checked in serialize)
-  }
+  void align(std::size_t a);
+  void put(const void* p, std::size_t n);
   std::vector<std::uint8_t>& out_;
 };
 
 /// \brief Reads a message back from its CDR bytes (tests, and a check of what was written).
-class CdrReader {
+class KELP_SIM_API CdrReader {
  public:
   /// \brief Reads from `n` bytes at `data`.
   /// \throws kelp::error when the encapsulation header is not CDR_LE.
-  CdrReader(const std::uint8_t* data, std::size_t n) : data_(data), n_(n) {
-    if (n < 4 || data[0] != 0x00 || data[1] != 0x01)
-      throw kelp::error("CDR: not little-endian plain CDR (encapsulation header 00 01)");
-    pos_ = 4;
-  }
+  CdrReader(const std::uint8_t* data, std::size_t n);
 
   /// \brief Reads a primitive, string, sequence, fixed array or message.
   /// \throws kelp::error on truncated or malformed data.
@@ -132,14 +118,8 @@ class CdrReader {
   struct is_std_array : std::false_type {};
   template <class T, std::size_t N>
   struct is_std_array<std::array<T, N>> : std::true_type {};
-  void align(std::size_t a) {
-    const std::size_t offset = pos_ - 4;
-    pos_ += (a - offset % a) % a;
-    if (pos_ > n_) throw kelp::error("CDR: data truncated");
-  }
-  void need(std::size_t k) const {
-    if (k > n_ - pos_) throw kelp::error("CDR: data truncated");
-  }
+  void align(std::size_t a);
+  void need(std::size_t k) const;
   const std::uint8_t* data_;
   std::size_t n_, pos_;
 };

@@ -15,7 +15,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <cmath>
+
+#include "kelp/sim/export.hpp"
 
 namespace kelp {
 namespace ros2 {
@@ -31,14 +32,7 @@ inline Eigen::Vector3d frd_to_flu(const Eigen::Vector3d& v) { return {v.x(), -v.
 /// q_EN ⊗ q ⊗ q_FRD←FLU, with the sign chosen so that w ≥ 0 (the same rotation either way; one
 /// sign keeps bags and live topics identical).
 /// \param[in] q unit quaternion rotating FRD body vectors into NED (vehicle::VehicleState).
-inline Eigen::Quaterniond ned_frd_to_enu_flu(const Eigen::Quaterniond& q) {
-  const double s = std::sqrt(0.5);
-  const Eigen::Quaterniond world(0.0, s, s, 0.0);     // ENU ← NED
-  const Eigen::Quaterniond body(0.0, 1.0, 0.0, 0.0);  // FRD ← FLU (its own inverse)
-  Eigen::Quaterniond r = world * q * body;
-  if (r.w() < 0) r.coeffs() = -r.coeffs();
-  return r;
-}
+KELP_SIM_API Eigen::Quaterniond ned_frd_to_enu_flu(const Eigen::Quaterniond& q);
 
 }  // namespace ros2
 }  // namespace kelp

@@ -1,0 +1,56 @@
+// A run's samples as ROS 2 messages and its bag (kelp/sim/ros2.hpp): Ros2Sampler's and
+// BagRecorder's members.
+#include "kelp/sim/ros2.hpp"
+
+#include <cmath>
+
+namespace kelp {
+namespace sim {
+
+const ros2::RunSample& Ros2Sampler::sample(const LogRow& r) {
+  KELP_CHECK(r.asv && r.auv && r.tether && r.tether_model,
+             "Ros2Sampler: the row needs both vehicles and the tether (model and state)");
+  KELP_CHECK(r.force_on_asv.allFinite() && r.force_on_auv.allFinite(),
+             "Ros2Sampler: the row needs the tether's force on each vehicle");
+  const auto& line = *r.tether_model;
+  const auto& x = *r.tether;
+  const int segments = static_cast<int>(x.position.cols()) - 1;
+  tensions_.resize(segments);
+  for (int i = 0; i < segments; ++i) tensions_(i) = kelp::tether::segment_axial_force(line, x, i);
+  s_.time = r.t;
+  s_.boat = r.asv;
+  s_.rov = r.auv;
+  s_.rov_nu_dot = r.auv_nu_dot;
+  s_.gravity = std::isfinite(r.gravity) ? r.gravity : kelp::standard_gravity;
+  s_.nodes = &x.position;
+  s_.tensions = &tensions_;
+  s_.force_on_boat = r.force_on_asv;
+  s_.force_on_rov = r.force_on_auv;
+  s_.boat_thrust = r.asv_thrust;
+  s_.boat_command = r.asv_command;
+  s_.rov_thrust = r.auv_thrust;
+  s_.rov_command = r.auv_command;
+  return s_;
+}
+
+const ros2::Messages& Ros2Sampler::messages(const LogRow& r) {
+  ros2::fill_messages(sample(r), m_);
+  return m_;
+}
+
+BagRecorder::BagRecorder(const std::filesystem::path& path, double marker_rate,
+                         const ros2::McapOptions& options)
+    : bag_(path, options), marker_period_(1.0 / marker_rate) {
+  KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
+             "BagRecorder: the marker rate must be > 0");
+}
+
+void BagRecorder::record(const LogRow& r) {
+  const ros2::Messages& m = sampler_.messages(r);
+  const bool markers = r.t + 1e-9 >= next_marker_;
+  if (markers) next_marker_ = r.t + marker_period_;
+  bag_.write(m, markers);
+}
+
+}  // namespace sim
+}  // namespace kelp
