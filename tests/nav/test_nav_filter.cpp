@@ -80,9 +80,8 @@ Run fly(bool with_dvl) {
       out.max_late = std::max(out.max_late, e);
       out.velocity_late = std::max(out.velocity_late, (nav.nu.head<3>() - x.nu.head<3>()).norm());
       out.heading_late =
-          std::max(out.heading_late,
-                   std::abs(kelp::control::wrap_angle(kelp::control::heading_of(nav.attitude) -
-                                                      kelp::control::heading_of(x.attitude))));
+          std::max(out.heading_late, std::abs(kelp::wrap_angle(kelp::heading_of(nav.attitude) -
+                                                               kelp::heading_of(x.attitude))));
       ++n;
     }
   }
@@ -140,4 +139,56 @@ TEST_CASE("filter settings are checked", "[nav][filter][errors]") {
   CHECK_THROWS_WITH(kn::validate(s), Catch::Contains("initial_position_sigma"));
   kn::NavigationFilter f(kn::ImuParameters{});
   CHECK_THROWS_AS(f.predict(kn::ImuSample{}), kelp::invalid_argument);  // not initialised
+}
+
+TEST_CASE("Navigation filter in float follows the double one on the same samples",
+          "[nav][filter][float]") {
+  const Circle c;
+  kn::ImuParameters ip;
+  kn::ImuSensor imu(ip, 5, 0);
+  kn::DepthSensor depth(kn::DepthParameters{}, 5, 2);
+  kn::Compass compass(kn::CompassParameters{}, 5, 4);
+  kn::NavigationFilter f(ip);
+  kn::NavigationFilterT<float> ff(ip);
+  const kelp::Vector6<double> nu_dot = kelp::Vector6<double>::Zero();
+  const double g = kelp::standard_gravity;
+  {
+    const auto x = c.at(0);
+    const kn::ImuSample s = imu.measure(x.nu.tail<3>(), kn::specific_force(x, nu_dot, g), 0.0);
+    f.initialize(x.position + V3(1.0, -1.0, 0.5), V3(0.8, 0.0, 0.0), 0.0, s);
+    ff.initialize((x.position + V3(1.0, -1.0, 0.5)).cast<float>(), kelp::Vector3<float>(0.8f, 0, 0),
+                  0.0, s);
+  }
+  double worst = 0;
+  for (int k = 1; k <= 3000; ++k) {
+    const double t = k * 0.01;
+    const auto x = c.at(t);
+    kn::ImuSample s;
+    REQUIRE(imu.sample(x, nu_dot, g, t, s));
+    f.predict(s);
+    ff.predict(s);
+    double z, psi;
+    if (depth.sample(x.position.z(), t, z)) {
+      f.update_depth(z, 0.002);
+      ff.update_depth(z, 0.002);
+    }
+    if (compass.sample(x.attitude, t, psi)) {
+      f.update_heading(psi, 0.02);
+      ff.update_heading(psi, 0.02);
+    }
+    if (k % 100 == 0) {
+      f.update_position(x.position, V3::Constant(0.3), t);
+      ff.update_position(x.position.cast<float>(), kelp::Vector3<float>::Constant(0.3f), t);
+      f.update_horizontal_position(x.position.head<2>(), 0.5, t);
+      ff.update_horizontal_position(x.position.head<2>().cast<float>(), 0.5, t);
+    }
+    worst = std::max(
+        worst,
+        (ff.navigation().position.cast<double>() - f.navigation().position).cwiseAbs().maxCoeff());
+  }
+  CHECK(worst < 0.01);  // [m]: float rounding over 30 s, not a different filter
+  CHECK((f.navigation().position - c.at(30.0).position).norm() < 1.0);  // both converged
+  CHECK((ff.navigation().position.cast<double>() - c.at(30.0).position).norm() < 1.0);
+  CHECK(ff.covariance().diagonal().minCoeff() >= 0.0f);
+  CHECK(std::abs(kelp::wrap_angle(kelp::heading_of(ff.navigation().attitude) - 3.0)) < 0.05);
 }
