@@ -2,7 +2,7 @@
 //
 // Oracle: parse_scenario(input) either throws kelp::sim::scenario_error (the documented
 // error, whose message names the file) or returns a scenario whose every number is finite and
-// within the schema's ranges; to_json() of it parses back to the same scenario (the echo in the
+// within the schema's ranges; scenario_json() of it parses back to the same scenario (the echo in the
 // run's summary is a valid scenario file). Any other exception, crash or sanitizer report is a
 // finding.
 #include <string>
@@ -42,14 +42,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   check_ranges(s);
-  const std::string echo = kelp::sim::to_json(s).dump();
+  const std::string echo = kelp::sim::scenario_json(s);
   kelp::sim::Scenario again;
   try {
     again = kelp::sim::parse_scenario(echo, "echo.json");
   } catch (const kelp::sim::scenario_error& e) {
-    kelp_fuzz::finding(std::string("to_json() of a valid scenario is refused: ") + e.what());
+    kelp_fuzz::finding(std::string("scenario_json() of a valid scenario is refused: ") + e.what());
   }
-  KELP_FUZZ_REQUIRE(kelp::sim::to_json(again) == kelp::sim::to_json(s),
-                    "to_json() does not read back to the same scenario");
+  KELP_FUZZ_REQUIRE(kelp::sim::scenario_json(again) == kelp::sim::scenario_json(s),
+                    "scenario_json() does not read back to the same scenario");
   return 0;
 }

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "kelp/control/controllers.hpp"
+#include "kelp/core/angles.hpp"
 #include "kelp/core/error.hpp"
 
 namespace kelp {
@@ -70,8 +70,8 @@ void PairNavigation::update(const system::SystemModeld& model, const system::Sys
     asv_.update_depth(0.0, p_.asv_heave_sigma);
   }
   // The USBL ping, computed on the boat from its own estimate.
-  const double boat_heading_error = control::wrap_angle(
-      control::heading_of(asv_.navigation().attitude) - control::heading_of(state.asv.attitude));
+  const double boat_heading_error = kelp::wrap_angle(
+      kelp::heading_of(asv_.navigation().attitude) - kelp::heading_of(state.asv.attitude));
   // The transceiver's depth is known (mounted on the hull), its horizontal position is the
   // boat's estimate.
   const Vector3<double> transceiver(asv_.navigation().position.x(),
@@ -97,11 +97,11 @@ void PairNavigation::update(const system::SystemModeld& model, const system::Sys
   accumulate(auv_.navigation(), state.auv, auv_errors_);
   accumulate(asv_.navigation(), state.asv, asv_errors_);
 }
-void PairNavigation::accumulate(const control::Navigation& est, const vehicle::VehicleStated& x,
+void PairNavigation::accumulate(const nav::Navigation& est, const vehicle::VehicleStated& x,
                        EstimateErrors& e) {
   const double dp = (est.position - x.position).norm();
   const double dpsi =
-      control::wrap_angle(control::heading_of(est.attitude) - control::heading_of(x.attitude));
+      kelp::wrap_angle(kelp::heading_of(est.attitude) - kelp::heading_of(x.attitude));
   e.position_squared_sum += dp * dp;
   e.horizontal_squared_sum += (est.position - x.position).head<2>().squaredNorm();
   e.heading_squared_sum += dpsi * dpsi;

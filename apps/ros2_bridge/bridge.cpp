@@ -219,7 +219,7 @@ class Subscriptions {
 
 }  // namespace
 
-nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::RunOptions& run,
+kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::RunOptions& run,
                              const Ros2Options& o) {
   KELP_CHECK(std::isfinite(o.speed) && o.speed > 0, "--ros2 speed must be positive");
   KELP_CHECK(std::isfinite(o.clock_timeout) && o.clock_timeout > 0,
@@ -278,9 +278,10 @@ nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::Run
   if (log) log->close();
   if (bag) bag->close();
 
-  nlohmann::json summary = loop.summary();
-  summary["wall_s"] = wall;
-  summary["realtime_factor"] = loop.time() / wall;
+  kelp::sim::RunSummary summary = loop.summary();
+  summary.wall_s = wall;
+  summary.realtime_factor = loop.time() / wall;
+  if (!run.version.empty()) summary.kelp_version = run.version;
   nlohmann::json r;
   r["mode"] = o.lockstep ? "lockstep" : "paced";
   if (!o.lockstep) r["speed"] = o.speed;
@@ -297,8 +298,10 @@ nlohmann::json run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::Run
   if (o.lockstep)
     r["subscriptions"]["/clock"] = {{"received", subs.clock_received},
                                     {"refused", subs.clock_refused}};
-  summary["ros2"] = r;
-  kelp::sim::finish_run(summary, run);
+  // summary.json: the run's summary with the live run's `ros2` object.
+  nlohmann::json text = nlohmann::json::parse(kelp::sim::summary_json(summary));
+  text["ros2"] = r;
+  kelp::sim::finish_run_with(text.dump(2), run);
   return summary;
 }
 

@@ -31,9 +31,9 @@ struct Ros2Options {
 
 /// Runs a scenario as run_scenario() does (CSV log, summary.json in `run.out`) with the ROS 2
 /// topics live; the summary has a `ros2` object (mode, domain, messages published per topic,
-/// subscriptions' counters, publish cost). \throws as run_scenario(), and kelp::error when DDS
-/// cannot be set up.
-nlohmann::json run_with_ros2(const kelp::sim::Scenario& scenario, const kelp::sim::RunOptions& run,
+/// subscriptions' counters, publish cost) in summary.json. \returns the run's summary (as
+/// run_scenario()'s). \throws as run_scenario(), and kelp::error when DDS cannot be set up.
+kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& scenario, const kelp::sim::RunOptions& run,
                              const Ros2Options& options);
 
 }  // namespace kelp_ros2

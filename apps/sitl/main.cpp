@@ -30,7 +30,7 @@
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
-#include "kelp/sim/solver_report.hpp"
+#include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"
 
@@ -288,7 +288,8 @@ int run(const Options& o) {
   summary["kernel"] = kelp::simd::kernel_name(model.environment().waves().active_kernel());
   summary["math_library"] = kelp::simd::math_library_fingerprint();
   summary["tether_solver"] =
-      kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters());
+      nlohmann::json::parse(kelp::sim::solver_summary_json(
+          kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters())));
   // Propulsion: the energy each battery delivered [Wh] and its final state of charge.
   const auto battery = [&](const kelp::vehicle::PropulsionModeld* pm,
                            const kelp::vehicle::PropulsionStated& x) {
@@ -313,7 +314,7 @@ int run(const Options& o) {
          {"position_m", {f.position.x(), f.position.y(), f.position.z()}},
          {"tension_n", f.tension}});
   summary["scenario_file"] = o.scenario_file;
-  summary["scenario"] = kelp::sim::to_json(o.scenario);
+  summary["scenario"] = nlohmann::json::parse(kelp::sim::scenario_json(o.scenario));
   std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
   // The 3-D replay (docs/replay.md): without the page's template (kelp built without three.js)
   // the run is still complete; a replay that cannot be made is reported, not fatal.

@@ -312,7 +312,7 @@ inline Sweep parse_sweep(const std::string& text, const std::string& file) {
       char h[17];
       std::snprintf(
           h, sizeof h, "%016llx",
-          static_cast<unsigned long long>(detail::fnv1a(kelp::sim::to_json(r.scenario).dump())));
+          static_cast<unsigned long long>(detail::fnv1a(kelp::sim::scenario_json(r.scenario))));
       r.hash = h;
       s.runs.push_back(std::move(r));
     }

@@ -67,7 +67,7 @@ void bind_scenario(py::module_& m) {
         std::string summary;
         {
           py::gil_scoped_release release;
-          summary = kelp::sim::run_scenario(sc, ro).dump();
+          summary = kelp::sim::summary_json(kelp::sim::run_scenario(sc, ro));
         }
         if (!timeseries) return py::make_tuple(summary, py::none());
         // One (columns, samples) array; each column a contiguous view into it.

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/tether/state.hpp"
@@ -72,7 +73,7 @@ class TurnCounter {
       azimuth_ = heading;
     const double phi = heading - azimuth_;
     if (started_) {
-      turns_ += wrap(phi - phi_) / (2.0 * kelp::pi);
+      turns_ += kelp::wrap_angle_exact(phi - phi_) / (2.0 * kelp::pi);
       max_abs_ = std::max(max_abs_, std::abs(turns_));
     }
     phi_ = phi;
@@ -85,11 +86,6 @@ class TurnCounter {
   double max_abs_turns() const { return max_abs_; }
 
  private:
-  // An angle wrapped to (−π, π].
-  static double wrap(double a) {
-    a = std::remainder(a, 2.0 * kelp::pi);
-    return a <= -kelp::pi ? a + 2.0 * kelp::pi : a;
-  }
   double reference_ = 2.0, azimuth_ = 0.0, phi_ = 0.0, turns_ = 0.0, max_abs_ = 0.0;
   bool started_ = false;
 };

@@ -11,6 +11,7 @@
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/sim/export.hpp"
+#include "kelp/sim/instantiation.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"

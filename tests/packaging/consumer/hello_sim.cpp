@@ -69,12 +69,18 @@ int main() {
   // A 10 m tether between vehicles a few metres apart hangs in the water: it pulls on both.
   check(loop.sample().tension_auv > 0.0 && loop.sample().tension_asv > 0.0,
         "no tether tension at the end of the run");
-  const nlohmann::json s = loop.summary();
-  for (const char* key : {"rms_path_error_m", "max_path_error_m"})
-    check(std::isfinite(s["auv"][key].get<double>()), std::string("summary auv/") + key);
-  check(std::isfinite(s["energy_j"].get<double>()), "summary energy_j not finite");
-  check(s["tether"]["max_tension_n"].get<double>() > 0.0, "summary: no tension");
-  check(s["scenario"] == kelp::sim::to_json(sc), "summary does not echo the scenario");
+  const kelp::sim::RunSummary s = loop.summary();
+  check(std::isfinite(s.auv.rms_path_error_m) && std::isfinite(s.auv.max_path_error_m) &&
+            s.auv.max_path_error_m >= s.auv.rms_path_error_m,
+        "summary auv: path errors not finite or the largest below the RMS");
+  check(std::isfinite(s.energy_j), "summary energy_j not finite");
+  check(s.tether.max_tension_n > 0.0, "summary: no tension");
+  check(kelp::sim::scenario_json(s.scenario) == kelp::sim::scenario_json(sc),
+        "summary does not echo the scenario");
+  const std::string text = kelp::sim::summary_json(s);
+  check(text.find("\"max_tension_n\":") != std::string::npos &&
+            text.find(kelp::sim::scenario_json(sc)) != std::string::npos,
+        "summary_json() lacks the tension or the scenario's echo");
   // timeseries.csv: the header and one row every 0.2 s from 0 to 10 s; nodes.csv: the header and
   // 11 nodes every second from 0 to 10 s.
   check(lines_of(dir / "timeseries.csv") == 1 + 51, "timeseries.csv does not have 51 rows");
