@@ -26,6 +26,9 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
+  /// The file the errors name (a seabed's height-field file is relative to its directory).
+  const std::string& file() const { return file_; }
+
   [[noreturn]] void fail(const std::string& path, const std::string& what) const {
     throw scenario_error(file_ + ": " + (path.empty() ? "/" : path) + ": " + what);
   }

@@ -1,0 +1,415 @@
+/// \file
+/// \brief The machinery of the scenario's field table (src/scenario.cpp's `scenario_fields`):
+/// each JSON object of a scenario lists its keys once, as calls on a visitor, and three visitors
+/// walk that one list: Keys (the keys an object allows, and those it requires), Parser (reads and
+/// checks each key through Reader: errors name the file and the JSON path) and Writer (writes
+/// each key back, under its when-to-write rule). The shape follows kelp/sim/ros2/messages.hpp's
+/// `fields()`. Private to the kelp::sim library.
+///
+/// A table is a function of a visitor `v` (a generic lambda or a template) that calls, per key:
+///
+///     v.number(key, member, lo, hi[, rule])     a finite number in [lo, hi]
+///     v.integer(key, member, lo, hi[, rule])    an integer in [lo, hi] (std::uint64_t or int)
+///     v.whole(key, member, lo, hi[, rule])      a number in [lo, hi] that must be whole (int)
+///     v.boolean(key, member[, rule])            true or false
+///     v.choice(key, member, {options}[, rule])  one of the options (a string)
+///     v.vec3(key, member[, rule])               [x, y, z] within ±1e4 (Vector3, or a
+///                                               std::vector<double> that is empty when unset)
+///     v.vec3_list(key, member[, rule])          a non-empty array of [x, y, z]
+///     v.gains(key, member[, rule])              non-negative [kp, ki, kd]
+///     v.object(key, object_rule, body)          a nested object, `body` its own table
+///     v.preset_or_object(key, member, {presets}, custom, body)
+///                                               a preset's name, or an object (then member is
+///                                               `custom` and `body` reads it)
+///     v.custom(key, parse, write)               a key read and written by hand (lists)
+///     v.key(key)                                a key read by the caller (allowed, not visited)
+///     v.on_read(f)                              parse only: f() at this point of the reading
+///     v.check(f)                                parse only: f(reader, path) or f(reader, path,
+///                                               object) at this point, for checks between keys
+///
+/// in the order the keys are read (the first error found is the one reported). The rule says
+/// when the writer writes the key: `always` (the default), `never`, `required` (always, and
+/// the parser requires it), `unless(value)`, `above(x)`, `at_least(x)`, `finite`, `if_set` (a
+/// non-empty list), or any predicate on the value. An object's rule: a bool (written when
+/// true), `unless_default` (only when it differs from the default scenario's) or `non_empty`.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "json_reader.hpp"
+
+namespace kelp {
+namespace sim {
+namespace detail {
+namespace schema {
+
+/// \brief Rule: always written.
+struct Always {
+  template <class X>
+  bool operator()(const X&) const {
+    return true;
+  }
+};
+/// \brief Rule: never written (a key that is read only, e.g. `deterministic`).
+struct Never {
+  template <class X>
+  bool operator()(const X&) const {
+    return false;
+  }
+};
+/// \brief Rule: always written, and the parser requires the key (before reading any of the
+/// object's keys: `missing "key"`).
+struct Required : Always {};
+/// \brief Rule: written unless the value is `value` (e.g. a choice's default).
+template <class T>
+struct Unless {
+  T value;  ///< the value not written
+  template <class X>
+  bool operator()(const X& x) const {
+    return !(x == value);
+  }
+};
+/// \brief Rule: written when the value is above `unset` (a property's "keep the preset's" value).
+struct Above {
+  double unset;  ///< the unset value
+  bool operator()(double x) const { return x > unset; }
+};
+/// \brief Rule: written when the value is at least `lo`.
+struct AtLeast {
+  double lo;  ///< the least value written
+  bool operator()(double x) const { return x >= lo; }
+};
+/// \brief Rule: written when the value is finite (+∞: unset).
+struct Finite {
+  bool operator()(double x) const { return std::isfinite(x); }
+};
+/// \brief Rule: written when the list is not empty.
+struct IfSet {
+  template <class X>
+  bool operator()(const X& x) const {
+    return !x.empty();
+  }
+};
+/// \brief Object rule: written only when it differs from the default scenario's.
+struct UnlessDefault {};
+/// \brief Object rule: written only when it has a key.
+struct NonEmpty {};
+
+inline constexpr Always always{};                 ///< \brief Rule: always written.
+inline constexpr Never never{};                   ///< \brief Rule: never written.
+inline constexpr Required required{};             ///< \brief Rule: required, always written.
+inline constexpr Finite finite{};                 ///< \brief Rule: written when finite.
+inline constexpr IfSet if_set{};                  ///< \brief Rule: written when not empty.
+inline constexpr UnlessDefault unless_default{};  ///< \brief Object rule: see UnlessDefault.
+inline constexpr NonEmpty non_empty{};            ///< \brief Object rule: see NonEmpty.
+/// \brief Rule: written unless the value is `v`.
+template <class T>
+Unless<T> unless(T v) {
+  return {v};
+}
+/// \brief Rule: written when above `unset`.
+inline Above above(double unset) { return {unset}; }
+/// \brief Rule: written when at least `lo`.
+inline AtLeast at_least(double lo) { return {lo}; }
+
+using Options = std::set<std::string>;  ///< a choice's options
+
+/// \brief The visitor that collects an object's keys (allowed, and required) from its table.
+class Keys {
+ public:
+  std::set<std::string> allowed;      ///< every key the table lists
+  std::vector<std::string> required;  ///< the keys with the `required` rule, in table order
+
+  template <class X, class R = Always>
+  void number(const char* k, X&, double, double, R rule = {}) {
+    add(k, rule);
+  }
+  template <class X, class R = Always>
+  void integer(const char* k, X&, double, double, R rule = {}) {
+    add(k, rule);
+  }
+  template <class R = Always>
+  void whole(const char* k, int&, double, double, R rule = {}) {
+    add(k, rule);
+  }
+  template <class R = Always>
+  void boolean(const char* k, bool&, R rule = {}) {
+    add(k, rule);
+  }
+  template <class R = Always>
+  void choice(const char* k, std::string&, const Options&, R rule = {}) {
+    add(k, rule);
+  }
+  template <class X, class R = Always>
+  void vec3(const char* k, X&, R rule = {}) {
+    add(k, rule);
+  }
+  template <class X, class R = Always>
+  void vec3_list(const char* k, X&, R rule = {}) {
+    add(k, rule);
+  }
+  template <class R = Always>
+  void gains(const char* k, Gains&, R rule = {}) {
+    add(k, rule);
+  }
+  template <class R, class Body>
+  void object(const char* k, R, Body&&) {
+    allowed.insert(k);
+  }
+  template <class Body>
+  void preset_or_object(const char* k, std::string&, const Options&, const char*, Body&&) {
+    allowed.insert(k);
+  }
+  template <class P, class W>
+  void custom(const char* k, P&&, W&&) {
+    allowed.insert(k);
+  }
+  void key(const char* k) { allowed.insert(k); }
+  template <class F>
+  void on_read(F&&) {}
+  template <class F>
+  void check(F&&) {}
+
+ private:
+  template <class R>
+  void add(const char* k, const R&) {
+    allowed.insert(k);
+    if (std::is_same<R, Required>::value) required.push_back(k);
+  }
+};
+
+/// \brief Reads the object `o` at `path` through its table `body`: the keys it allows first,
+/// then the required ones, then each key in table order.
+template <class Body>
+void parse_object(const Reader& r, const nlohmann::json& o, const std::string& path, Body& body);
+
+/// \brief The visitor that reads an object's keys (each through Reader, as the table orders them).
+class Parser {
+ public:
+  /// \brief Reads the keys of `j`, the object at `path`.
+  Parser(const Reader& r, const nlohmann::json& j, std::string path)
+      : r_(r), j_(j), path_(std::move(path)) {}
+
+  template <class R = Always>
+  void number(const char* k, double& x, double lo, double hi, R = {}) {
+    r_.number(j_, path_, k, x, lo, hi);
+  }
+  template <class R = Always>
+  void integer(const char* k, std::uint64_t& x, double lo, double hi, R = {}) {
+    r_.integer(j_, path_, k, x, lo, hi);
+  }
+  template <class R = Always>
+  void integer(const char* k, int& x, double lo, double hi, R = {}) {
+    std::uint64_t u = std::uint64_t(x);
+    r_.integer(j_, path_, k, u, lo, hi);
+    x = int(u);
+  }
+  template <class R = Always>
+  void whole(const char* k, int& x, double lo, double hi, R = {}) {
+    double n = x;
+    r_.number(j_, path_, k, n, lo, hi);
+    if (n != std::floor(n)) r_.fail(path_ + "/" + k, "expected an integer");
+    x = static_cast<int>(n);
+  }
+  template <class R = Always>
+  void boolean(const char* k, bool& x, R = {}) {
+    r_.boolean(j_, path_, k, x);
+  }
+  template <class R = Always>
+  void choice(const char* k, std::string& x, const Options& options, R = {}) {
+    r_.choice(j_, path_, k, x, options);
+  }
+  template <class R = Always>
+  void vec3(const char* k, kelp::Vector3<double>& x, R = {}) {
+    if (j_.contains(k)) x = r_.vec3(j_.at(k), path_ + "/" + k);
+  }
+  template <class R = Always>
+  void vec3(const char* k, std::vector<double>& x, R = {}) {
+    if (!j_.contains(k)) return;
+    const kelp::Vector3<double> p = r_.vec3(j_.at(k), path_ + "/" + k);
+    x = {p(0), p(1), p(2)};
+  }
+  template <class R = Always>
+  void vec3_list(const char* k, std::vector<kelp::Vector3<double>>& x, R = {}) {
+    if (!j_.contains(k)) return;
+    const auto& w = j_.at(k);
+    const std::string p = path_ + "/" + k;
+    if (!w.is_array()) r_.fail(p, "expected an array of [x, y, z]");
+    if (w.empty()) r_.fail(p, "expected at least one waypoint, got []");
+    for (std::size_t i = 0; i < w.size(); ++i)
+      x.push_back(r_.vec3(w[i], p + "/" + std::to_string(i)));
+  }
+  template <class R = Always>
+  void gains(const char* k, Gains& x, R = {}) {
+    r_.gains(j_, path_, k, x);
+  }
+  template <class R, class Body>
+  void object(const char* k, R, Body&& body) {
+    if (j_.contains(k)) parse_object(r_, j_.at(k), path_ + "/" + k, body);
+  }
+  template <class Body>
+  void preset_or_object(const char* k, std::string& x, const Options& presets, const char*,
+                        Body&& body) {
+    if (!j_.contains(k)) return;
+    if (j_.at(k).is_string())
+      r_.choice(j_, path_, k, x, presets);
+    else
+      parse_object(r_, j_.at(k), path_ + "/" + k, body);
+  }
+  /// `parse(value, reader, path)` when the key is given.
+  template <class P, class W>
+  void custom(const char* k, P&& parse, W&&) {
+    if (j_.contains(k)) parse(j_.at(k), r_, path_ + "/" + k);
+  }
+  void key(const char*) {}
+  template <class F>
+  void on_read(F&& f) {
+    f();
+  }
+  template <class F>
+  void check(F&& f) {
+    if constexpr (std::is_invocable<F&, const Reader&, const std::string&>::value)
+      f(r_, path_);
+    else
+      f(r_, path_, j_);
+  }
+
+ private:
+  const Reader& r_;
+  const nlohmann::json& j_;
+  std::string path_;
+};
+
+template <class Body>
+void parse_object(const Reader& r, const nlohmann::json& o, const std::string& path, Body& body) {
+  Keys keys;
+  body(keys);
+  r.object(o, path, keys.allowed);
+  for (const auto& k : keys.required)
+    if (!o.contains(k)) r.fail(path, "missing \"" + k + "\"");
+  Parser p(r, o, path);
+  body(p);
+}
+
+/// \brief The visitor that writes an object's keys, each under its rule.
+class Writer {
+ public:
+  /// \brief Writes into `out`; `defaults` is the default scenario's JSON at the same place (for
+  /// `unless_default`), or nullptr to write every such object (when writing the defaults).
+  Writer(nlohmann::json& out, const nlohmann::json* defaults) : out_(out), defaults_(defaults) {}
+
+  template <class X, class R = Always>
+  void number(const char* k, X& x, double, double, R rule = {}) {
+    put(k, x, rule);
+  }
+  template <class X, class R = Always>
+  void integer(const char* k, X& x, double, double, R rule = {}) {
+    put(k, x, rule);
+  }
+  template <class R = Always>
+  void whole(const char* k, int& x, double, double, R rule = {}) {
+    put(k, x, rule);
+  }
+  template <class R = Always>
+  void boolean(const char* k, bool& x, R rule = {}) {
+    put(k, x, rule);
+  }
+  template <class R = Always>
+  void choice(const char* k, std::string& x, const Options&, R rule = {}) {
+    put(k, x, rule);
+  }
+  template <class R = Always>
+  void vec3(const char* k, kelp::Vector3<double>& x, R rule = {}) {
+    if (rule(x)) out_[k] = v3(x);
+  }
+  template <class R = Always>
+  void vec3(const char* k, std::vector<double>& x, R rule = {}) {
+    put(k, x, rule);
+  }
+  template <class R = Always>
+  void vec3_list(const char* k, std::vector<kelp::Vector3<double>>& x, R rule = {}) {
+    if (!rule(x)) return;
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& p : x) a.push_back(v3(p));
+    out_[k] = a;
+  }
+  template <class R = Always>
+  void gains(const char* k, Gains& x, R rule = {}) {
+    if (rule(x)) out_[k] = nlohmann::json::array({x.kp, x.ki, x.kd});
+  }
+  template <class Body>
+  void object(const char* k, bool when, Body&& body) {
+    if (when) out_[k] = sub(k, body);
+  }
+  template <class Body>
+  void object(const char* k, NonEmpty, Body&& body) {
+    nlohmann::json o = sub(k, body);
+    if (!o.empty()) out_[k] = std::move(o);
+  }
+  template <class Body>
+  void object(const char* k, UnlessDefault, Body&& body) {
+    nlohmann::json o = sub(k, body);
+    if (!defaults_ || !defaults_->contains(k) || o != defaults_->at(k)) out_[k] = std::move(o);
+  }
+  template <class Body>
+  void preset_or_object(const char* k, std::string& x, const Options&, const char* custom,
+                        Body&& body) {
+    if (x == custom)
+      out_[k] = sub(k, body);
+    else
+      out_[k] = x;
+  }
+  /// `write()`'s value, unless null.
+  template <class P, class W>
+  void custom(const char* k, P&&, W&& write) {
+    nlohmann::json v = write();
+    if (!v.is_null()) out_[k] = std::move(v);
+  }
+  void key(const char*) {}
+  template <class F>
+  void on_read(F&&) {}
+  template <class F>
+  void check(F&&) {}
+
+ private:
+  static nlohmann::json v3(const kelp::Vector3<double>& v) {
+    return nlohmann::json::array({v(0), v(1), v(2)});
+  }
+  template <class X, class R>
+  void put(const char* k, const X& x, const R& rule) {
+    if (rule(x)) out_[k] = x;
+  }
+  template <class Body>
+  nlohmann::json sub(const char* k, Body& body) {
+    nlohmann::json o = nlohmann::json::object();
+    const nlohmann::json* d = defaults_ && defaults_->contains(k) ? &defaults_->at(k)
+                              : defaults_                         ? &null_
+                                                                  : nullptr;
+    Writer w(o, d);
+    body(w);
+    return o;
+  }
+  nlohmann::json& out_;
+  const nlohmann::json* defaults_;
+  const nlohmann::json null_;
+};
+
+/// \brief The object written by the table `body` (every `unless_default` object written).
+template <class Body>
+nlohmann::json write_object(Body&& body) {
+  nlohmann::json o = nlohmann::json::object();
+  Writer w(o, nullptr);
+  body(w);
+  return o;
+}
+
+}  // namespace schema
+}  // namespace detail
+}  // namespace sim
+}  // namespace kelp
