@@ -3,10 +3,29 @@
 #include "kelp/sim/instantiation.hpp"
 
 namespace kelp {
+namespace environment {
+namespace detail {
+
+template void wave_accumulate_baseline<double>(const WaveComponentsView&, WaveBlock&, int, double,
+                                               bool);
+#ifdef KELP_X86_DISPATCH
+template void wave_accumulate_avx2<double>(const WaveComponentsView&, WaveBlock&, int, double,
+                                           bool);
+template void wave_accumulate_avx512<double>(const WaveComponentsView&, WaveBlock&, int, double,
+                                             bool);
+template void wave_accumulate_avx2_exact<double>(const WaveComponentsView&, WaveBlock&, int,
+                                                 double, bool);
+#if KELP_PORTABLE_AVX512
+template void wave_accumulate_avx512_exact<double>(const WaveComponentsView&, WaveBlock&, int,
+                                                   double, bool);
+#endif
+#endif
+
+}  // namespace detail
+}  // namespace environment
+
 namespace system {
 
-template class SystemModel<double>;
-template struct SystemWorkspace<double>;
 template SystemReport<double> step<double>(const SystemModel<double>&, SystemWorkspace<double>&,
                                            SystemState<double>&, const SystemInputs<double>&,
                                            double, SystemStepOptions);

@@ -30,6 +30,7 @@
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"

@@ -227,9 +227,15 @@ KELP_ALWAYS_INLINE inline void wave_accumulate_impl(const WaveComponentsView& c,
   }
 }
 
+// The kernels below are function templates (of a placeholder type, `double` by default) rather
+// than inline functions, so that a unit compiles their several instruction sets only when it
+// instantiates them: a compiled layer on kelp (kelp::sim) instantiates them once
+// (`extern template`) instead of in every one of its units.
+
 /// The kernel for the baseline instruction set of the build.
-inline void wave_accumulate_baseline(const WaveComponentsView& c, WaveBlock& b, int m, double t,
-                                     bool finite) {
+template <typename Instance = double>
+void wave_accumulate_baseline(const WaveComponentsView& c, WaveBlock& b, int m, double t,
+                              bool finite) {
   if (finite)
     wave_accumulate_impl<true, 8>(c, b, m, t);
   else
@@ -239,9 +245,10 @@ inline void wave_accumulate_baseline(const WaveComponentsView& c, WaveBlock& b, 
 #ifdef KELP_X86_DISPATCH
 /// The same kernel compiled for AVX2 + FMA (4 doubles per instruction), chosen at run time when
 /// the CPU has them. Results differ from the baseline only by FMA rounding (≲ 1e-15 relative).
-__attribute__((target("avx2,fma"))) inline void wave_accumulate_avx2(const WaveComponentsView& c,
-                                                                     WaveBlock& b, int m, double t,
-                                                                     bool finite) {
+template <typename Instance = double>
+__attribute__((target("avx2,fma"))) void wave_accumulate_avx2(const WaveComponentsView& c,
+                                                              WaveBlock& b, int m, double t,
+                                                              bool finite) {
   if (finite)
     wave_accumulate_impl<true, 8>(c, b, m, t);
   else
@@ -255,8 +262,9 @@ __attribute__((target("avx2,fma"))) inline void wave_accumulate_avx2(const WaveC
   __attribute__((target("avx512f,avx512dq,avx2,fma,prefer-vector-width=512")))
 #endif
 /// The same kernel compiled for AVX-512 (8 doubles per instruction).
-KELP_ENV_TARGET_AVX512 inline void wave_accumulate_avx512(const WaveComponentsView& c, WaveBlock& b,
-                                                          int m, double t, bool finite) {
+template <typename Instance = double>
+KELP_ENV_TARGET_AVX512 void wave_accumulate_avx512(const WaveComponentsView& c, WaveBlock& b, int m,
+                                                   double t, bool finite) {
   if (finite)
     wave_accumulate_impl<true, 16>(c, b, m, t);
   else
@@ -270,9 +278,10 @@ KELP_ENV_TARGET_AVX512 inline void wave_accumulate_avx512(const WaveComponentsVi
 // each point's (or lane's) sum keeps its order, and no reassociation is allowed (kelp refuses
 // -fassociative-math): the same bits as the baseline build (tested), 2–4× faster.
 /// The baseline kernel compiled for AVX2 without FMA (`target("avx2")` enables no FMA).
-__attribute__((target("avx2"))) inline void wave_accumulate_avx2_exact(const WaveComponentsView& c,
-                                                                       WaveBlock& b, int m,
-                                                                       double t, bool finite) {
+template <typename Instance = double>
+__attribute__((target("avx2"))) void wave_accumulate_avx2_exact(const WaveComponentsView& c,
+                                                                WaveBlock& b, int m, double t,
+                                                                bool finite) {
   if (finite)
     wave_accumulate_impl<true, 8>(c, b, m, t);
   else
@@ -281,8 +290,9 @@ __attribute__((target("avx2"))) inline void wave_accumulate_avx2_exact(const Wav
 #if KELP_PORTABLE_AVX512
 /// The baseline kernel compiled for AVX-512 with contraction off (GCC's AVX-512 enables FMA, so
 /// `optimize("fp-contract=off")` forbids fusing; clang has no such attribute: not built there).
+template <typename Instance = double>
 __attribute__((target("avx512f,avx512dq,avx2,prefer-vector-width=512"),
-               optimize("fp-contract=off"))) inline void
+               optimize("fp-contract=off"))) void
 wave_accumulate_avx512_exact(const WaveComponentsView& c, WaveBlock& b, int m, double t,
                              bool finite) {
   if (finite)
@@ -300,17 +310,17 @@ wave_accumulate_avx512_exact(const WaveComponentsView& c, WaveBlock& b, int m, d
 inline void wave_accumulate(const WaveComponentsView& c, WaveBlock& b, int m, double t, bool finite,
                             simd::KernelPath path) {
 #ifdef KELP_X86_DISPATCH
-  if (path == simd::KernelPath::avx512) return wave_accumulate_avx512(c, b, m, t, finite);
-  if (path == simd::KernelPath::avx2) return wave_accumulate_avx2(c, b, m, t, finite);
+  if (path == simd::KernelPath::avx512) return wave_accumulate_avx512<>(c, b, m, t, finite);
+  if (path == simd::KernelPath::avx2) return wave_accumulate_avx2<>(c, b, m, t, finite);
   const int build = simd::detail::portable_build();
 #if KELP_PORTABLE_AVX512
-  if (build == 2) return wave_accumulate_avx512_exact(c, b, m, t, finite);
+  if (build == 2) return wave_accumulate_avx512_exact<>(c, b, m, t, finite);
 #endif
-  if (build >= 1) return wave_accumulate_avx2_exact(c, b, m, t, finite);
+  if (build >= 1) return wave_accumulate_avx2_exact<>(c, b, m, t, finite);
 #else
   (void)path;
 #endif
-  wave_accumulate_baseline(c, b, m, t, finite);
+  wave_accumulate_baseline<>(c, b, m, t, finite);
 }
 
 }  // namespace detail
