@@ -12,8 +12,8 @@
 //  - that the energy stays bounded: the system's mechanical energy (vehicles' kinetic and
 //    hydrostatic, tether's kinetic, elastic, weight and buoyancy) is finite, and its peak in every
 //    later window of 10 minutes is within the first windows' envelope (no secular growth);
-//  - flat memory: no heap allocation after the first simulated minute (operator new counted, and
-//    Eigen's own allocator forbidden through EIGEN_RUNTIME_NO_MALLOC), and resident memory growing
+//  - flat memory: no heap allocation after the first simulated minute (the program's malloc
+//    counted, tests/support/heap_counter.hpp: the library's allocations and Eigen's included), and resident memory growing
 //    by less than 1 MiB (not checked under AddressSanitizer, whose shadow memory grows it);
 //  - that the vehicles stay under control: over the second half of the run the ROV within 20 m of
 //    its survey path and the boat within 25 m of the ROV horizontally (the waves move both by a
@@ -31,9 +31,9 @@
 #include <vector>
 
 #include "kelp/sim/closed_loop.hpp"
+#include "support/heap_counter.hpp"
 
 namespace {
-std::atomic<long> g_heap_allocations{0};
 
 // Under AddressSanitizer the resident set grows with its shadow memory and the fake stack frames
 // of detect_stack_use_after_return, whatever the program does: the resident-memory check is left
@@ -51,30 +51,6 @@ constexpr bool kResidentMemoryChecked = true;
 #endif
 }  // namespace
 
-// Every operator new of this program is counted: the non-array, non-aligned forms are replaced,
-// new and delete together, on std::malloc/std::free (libstdc++'s default operator new[] calls
-// the replaced operator new, its delete[] the replaced delete). Replacing new alone is not
-// enough: an allocator that replaces the library's own (AddressSanitizer's) would then free
-// malloc'ed memory with its operator delete.
-void* operator new(std::size_t n) {
-  g_heap_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  g_heap_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(n ? n : 1);
-}
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic push  // GCC takes the inlined malloc/free pair for a new/free mismatch
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
 
 namespace {
 
@@ -161,7 +137,7 @@ int main(int argc, char** argv) {
   o.scenario_file = "(soak: rough sea, 0.5 m/s current)";
   o.on_step = [&](const kelp::sim::StepView& v) {
     Eigen::internal::set_is_malloc_allowed(true);
-    const long allocated = g_heap_allocations.load() - last_allocations;
+    const long allocated = kelp_test::heap_allocations() - last_allocations;
     if (v.step > warm_up) allocations_after_warm_up += allocated;
     if (v.step == warm_up) rss_start = resident_kib();
     const auto& p = v.model.parameters();
@@ -201,7 +177,7 @@ int main(int argc, char** argv) {
                " m at t = " + std::to_string(v.state.time) + " s";
       });
     }
-    last_allocations = g_heap_allocations.load();
+    last_allocations = kelp_test::heap_allocations();
     // Between two observations only the controllers and the step run: no allocation allowed.
     Eigen::internal::set_is_malloc_allowed(v.step < warm_up);
   };

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kelp/sim/batch.hpp"
+#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 
@@ -134,9 +135,11 @@ TEST_CASE("a batch step allocates nothing", "[sim][batch][malloc]") {
   ks::Batch b(short_batch_run(), 2, 1, o);
   const std::vector<double> a = actions(2, 0);
   b.step(1, a.data());
+  const long before = kelp_test::heap_allocations();  // the whole program's, the library's too
   Eigen::internal::set_is_malloc_allowed(false);
   b.step(2, a.data());
   b.step(1);
   Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(kelp_test::heap_allocations() == before);
   CHECK(b.time()(0, 0) == Approx(0.4));
 }

@@ -8,6 +8,7 @@
 
 #include "kelp/sim.hpp"
 #include "sim_test_support.hpp"
+#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 
@@ -131,8 +132,10 @@ TEST_CASE("closed loop, perfect navigation: no sensors, the summary says so", "[
 TEST_CASE("closed loop on sensors: a step allocates nothing", "[nav][sim][malloc]") {
   ks::ClosedLoop loop(ks::parse_scenario(sensors_run(3, 1), "t"));
   loop.run_for(1.0);
+  const long before = kelp_test::heap_allocations();  // the whole program's, the library's too
   Eigen::internal::set_is_malloc_allowed(false);
   loop.run_for(1.5);  // USBL fixes, DVL pings and GPS fixes all fall in here
   Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(kelp_test::heap_allocations() == before);
   CHECK(loop.navigation()->usbl_fixes() >= 1);
 }

@@ -9,6 +9,7 @@
 
 #include "kelp/sim/pair_env.hpp"
 #include "kelp/vehicle/presets.hpp"
+#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 
@@ -204,8 +205,10 @@ TEST_CASE("an environment step allocates nothing", "[sim][env][malloc]") {
   ks::TetheredPairEnv env(short_run());
   const double action[6] = {0.2, 0.1, 0.3, 0, 0, 0.1};
   env.step(action);
+  const long before = kelp_test::heap_allocations();  // the whole program's, the library's too
   Eigen::internal::set_is_malloc_allowed(false);
   for (int k = 0; k < 5; ++k) env.step(action);
   Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(kelp_test::heap_allocations() == before);
   CHECK(env.loop().steps_taken() == 60);
 }

@@ -11,6 +11,7 @@
 
 #include "kelp/sim.hpp"
 #include "sim_test_support.hpp"
+#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 
@@ -200,8 +201,11 @@ TEST_CASE("the tether's line_model: parsed, written back, passed to the tether, 
 TEST_CASE("a closed-loop step allocates nothing", "[sim][malloc]") {
   ks::ClosedLoop loop(short_calm_run());
   loop.run_for(0.1);  // past the first controller updates
+  // Counted in the whole program: the library's code is compiled without Eigen's malloc check.
+  const long before = kelp_test::heap_allocations();
   Eigen::internal::set_is_malloc_allowed(false);
   for (int k = 0; k < 100; ++k) loop.step();
   Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(kelp_test::heap_allocations() == before);
   CHECK(loop.steps_taken() == 110);
 }
