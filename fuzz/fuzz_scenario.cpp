@@ -2,8 +2,8 @@
 //
 // Oracle: parse_scenario(input) either throws kelp::sim::scenario_error (the documented
 // error, whose message names the file) or returns a scenario whose every number is finite and
-// within the schema's ranges; scenario_json() of it parses back to the same scenario (the echo in the
-// run's summary is a valid scenario file). Any other exception, crash or sanitizer report is a
+// within the schema's ranges; scenario_json() of it parses back to the same scenario (the echo in
+// the run's summary is a valid scenario file). Any other exception, crash or sanitizer report is a
 // finding.
 #include <string>
 

@@ -7,7 +7,7 @@ namespace kelp {
 namespace sim {
 
 Batch::Batch(const Scenario& scenario, std::size_t n, std::uint64_t seed,
-      const BatchOptions& options)
+             const BatchOptions& options)
     : scenario_(scenario), options_(options), seed_(seed) {
   KELP_CHECK(n >= 1, "Batch: n must be at least 1");
   unsigned t = options.threads ? options.threads : std::thread::hardware_concurrency();

@@ -24,7 +24,7 @@ namespace sim {
 namespace {
 /// Distance from p to the segment a–b.
 double distance_to_segment(const kelp::Vector3<double>& p, const kelp::Vector3<double>& a,
-                                  const kelp::Vector3<double>& b) {
+                           const kelp::Vector3<double>& b) {
   const kelp::Vector3<double> ab = b - a;
   const double l2 = ab.squaredNorm();
   const double s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
@@ -32,7 +32,8 @@ double distance_to_segment(const kelp::Vector3<double>& p, const kelp::Vector3<d
 }
 }  // namespace
 
-ClosedLoop::ClosedLoop(const Scenario& sc, const WorldSetup& world, const ClosedLoopOptions& options)
+ClosedLoop::ClosedLoop(const Scenario& sc, const WorldSetup& world,
+                       const ClosedLoopOptions& options)
     : scenario_(sc),
       options_(options),
       model_(world.parameters, world.environment),
@@ -80,8 +81,8 @@ ClosedLoop::ClosedLoop(const Scenario& sc, const WorldSetup& world, const Closed
   line_mass_start_ = kelp::tether::line_mass(model_.tether_of(state_), state_.tether);
   length_start_ = kelp::tether::unstretched_length(model_.tether_of(state_), state_.tether);
   if (sc.navigation.mode == "sensors")
-    navigation_ = std::make_unique<PairNavigation>(sc.navigation.sensors,
-                                                              sc.navigation.seed, model_, state_);
+    navigation_ =
+        std::make_unique<PairNavigation>(sc.navigation.sensors, sc.navigation.seed, model_, state_);
   observe();
 }
 
@@ -133,7 +134,8 @@ long ClosedLoop::run_for(double seconds) {
   return n;
 }
 
-std::vector<EntanglementAxis> ClosedLoop::entanglement_axes(const kelp::system::SystemModeld& model) {
+std::vector<EntanglementAxis> ClosedLoop::entanglement_axes(
+    const kelp::system::SystemModeld& model) {
   std::vector<EntanglementAxis> axes;
   if (const kelp::environment::ObstacleSet* o = model.environment().obstacles()) {
     for (std::size_t k = 0; k < o->cylinders().size(); ++k) {
@@ -214,10 +216,8 @@ void ClosedLoop::observe() {
                      pm.parameters().battery,
                      kelp::vehicle::state_of_charge(pm.parameters().battery, x.battery));
   };
-  if (const auto* pm = model_.auv_propulsion())
-    auv_.set_voltage(volts(*pm, state_.auv_propulsion));
-  if (const auto* pm = model_.asv_propulsion())
-    asv_.set_voltage(volts(*pm, state_.asv_propulsion));
+  if (const auto* pm = model_.auv_propulsion()) auv_.set_voltage(volts(*pm, state_.auv_propulsion));
+  if (const auto* pm = model_.asv_propulsion()) asv_.set_voltage(volts(*pm, state_.asv_propulsion));
   // What the controllers see: the true state, or the sensors' estimates (the boat takes the
   // ROV's position from the ROV's estimate, which it receives over the tether).
   if (navigation_) {
@@ -264,9 +264,9 @@ void ClosedLoop::observe() {
   {
     const Eigen::Index segments = state_.tether.position.cols() - 1;
     const auto& tension = workspace_.tether.tension;
-    const int raised = entanglement_.update(
-        t, state_.tether.position, state_.tether.velocity,
-        tension.head(tension.size() == segments ? segments : Eigen::Index(0)));
+    const int raised =
+        entanglement_.update(t, state_.tether.position, state_.tether.velocity,
+                             tension.head(tension.size() == segments ? segments : Eigen::Index(0)));
     if (options_.log)
       for (std::size_t k = entanglement_.events().size() - std::size_t(raised);
            k < entanglement_.events().size(); ++k) {
@@ -345,7 +345,6 @@ void ClosedLoop::observe() {
   if (options_.log && k_ % node_every_ == 0)
     options_.log->nodes(t, model_.tether_of(state_), state_.tether);
 }
-
 
 SolverSummary solver_summary(const kelp::system::SolverStatsd& stats,
                              const kelp::system::SystemParametersd& p) {

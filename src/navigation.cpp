@@ -23,8 +23,8 @@ void validate(const PairSensors& p) {
   check_positive(p.asv_heave_sigma, "asv_heave_sigma");
 }
 
-PairNavigation::PairNavigation(const PairSensors& p, std::uint64_t seed, const system::SystemModeld& model,
-               const system::SystemStated& state)
+PairNavigation::PairNavigation(const PairSensors& p, std::uint64_t seed,
+                               const system::SystemModeld& model, const system::SystemStated& state)
     : p_((validate(p), p)),
       auv_imu_(p.imu, seed, 0),
       asv_imu_(p.imu, seed, 1),
@@ -44,10 +44,10 @@ PairNavigation::PairNavigation(const PairSensors& p, std::uint64_t seed, const s
   double rpsi = 0, bpsi = 0;
   auv_compass_.sample(state.auv.attitude, t, rpsi);
   asv_compass_.sample(state.asv.attitude, t, bpsi);
-  auv_.initialize(state.auv.position,
-                  state.auv.attitude * Vector3<double>(state.auv.nu.head<3>()), rpsi, ri);
-  asv_.initialize(state.asv.position,
-                   state.asv.attitude * Vector3<double>(state.asv.nu.head<3>()), bpsi, bi);
+  auv_.initialize(state.auv.position, state.auv.attitude * Vector3<double>(state.auv.nu.head<3>()),
+                  rpsi, ri);
+  asv_.initialize(state.asv.position, state.asv.attitude * Vector3<double>(state.asv.nu.head<3>()),
+                  bpsi, bi);
   last_ = t;
 }
 
@@ -70,12 +70,12 @@ void PairNavigation::update(const system::SystemModeld& model, const system::Sys
     asv_.update_depth(0.0, p_.asv_heave_sigma);
   }
   // The USBL ping, computed on the boat from its own estimate.
-  const double boat_heading_error = kelp::wrap_angle(
-      kelp::heading_of(asv_.navigation().attitude) - kelp::heading_of(state.asv.attitude));
+  const double boat_heading_error = kelp::wrap_angle(kelp::heading_of(asv_.navigation().attitude) -
+                                                     kelp::heading_of(state.asv.attitude));
   // The transceiver's depth is known (mounted on the hull), its horizontal position is the
   // boat's estimate.
-  const Vector3<double> transceiver(asv_.navigation().position.x(),
-                                    asv_.navigation().position.y(), state.asv.position.z());
+  const Vector3<double> transceiver(asv_.navigation().position.x(), asv_.navigation().position.y(),
+                                    state.asv.position.z());
   usbl_.sample(state.auv.position, state.asv.position, transceiver, boat_heading_error, t);
   // The ROV: IMU, depth, DVL, compass, the USBL fixes delivered by now.
   if (auv_imu_.sample(state.auv, state.auv_nu_dot, g, t, imu)) auv_.predict(imu);
@@ -98,7 +98,7 @@ void PairNavigation::update(const system::SystemModeld& model, const system::Sys
   accumulate(asv_.navigation(), state.asv, asv_errors_);
 }
 void PairNavigation::accumulate(const nav::Navigation& est, const vehicle::VehicleStated& x,
-                       EstimateErrors& e) {
+                                EstimateErrors& e) {
   const double dp = (est.position - x.position).norm();
   const double dpsi =
       kelp::wrap_angle(kelp::heading_of(est.attitude) - kelp::heading_of(x.attitude));

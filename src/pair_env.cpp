@@ -113,8 +113,7 @@ void TetheredPairEnv::observe(double* out) const {
 }
 
 double TetheredPairEnv::energy_drawn() const {
-  return loop_->model().auv_propulsion() ? loop_->state().auv_propulsion.battery.energy_drawn
-                                         : 0.0;
+  return loop_->model().auv_propulsion() ? loop_->state().auv_propulsion.battery.energy_drawn : 0.0;
 }
 
 }  // namespace sim

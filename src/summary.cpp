@@ -54,9 +54,8 @@ nlohmann::json navigation_json(const NavigationSummary& n) {
   j["asv_max_position_error_m"] = e.asv_max_position_error_m;
   j["asv_rms_heading_error_deg"] = e.asv_rms_heading_error_deg;
   j["asv_rms_velocity_error_m_s"] = e.asv_rms_velocity_error_m_s;
-  j["usbl"] = {{"pings", e.usbl_pings},
-               {"dropouts", e.usbl_dropouts},
-               {"fixes_used", e.usbl_fixes_used}};
+  j["usbl"] = {
+      {"pings", e.usbl_pings}, {"dropouts", e.usbl_dropouts}, {"fixes_used", e.usbl_fixes_used}};
   j["dvl_pings"] = {
       {"bottom", e.dvl_pings_bottom}, {"water", e.dvl_pings_water}, {"none", e.dvl_pings_none}};
   return j;

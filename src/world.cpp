@@ -122,8 +122,8 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
 }
 
 kelp::system::SystemStated start_state(const kelp::system::SystemModeld& model,
-                                              kelp::system::SystemWorkspaced& ws,
-                                              const WorldSetup& world, const Scenario& sc) {
+                                       kelp::system::SystemWorkspaced& ws, const WorldSetup& world,
+                                       const Scenario& sc) {
   kelp::system::SystemStated s =
       kelp::system::initial_state(model, ws, world.start.asv, world.start.auv);
   if (sc.start_with_water) {

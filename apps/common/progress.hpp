@@ -14,8 +14,7 @@ inline std::function<void(long, long, double)> progress_bar(double duration) {
   return [duration](long k, long steps, double t) {
     if (k % 500 != 0) return;
     std::fprintf(stderr, "\r[%-40s] %5.1f / %.0f s",
-                 std::string(static_cast<std::size_t>(40.0 * k / steps), '#').c_str(), t,
-                 duration);
+                 std::string(static_cast<std::size_t>(40.0 * k / steps), '#').c_str(), t, duration);
   };
 }
 

@@ -9,8 +9,8 @@
 #include <iterator>
 #include <string>
 
-#include "kelp/sim/replay.hpp"
 #include "common/replay_template.hpp"
+#include "kelp/sim/replay.hpp"
 
 namespace fs = std::filesystem;
 

@@ -220,7 +220,7 @@ class Subscriptions {
 }  // namespace
 
 kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& sc, const kelp::sim::RunOptions& run,
-                             const Ros2Options& o) {
+                                    const Ros2Options& o) {
   KELP_CHECK(std::isfinite(o.speed) && o.speed > 0, "--ros2 speed must be positive");
   KELP_CHECK(std::isfinite(o.clock_timeout) && o.clock_timeout > 0,
              "--ros2 clock timeout must be positive");

@@ -33,7 +33,7 @@ struct Ros2Options {
 /// topics live; the summary has a `ros2` object (mode, domain, messages published per topic,
 /// subscriptions' counters, publish cost) in summary.json. \returns the run's summary (as
 /// run_scenario()'s). \throws as run_scenario(), and kelp::error when DDS cannot be set up.
-kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& scenario, const kelp::sim::RunOptions& run,
-                             const Ros2Options& options);
+kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& scenario,
+                                    const kelp::sim::RunOptions& run, const Ros2Options& options);
 
 }  // namespace kelp_ros2

@@ -24,13 +24,13 @@
 #include <vector>
 
 #include "bridge.hpp"
-#include "default_world.hpp"
-#include "kelp/sim/replay.hpp"
 #include "common/replay_template.hpp"
+#include "default_world.hpp"
+#include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/replay.hpp"
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
-#include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"
@@ -288,9 +288,8 @@ int run(const Options& o) {
   // The wave kernel's instruction path and the C library's math (kelp/core/kernel_path.hpp).
   summary["kernel"] = kelp::simd::kernel_name(model.environment().waves().active_kernel());
   summary["math_library"] = kelp::simd::math_library_fingerprint();
-  summary["tether_solver"] =
-      nlohmann::json::parse(kelp::sim::solver_summary_json(
-          kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters())));
+  summary["tether_solver"] = nlohmann::json::parse(kelp::sim::solver_summary_json(
+      kelp::sim::solver_summary(bridge.solver_stats(), bridge.model().parameters())));
   // Propulsion: the energy each battery delivered [Wh] and its final state of charge.
   const auto battery = [&](const kelp::vehicle::PropulsionModeld* pm,
                            const kelp::vehicle::PropulsionStated& x) {

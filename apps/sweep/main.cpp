@@ -179,7 +179,8 @@ int run(const RunOptions& o) {
                                                          r.scenario.node_rate);
           so.on_sample = [&bag](const kelp::sim::LogRow& row) { bag->record(row); };
         }
-        result["summary"] = nlohmann::json::parse(kelp::sim::summary_json(kelp::sim::simulate(r.scenario, so)));
+        result["summary"] =
+            nlohmann::json::parse(kelp::sim::summary_json(kelp::sim::simulate(r.scenario, so)));
         if (bag) bag->close();
         if (o.keep_series)
           write_atomically(series / "summary.json", result["summary"].dump(2) + "\n");

@@ -62,16 +62,15 @@ int run(const Options& o) {
     std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
                  kelp_apps::replay_template_missing_note().c_str());
 #ifdef KELP_WITH_ROS2
-  const kelp::sim::RunSummary summary = o.ros2
-                                            ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)
-                                            : kelp::sim::run_scenario(o.scenario, ro);
+  const kelp::sim::RunSummary summary =
+      o.ros2 ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)
+             : kelp::sim::run_scenario(o.scenario, ro);
 #else
   const kelp::sim::RunSummary summary = kelp::sim::run_scenario(o.scenario, ro);
 #endif
   if (progress) kelp_apps::progress_done();
   const double duration = summary.simulated_s, wall = summary.wall_s.value_or(0.0);
-  const double auv_rms = summary.auv.rms_path_error_m,
-               asv_rms = summary.asv.rms_distance_to_auv_m,
+  const double auv_rms = summary.auv.rms_path_error_m, asv_rms = summary.asv.rms_distance_to_auv_m,
                t_max = summary.tether.max_tension_n;
 
   std::string plots;

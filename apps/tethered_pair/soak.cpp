@@ -13,8 +13,9 @@
 //    hydrostatic, tether's kinetic, elastic, weight and buoyancy) is finite, and its peak in every
 //    later window of 10 minutes is within the first windows' envelope (no secular growth);
 //  - flat memory: no heap allocation after the first simulated minute (the program's malloc
-//    counted, tests/support/heap_counter.hpp: the library's allocations and Eigen's included), and resident memory growing
-//    by less than 1 MiB (not checked under AddressSanitizer, whose shadow memory grows it);
+//    counted, tests/support/heap_counter.hpp: the library's allocations and Eigen's included), and
+//    resident memory growing by less than 1 MiB (not checked under AddressSanitizer, whose shadow
+//    memory grows it);
 //  - that the vehicles stay under control: over the second half of the run the ROV within 20 m of
 //    its survey path and the boat within 25 m of the ROV horizontally (the waves move both by a
 //    few metres; a vehicle losing control to the current drifts off by a hundred).
@@ -50,7 +51,6 @@ constexpr bool kResidentMemoryChecked = true;
 constexpr bool kResidentMemoryChecked = true;
 #endif
 }  // namespace
-
 
 namespace {
 

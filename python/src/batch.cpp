@@ -189,7 +189,8 @@ Build it through ``kelp.Batch(scenario, n, seed, ...)``.)")
       .def(
           "summary",
           [](const ks::Batch& b, std::size_t i) {
-            return json_to_python(nlohmann::json::parse(kelp::sim::summary_json(b.world(i).loop().summary())));
+            return json_to_python(
+                nlohmann::json::parse(kelp::sim::summary_json(b.world(i).loop().summary())));
           },
           py::arg("i"),
           "World i's summary so far, as kelp-tethered-pair's summary.json (without the wall "

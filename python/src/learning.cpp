@@ -94,7 +94,8 @@ controller's thrust allocation, with a 20-entry observation and the reward
       .def(
           "summary",
           [](const Env& e) {
-            return py::module_::import("json").attr("loads")(kelp::sim::summary_json(e.loop().summary()));
+            return py::module_::import("json").attr("loads")(
+                kelp::sim::summary_json(e.loop().summary()));
           },
           "The episode's summary so far, as kelp-tethered-pair's summary.json (no wall time).");
 }

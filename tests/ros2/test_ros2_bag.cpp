@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../sim/sim_test_support.hpp"
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run.hpp"
-#include "../sim/sim_test_support.hpp"
 
 namespace {
 void put(std::FILE* f, double v) { std::fprintf(f, ",%.17g", v); }

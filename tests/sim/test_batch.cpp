@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "kelp/sim/batch.hpp"
 #include "../support/heap_counter.hpp"
+#include "kelp/sim/batch.hpp"
 
 namespace ks = kelp::sim;
 

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <string>
 
+#include "../support/heap_counter.hpp"
 #include "kelp/sim.hpp"
 #include "sim_test_support.hpp"
-#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 
@@ -24,7 +24,8 @@ std::string sensors_run(double duration, int seed, const std::string& extra = ""
 TEST_CASE("scenario navigation: perfect by default, every sensor's key read", "[nav][scenario]") {
   const ks::Scenario d = ks::parse_scenario("{}", "t.json");
   CHECK(d.navigation.mode == "perfect");
-  CHECK_FALSE(kelp_test::json_of(d).contains("navigation"));  // the default leaves the echo as it was
+  CHECK_FALSE(
+      kelp_test::json_of(d).contains("navigation"));  // the default leaves the echo as it was
   const ks::Scenario s = ks::parse_scenario(R"({"navigation": {"mode": "sensors", "seed": 9,
       "imu": {"rate": 50, "gyro_noise_density": 1e-4, "gyro_bias_walk": 2e-5,
               "gyro_bias_initial": 0.01, "accel_noise_density": 2e-3, "accel_bias_walk": 1e-3,
@@ -113,7 +114,8 @@ TEST_CASE("closed loop on sensors: the same seed gives the same run, another see
   const auto run = [](int seed) {
     ks::ClosedLoop loop(ks::parse_scenario(sensors_run(5, seed), "t"));
     loop.run();
-    return std::make_pair(kelp_test::json_of(loop.summary())["navigation"], loop.state().auv.position);
+    return std::make_pair(kelp_test::json_of(loop.summary())["navigation"],
+                          loop.state().auv.position);
   };
   const auto a = run(3), b = run(3), c = run(4);
   CHECK(a.first == b.first);

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <vector>
 
+#include "../support/heap_counter.hpp"
 #include "kelp/sim/pair_env.hpp"
 #include "kelp/vehicle/presets.hpp"
-#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 

@@ -9,9 +9,9 @@
 #include <fstream>
 #include <string>
 
+#include "../support/heap_counter.hpp"
 #include "kelp/sim.hpp"
 #include "sim_test_support.hpp"
-#include "../support/heap_counter.hpp"
 
 namespace ks = kelp::sim;
 
@@ -150,7 +150,8 @@ TEST_CASE("a scenario's tether.explicit_fallback is off unless set, and reaches 
   CHECK(ks::world_setup(on, "on.json").parameters.explicit_fallback);
   // The summary's echo reads back to the same setting.
   CHECK(ks::parse_scenario(kelp_test::json_of(on).dump(), "echo").explicit_fallback);
-  CHECK_FALSE(ks::parse_scenario(kelp_test::json_of(ks::Scenario{}).dump(), "echo").explicit_fallback);
+  CHECK_FALSE(
+      ks::parse_scenario(kelp_test::json_of(ks::Scenario{}).dump(), "echo").explicit_fallback);
   CHECK_THROWS_WITH(ks::parse_scenario(R"({"tether": {"explicit_fallback": 1}})", "bad.json"),
                     Catch::Contains("/tether/explicit_fallback"));
 }

@@ -3,8 +3,8 @@
 /// compiled library (src/instantiation.cpp): a program on kelp::sim that calls
 /// `kelp::system::step`, `initial_state` or `energy` on doubles links the library's code instead
 /// of compiling the system's templates again (Pinocchio's explicit-instantiation pattern; the
-/// classes' inline members are left to the compiler). kelp::kelp stays header-only for every scalar:
-/// these declarations are kelp::sim's, seen only by its consumers, who link it.
+/// classes' inline members are left to the compiler). kelp::kelp stays header-only for every
+/// scalar: these declarations are kelp::sim's, seen only by its consumers, who link it.
 #pragma once
 
 #include "kelp/environment/wave_kernels.hpp"
@@ -24,8 +24,7 @@ extern template KELP_SIM_API void wave_accumulate_avx2<double>(const WaveCompone
 extern template KELP_SIM_API void wave_accumulate_avx512<double>(const WaveComponentsView&,
                                                                  WaveBlock&, int, double, bool);
 extern template KELP_SIM_API void wave_accumulate_avx2_exact<double>(const WaveComponentsView&,
-                                                                     WaveBlock&, int, double,
-                                                                     bool);
+                                                                     WaveBlock&, int, double, bool);
 #if KELP_PORTABLE_AVX512
 extern template KELP_SIM_API void wave_accumulate_avx512_exact<double>(const WaveComponentsView&,
                                                                        WaveBlock&, int, double,
@@ -41,8 +40,8 @@ namespace system {
 extern template KELP_SIM_API SystemReport<double> step<double>(const SystemModel<double>&,
                                                                SystemWorkspace<double>&,
                                                                SystemState<double>&,
-                                                               const SystemInputs<double>&,
-                                                               double, SystemStepOptions);
+                                                               const SystemInputs<double>&, double,
+                                                               SystemStepOptions);
 extern template KELP_SIM_API SystemState<double> initial_state<double>(
     const SystemModel<double>&, SystemWorkspace<double>&, const vehicle::VehicleState<double>&,
     const vehicle::VehicleState<double>&, double, tether::StaticOptions<double>);

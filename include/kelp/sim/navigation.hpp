@@ -24,7 +24,6 @@
 namespace kelp {
 namespace sim {
 
-
 /// \brief The sensors of the pair (one IMU and compass model for both vehicles: each carries a
 /// Navigator) and the filters' settings.
 struct PairSensors {
@@ -83,7 +82,6 @@ class KELP_SIM_API PairNavigation {
   /// per step, after the step). Errors against the truth are accumulated for t > 0.
   void update(const system::SystemModeld& model, const system::SystemStated& state);
 
-
   /// \brief The ROV's estimate.
   const nav::Navigation& auv() const { return auv_.navigation(); }
   /// \brief The boat's estimate.
@@ -108,7 +106,6 @@ class KELP_SIM_API PairNavigation {
  private:
   static void accumulate(const nav::Navigation& est, const vehicle::VehicleStated& x,
                          EstimateErrors& e);
-
 
   PairSensors p_;
   nav::ImuSensor auv_imu_, asv_imu_;

@@ -19,9 +19,9 @@
 
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/error.hpp"
-#include "kelp/sim/export.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/export.hpp"
 #include "kelp/sim/scenario.hpp"
 
 namespace kelp {

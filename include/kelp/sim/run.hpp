@@ -86,7 +86,7 @@ class KELP_SIM_API RunBag {
 /// every sample is recorded before it is passed on. Close the bag after the run.
 /// \returns the bag, or null when none is written.
 KELP_SIM_API std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
-                                                 std::function<void(const LogRow&)>& on_sample);
+                                                  std::function<void(const LogRow&)>& on_sample);
 
 /// \brief What a run leaves after its last step: the summary's `kelp_version`, summary.json
 /// (indented by 2) in `o.out` and, with a `replay_template`, replay.html there (write_replay(),

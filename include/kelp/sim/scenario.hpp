@@ -28,8 +28,8 @@ namespace sim {
 /// \brief What the controllers navigate by (the scenario's `navigation` object): the true state
 /// ("perfect", the default) or the estimates of kelp::nav's sensors and filters ("sensors").
 struct NavigationSettings {
-  std::string mode = "perfect";    ///< "perfect" or "sensors"
-  std::uint64_t seed = 1;          ///< seed of the sensors' noise
+  std::string mode = "perfect";  ///< "perfect" or "sensors"
+  std::uint64_t seed = 1;        ///< seed of the sensors' noise
   PairSensors sensors;           ///< every sensor's parameters (defaults: kelp/nav/sensors.hpp)
 };
 

@@ -45,10 +45,10 @@ struct AsvSummary {
 
 /// \brief One parting of the line (kelp/tether/failure.hpp).
 struct LineFailureSummary {
-  double time_s = 0;                    ///< when [s]
-  int segment = -1;                     ///< which segment
-  std::array<double, 3> position_m{};   ///< where (NED) [m]
-  double tension_n = 0;                 ///< under what force [N]
+  double time_s = 0;                   ///< when [s]
+  int segment = -1;                    ///< which segment
+  std::array<double, 3> position_m{};  ///< where (NED) [m]
+  double tension_n = 0;                ///< under what force [N]
 };
 
 /// \brief The winch's work over the run (`tether.winch`).
@@ -63,17 +63,17 @@ struct WinchSummary {
 
 /// \brief The tether over the run (`tether`).
 struct TetherSummary {
-  double max_tension_n = 0;        ///< largest end force, either end [N]
-  double mean_tension_auv_n = 0;   ///< mean end force at the AUV [N]
-  double slack_fraction = 0;       ///< fraction of samples under 0.1 N at the AUV
-  double net_turns = 0;            ///< the AUV's turns about the tether (TurnCounter)
-  double max_abs_turns = 0;        ///< the largest |turns|
+  double max_tension_n = 0;       ///< largest end force, either end [N]
+  double mean_tension_auv_n = 0;  ///< mean end force at the AUV [N]
+  double slack_fraction = 0;      ///< fraction of samples under 0.1 N at the AUV
+  double net_turns = 0;           ///< the AUV's turns about the tether (TurnCounter)
+  double max_abs_turns = 0;       ///< the largest |turns|
   std::vector<LineFailureSummary> line_failures;  ///< partings, in time order
-  double line_mass_start_kg = 0;   ///< structural mass of the line at the start [kg]
-  double line_mass_end_kg = 0;     ///< and at the end [kg]
-  double length_start_m = 0;       ///< unstretched length at the start [m]
-  double length_end_m = 0;         ///< and at the end [m]
-  std::optional<WinchSummary> winch;  ///< with a winch
+  double line_mass_start_kg = 0;                  ///< structural mass of the line at the start [kg]
+  double line_mass_end_kg = 0;                    ///< and at the end [kg]
+  double length_start_m = 0;                      ///< unstretched length at the start [m]
+  double length_end_m = 0;                        ///< and at the end [m]
+  std::optional<WinchSummary> winch;              ///< with a winch
 };
 
 /// \brief How hard the tether's solver worked (`tether_solver`): the integrator, the Newton
@@ -93,7 +93,7 @@ struct SolverSummary {
   long retried_steps = 0;                             ///< sub-steps retried shorter
   long explicit_fallbacks = 0;                        ///< sub-steps redone with RK4
   long force_evaluations = 0;                         ///< force passes
-  double worst_residual_m_s = 0;           ///< worst accepted residual [m/s]
+  double worst_residual_m_s = 0;                      ///< worst accepted residual [m/s]
   double worst_rejected_residual_m_s = 0;  ///< worst rejected residual [m/s]; NaN: diverged
   double residual_tolerance_m_s = 0;       ///< tolerance of a full tether sub-step [m/s]
 };
@@ -101,23 +101,23 @@ struct SolverSummary {
 /// \brief The estimates' errors of the sensors-and-filters navigation (`navigation` with mode
 /// "sensors"): RMS over every step after t = 0.
 struct NavigationErrorsSummary {
-  std::uint64_t seed = 0;                  ///< the sensors' seed
-  double auv_rms_position_error_m = 0;     ///< 3-D [m]
-  double auv_rms_horizontal_error_m = 0;   ///< north and east [m]
-  double auv_max_position_error_m = 0;     ///< largest 3-D [m]
-  double auv_rms_heading_error_deg = 0;    ///< [deg]
-  double auv_rms_velocity_error_m_s = 0;   ///< body velocity [m/s]
-  double asv_rms_position_error_m = 0;     ///< 3-D [m]
-  double asv_rms_horizontal_error_m = 0;   ///< north and east [m]
-  double asv_max_position_error_m = 0;     ///< largest 3-D [m]
-  double asv_rms_heading_error_deg = 0;    ///< [deg]
-  double asv_rms_velocity_error_m_s = 0;   ///< body velocity [m/s]
-  long usbl_pings = 0;                     ///< USBL pings
-  long usbl_dropouts = 0;                  ///< USBL pings lost
-  long usbl_fixes_used = 0;                ///< USBL fixes fused
-  long dvl_pings_bottom = 0;               ///< DVL pings locked on the bottom
-  long dvl_pings_water = 0;                ///< DVL pings water-tracking
-  long dvl_pings_none = 0;                 ///< DVL pings with no lock
+  std::uint64_t seed = 0;                 ///< the sensors' seed
+  double auv_rms_position_error_m = 0;    ///< 3-D [m]
+  double auv_rms_horizontal_error_m = 0;  ///< north and east [m]
+  double auv_max_position_error_m = 0;    ///< largest 3-D [m]
+  double auv_rms_heading_error_deg = 0;   ///< [deg]
+  double auv_rms_velocity_error_m_s = 0;  ///< body velocity [m/s]
+  double asv_rms_position_error_m = 0;    ///< 3-D [m]
+  double asv_rms_horizontal_error_m = 0;  ///< north and east [m]
+  double asv_max_position_error_m = 0;    ///< largest 3-D [m]
+  double asv_rms_heading_error_deg = 0;   ///< [deg]
+  double asv_rms_velocity_error_m_s = 0;  ///< body velocity [m/s]
+  long usbl_pings = 0;                    ///< USBL pings
+  long usbl_dropouts = 0;                 ///< USBL pings lost
+  long usbl_fixes_used = 0;               ///< USBL fixes fused
+  long dvl_pings_bottom = 0;              ///< DVL pings locked on the bottom
+  long dvl_pings_water = 0;               ///< DVL pings water-tracking
+  long dvl_pings_none = 0;                ///< DVL pings with no lock
 };
 
 /// \brief What the controllers navigated by (`navigation`).
@@ -139,12 +139,12 @@ struct EntanglementEventSummary {
 
 /// \brief The tether's winding about one cylinder (`entanglement.obstacles`).
 struct ObstacleWindingSummary {
-  std::string name;                 ///< the cylinder's name
-  int index = 0;                    ///< its index in the scenario's obstacles
-  double max_abs_winding_rad = 0;   ///< largest |winding| [rad]
-  double final_winding_rad = 0;     ///< winding at the end [rad]
-  double entangled_s = 0;           ///< first `entangled` event [s]; NaN (`null`): none
-  double pinned_s = 0;              ///< first `pinned` event [s]; NaN (`null`): none
+  std::string name;                ///< the cylinder's name
+  int index = 0;                   ///< its index in the scenario's obstacles
+  double max_abs_winding_rad = 0;  ///< largest |winding| [rad]
+  double final_winding_rad = 0;    ///< winding at the end [rad]
+  double entangled_s = 0;          ///< first `entangled` event [s]; NaN (`null`): none
+  double pinned_s = 0;             ///< first `pinned` event [s]; NaN (`null`): none
   std::vector<EntanglementEventSummary> events;  ///< its events
 };
 
@@ -159,20 +159,20 @@ struct EntanglementSummary {
 
 /// \brief A run's summary (summary.json).
 struct RunSummary {
-  double simulated_s = 0;        ///< simulated time [s]
-  AuvSummary auv;                ///< the AUV
-  AsvSummary asv;                ///< the ASV
-  TetherSummary tether;          ///< the tether
-  SolverSummary tether_solver;   ///< the tether's solver
-  double energy_j = 0;           ///< the system's total energy at the end [J]
-  std::string kernel;            ///< the wave kernel's instruction path
-  std::string math_library;      ///< fingerprint of the C library's math
-  NavigationSummary navigation;  ///< the navigation
-  EntanglementSummary entanglement;  ///< the entanglement
-  std::string scenario_file;     ///< the scenario's file, or "(embedded default)"
-  Scenario scenario;             ///< the scenario, every field as used
-  std::optional<double> wall_s;  ///< wall-clock time of the run [s] (simulate())
-  std::optional<double> realtime_factor;  ///< simulated / wall-clock time (simulate())
+  double simulated_s = 0;                   ///< simulated time [s]
+  AuvSummary auv;                           ///< the AUV
+  AsvSummary asv;                           ///< the ASV
+  TetherSummary tether;                     ///< the tether
+  SolverSummary tether_solver;              ///< the tether's solver
+  double energy_j = 0;                      ///< the system's total energy at the end [J]
+  std::string kernel;                       ///< the wave kernel's instruction path
+  std::string math_library;                 ///< fingerprint of the C library's math
+  NavigationSummary navigation;             ///< the navigation
+  EntanglementSummary entanglement;         ///< the entanglement
+  std::string scenario_file;                ///< the scenario's file, or "(embedded default)"
+  Scenario scenario;                        ///< the scenario, every field as used
+  std::optional<double> wall_s;             ///< wall-clock time of the run [s] (simulate())
+  std::optional<double> realtime_factor;    ///< simulated / wall-clock time (simulate())
   std::optional<std::string> kelp_version;  ///< the program's version (finish_run())
 };
 

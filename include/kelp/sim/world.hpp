@@ -43,8 +43,8 @@ KELP_SIM_API WorldSetup world_setup(const Scenario& sc, const std::string& file)
 /// kelp-sweep, kelp-sitl), so a run flown by kelp's controllers and one flown by SITL start alike.
 /// \throws kelp::numerical_error when the tether's static shape does not converge.
 KELP_SIM_API kelp::system::SystemStated start_state(const kelp::system::SystemModeld& model,
-                                                   kelp::system::SystemWorkspaced& ws,
-                                                   const WorldSetup& world, const Scenario& sc);
+                                                    kelp::system::SystemWorkspaced& ws,
+                                                    const WorldSetup& world, const Scenario& sc);
 
 }  // namespace sim
 }  // namespace kelp
