@@ -70,13 +70,13 @@ void PairNavigation::update(const system::SystemModeld& model, const system::Sys
     asv_.update_depth(0.0, p_.asv_heave_sigma);
   }
   // The USBL ping, computed on the boat from its own estimate.
-  const double boat_heading_error = kelp::wrap_angle(kelp::heading_of(asv_.navigation().attitude) -
-                                                     kelp::heading_of(state.asv.attitude));
+  const double asv_heading_error = kelp::wrap_angle(kelp::heading_of(asv_.navigation().attitude) -
+                                                    kelp::heading_of(state.asv.attitude));
   // The transceiver's depth is known (mounted on the hull), its horizontal position is the
   // boat's estimate.
   const Vector3<double> transceiver(asv_.navigation().position.x(), asv_.navigation().position.y(),
                                     state.asv.position.z());
-  usbl_.sample(state.auv.position, state.asv.position, transceiver, boat_heading_error, t);
+  usbl_.sample(state.auv.position, state.asv.position, transceiver, asv_heading_error, t);
   // The ROV: IMU, depth, DVL, compass, the USBL fixes delivered by now.
   if (auv_imu_.sample(state.auv, state.auv_nu_dot, g, t, imu)) auv_.predict(imu);
   if (depth_.sample(state.auv.position.z(), t, z)) auv_.update_depth(z, p_.depth.noise);

@@ -23,8 +23,8 @@ TetheredPairEnv::TetheredPairEnv(const Scenario& scenario, const PairEnvOptions&
   const Eigen::Index n = 8;  // the BlueROV2 Heavy's thrusters
   force_ = Eigen::VectorXd::Zero(n);
   scratch_ = Eigen::VectorXd::Zero(n);
-  rov_.thrust = Eigen::VectorXd::Zero(n);
-  rov_.command = Eigen::VectorXd::Zero(n);
+  auv_.thrust = Eigen::VectorXd::Zero(n);
+  auv_.command = Eigen::VectorXd::Zero(n);
   reset(scenario.seed);
 }
 
@@ -53,24 +53,24 @@ void TetheredPairEnv::apply(const double* action) {
   const auto& chain = loop_->auv_controller().thruster_chain();
   const control::AllocationScales s =
       control::allocate_wrench(chain, tau, max_thrust_, true, force_, scratch_);
-  chain.commands_for(force_, rov_.command, rov_.thrust);
-  rov_.wrench = chain.wrench(rov_.thrust);
-  rov_.saturated = s.saturated();
-  if (options_.boat_action) {
+  chain.commands_for(force_, auv_.command, auv_.thrust);
+  auv_.wrench = chain.wrench(auv_.thrust);
+  auv_.saturated = s.saturated();
+  if (options_.asv_action) {
     const auto& boat = loop_->asv_controller().thruster_chain();
     const double c = scenario_.asv_thrust_clip;
     const Eigen::Vector2d wanted(clip(action[6]) * c, clip(action[7]) * c);
-    boat_.left = wanted(0);
-    boat_.right = wanted(1);
-    boat.commands_for(wanted, boat_.command, boat_thrust_);
-    boat_.wrench = boat.wrench(boat_thrust_);
+    asv_.left = wanted(0);
+    asv_.right = wanted(1);
+    boat.commands_for(wanted, asv_.command, asv_thrust_);
+    asv_.wrench = boat.wrench(asv_thrust_);
   }
 }
 
 void TetheredPairEnv::fly_by_controllers(bool yes) {
   controllers_ = yes;
-  loop_->set_auv_override(yes ? nullptr : &rov_);
-  loop_->set_asv_override(yes || !options_.boat_action ? nullptr : &boat_);
+  loop_->set_auv_override(yes ? nullptr : &auv_);
+  loop_->set_asv_override(yes || !options_.asv_action ? nullptr : &asv_);
 }
 
 double TetheredPairEnv::step(const double* action) {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "json_reader.hpp"
+#include "kelp/sim/heightfield_file.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "scenario_schema.hpp"
 
@@ -108,7 +109,7 @@ void parse_seabed_heightfield(const nlohmann::json& h, const Reader& r, const st
         const std::string beside = file.substr(0, slash + 1) + name;
         if (std::ifstream(beside).good()) path = beside;
       }
-      s.heightfield = kelp::environment::load_heightfield(path);
+      s.heightfield = load_heightfield(path);
       s.heightfield_file = name;
     } else {
       s.heightfield = parse_heightfield_object(h, r, p, false);

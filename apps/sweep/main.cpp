@@ -264,7 +264,7 @@ int main(int argc, char** argv) {
       "length x sea state x compensation x 5 seeds, 300 s each), in parallel, shardable, "
       "resumable"};
   RunOptions o;
-  app.add_option("--sweep", o.sweep_file, "sweep file (JSON; see examples/paper_sweep/README.md)");
+  app.add_option("--sweep", o.sweep_file, "sweep file (JSON; see apps/sweep/README.md)");
   app.add_option("--out", o.out, "output directory (runs/, table.csv, table.md, errors.png)")
       ->capture_default_str();
   app.add_option("--jobs", o.jobs, "parallel runs (default: the number of cores)");

@@ -29,7 +29,7 @@ struct Options {
   std::string out = "kelp-run";
   bool quiet = false;
   bool no_plots = false;
-  bool ros2 = false;  // --ros2: live ROS 2 topics over DDS (examples/ros2/)
+  bool ros2 = false;  // --ros2: live ROS 2 topics over DDS (apps/ros2_bridge/)
 #ifdef KELP_WITH_ROS2
   kelp_ros2::Ros2Options ros2_options;
 #endif
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
   std::string file;
   double duration = -1;
   std::int64_t seed = -1;
-  app.add_option("--scenario", file, "scenario file (JSON; see examples/tethered_pair/README.md)");
+  app.add_option("--scenario", file, "scenario file (JSON; see apps/tethered_pair/README.md)");
   app.add_option("--duration", duration, "simulated time [s] (overrides the scenario)")
       ->check(CLI::Range(1e-3, 1e7));
   app.add_option("--seed", seed, "seed of the waves and gusts (overrides the scenario)")

@@ -12,6 +12,7 @@
 #include "kelp/sim/batch.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/entanglement.hpp"
+#include "kelp/sim/heightfield_file.hpp"
 #include "kelp/sim/instantiation.hpp"
 #include "kelp/sim/navigation.hpp"
 #include "kelp/sim/pair_env.hpp"

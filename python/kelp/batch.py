@@ -11,6 +11,7 @@ See ``help(kelp.Batch)`` for the arrays it exposes (numpy views, no copy).
 
 import json as _json
 import os as _os
+import warnings as _warnings
 
 from . import _kelp
 
@@ -40,19 +41,25 @@ class Batch(_kelp.Batch):
     __doc__ = _kelp.Batch.__doc__
 
     def __init__(self, scenario=None, n=64, seed=1, threads=None, control_period=0.1,
-                 boat_action=False, max_path_error=20.0, path_weight=1.0, energy_weight=0.01):
+                 asv_action=False, max_path_error=20.0, path_weight=1.0, energy_weight=0.01,
+                 boat_action=None):
         """n worlds of `scenario` (None: the embedded default run; a dict; a path) with sea
         seeds seed, seed + 1, ..., seed + n - 1, stepped on `threads` threads (None: one per
         CPU, at most n). One step() is `control_period` seconds (a multiple of 0.01 s); the
-        environment options (boat_action, max_path_error, path_weight, energy_weight) are
-        TetheredPairEnv's. Raises kelp.ScenarioError naming a bad key, kelp.InvalidArgument."""
+        environment options (asv_action, max_path_error, path_weight, energy_weight) are
+        TetheredPairEnv's (`boat_action`: asv_action's former name, deprecated). Raises
+        kelp.ScenarioError naming a bad key, kelp.InvalidArgument."""
+        if boat_action is not None:
+            _warnings.warn("kelp.Batch: boat_action is now asv_action", DeprecationWarning,
+                           stacklevel=2)
+            asv_action = boat_action
         text, name = _scenario_source(scenario)
         if int(n) < 1:
             raise _kelp.InvalidArgument(f"Batch: n must be at least 1, got {n}")
         if threads is not None and int(threads) < 1:
             raise _kelp.InvalidArgument(f"Batch: threads must be at least 1, got {threads}")
         super().__init__(text, name, int(n), int(seed), 0 if threads is None else int(threads),
-                         float(control_period), bool(boat_action), float(max_path_error),
+                         float(control_period), bool(asv_action), float(max_path_error),
                          float(path_weight), float(energy_weight))
 
     def __repr__(self):

@@ -15,6 +15,8 @@ With gymnasium installed, one line makes it a ``gymnasium.Env`` (its spaces are 
     class Env(kelp.TetheredPairEnv, gymnasium.Env): pass
 """
 
+import warnings as _warnings
+
 import numpy as _np
 
 from . import _kelp
@@ -71,12 +73,12 @@ class TetheredPairEnv:
     as an environment with gymnasium's API: ``reset(seed=None, options=None) -> (obs, info)``,
     ``step(action) -> (obs, reward, terminated, truncated, info)``.
 
-    **Action** (``action_shape`` (6,), or (8,) with ``boat_action``; ``action_space`` is the box
+    **Action** (``action_shape`` (6,), or (8,) with ``asv_action``; ``action_space`` is the box
     [-1, 1]^n, values outside are clipped): the ROV's body wrench [X, Y, Z, K, M, N] as fractions
     of ``action_scale`` = (80 N, 80 N, 100 N, 10 N m, 10 N m, 15 N m) (the ROV controller's PID
     output limits), allocated to its eight T200 thrusters through the same allocation and
     saturation as the ROV's controller (``control::allocate_wrench``, split saturation), at its
-    battery's voltage; with ``boat_action`` two more entries, the boat's port and starboard thrust
+    battery's voltage; with ``asv_action`` two more entries, the boat's port and starboard thrust
     as fractions of the scenario's ``asv_thrust_clip`` (25 N); otherwise the boat's controller
     follows the ROV. The action is held for ``control_period`` seconds (0.1 s by default; a
     multiple of the system's 10 ms step).
@@ -111,13 +113,18 @@ class TetheredPairEnv:
     render_mode = None
     reward_range = (-float("inf"), 0.0)
 
-    def __init__(self, scenario=None, control_period=0.1, boat_action=False,
-                 max_path_error=20.0, path_weight=1.0, energy_weight=0.01):
+    def __init__(self, scenario=None, control_period=0.1, asv_action=False,
+                 max_path_error=20.0, path_weight=1.0, energy_weight=0.01, boat_action=None):
         """An environment over `scenario` (None: the embedded default run; a dict; a path to a
         scenario file). Raises kelp.ScenarioError naming a bad key, kelp.InvalidArgument for bad
-        options (a control period that is not a positive multiple of 0.01 s, ...)."""
+        options (a control period that is not a positive multiple of 0.01 s, ...). `boat_action` is
+        asv_action's former name (deprecated)."""
+        if boat_action is not None:
+            _warnings.warn("kelp.TetheredPairEnv: boat_action is now asv_action",
+                           DeprecationWarning, stacklevel=2)
+            asv_action = boat_action
         text, name = _scenario_source(scenario)
-        self._core = _kelp.PairEnvCore(text, name, float(control_period), bool(boat_action),
+        self._core = _kelp.PairEnvCore(text, name, float(control_period), bool(asv_action),
                                        float(max_path_error), float(path_weight),
                                        float(energy_weight))
         self.control_period = float(control_period)

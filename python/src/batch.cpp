@@ -65,27 +65,26 @@ The per-world properties (``auv_position`` (n, 3), ``auv_attitude`` (n, 4), ``au
 keep the batch alive. Copy them (``np.array(b.auv_position)``) to keep a value.
 
 Build it through ``kelp.Batch(scenario, n, seed, ...)``.)")
-      .def(
-          py::init([](const std::string& text, const std::string& name, std::size_t n,
-                      std::uint64_t seed, unsigned threads, double control_period, bool boat_action,
-                      double max_path_error, double path_weight, double energy_weight) {
-            const ks::Scenario sc = ks::parse_scenario(text, name);
-            ks::BatchOptions o;
-            o.threads = threads;
-            o.env.control_period = control_period;
-            o.env.boat_action = boat_action;
-            o.env.max_path_error = max_path_error;
-            o.env.path_weight = path_weight;
-            o.env.energy_weight = energy_weight;
-            py::gil_scoped_release release;
-            return std::make_unique<ks::Batch>(sc, n, seed, o);
-          }),
-          py::arg("scenario_json"), py::arg("scenario_name"), py::arg("n"), py::arg("seed"),
-          py::arg("threads") = 0, py::arg("control_period") = 0.1, py::arg("boat_action") = false,
-          py::arg("max_path_error") = 20.0, py::arg("path_weight") = 1.0,
-          py::arg("energy_weight") = 0.01,
-          "Builds n worlds from scenario JSON text (its name is used in errors), seeds seed … "
-          "seed + n − 1, on `threads` threads (0: one per CPU, at most n).")
+      .def(py::init([](const std::string& text, const std::string& name, std::size_t n,
+                       std::uint64_t seed, unsigned threads, double control_period, bool asv_action,
+                       double max_path_error, double path_weight, double energy_weight) {
+             const ks::Scenario sc = ks::parse_scenario(text, name);
+             ks::BatchOptions o;
+             o.threads = threads;
+             o.env.control_period = control_period;
+             o.env.asv_action = asv_action;
+             o.env.max_path_error = max_path_error;
+             o.env.path_weight = path_weight;
+             o.env.energy_weight = energy_weight;
+             py::gil_scoped_release release;
+             return std::make_unique<ks::Batch>(sc, n, seed, o);
+           }),
+           py::arg("scenario_json"), py::arg("scenario_name"), py::arg("n"), py::arg("seed"),
+           py::arg("threads") = 0, py::arg("control_period") = 0.1, py::arg("asv_action") = false,
+           py::arg("max_path_error") = 20.0, py::arg("path_weight") = 1.0,
+           py::arg("energy_weight") = 0.01,
+           "Builds n worlds from scenario JSON text (its name is used in errors), seeds seed … "
+           "seed + n − 1, on `threads` threads (0: one per CPU, at most n).")
       .def(
           "step",
           [](ks::Batch& b, long n_steps, py::object actions) {

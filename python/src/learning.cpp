@@ -21,18 +21,18 @@ A scenario's world whose ROV (and optionally boat) is flown by an action through
 controller's thrust allocation, with a 20-entry observation and the reward
 -path_weight * path error - energy_weight * battery energy (see kelp.TetheredPairEnv).)")
       .def(py::init([](const std::string& text, const std::string& name, double control_period,
-                       bool boat_action, double max_path_error, double path_weight,
+                       bool asv_action, double max_path_error, double path_weight,
                        double energy_weight) {
              ks::PairEnvOptions o;
              o.control_period = control_period;
-             o.boat_action = boat_action;
+             o.asv_action = asv_action;
              o.max_path_error = max_path_error;
              o.path_weight = path_weight;
              o.energy_weight = energy_weight;
              return std::make_unique<Env>(ks::parse_scenario(text, name), o);
            }),
            py::arg("scenario_json"), py::arg("scenario_name"), py::arg("control_period") = 0.1,
-           py::arg("boat_action") = false, py::arg("max_path_error") = 20.0,
+           py::arg("asv_action") = false, py::arg("max_path_error") = 20.0,
            py::arg("path_weight") = 1.0, py::arg("energy_weight") = 0.01,
            "An environment over the scenario in JSON text (its name is used in errors).")
       .def("reset", &Env::reset, py::arg("seed"),
@@ -79,7 +79,7 @@ controller's thrust allocation, with a 20-entry observation and the reward
       .def_property_readonly("energy_drawn", &Env::energy_drawn,
                              "Energy the ROV's battery delivered since reset [J].")
       .def_property_readonly(
-          "saturated", [](const Env& e) { return e.rov_command().saturated; },
+          "saturated", [](const Env& e) { return e.auv_command().saturated; },
           "The ROV's action asked for more than its thrusters give.")
       .def_property_readonly("terminated", &Env::terminated, "The episode terminated.")
       .def_property_readonly("truncated", &Env::truncated, "The episode was truncated.")

@@ -87,8 +87,10 @@ def test_the_action_flies_the_rov():
     e2.reset(seed=1)
     assert np.array_equal(e1.step(np.array([5.0, 0, 0, 0, 0, 0]))[0],
                           e2.step(np.array([1.0, 0, 0, 0, 0, 0]))[0])
-    boat = kelp.TetheredPairEnv({"sea": "calm"}, boat_action=True)
+    boat = kelp.TetheredPairEnv({"sea": "calm"}, asv_action=True)
     assert boat.action_shape == (8,)
+    with pytest.warns(DeprecationWarning, match="asv_action"):
+        assert kelp.TetheredPairEnv({"sea": "calm"}, boat_action=True).action_shape == (8,)
     boat.reset(seed=1)
     for _ in range(10):
         obs, *_ = boat.step(np.array([0, 0, 0, 0, 0, 0, 1.0, -1.0]))

@@ -100,7 +100,7 @@ TEST_CASE("the action flies the ROV through the controller's allocation", "[sim]
   // 2 s of full surge either way: body-x speeds of opposite signs, positions apart.
   CHECK(ahead.loop().state().auv.nu(0) > 0.2);
   CHECK(astern.loop().state().auv.nu(0) < -0.2);
-  const auto& cmd = ahead.rov_command();
+  const auto& cmd = ahead.auv_command();
   CHECK(cmd.wrench(0) > 70.0);  // 80 N asked; the allocation delivers it (within the T200s)
   CHECK(std::abs(cmd.wrench(1)) < 1e-6);
   // The ROV's thrusters follow the commands (the propulsion's lagged thrust).
@@ -189,7 +189,7 @@ TEST_CASE("the boat action drives the boat's thrusters", "[sim][env]") {
   ks::Scenario sc = short_run();
   sc.sea = "calm";
   ks::PairEnvOptions o;
-  o.boat_action = true;
+  o.asv_action = true;
   ks::TetheredPairEnv env(sc, o);
   CHECK(env.action_size() == 8);
   const double turn[8] = {0, 0, 0, 0, 0, 0, 1, -1};  // port ahead, starboard astern

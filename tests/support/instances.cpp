@@ -13,8 +13,8 @@ template void wave_accumulate_avx2<double>(const WaveComponentsView&, WaveBlock&
                                            bool);
 template void wave_accumulate_avx512<double>(const WaveComponentsView&, WaveBlock&, int, double,
                                              bool);
-template void wave_accumulate_avx2_exact<double>(const WaveComponentsView&, WaveBlock&, int,
-                                                 double, bool);
+template void wave_accumulate_avx2_exact<double>(const WaveComponentsView&, WaveBlock&, int, double,
+                                                 bool);
 #if KELP_PORTABLE_AVX512
 template void wave_accumulate_avx512_exact<double>(const WaveComponentsView&, WaveBlock&, int,
                                                    double, bool);

@@ -19,8 +19,8 @@ extern template void wave_accumulate_avx2<double>(const WaveComponentsView&, Wav
                                                   double, bool);
 extern template void wave_accumulate_avx512<double>(const WaveComponentsView&, WaveBlock&, int,
                                                     double, bool);
-extern template void wave_accumulate_avx2_exact<double>(const WaveComponentsView&, WaveBlock&,
-                                                        int, double, bool);
+extern template void wave_accumulate_avx2_exact<double>(const WaveComponentsView&, WaveBlock&, int,
+                                                        double, bool);
 #if KELP_PORTABLE_AVX512
 extern template void wave_accumulate_avx512_exact<double>(const WaveComponentsView&, WaveBlock&,
                                                           int, double, bool);

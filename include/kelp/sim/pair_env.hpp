@@ -34,7 +34,7 @@ struct PairEnvOptions {
   double control_period = 0.1;
   /// The action also drives the boat (two more entries: port and starboard thrust); false: the
   /// boat's controller follows the ROV as in the scenario's runs.
-  bool boat_action = false;
+  bool asv_action = false;
   /// The episode terminates when the ROV is farther than this from the survey path [m].
   double max_path_error = 20.0;
   /// Reward per metre of path error, per control period (see TetheredPairEnv).
@@ -53,12 +53,12 @@ struct PairEnvOptions {
 /// than `max_path_error` from the survey path or a step fails (kelp::numerical_error: the world
 /// stays as it was before the failing step; error() says why).
 ///
-/// **Action** (action_size() = 6, or 8 with `boat_action`), each entry in [−1, 1] (clipped):
+/// **Action** (action_size() = 6, or 8 with `asv_action`), each entry in [−1, 1] (clipped):
 /// the ROV's desired body wrench [X, Y, Z, K, M, N] as fractions of (80 N, 80 N, 100 N, 10 N m,
 /// 10 N m, 15 N m) — the output limits of the ROV controller's PIDs
 /// (control::AuvControllerSettings) — allocated to its eight thrusters by
 /// control::allocate_wrench with split saturation, as the controller's "kelp" preset does; with
-/// `boat_action`, then the boat's port and starboard thrust as fractions of the scenario's
+/// `asv_action`, then the boat's port and starboard thrust as fractions of the scenario's
 /// `asv_thrust_clip` (25 N by default), through its controller's thruster chain.
 ///
 /// **Observation** (observation_size() = 20 doubles, unbounded): [0, 3) the ROV's position
@@ -79,8 +79,8 @@ class KELP_SIM_API TetheredPairEnv {
  public:
   /// Observation entries.
   static constexpr int observation_size = 20;
-  /// ROV action entries (the boat's two follow with PairEnvOptions::boat_action).
-  static constexpr int rov_action_size = 6;
+  /// ROV action entries (the boat's two follow with PairEnvOptions::asv_action).
+  static constexpr int auv_action_size = 6;
   /// \brief The wrench an action entry of 1 asks for [N, N m] (see the class).
   static constexpr std::array<double, 6> action_scale{80.0, 80.0, 100.0, 10.0, 10.0, 15.0};
 
@@ -94,8 +94,8 @@ class KELP_SIM_API TetheredPairEnv {
   TetheredPairEnv(const TetheredPairEnv&) = delete;
   TetheredPairEnv& operator=(const TetheredPairEnv&) = delete;
 
-  /// \brief Entries of an action: 6, or 8 with PairEnvOptions::boat_action.
-  int action_size() const { return options_.boat_action ? 8 : 6; }
+  /// \brief Entries of an action: 6, or 8 with PairEnvOptions::asv_action.
+  int action_size() const { return options_.asv_action ? 8 : 6; }
   /// \brief System steps (10 ms) per step().
   long substeps() const { return substeps_; }
   /// \brief The options.
@@ -144,7 +144,7 @@ class KELP_SIM_API TetheredPairEnv {
   /// \brief The world (state, metrics, summary; its ROV is flown by the action).
   const ClosedLoop& loop() const { return *loop_; }
   /// \brief The ROV's command of the current action (thrusts, commands, wrench, saturation).
-  const control::AuvCommand& rov_command() const { return rov_; }
+  const control::AuvCommand& auv_command() const { return auv_; }
   /// \brief The energy the ROV's battery has delivered since reset() [J] (0 without propulsion).
   double energy_drawn() const;
 
@@ -154,9 +154,9 @@ class KELP_SIM_API TetheredPairEnv {
   long substeps_ = 1;
   double max_thrust_ = control::AuvControllerSettings{}.max_thrust;  // the controller's cap [N]
   std::unique_ptr<ClosedLoop> loop_;
-  control::AuvCommand rov_;
-  control::AsvCommand boat_;
-  Eigen::Vector2d boat_thrust_ = Eigen::Vector2d::Zero();
+  control::AuvCommand auv_;
+  control::AsvCommand asv_;
+  Eigen::Vector2d asv_thrust_ = Eigen::Vector2d::Zero();
   Eigen::VectorXd force_, scratch_;
   std::array<double, observation_size> obs_{};
   double reward_ = 0.0;

@@ -13,9 +13,9 @@
 /// values of ζ computed by kelp itself (`elevation_check`) let the page be checked against it.
 ///
 /// kelp-tethered-pair (through run_scenario()) and kelp-sitl write replay.html at the end of a
-/// run, kelp-replay for an existing run directory. Part of the optional `kelp::sim` component,
-/// compiled in it (src/replay.cpp; the JSON is built with nlohmann-json there, and given out as
-/// text). Where a program finds the page's template is the program's concern (apps/common/).
+/// run, kelp-replay for an existing run directory. Part of the compiled `kelp::sim` component
+/// (src/replay.cpp builds the JSON and gives it out as text). Where a program finds the page's
+/// template is the program's concern (apps/common/).
 #pragma once
 
 #include <filesystem>

@@ -5,8 +5,8 @@
 /// parting, the tether's entanglement with obstacles).
 ///
 /// The format is shared by kelp-tethered-pair and kelp-sitl and plotted by
-/// examples/tethered_pair/plot_run.py; its columns are documented in
-/// examples/tethered_pair/README.md. It knows vehicle and tether states only, not the scenario or
+/// apps/tethered_pair/plot_run.py; its columns are documented in
+/// apps/tethered_pair/README.md. It knows vehicle and tether states only, not the scenario or
 /// the controllers: a program fills a LogRow from whatever flies the vehicles. Numbers are written
 /// with printf's `%.6g`. Part of the optional `kelp::sim` component (it needs no JSON itself).
 #pragma once
@@ -88,7 +88,7 @@ struct LogRow {
 };
 
 /// \brief The columns of timeseries.csv, in order (documented in
-/// examples/tethered_pair/README.md); for_each_value gives a row's values in the same order.
+/// apps/tethered_pair/README.md); for_each_value gives a row's values in the same order.
 KELP_SIM_API const std::vector<std::string>& timeseries_columns();
 
 /// \brief Calls `f(value)` for each value of row `r`, in timeseries_columns()' order (what
@@ -145,7 +145,7 @@ void for_each_value(const LogRow& r, F&& f) {
 }
 
 /// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
-/// documented in examples/tethered_pair/README.md). Writes the header lines when constructed.
+/// documented in apps/tethered_pair/README.md). Writes the header lines when constructed.
 class KELP_SIM_API RunLog {
  public:
   /// \brief Creates `dir` (and its parents) and the three files in it, each with its header line.

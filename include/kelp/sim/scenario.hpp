@@ -168,7 +168,7 @@ struct Scenario {
   /// NED z of a flat seabed [m] (`"seabed": {"depth": m}`); +∞: none.
   double seabed_depth = std::numeric_limits<double>::infinity();
   /// A height-field seabed (`"seabed": {"heightfield": "file"}` in MoorDyn's seafloor format,
-  /// kelp::environment::load_heightfield, a path relative to the scenario file; or inline,
+  /// kelp::sim::load_heightfield, a path relative to the scenario file; or inline,
   /// `{"origin": [n, e], "spacing": [dn, de], "size": [rows, cols], "depth": [...]}`).
   bool has_heightfield = false;
   kelp::environment::HeightField heightfield;

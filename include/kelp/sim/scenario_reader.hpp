@@ -31,8 +31,8 @@ struct Gains {
 };
 
 /// \brief The deepest nesting of arrays and objects a scenario (or sweep) file may have; a scenario
-/// needs 4. nlohmann-json parses iteratively but copies, compares and dumps recursively, so a file
-/// nested a hundred thousand levels deep would overflow the stack after parsing.
+/// needs 4. The library's JSON parser is iterative but copies, compares and dumps recursively, so
+/// a file nested a hundred thousand levels deep would overflow the stack after parsing.
 inline constexpr int max_json_depth = 64;
 
 /// \brief Nesting depth of the arrays and objects in JSON text (brackets inside strings do not
