@@ -7,20 +7,4 @@
 #include "kelp/system/system.hpp"
 #include "support/instances.hpp"
 
-namespace kelp {
-namespace system {
-
-extern template SystemReport<double> step<double>(const SystemModel<double>&,
-                                                  SystemWorkspace<double>&, SystemState<double>&,
-                                                  const SystemInputs<double>&, double,
-                                                  SystemStepOptions);
-extern template SystemState<double> initial_state<double>(const SystemModel<double>&,
-                                                          SystemWorkspace<double>&,
-                                                          const vehicle::VehicleState<double>&,
-                                                          const vehicle::VehicleState<double>&,
-                                                          double, tether::StaticOptions<double>);
-extern template SystemEnergy<double> energy<double>(const SystemModel<double>&,
-                                                    const SystemState<double>&);
-
-}  // namespace system
-}  // namespace kelp
+KELP_SYSTEM_INSTANCES(extern template)

@@ -327,3 +327,29 @@ inline void wave_accumulate(const WaveComponentsView& c, WaveBlock& b, int m, do
 
 }  // namespace environment
 }  // namespace kelp
+
+/// \brief The double-precision wave kernels of this build (one per instruction set), for a
+/// compiled layer that instantiates them once: `KELP_WAVE_KERNEL_INSTANCES(template)` in one
+/// unit, `KELP_WAVE_KERNEL_INSTANCES(extern template)` wherever they are used (kelp::sim does:
+/// kelp/sim/instantiation.hpp). `prefix` may carry attributes after `template`.
+#define KELP_WAVE_KERNEL_INSTANCE(prefix, name)                                                    \
+  prefix void kelp::environment::detail::name<double>(                                             \
+      const kelp::environment::detail::WaveComponentsView&, kelp::environment::detail::WaveBlock&, \
+      int, double, bool);
+#ifdef KELP_X86_DISPATCH
+#if KELP_PORTABLE_AVX512
+#define KELP_WAVE_KERNEL_INSTANCES_AVX512_EXACT(prefix) \
+  KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_avx512_exact)
+#else
+#define KELP_WAVE_KERNEL_INSTANCES_AVX512_EXACT(prefix)
+#endif
+#define KELP_WAVE_KERNEL_INSTANCES(prefix)                      \
+  KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_baseline)   \
+  KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_avx2)       \
+  KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_avx512)     \
+  KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_avx2_exact) \
+  KELP_WAVE_KERNEL_INSTANCES_AVX512_EXACT(prefix)
+#else
+#define KELP_WAVE_KERNEL_INSTANCES(prefix) \
+  KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_baseline)
+#endif

@@ -657,3 +657,19 @@ using SystemReportf = SystemReport<float>;           ///< SystemReport<float>
 using SystemEnergyf = SystemEnergy<float>;           ///< SystemEnergy<float>
 
 }  // namespace kelp::system
+
+/// \brief The double-precision system step, initial state and energy, for a compiled layer that
+/// instantiates them once: `KELP_SYSTEM_INSTANCES(template)` in one unit,
+/// `KELP_SYSTEM_INSTANCES(extern template)` wherever they are called (kelp::sim does:
+/// kelp/sim/instantiation.hpp). `prefix` may carry attributes after `template`.
+#define KELP_SYSTEM_INSTANCES(prefix)                                                         \
+  prefix kelp::system::SystemReport<double> kelp::system::step<double>(                       \
+      const kelp::system::SystemModel<double>&, kelp::system::SystemWorkspace<double>&,       \
+      kelp::system::SystemState<double>&, const kelp::system::SystemInputs<double>&, double,  \
+      kelp::system::SystemStepOptions);                                                       \
+  prefix kelp::system::SystemState<double> kelp::system::initial_state<double>(               \
+      const kelp::system::SystemModel<double>&, kelp::system::SystemWorkspace<double>&,       \
+      const kelp::vehicle::VehicleState<double>&, const kelp::vehicle::VehicleState<double>&, \
+      double, kelp::tether::StaticOptions<double>);                                           \
+  prefix kelp::system::SystemEnergy<double> kelp::system::energy<double>(                     \
+      const kelp::system::SystemModel<double>&, const kelp::system::SystemState<double>&);
