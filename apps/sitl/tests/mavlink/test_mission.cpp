@@ -302,7 +302,9 @@ TEST_CASE("kelp-mission paces HEARTBEATs by the vehicles' clocks: no GCS failsaf
     double max_gap = 0;
     for (std::size_t i = 1; i < rec.gcs_heartbeat_clock.size(); ++i)
       max_gap = std::max(max_gap, rec.gcs_heartbeat_clock[i] - rec.gcs_heartbeat_clock[i - 1]);
-    CHECK(max_gap < 2.5);  // s of the vehicle's clock; the failsafe needs 5
+    // s of the vehicle's clock; the failsafe needs 5. At 10x a wall-clock stall of the client
+    // (a loaded machine: 0.35 s seen once beside a build) is ten times longer on this clock.
+    CHECK(max_gap < 4.0);
   }
   std::filesystem::remove_all(o.log_dir);
 }
