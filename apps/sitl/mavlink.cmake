@@ -11,8 +11,8 @@ install(TARGETS kelp-mission RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONE
 
 if(KELP_BUILD_TESTS)
   # The codec: CRC, definitions, framing, parser against corrupt and random input.
-  kelp_add_test(test_sitl_mavlink SOURCES tests/mavlink/test_codec.cpp)
-  target_include_directories(test_sitl_mavlink PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
+  kelp_add_test(test_sitl_mavlink SIM SOURCES tests/mavlink/test_codec.cpp
+                INCLUDES ${CMAKE_CURRENT_SOURCE_DIR})
 
   # Cross-check against node-mavlink (npm), both directions. node/crosscheck.js drives
   # kelp-mavlink-vectors; node-mavlink is installed by scripts/install-deps (npm ci in
@@ -38,9 +38,8 @@ if(KELP_BUILD_TESTS)
 
   # kelp-mission's logic against fake autopilots (threads serving loopback TCP).
   find_package(Threads REQUIRED)
-  kelp_add_test(test_sitl_mission SOURCES tests/mavlink/test_mission.cpp)
-  target_include_directories(test_sitl_mission PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}
-                                                       ${CMAKE_CURRENT_SOURCE_DIR}/tests/mavlink)
-  target_link_libraries(test_sitl_mission PRIVATE Threads::Threads)
+  kelp_add_test(test_sitl_mission SIM SOURCES tests/mavlink/test_mission.cpp
+                INCLUDES ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/tests/mavlink
+                LIBRARIES Threads::Threads)
   set_tests_properties(test_sitl_mission PROPERTIES TIMEOUT 120)
 endif()

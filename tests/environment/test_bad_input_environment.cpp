@@ -15,6 +15,7 @@
 #include "kelp/environment/wave_loads.hpp"
 #include "kelp/environment/waves.hpp"
 #include "kelp/environment/wind.hpp"
+#include "support/non_finite.hpp"
 
 using kelp::Matrix3X;
 using kelp::Vector3;
@@ -22,8 +23,8 @@ using namespace kelp::environment;
 
 namespace {
 
-constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using kelp_test::kInf;
+using kelp_test::kNan;
 
 WaveFieldParameters sea(double hs = 2.0, double tp = 7.0) {
   WaveFieldParameters p;

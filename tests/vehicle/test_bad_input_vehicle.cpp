@@ -18,6 +18,7 @@
 #include "kelp/vehicle/restoring.hpp"
 #include "kelp/vehicle/rigid_body.hpp"
 #include "kelp/vehicle/thrusters.hpp"
+#include "support/non_finite.hpp"
 
 using kelp::Vector3;
 using kelp::Vector6;
@@ -26,8 +27,8 @@ namespace ke = kelp::environment;
 
 namespace {
 
-constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using kelp_test::kInf;
+using kelp_test::kNan;
 
 bool same(const kv::VehicleState<double>& a, const kv::VehicleState<double>& b) {
   return a.position == b.position && a.attitude.coeffs() == b.attitude.coeffs() && a.nu == b.nu &&

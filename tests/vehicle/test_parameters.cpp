@@ -2,6 +2,7 @@
 // (kelp/vehicle/model.hpp, rigid_body.hpp, damping.hpp, thrusters.hpp).
 #include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
+
 #include <functional>
 #include <limits>
 #include <random>
@@ -10,6 +11,7 @@
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"
 #include "kelp/vehicle/thrusters.hpp"
+#include "support/non_finite.hpp"
 
 namespace kv = kelp::vehicle;
 using P = kv::VehicleParameters<double>;
@@ -24,8 +26,8 @@ void expect_rejected(const std::function<void(P&)>& spoil, const char* field) {
   CHECK_THROWS_WITH(kv::VehicleModel<double>(p), Catch::Contains(field));
 }
 
-const double kNan = std::numeric_limits<double>::quiet_NaN();
-const double kInf = std::numeric_limits<double>::infinity();
+using kelp_test::kInf;
+using kelp_test::kNan;
 
 }  // namespace
 

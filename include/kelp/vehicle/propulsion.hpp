@@ -217,7 +217,9 @@ PropulsionStep<Scalar> advance(const PropulsionModel<Scalar>& m, PropulsionState
       },
       s.battery.voltage);
   PropulsionStep<Scalar> out;
-  ThrusterVector<Scalar> mean(n);
+  // Zeroed although the loop sets every entry: GCC 12 at -O3 otherwise warns that entries past
+  // a one-thruster command may be read uninitialised in the allocation product below.
+  ThrusterVector<Scalar> mean = ThrusterVector<Scalar>::Zero(n);
   double total = bp.hotel_current;
   const double tc = m.parameters().time_constant;
   // What is left of f₀ − F* at the end of the step, e^{−h/T}, and on average over it,
