@@ -27,7 +27,7 @@ struct World {
   kelp::system::SystemStated initial;
   static kelp::sim::Scenario calm() {
     kelp::sim::Scenario s;
-    s.sea = "calm";
+    s.sea = kelp::sim::Sea::calm;
     // Two segments instead of twenty: the bridge's state machine is the target, and with the
     // coverage instrumentation's comparison tracing the tether's loops took half of every run.
     s.segment_length = 5.0;

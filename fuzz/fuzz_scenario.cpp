@@ -26,7 +26,7 @@ void check_ranges(const kelp::sim::Scenario& s) {
   KELP_FUZZ_REQUIRE(in(s.depth, 0.5, 1000) && in(s.square_side, 0.5, 1000), "mission");
   KELP_FUZZ_REQUIRE(s.asv_attachment.allFinite() && s.auv_attachment.allFinite(), "attachments");
   for (const auto& w : s.waypoints) KELP_FUZZ_REQUIRE(w.allFinite(), "waypoint");
-  KELP_FUZZ_REQUIRE(s.auv_start.empty() || s.auv_start.size() == 3, "auv_start");
+  KELP_FUZZ_REQUIRE(!s.auv_start || s.auv_start->allFinite(), "auv_start");
 }
 
 }  // namespace

@@ -67,7 +67,7 @@ ClosedLoop::ClosedLoop(const Scenario& sc, const WorldSetup& world,
   failures_.reserve(std::size_t(model_.tether().segments()));
   if (sc.winch.enabled) {
     kelp::control::TetherManagementSettings& w = winch_settings_;
-    w.strategy = kelp::control::winch_strategy_from_name(sc.winch_strategy);
+    w.strategy = sc.winch_strategy;
     w.tension_low = sc.winch.tension_low;
     w.tension_high = sc.winch.tension_high;
     w.tension_gain = sc.winch.tension_gain;
@@ -80,7 +80,7 @@ ClosedLoop::ClosedLoop(const Scenario& sc, const WorldSetup& world,
   }
   line_mass_start_ = kelp::tether::line_mass(model_.tether_of(state_), state_.tether);
   length_start_ = kelp::tether::unstretched_length(model_.tether_of(state_), state_.tether);
-  if (sc.navigation.mode == "sensors")
+  if (sc.navigation.mode == NavigationMode::sensors)
     navigation_ =
         std::make_unique<PairNavigation>(sc.navigation.sensors, sc.navigation.seed, model_, state_);
   observe();
@@ -177,7 +177,7 @@ kelp::control::AuvControllerSettings ClosedLoop::auv_settings(const Scenario& sc
   set_gains(s.sway, sc.auv_sway);
   set_gains(s.heave, sc.auv_heave);
   set_gains(s.yaw, sc.auv_yaw);
-  if (sc.control_preset == "kelp") {
+  if (sc.control_preset == ControlPreset::kelp) {
     // Track the survey's legs (a reference moving at leg_speed, at most 1 m ahead), with the
     // horizontal and vertical thrust saturated apart.
     s.follow_legs = true;
@@ -193,7 +193,7 @@ kelp::control::AsvControllerSettings ClosedLoop::asv_settings(const Scenario& sc
   s.compensate = sc.compensation;
   s.period = 1.0 / sc.asv_rate;
   s.thrust_clip = sc.asv_thrust_clip;
-  if (sc.control_preset == "kelp") s.law = kelp::control::AsvLaw::track;
+  if (sc.control_preset == ControlPreset::kelp) s.law = kelp::control::AsvLaw::track;
   const auto set = [&](kelp::control::PidGains& g, const Gains& x) {
     set_gains(g, x);
     g.output_limit = sc.asv_thrust_clip;

@@ -20,8 +20,8 @@ Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o) {
       "ScenarioOverrides: deterministic pins the kernel \"portable\", not \"" + o.kernel + "\"");
   if (o.duration > 0) sc.duration = o.duration;
   if (o.seed >= 0) sc.seed = static_cast<std::uint64_t>(o.seed);
-  if (!o.kernel.empty()) sc.kernel = o.kernel;
-  if (o.deterministic) sc.kernel = "portable";
+  if (!o.kernel.empty()) sc.kernel = kelp::simd::parse_kernel_path(o.kernel);
+  if (o.deterministic) sc.kernel = kelp::simd::KernelPath::portable;
   if (o.mcap >= 0) sc.mcap = o.mcap != 0;
   return sc;
 }

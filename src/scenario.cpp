@@ -10,6 +10,7 @@
 #include <limits>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "json_reader.hpp"
 #include "kelp/sim/heightfield_file.hpp"
@@ -45,7 +46,7 @@ kelp::environment::ObstacleSet obstacle_set(const Scenario& s) {
   kelp::environment::ObstacleSet set;
   for (const auto& c : s.cylinders) set.add(c);
   for (const auto& b : s.boxes) set.add(b);
-  if (s.has_heightfield) set.set_seabed(s.heightfield);
+  if (s.heightfield) set.set_seabed(*s.heightfield);
   return set;
 }
 
@@ -97,7 +98,7 @@ kelp::environment::HeightField parse_heightfield_object(const nlohmann::json& h,
 /// scenario file when one is beside it) or an object (parse_heightfield_object).
 void parse_seabed_heightfield(const nlohmann::json& h, const Reader& r, const std::string& p,
                               Scenario& s) {
-  if (s.has_heightfield) r.fail(p, "a second height field (one seabed per scenario)");
+  if (s.heightfield) r.fail(p, "a second height field (one seabed per scenario)");
   try {
     if (h.is_string()) {
       const std::string name = h.get<std::string>();
@@ -112,8 +113,9 @@ void parse_seabed_heightfield(const nlohmann::json& h, const Reader& r, const st
       s.heightfield = load_heightfield(path);
       s.heightfield_file = name;
     } else {
-      s.heightfield = parse_heightfield_object(h, r, p, false);
-      kelp::environment::validate(s.heightfield);
+      kelp::environment::HeightField hf = parse_heightfield_object(h, r, p, false);
+      kelp::environment::validate(hf);
+      s.heightfield = std::move(hf);
       s.heightfield_file.clear();
     }
   } catch (const scenario_error&) {
@@ -121,14 +123,13 @@ void parse_seabed_heightfield(const nlohmann::json& h, const Reader& r, const st
   } catch (const kelp::invalid_argument& e) {
     r.fail(p, e.what());
   }
-  s.has_heightfield = true;
 }
 
 /// The seabed's `heightfield` as JSON: the file's name, or the grid; null when there is none.
 nlohmann::json seabed_heightfield_json(const Scenario& s) {
-  if (!s.has_heightfield) return nullptr;
+  if (!s.heightfield) return nullptr;
   if (!s.heightfield_file.empty()) return s.heightfield_file;
-  const auto& h = s.heightfield;
+  const auto& h = *s.heightfield;
   return {{"origin", {h.origin.x(), h.origin.y()}},
           {"spacing", {h.spacing.x(), h.spacing.y()}},
           {"size", {h.rows, h.cols}},
@@ -184,7 +185,7 @@ void seabed_fields(V& v, Scenario& s) {
       r.fail(p, "expected \"depth\" (flat) or \"heightfield\", not both");
   });
   v.number("depth", s.seabed_depth, 0.1, 1e5, finite);
-  v.number("friction", s.seabed_friction, 0, 100, at_least(0));
+  v.number("friction", s.seabed_friction, 0, 100, if_set);
   v.custom(
       "heightfield",
       [&](const nlohmann::json& h, const Reader& r, const std::string& p) {
@@ -203,7 +204,7 @@ void winch_fields(V& v, Scenario& s) {
   v.number("max_pull", x.max_pull, 1, 1e6);
   v.number("min_length", x.min_length, 0.5, 1000);
   v.number("max_length", x.max_length, 0.5, 1000);
-  v.choice("strategy", s.winch_strategy, {"hold", "constant_tension", "slack", "depth_following"});
+  v.choice("strategy", s.winch_strategy, winch_strategy_names);
   v.number("tension_low", x.tension_low, 0, 1e5);
   v.number("tension_high", x.tension_high, 0, 1e5);
   v.number("tension_gain", x.tension_gain, 0, 10);
@@ -225,7 +226,7 @@ void winch_fields(V& v, Scenario& s) {
 /// closed loop's 100 steps per second: a sensor samples at most once a step.
 template <class V>
 void navigation_fields(V& v, NavigationSettings& n) {
-  v.choice("mode", n.mode, {"perfect", "sensors"});
+  v.choice("mode", n.mode, navigation_mode_names);
   v.integer("seed", n.seed, 0, 1e18);
   PairSensors& s = n.sensors;
   v.object("imu", true, [&](auto& o) {
@@ -305,9 +306,9 @@ void scenario_fields(V& v, Scenario& s) {
   v.integer("seed", s.seed, 0, 1e18);
   // The sea: a preset's name, or an object of values (then "custom", its peak period 8 s unless
   // set).
-  v.preset_or_object("sea", s.sea, {"calm", "moderate", "rough"}, "custom", [&](auto& o) {
+  v.preset_or_object("sea", s.sea, sea_names, Sea::custom, [&](auto& o) {
     o.on_read([&] {
-      s.sea = "custom";
+      s.sea = Sea::custom;
       s.peak_period = 8.0;
     });
     o.number("significant_height", s.significant_height, 0, 20);
@@ -319,20 +320,20 @@ void scenario_fields(V& v, Scenario& s) {
     o.number("current_direction", s.current_direction, -10, 10);
     o.whole("wave_components", s.wave_components, 1, 4096);
   });
-  // The cable properties are written when set (above their "keep the kind's" value).
+  // The cable properties are written when set (unset: keep the kind's).
   v.object("tether", true, [&](auto& o) {
-    o.number("breaking_strength", s.breaking_strength, 0, 1e7, above(-1));
-    o.number("diameter", s.diameter, 1e-4, 0.5, above(0));
-    o.number("mass_per_length", s.mass_per_length, 1e-4, 100, above(0));
-    o.number("axial_stiffness", s.axial_stiffness, 1, 1e10, above(0));
-    o.number("internal_damping", s.internal_damping, 0, 1e6, above(-1));
-    o.number("normal_drag", s.normal_drag, 0, 10, above(-1));
-    o.number("tangential_drag", s.tangential_drag, 0, 10, above(-1));
+    o.number("breaking_strength", s.breaking_strength, 0, 1e7, if_set);
+    o.number("diameter", s.diameter, 1e-4, 0.5, if_set);
+    o.number("mass_per_length", s.mass_per_length, 1e-4, 100, if_set);
+    o.number("axial_stiffness", s.axial_stiffness, 1, 1e10, if_set);
+    o.number("internal_damping", s.internal_damping, 0, 1e6, if_set);
+    o.number("normal_drag", s.normal_drag, 0, 10, if_set);
+    o.number("tangential_drag", s.tangential_drag, 0, 10, if_set);
     o.number("length", s.tether_length, 0.5, 1000);
-    o.choice("kind", s.tether_kind, {"rov_tether", "bead_chain"});
+    o.choice("kind", s.tether_kind, tether_kind_names);
     o.number("segment_length", s.segment_length, 0.05, 10);
     o.boolean("explicit_fallback", s.explicit_fallback);
-    o.choice("line_model", s.line_model, {"kelp", "moordyn"}, unless("kelp"));
+    o.choice("line_model", s.line_model, line_model_names, unless(kelp::tether::LineModel::kelp));
     o.object("winch", s.winch.enabled, [&](auto& w) { winch_fields(w, s); });
   });
   v.object("vehicles", true, [&](auto& o) {
@@ -345,9 +346,10 @@ void scenario_fields(V& v, Scenario& s) {
     o.boolean("with_water", s.start_with_water);
   });
   v.object("control", true, [&](auto& o) {
-    o.choice("preset", s.control_preset, {"kelp", "paper"});
+    o.choice("preset", s.control_preset, control_preset_names);
     o.on_read([&] {
-      if (s.control_preset == "paper") s.asv_thrust_clip = 15.0;  // the paper's, unless set
+      // the paper's, unless set
+      if (s.control_preset == ControlPreset::paper) s.asv_thrust_clip = 15.0;
     });
     o.boolean("compensation", s.compensation);
     o.object("asv", true, [&](auto& a) {
@@ -415,15 +417,16 @@ void scenario_fields(V& v, Scenario& s) {
   });
   // The kernel only when pinned: the default leaves the JSON (and kelp-sweep's run hashes) as they
   // were. `deterministic` is read only: true pins "portable".
-  v.choice("kernel", s.kernel, {"auto", "portable", "avx2", "avx512"}, unless("auto"));
+  using kelp::simd::KernelPath;
+  v.choice("kernel", s.kernel, kernel_path_names, unless(KernelPath::automatic));
   bool deterministic = false;
   v.boolean("deterministic", deterministic, never);
   v.check([&](const Reader& r, const std::string&) {
     if (!deterministic) return;
-    if (s.kernel != "auto" && s.kernel != "portable")
-      r.fail("/deterministic",
-             "true pins the \"portable\" kernel, but /kernel is \"" + s.kernel + "\"");
-    s.kernel = "portable";
+    if (s.kernel != KernelPath::automatic && s.kernel != KernelPath::portable)
+      r.fail("/deterministic", std::string("true pins the \"portable\" kernel, but /kernel is \"") +
+                                   to_string(s.kernel) + "\"");
+    s.kernel = KernelPath::portable;
   });
 }
 
@@ -464,10 +467,10 @@ void parse_obstacles(const nlohmann::json& list, const Reader& r, Scenario& s) {
         check.add(b);
         s.boxes.push_back(b);
       } else if (type == "heightfield") {
-        if (s.has_heightfield) r.fail(p, "a second height field (one seabed per scenario)");
-        s.heightfield = parse_heightfield_object(o, r, p, true);
-        kelp::environment::validate(s.heightfield);
-        s.has_heightfield = true;
+        if (s.heightfield) r.fail(p, "a second height field (one seabed per scenario)");
+        kelp::environment::HeightField hf = parse_heightfield_object(o, r, p, true);
+        kelp::environment::validate(hf);
+        s.heightfield = std::move(hf);
         s.heightfield_file.clear();
       } else {
         r.fail(p + "/type",

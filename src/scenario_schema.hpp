@@ -12,15 +12,20 @@
 ///     v.integer(key, member, lo, hi[, rule])    an integer in [lo, hi] (std::uint64_t or int)
 ///     v.whole(key, member, lo, hi[, rule])      a number in [lo, hi] that must be whole (int)
 ///     v.boolean(key, member[, rule])            true or false
-///     v.choice(key, member, {options}[, rule])  one of the options (a string)
+///     v.number(key, optional, lo, hi, if_set)   likewise, into a std::optional<double> (unset
+///                                               until the key is read)
+///     v.choice(key, member, names[, rule])      one of the names of an enum's table (a
+///                                               ChoiceName<E> array, kelp/sim/scenario.hpp: the
+///                                               file spells the name, the member is the enum)
 ///     v.vec3(key, member[, rule])               [x, y, z] within ±1e4 (Vector3, or a
-///                                               std::vector<double> that is empty when unset)
+///                                               std::optional<Vector3> unset until read)
 ///     v.vec3_list(key, member[, rule])          a non-empty array of [x, y, z]
 ///     v.gains(key, member[, rule])              non-negative [kp, ki, kd]
 ///     v.object(key, object_rule, body)          a nested object, `body` its own table
-///     v.preset_or_object(key, member, {presets}, custom, body)
-///                                               a preset's name, or an object (then member is
-///                                               `custom` and `body` reads it)
+///     v.preset_or_object(key, member, names, custom, body)
+///                                               a preset's name (any of the table's but
+///                                               `custom`), or an object (then member is `custom`
+///                                               and `body` reads it)
 ///     v.custom(key, parse, write)               a key read and written by hand (lists)
 ///     v.key(key)                                a key read by the caller (allowed, not visited)
 ///     v.on_read(f)                              parse only: f() at this point of the reading
@@ -29,13 +34,16 @@
 ///
 /// in the order the keys are read (the first error found is the one reported). The rule says
 /// when the writer writes the key: `always` (the default), `never`, `required` (always, and
-/// the parser requires it), `unless(value)`, `above(x)`, `at_least(x)`, `finite`, `if_set` (a
-/// non-empty list), or any predicate on the value. An object's rule: a bool (written when
-/// true), `unless_default` (only when it differs from the default scenario's) or `non_empty`.
+/// the parser requires it), `unless(value)`, `finite`, `if_set` (a
+/// non-empty list, or an optional with a value), or any predicate on the value. An object's rule: a
+/// bool (written when true), `unless_default` (only when it differs from the default scenario's) or
+/// `non_empty`.
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <set>
 #include <string>
 #include <type_traits>
@@ -43,6 +51,7 @@
 #include <vector>
 
 #include "json_reader.hpp"
+#include "kelp/sim/scenario.hpp"
 
 namespace kelp {
 namespace sim {
@@ -75,25 +84,19 @@ struct Unless {
     return !(x == value);
   }
 };
-/// \brief Rule: written when the value is above `unset` (a property's "keep the preset's" value).
-struct Above {
-  double unset;  ///< the unset value
-  bool operator()(double x) const { return x > unset; }
-};
-/// \brief Rule: written when the value is at least `lo`.
-struct AtLeast {
-  double lo;  ///< the least value written
-  bool operator()(double x) const { return x >= lo; }
-};
 /// \brief Rule: written when the value is finite (+∞: unset).
 struct Finite {
   bool operator()(double x) const { return std::isfinite(x); }
 };
-/// \brief Rule: written when the list is not empty.
+/// \brief Rule: written when the list is not empty, or the optional has a value.
 struct IfSet {
   template <class X>
   bool operator()(const X& x) const {
     return !x.empty();
+  }
+  template <class X>
+  bool operator()(const std::optional<X>& x) const {
+    return x.has_value();
   }
 };
 /// \brief Object rule: written only when it differs from the default scenario's.
@@ -105,7 +108,7 @@ inline constexpr Always always{};                 ///< \brief Rule: always writt
 inline constexpr Never never{};                   ///< \brief Rule: never written.
 inline constexpr Required required{};             ///< \brief Rule: required, always written.
 inline constexpr Finite finite{};                 ///< \brief Rule: written when finite.
-inline constexpr IfSet if_set{};                  ///< \brief Rule: written when not empty.
+inline constexpr IfSet if_set{};                  ///< \brief Rule: written when set.
 inline constexpr UnlessDefault unless_default{};  ///< \brief Object rule: see UnlessDefault.
 inline constexpr NonEmpty non_empty{};            ///< \brief Object rule: see NonEmpty.
 /// \brief Rule: written unless the value is `v`.
@@ -113,12 +116,38 @@ template <class T>
 Unless<T> unless(T v) {
   return {v};
 }
-/// \brief Rule: written when above `unset`.
-inline Above above(double unset) { return {unset}; }
-/// \brief Rule: written when at least `lo`.
-inline AtLeast at_least(double lo) { return {lo}; }
 
 using Options = std::set<std::string>;  ///< a choice's options
+
+/// \brief The names of a choice's table (all but `except`'s, when given), sorted: what Reader
+/// checks the file's string against and lists in its error.
+template <class E, std::size_t N>
+Options option_names(const ChoiceName<E> (&names)[N], const E* except = nullptr) {
+  Options o;
+  for (const ChoiceName<E>& n : names)
+    if (!except || n.value != *except) o.insert(n.name);
+  return o;
+}
+
+/// \brief The enumerator named `name` in the table (the name is one of the table's).
+template <class E, std::size_t N>
+E choice_value(const std::string& name, const ChoiceName<E> (&names)[N]) {
+  for (const ChoiceName<E>& n : names)
+    if (name == n.name) return n.value;
+  return names[0].value;
+}
+
+/// \brief The name of `value` in the table, for writing; throws kelp::invalid_argument for a
+/// value outside it.
+template <class E, std::size_t N>
+std::string written_name(const char* key, E value, const ChoiceName<E> (&names)[N]) {
+  const char* n = choice_name(value, names);
+  if (!n)
+    throw kelp::invalid_argument(std::string("scenario_json: \"") + key + "\" is " +
+                                 std::to_string(static_cast<long long>(value)) +
+                                 ", not one of its choices");
+  return n;
+}
 
 /// \brief The visitor that collects an object's keys (allowed, and required) from its table.
 class Keys {
@@ -142,8 +171,8 @@ class Keys {
   void boolean(const char* k, bool&, R rule = {}) {
     add(k, rule);
   }
-  template <class R = Always>
-  void choice(const char* k, std::string&, const Options&, R rule = {}) {
+  template <class E, std::size_t N, class R = Always>
+  void choice(const char* k, E&, const ChoiceName<E> (&)[N], R rule = {}) {
     add(k, rule);
   }
   template <class X, class R = Always>
@@ -162,8 +191,8 @@ class Keys {
   void object(const char* k, R, Body&&) {
     allowed.insert(k);
   }
-  template <class Body>
-  void preset_or_object(const char* k, std::string&, const Options&, const char*, Body&&) {
+  template <class E, std::size_t N, class Body>
+  void preset_or_object(const char* k, E&, const ChoiceName<E> (&)[N], E, Body&&) {
     allowed.insert(k);
   }
   template <class P, class W>
@@ -201,6 +230,13 @@ class Parser {
     r_.number(j_, path_, k, x, lo, hi);
   }
   template <class R = Always>
+  void number(const char* k, std::optional<double>& x, double lo, double hi, R = {}) {
+    if (!j_.contains(k)) return;
+    double v = 0;
+    r_.number(j_, path_, k, v, lo, hi);
+    x = v;
+  }
+  template <class R = Always>
   void integer(const char* k, std::uint64_t& x, double lo, double hi, R = {}) {
     r_.integer(j_, path_, k, x, lo, hi);
   }
@@ -221,19 +257,20 @@ class Parser {
   void boolean(const char* k, bool& x, R = {}) {
     r_.boolean(j_, path_, k, x);
   }
-  template <class R = Always>
-  void choice(const char* k, std::string& x, const Options& options, R = {}) {
-    r_.choice(j_, path_, k, x, options);
+  template <class E, std::size_t N, class R = Always>
+  void choice(const char* k, E& x, const ChoiceName<E> (&names)[N], R = {}) {
+    if (!j_.contains(k)) return;
+    std::string name;
+    r_.choice(j_, path_, k, name, option_names(names));
+    x = choice_value(name, names);
   }
   template <class R = Always>
   void vec3(const char* k, kelp::Vector3<double>& x, R = {}) {
     if (j_.contains(k)) x = r_.vec3(j_.at(k), path_ + "/" + k);
   }
   template <class R = Always>
-  void vec3(const char* k, std::vector<double>& x, R = {}) {
-    if (!j_.contains(k)) return;
-    const kelp::Vector3<double> p = r_.vec3(j_.at(k), path_ + "/" + k);
-    x = {p(0), p(1), p(2)};
+  void vec3(const char* k, std::optional<kelp::Vector3<double>>& x, R = {}) {
+    if (j_.contains(k)) x = r_.vec3(j_.at(k), path_ + "/" + k);
   }
   template <class R = Always>
   void vec3_list(const char* k, std::vector<kelp::Vector3<double>>& x, R = {}) {
@@ -253,14 +290,17 @@ class Parser {
   void object(const char* k, R, Body&& body) {
     if (j_.contains(k)) parse_object(r_, j_.at(k), path_ + "/" + k, body);
   }
-  template <class Body>
-  void preset_or_object(const char* k, std::string& x, const Options& presets, const char*,
+  template <class E, std::size_t N, class Body>
+  void preset_or_object(const char* k, E& x, const ChoiceName<E> (&names)[N], E custom,
                         Body&& body) {
     if (!j_.contains(k)) return;
-    if (j_.at(k).is_string())
-      r_.choice(j_, path_, k, x, presets);
-    else
+    if (j_.at(k).is_string()) {
+      std::string name;
+      r_.choice(j_, path_, k, name, option_names(names, &custom));
+      x = choice_value(name, names);
+    } else {
       parse_object(r_, j_.at(k), path_ + "/" + k, body);
+    }
   }
   /// `parse(value, reader, path)` when the key is given.
   template <class P, class W>
@@ -320,17 +360,17 @@ class Writer {
   void boolean(const char* k, bool& x, R rule = {}) {
     put(k, x, rule);
   }
-  template <class R = Always>
-  void choice(const char* k, std::string& x, const Options&, R rule = {}) {
-    put(k, x, rule);
+  template <class E, std::size_t N, class R = Always>
+  void choice(const char* k, E& x, const ChoiceName<E> (&names)[N], R rule = {}) {
+    if (rule(x)) out_[k] = written_name(k, x, names);
   }
   template <class R = Always>
   void vec3(const char* k, kelp::Vector3<double>& x, R rule = {}) {
     if (rule(x)) out_[k] = v3(x);
   }
   template <class R = Always>
-  void vec3(const char* k, std::vector<double>& x, R rule = {}) {
-    put(k, x, rule);
+  void vec3(const char* k, std::optional<kelp::Vector3<double>>& x, R rule = {}) {
+    if (x && rule(x)) out_[k] = v3(*x);
   }
   template <class R = Always>
   void vec3_list(const char* k, std::vector<kelp::Vector3<double>>& x, R rule = {}) {
@@ -357,13 +397,13 @@ class Writer {
     nlohmann::json o = sub(k, body);
     if (!defaults_ || !defaults_->contains(k) || o != defaults_->at(k)) out_[k] = std::move(o);
   }
-  template <class Body>
-  void preset_or_object(const char* k, std::string& x, const Options&, const char* custom,
+  template <class E, std::size_t N, class Body>
+  void preset_or_object(const char* k, E& x, const ChoiceName<E> (&names)[N], E custom,
                         Body&& body) {
     if (x == custom)
       out_[k] = sub(k, body);
     else
-      out_[k] = x;
+      out_[k] = written_name(k, x, names);
   }
   /// `write()`'s value, unless null.
   template <class P, class W>
@@ -384,6 +424,10 @@ class Writer {
   template <class X, class R>
   void put(const char* k, const X& x, const R& rule) {
     if (rule(x)) out_[k] = x;
+  }
+  template <class X, class R>
+  void put(const char* k, const std::optional<X>& x, const R& rule) {
+    if (x && rule(x)) out_[k] = *x;
   }
   template <class Body>
   nlohmann::json sub(const char* k, Body& body) {

@@ -40,7 +40,7 @@ nlohmann::json event_json(const EntanglementEventSummary& v) {
 }
 
 nlohmann::json navigation_json(const NavigationSummary& n) {
-  nlohmann::json j = {{"mode", n.mode}};
+  nlohmann::json j = {{"mode", to_string(n.mode)}};
   if (!n.errors) return j;
   const NavigationErrorsSummary& e = *n.errors;
   j["seed"] = e.seed;

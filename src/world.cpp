@@ -18,24 +18,32 @@ namespace sim {
 WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   namespace sp = kelp::system::presets;
   namespace ke = kelp::environment;
-  const sp::TetherKind kind =
-      sc.tether_kind == "bead_chain" ? sp::TetherKind::bead_chain : sp::TetherKind::rov_tether;
+  const sp::TetherKind kind = sc.tether_kind == TetherKind::bead_chain ? sp::TetherKind::bead_chain
+                                                                       : sp::TetherKind::rov_tether;
   kelp::system::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
   if (kind == sp::TetherKind::rov_tether)
     params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
   auto& tp = params.tether;
-  if (sc.diameter > 0) tp.diameter = sc.diameter;
-  if (sc.mass_per_length > 0) tp.mass_per_length = sc.mass_per_length;
-  if (sc.axial_stiffness > 0) tp.axial_stiffness = sc.axial_stiffness;
-  if (sc.internal_damping >= 0) tp.internal_damping = sc.internal_damping;
-  if (sc.normal_drag >= 0) tp.normal_drag = sc.normal_drag;
-  if (sc.tangential_drag >= 0) tp.tangential_drag = sc.tangential_drag;
-  if (sc.breaking_strength >= 0) tp.breaking_strength = sc.breaking_strength;
+  if (sc.diameter) tp.diameter = *sc.diameter;
+  if (sc.mass_per_length) tp.mass_per_length = *sc.mass_per_length;
+  if (sc.axial_stiffness) tp.axial_stiffness = *sc.axial_stiffness;
+  if (sc.internal_damping) tp.internal_damping = *sc.internal_damping;
+  if (sc.normal_drag) tp.normal_drag = *sc.normal_drag;
+  if (sc.tangential_drag) tp.tangential_drag = *sc.tangential_drag;
+  if (sc.breaking_strength) tp.breaking_strength = *sc.breaking_strength;
   params.explicit_fallback = sc.explicit_fallback;
-  if (sc.line_model != "kelp" && sc.line_model != "moordyn")
-    throw scenario_error(file + ": /tether/line_model: expected \"kelp\" or \"moordyn\", got \"" +
-                         sc.line_model + "\"");
-  if (sc.line_model == "moordyn") tp.line_model = kelp::tether::LineModel::moordyn;
+  // A Scenario built by hand may hold a value cast from an integer: named as the file's error.
+  const auto refuse = [&](const char* path, int value) {
+    throw scenario_error(file + ": " + path + ": " + std::to_string(value) +
+                         " is not one of its choices");
+  };
+  if (!choice_name(sc.line_model, line_model_names))
+    refuse("/tether/line_model", static_cast<int>(sc.line_model));
+  if (!choice_name(sc.tether_kind, tether_kind_names))
+    refuse("/tether/kind", static_cast<int>(sc.tether_kind));
+  if (!choice_name(sc.sea, sea_names)) refuse("/sea", static_cast<int>(sc.sea));
+  if (!choice_name(sc.kernel, kernel_path_names)) refuse("/kernel", static_cast<int>(sc.kernel));
+  tp.line_model = sc.line_model;
   if (sc.winch.enabled) {
     kelp::tether::WinchParameters<double> w;
     w.max_speed = sc.winch.max_speed;
@@ -69,9 +77,9 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   sea_options.wave_components = sc.wave_components;
   sea_options.ramp = sc.start_ramp;
   ke::SeaState sea = ke::presets::calm();
-  if (sc.sea == "moderate") sea = ke::presets::moderate();
-  if (sc.sea == "rough") sea = ke::presets::rough();
-  if (sc.sea == "custom") {
+  if (sc.sea == Sea::moderate) sea = ke::presets::moderate();
+  if (sc.sea == Sea::rough) sea = ke::presets::rough();
+  if (sc.sea == Sea::custom) {
     sea = ke::SeaState{};  // no waves unless a height is given
     sea.significant_height = sc.significant_height;
     sea.peak_period = sc.peak_period;
@@ -84,8 +92,7 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     sea.current_direction = sc.current_direction;
   }
   sp::StartPoses<double> start = sp::paper_start(sc.tether_length);
-  if (!sc.auv_start.empty())
-    start.auv.position = kelp::Vector3<double>(sc.auv_start[0], sc.auv_start[1], sc.auv_start[2]);
+  if (sc.auv_start) start.auv.position = *sc.auv_start;
   const double span = (start.auv.point_position(params.auv_attachment) -
                        start.asv.point_position(params.asv_attachment))
                           .norm();
@@ -97,10 +104,10 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   // The wave kernel's instruction path: pinned by the scenario (a path this CPU lacks is named
   // as the file's error), else the process' policy (a bad KELP_KERNEL throws
   // kelp::invalid_argument naming it); resolved here, before the run's first step.
-  if (sc.kernel != "auto") {
+  if (sc.kernel != kelp::simd::KernelPath::automatic) {
     ke::WaveFieldd waves = env.waves();
     try {
-      waves.set_kernel(kelp::simd::parse_kernel_path(sc.kernel));
+      waves.set_kernel(sc.kernel);
     } catch (const kelp::invalid_argument& e) {
       throw scenario_error(file + ": /kernel: " + e.what());
     }
@@ -110,7 +117,7 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   // Seabed and obstacles (kelp/environment/obstacles.hpp; the tether touches them through the
   // environment, kelp/tether/contact.hpp).
   if (std::isfinite(sc.seabed_depth)) env.set_seabed_depth(sc.seabed_depth);
-  if (sc.seabed_friction >= 0) tp.seabed_friction = sc.seabed_friction;
+  if (sc.seabed_friction) tp.seabed_friction = *sc.seabed_friction;
   env.set_obstacles(obstacle_set(sc));
   // The hulls against the seabed and the obstacles (kelp/system/hull_contact.hpp), when there is
   // something to touch: in open water without a seabed a run is as it was.

@@ -12,7 +12,7 @@ namespace {
 
 kelp::sim::Scenario calm() {
   kelp::sim::Scenario sc;
-  sc.sea = "calm";
+  sc.sea = kelp::sim::Sea::calm;
   sc.duration = 5.0;
   sc.segment_length = 1.0;
   return sc;

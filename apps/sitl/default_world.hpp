@@ -15,7 +15,7 @@ namespace kelp_sitl {
 /// start (kelp-sitl with idle fake autopilots), time for kelp-mission to arm it and hold depth.
 inline kelp::sim::Scenario default_scenario() {
   kelp::sim::Scenario s;
-  s.auv_start = {-4.0, 0.0, 8.0};
+  s.auv_start = kelp::Vector3<double>(-4.0, 0.0, 8.0);
   return s;
 }
 

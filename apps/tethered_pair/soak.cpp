@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   namespace ke = kelp::environment;
   kelp::sim::Scenario sc;
   const ke::SeaState rough = ke::presets::rough();
-  sc.sea = "custom";
+  sc.sea = kelp::sim::Sea::custom;
   sc.significant_height = rough.significant_height;
   sc.peak_period = rough.peak_period;
   sc.wind_speed = rough.wind_speed;

@@ -22,7 +22,7 @@ TEST_CASE("run_scenario writes run.mcap beside the log; reference.csv for the np
   sc.segment_length = 1.0;  // a coarse tether: a quick test
   sc.log_rate = 10.0;
   sc.node_rate = 2.0;
-  sc.sea = "moderate";  // waves: the vehicles move, the tether pulls
+  sc.sea = kelp::sim::Sea::moderate;  // waves: the vehicles move, the tether pulls
   const std::filesystem::path dir = "ros2_bag_run";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);

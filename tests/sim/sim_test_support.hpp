@@ -21,7 +21,7 @@ inline nlohmann::json json_of(const kelp::sim::RunSummary& s) {
 /// A short calm run on a coarse tether: 5 s, samples at 5 Hz, tether snapshots at 2 Hz.
 inline kelp::sim::Scenario short_calm_run() {
   kelp::sim::Scenario sc;
-  sc.sea = "calm";
+  sc.sea = kelp::sim::Sea::calm;
   sc.duration = 5.0;
   sc.segment_length = 1.0;
   sc.log_rate = 5.0;

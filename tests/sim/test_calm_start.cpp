@@ -45,7 +45,7 @@ TEST_CASE("calm start: a resting ROV reads about g over its first second", "[sim
   SECTION("without the ramp and without starting with the water the transient is back") {
     sc.start_ramp = 0;
     sc.start_with_water = false;
-    sc.auv_start = {-4.0, 0.0, 0.3};  // kelp-sitl's start, at the surface
+    sc.auv_start = kelp::Vector3<double>(-4.0, 0.0, 0.3);  // kelp-sitl's start, at the surface
     const double e = worst_specific_force_error(sc, 1.0, ks::ClosedLoop::dt);
     INFO("worst |f - g| = " << e << " m/s^2");
     CHECK(e > 3.0);

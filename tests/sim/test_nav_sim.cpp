@@ -23,7 +23,7 @@ std::string sensors_run(double duration, int seed, const std::string& extra = ""
 
 TEST_CASE("scenario navigation: perfect by default, every sensor's key read", "[nav][scenario]") {
   const ks::Scenario d = ks::parse_scenario("{}", "t.json");
-  CHECK(d.navigation.mode == "perfect");
+  CHECK(d.navigation.mode == ks::NavigationMode::perfect);
   CHECK_FALSE(
       kelp_test::json_of(d).contains("navigation"));  // the default leaves the echo as it was
   const ks::Scenario s = ks::parse_scenario(R"({"navigation": {"mode": "sensors", "seed": 9,
@@ -40,7 +40,7 @@ TEST_CASE("scenario navigation: perfect by default, every sensor's key read", "[
                "dropout": 0.2, "max_range": 50}}})",
                                             "t.json");
   const auto& n = s.navigation;
-  CHECK(n.mode == "sensors");
+  CHECK(n.mode == ks::NavigationMode::sensors);
   CHECK(n.seed == 9);
   CHECK(n.sensors.imu.rate == 50);
   CHECK(n.sensors.imu.accel_bias_initial == 0.02);

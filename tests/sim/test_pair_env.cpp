@@ -90,7 +90,7 @@ TEST_CASE("the environment's episode is the same for a seed and differs between 
 
 TEST_CASE("the action flies the ROV through the controller's allocation", "[sim][env]") {
   ks::Scenario sc = short_run();
-  sc.sea = "calm";
+  sc.sea = ks::Sea::calm;
   ks::TetheredPairEnv ahead(sc), astern(sc);
   const double fwd[6] = {1, 0, 0, 0, 0, 0}, back[6] = {-1, 0, 0, 0, 0, 0};
   for (int k = 0; k < 20; ++k) {
@@ -187,7 +187,7 @@ TEST_CASE("the environment refuses bad options and actions", "[sim][env]") {
 
 TEST_CASE("the boat action drives the boat's thrusters", "[sim][env]") {
   ks::Scenario sc = short_run();
-  sc.sea = "calm";
+  sc.sea = ks::Sea::calm;
   ks::PairEnvOptions o;
   o.asv_action = true;
   ks::TetheredPairEnv env(sc, o);

@@ -49,7 +49,7 @@ struct LoggedRun {
 
 LoggedRun logged_run(const fs::path& dir) {
   LoggedRun r;
-  r.sc.sea = "moderate";
+  r.sc.sea = ks::Sea::moderate;
   r.sc.duration = 8.0;
   r.sc.segment_length = 1.0;
   r.sc.log_rate = 5.0;

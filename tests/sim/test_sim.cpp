@@ -167,25 +167,28 @@ TEST_CASE("bad scenarios throw scenario_error, a kelp::invalid_argument naming t
   CHECK_THROWS_AS(ks::load_scenario("/nonexistent/scenario.json"), ks::scenario_error);
   // A tether shorter than the distance between its ends at the start: refused by the world.
   ks::Scenario sc = short_calm_run();
-  sc.auv_start = {30.0, 0.0, 5.0};  // some 30 m from the boat, on a 10 m tether
+  sc.auv_start =
+      kelp::Vector3<double>(30.0, 0.0, 5.0);  // some 30 m from the boat, on a 10 m tether
   CHECK_THROWS_AS(ks::ClosedLoop(sc), ks::scenario_error);
 }
 
 TEST_CASE("the tether's line_model: parsed, written back, passed to the tether, checked", "[sim]") {
   // Default: kelp's line, and to_json leaves the key out.
   const ks::Scenario plain = ks::parse_scenario(R"({"tether": {"length": 10}})", "a.json");
-  CHECK(plain.line_model == "kelp");
+  CHECK(plain.line_model == kelp::tether::LineModel::kelp);
   CHECK_FALSE(kelp_test::json_of(plain).at("tether").contains("line_model"));
   CHECK(ks::world_setup(plain, "a.json").parameters.tether.line_model ==
         kelp::tether::LineModel::kelp);
   // "moordyn": parsed, round-tripped through to_json, and reaching the tether's parameters.
   const ks::Scenario md =
       ks::parse_scenario(R"({"tether": {"length": 10, "line_model": "moordyn"}})", "b.json");
-  CHECK(md.line_model == "moordyn");
-  CHECK(ks::parse_scenario(kelp_test::json_of(md).dump(), "c.json").line_model == "moordyn");
+  CHECK(md.line_model == kelp::tether::LineModel::moordyn);
+  CHECK(ks::parse_scenario(kelp_test::json_of(md).dump(), "c.json").line_model ==
+        kelp::tether::LineModel::moordyn);
   CHECK(ks::world_setup(md, "b.json").parameters.tether.line_model ==
         kelp::tether::LineModel::moordyn);
-  // Anything else is refused with the path, in the file and in a Scenario built by hand.
+  // Anything else is refused with the path, in the file and in a Scenario built by hand (a value
+  // cast from an integer).
   try {
     (void)ks::parse_scenario(R"({"tether": {"line_model": "MoorDyn"}})", "d.json");
     FAIL("line_model \"MoorDyn\" was accepted");
@@ -195,7 +198,7 @@ TEST_CASE("the tether's line_model: parsed, written back, passed to the tether, 
   CHECK_THROWS_AS(ks::parse_scenario(R"({"tether": {"line_model": 1}})", "e.json"),
                   ks::scenario_error);
   ks::Scenario bad = plain;
-  bad.line_model = "orcaflex";
+  bad.line_model = static_cast<kelp::tether::LineModel>(7);
   CHECK_THROWS_AS(ks::world_setup(bad, "f.json"), ks::scenario_error);
 }
 

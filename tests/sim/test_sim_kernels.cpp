@@ -24,7 +24,7 @@ namespace {
 // printed digits of the time series through the closed loop.
 ks::Scenario rough_run() {
   ks::Scenario sc;
-  sc.sea = "rough";
+  sc.sea = ks::Sea::rough;
   sc.duration = 30.0;
   sc.log_rate = 10.0;
   sc.node_rate = 1.0;
@@ -87,7 +87,7 @@ TEST_CASE("deterministic runs give the same summary and logs, bit for bit, on ev
       WARN("skipped " << simd::kernel_name(p) << ": this CPU lacks it");
 
   ks::Scenario det = rough_run();
-  det.kernel = "portable";  // what "deterministic": true gives
+  det.kernel = KernelPath::portable;  // what "deterministic": true gives
   const std::string root = "sim_kernels";
   const Run reference = run_with_policy(det, KernelPath::portable, root + "/det_portable");
   CHECK(reference.summary.at("kernel") == "portable");
@@ -129,17 +129,18 @@ TEST_CASE("deterministic runs give the same summary and logs, bit for bit, on ev
 
 TEST_CASE("a scenario's kernel and deterministic fields: parsing, echo and errors",
           "[sim][kernel]") {
-  CHECK(ks::parse_scenario("{}", "s.json").kernel == "auto");
+  CHECK(ks::parse_scenario("{}", "s.json").kernel == KernelPath::automatic);
   CHECK(!kelp_test::json_of(ks::parse_scenario("{}", "s.json")).contains("kernel"));
-  CHECK(ks::parse_scenario(R"({"deterministic": true})", "s.json").kernel == "portable");
-  CHECK(ks::parse_scenario(R"({"deterministic": false})", "s.json").kernel == "auto");
+  CHECK(ks::parse_scenario(R"({"deterministic": true})", "s.json").kernel == KernelPath::portable);
+  CHECK(ks::parse_scenario(R"({"deterministic": false})", "s.json").kernel ==
+        KernelPath::automatic);
   CHECK(ks::parse_scenario(R"({"deterministic": true, "kernel": "portable"})", "s.json").kernel ==
-        "portable");
+        KernelPath::portable);
   for (const char* k : {"auto", "portable", "avx2", "avx512"}) {
     const ks::Scenario s = ks::parse_scenario(std::string(R"({"kernel": ")") + k + "\"}", "s.json");
-    CHECK(s.kernel == k);
+    CHECK(std::string(ks::to_string(s.kernel)) == k);
     // The echo reads back to the same scenario.
-    CHECK(ks::parse_scenario(kelp_test::json_of(s).dump(), "echo").kernel == k);
+    CHECK(ks::parse_scenario(kelp_test::json_of(s).dump(), "echo").kernel == s.kernel);
   }
   CHECK_THROWS_WITH(ks::parse_scenario(R"({"kernel": "sse2"})", "s.json"),
                     Catch::Contains("s.json: /kernel: expected one of"));
@@ -153,7 +154,7 @@ TEST_CASE("a scenario's kernel and deterministic fields: parsing, echo and error
   // A pinned path reaches the world's wave field; one this CPU lacks is the file's error.
   for (KernelPath p : {KernelPath::portable, KernelPath::avx2, KernelPath::avx512}) {
     ks::Scenario sc;
-    sc.kernel = simd::kernel_name(p);
+    sc.kernel = p;
     if (simd::kernel_supported(p)) {
       CHECK(ks::world_setup(sc, "s.json").environment.waves().kernel() == p);
     } else {

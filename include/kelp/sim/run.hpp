@@ -37,8 +37,8 @@ struct ScenarioOverrides {
 };
 
 /// \brief The scenario with the overrides applied.
-/// \throws kelp::invalid_argument for a non-finite duration, or `deterministic` with a kernel
-/// other than "portable".
+/// \throws kelp::invalid_argument for a non-finite duration, an unknown kernel name, or
+/// `deterministic` with a kernel other than "portable".
 KELP_SIM_API Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o);
 
 /// \brief Options of run_scenario().

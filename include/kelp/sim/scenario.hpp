@@ -9,28 +9,146 @@
 /// compiled `kelp::sim` component (`find_package(kelp CONFIG COMPONENTS sim)`).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "kelp/control/tether_management.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/kernel_path.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/obstacles.hpp"
 #include "kelp/sim/entanglement.hpp"
 #include "kelp/sim/export.hpp"
 #include "kelp/sim/navigation.hpp"
 #include "kelp/sim/scenario_reader.hpp"
+#include "kelp/tether/model.hpp"
 
 namespace kelp {
 namespace sim {
 
+/// \brief A choice of a scenario file: an enumerator and its name, as scenario files, summaries
+/// and error messages spell it. Each choice's names are one table (e.g. sea_names), which the
+/// schema reads and writes by and to_string() looks up.
+template <class E>
+struct ChoiceName {
+  E value;           ///< the enumerator
+  const char* name;  ///< its name in scenario files
+};
+
+/// \brief The name of `value` in the table `names`, or nullptr when the table lacks it (a value
+/// cast from an integer).
+template <class E, std::size_t N>
+constexpr const char* choice_name(E value, const ChoiceName<E> (&names)[N]) {
+  for (const ChoiceName<E>& n : names)
+    if (n.value == value) return n.name;
+  return nullptr;
+}
+
+/// \brief What the controllers navigate by (the scenario's `navigation.mode`).
+enum class NavigationMode {
+  perfect,  ///< "perfect": the true state (the default)
+  sensors   ///< "sensors": the estimates of kelp::nav's sensors and filters
+            ///< (kelp/sim/navigation.hpp)
+};
+
+/// \brief The sea of a scenario (`sea`): one of the paper's presets, or the values of a `sea`
+/// object.
+enum class Sea {
+  calm,      ///< "calm": environment::presets::calm
+  moderate,  ///< "moderate": environment::presets::moderate (the default)
+  rough,     ///< "rough": environment::presets::rough
+  custom     ///< "custom": a `sea` object's values (Scenario::significant_height and the others)
+};
+
+/// \brief Which line joins the vehicles (`tether.kind`; system::presets::TetherKind's choice,
+/// kept apart so that this header does not include the system's).
+enum class TetherKind {
+  rov_tether,  ///< "rov_tether": Fathom-class ROV tether (tether::presets::rov_tether; default)
+  bead_chain   ///< "bead_chain": the paper's Gazebo bead chain (tether::presets::bead_chain)
+};
+
+/// \brief The controllers' preset (`control.preset`).
+enum class ControlPreset {
+  /// "kelp" (the default): the boat tracks the ROV's velocity and position
+  /// (control::AsvLaw::track), the ROV follows the survey's legs, thrust clip 25 N.
+  kelp,
+  /// "paper": Buchholz et al.'s pursuit with their gains, thrust clip 15 N.
+  paper
+};
+
+/// \brief The names of NavigationMode (`navigation.mode`).
+inline constexpr ChoiceName<NavigationMode> navigation_mode_names[] = {
+    {NavigationMode::perfect, "perfect"}, {NavigationMode::sensors, "sensors"}};
+/// \brief The names of Sea (`sea`; "custom" is written, and read, as an object).
+inline constexpr ChoiceName<Sea> sea_names[] = {{Sea::calm, "calm"},
+                                                {Sea::moderate, "moderate"},
+                                                {Sea::rough, "rough"},
+                                                {Sea::custom, "custom"}};
+/// \brief The names of TetherKind (`tether.kind`).
+inline constexpr ChoiceName<TetherKind> tether_kind_names[] = {
+    {TetherKind::rov_tether, "rov_tether"}, {TetherKind::bead_chain, "bead_chain"}};
+/// \brief The names of ControlPreset (`control.preset`).
+inline constexpr ChoiceName<ControlPreset> control_preset_names[] = {
+    {ControlPreset::kelp, "kelp"}, {ControlPreset::paper, "paper"}};
+/// \brief The names of tether::LineModel (`tether.line_model`).
+inline constexpr ChoiceName<kelp::tether::LineModel> line_model_names[] = {
+    {kelp::tether::LineModel::kelp, "kelp"}, {kelp::tether::LineModel::moordyn, "moordyn"}};
+/// \brief The names of control::WinchStrategy (`tether.winch.strategy`; as
+/// control::winch_strategy_name spells them).
+inline constexpr ChoiceName<kelp::control::WinchStrategy> winch_strategy_names[] = {
+    {kelp::control::WinchStrategy::hold, "hold"},
+    {kelp::control::WinchStrategy::constant_tension, "constant_tension"},
+    {kelp::control::WinchStrategy::slack, "slack"},
+    {kelp::control::WinchStrategy::depth_following, "depth_following"}};
+/// \brief The names of simd::KernelPath (`kernel`; as simd::kernel_name spells them).
+inline constexpr ChoiceName<kelp::simd::KernelPath> kernel_path_names[] = {
+    {kelp::simd::KernelPath::automatic, "auto"},
+    {kelp::simd::KernelPath::portable, "portable"},
+    {kelp::simd::KernelPath::avx2, "avx2"},
+    {kelp::simd::KernelPath::avx512, "avx512"}};
+
+/// \brief A choice's name in scenario files ("invalid" for a value outside the enumeration).
+/// @{
+inline const char* to_string(NavigationMode x) {
+  const char* n = choice_name(x, navigation_mode_names);
+  return n ? n : "invalid";
+}
+inline const char* to_string(Sea x) {
+  const char* n = choice_name(x, sea_names);
+  return n ? n : "invalid";
+}
+inline const char* to_string(TetherKind x) {
+  const char* n = choice_name(x, tether_kind_names);
+  return n ? n : "invalid";
+}
+inline const char* to_string(ControlPreset x) {
+  const char* n = choice_name(x, control_preset_names);
+  return n ? n : "invalid";
+}
+inline const char* to_string(kelp::tether::LineModel x) {
+  const char* n = choice_name(x, line_model_names);
+  return n ? n : "invalid";
+}
+inline const char* to_string(kelp::control::WinchStrategy x) {
+  const char* n = choice_name(x, winch_strategy_names);
+  return n ? n : "invalid";
+}
+inline const char* to_string(kelp::simd::KernelPath x) {
+  const char* n = choice_name(x, kernel_path_names);
+  return n ? n : "invalid";
+}
+/// @}
+
 /// \brief What the controllers navigate by (the scenario's `navigation` object): the true state
-/// ("perfect", the default) or the estimates of kelp::nav's sensors and filters ("sensors").
+/// (NavigationMode::perfect, the default) or the estimates of kelp::nav's sensors and filters.
 struct NavigationSettings {
-  std::string mode = "perfect";  ///< "perfect" or "sensors"
-  std::uint64_t seed = 1;        ///< seed of the sensors' noise
-  PairSensors sensors;           ///< every sensor's parameters (defaults: kelp/nav/sensors.hpp)
+  NavigationMode mode = NavigationMode::perfect;  ///< `mode`: "perfect" or "sensors"
+  std::uint64_t seed = 1;                         ///< seed of the sensors' noise
+  PairSensors sensors;  ///< every sensor's parameters (defaults: kelp/nav/sensors.hpp)
 };
 
 /// \brief A vehicle's battery in a scenario (`"battery": {"auv": {...}, "asv": {...}}`; see
@@ -45,7 +163,7 @@ struct BatteryScenario {
 
 /// \brief The boat's winch of a scenario (`"tether": {"winch": {...}}`): the winch
 /// (kelp::tether::WinchParameters) and its tether management settings
-/// (kelp::control::TetherManagementSettings; the strategy's name is Scenario::winch_strategy).
+/// (kelp::control::TetherManagementSettings; the strategy is Scenario::winch_strategy).
 /// Lengths in m, speeds in m/s, forces in N.
 struct WinchScenario {
   bool enabled = false;  ///< a `winch` object was given
@@ -61,10 +179,10 @@ struct WinchScenario {
 struct Scenario {
   double duration = 120.0;  ///< simulated time [s]
   std::uint64_t seed = 1;   ///< seed of the waves and gusts
-  /// \name Sea: a preset ("calm", "moderate", "rough": the paper's) or "custom" with the values
-  /// below (set by a `sea` object in the file; unused for a preset).
+  /// \name Sea: a preset ("calm", "moderate", "rough": the paper's) or Sea::custom with the
+  /// values below (set by a `sea` object in the file; unused for a preset).
   ///@{
-  std::string sea = "moderate";
+  Sea sea = Sea::moderate;
   double significant_height = 0, peak_period = 0, wave_direction = 0;
   double wind_speed = 0, wind_direction = 0, current_speed = 0, current_direction = 0;
   int wave_components = 64;
@@ -72,18 +190,19 @@ struct Scenario {
   /// \name Tether: its length, its kind ("rov_tether" or "bead_chain") and segment length [m].
   ///@{
   double tether_length = 10.0;
-  std::string tether_kind = "rov_tether";
+  TetherKind tether_kind = TetherKind::rov_tether;
   double segment_length = 0.5;
   ///@}
-  /// \name Cable properties overriding the kind's (unset, i.e. 0 or -1: keep the preset's).
+  /// \name Cable properties overriding the kind's (unset: keep the preset's; see
+  /// tether::TetherParameters for the units).
   ///@{
-  double diameter = 0, mass_per_length = 0, axial_stiffness = 0, internal_damping = -1;
-  double normal_drag = -1, tangential_drag = -1;
+  std::optional<double> diameter, mass_per_length, axial_stiffness, internal_damping;
+  std::optional<double> normal_drag, tangential_drag;
   /// The line model, "kelp" (default) or "moordyn" (MoorDyn v2's: kelp::tether::LineModel).
-  std::string line_model = "kelp";
-  /// Breaking strength [N] (tether::TetherParameters::breaking_strength; 0: never parts; unset,
-  /// -1: the kind's, 1557 N for the rov_tether).
-  double breaking_strength = -1;
+  kelp::tether::LineModel line_model = kelp::tether::LineModel::kelp;
+  /// Breaking strength [N] (tether::TetherParameters::breaking_strength; 0: never parts; unset:
+  /// the kind's, 1557 N for the rov_tether).
+  std::optional<double> breaking_strength;
   ///@}
   /// Redo a tether step whose implicit solve fails with RK4 instead of stopping the run
   /// (system::SystemParameters::explicit_fallback; counted in the summary's
@@ -93,12 +212,12 @@ struct Scenario {
   WinchScenario winch;
   /// Its strategy: "hold", "constant_tension", "slack" or "depth_following" (kept here rather
   /// than in WinchScenario, which GCC 12 then warns about as maybe uninitialised in Scenario{}).
-  std::string winch_strategy = "depth_following";
+  kelp::control::WinchStrategy winch_strategy = kelp::control::WinchStrategy::depth_following;
   /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
-  /// empty: the paper's start, 5 m down astern of the boat).
+  /// unset: the paper's start, 5 m down astern of the boat).
   ///@{
   kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
-  std::vector<double> auv_start;
+  std::optional<kelp::Vector3<double>> auv_start;
   ///@}
   /// \name Start (`"start": {"ramp": 10, "with_water": true}`): the sea (waves, current, wind)
   /// is ramped in over the first `start_ramp` seconds (environment::Environment::set_ramp; 0:
@@ -115,7 +234,7 @@ struct Scenario {
   /// "kelp" (default): the boat tracks the ROV's velocity and position
   /// (control::AsvLaw::track), thrust clip 25 N; "paper": Buchholz et al.'s pursuit with their
   /// gains (`asv_linear`, `asv_angular`, `asv_yaw`: used by this preset only), clip 15 N.
-  std::string control_preset = "kelp";
+  ControlPreset control_preset = ControlPreset::kelp;
   bool compensation = false;
   Gains asv_linear{0.5, 0.1, 0.05}, asv_angular{4.0, 2.0, 1.0}, asv_yaw{2.0, 0.0, 0.5};
   double asv_thrust_clip = 25.0, asv_rate = 10.0;
@@ -139,10 +258,11 @@ struct Scenario {
   /// Write run.mcap, a ROS 2 bag of the run (kelp/sim/ros2.hpp), beside the CSV log.
   bool mcap = true;
   ///@}
-  /// Instruction path of the wave kernel (kelp/core/kernel_path.hpp): "auto" (the process'
-  /// policy, i.e. `KELP_KERNEL`, else the widest the CPU runs), "portable" (the deterministic
-  /// mode: the same bits on every CPU; the file's `"deterministic": true`), "avx2" or "avx512".
-  std::string kernel = "auto";
+  /// Instruction path of the wave kernel (kelp/core/kernel_path.hpp): "auto" (automatic: the
+  /// process' policy, i.e. `KELP_KERNEL`, else the widest the CPU runs), "portable" (the
+  /// deterministic mode: the same bits on every CPU; the file's `"deterministic": true`), "avx2"
+  /// or "avx512".
+  kelp::simd::KernelPath kernel = kelp::simd::KernelPath::automatic;
   /// Navigation: perfect or from sensors.
   NavigationSettings navigation;
   /// \name Propulsion: the thrusters and batteries as part of the system (`"thrusters"`,
@@ -169,14 +289,15 @@ struct Scenario {
   double seabed_depth = std::numeric_limits<double>::infinity();
   /// A height-field seabed (`"seabed": {"heightfield": "file"}` in MoorDyn's seafloor format,
   /// kelp::sim::load_heightfield, a path relative to the scenario file; or inline,
-  /// `{"origin": [n, e], "spacing": [dn, de], "size": [rows, cols], "depth": [...]}`).
-  bool has_heightfield = false;
-  kelp::environment::HeightField heightfield;
+  /// `{"origin": [n, e], "spacing": [dn, de], "size": [rows, cols], "depth": [...]}`); unset:
+  /// none.
+  std::optional<kelp::environment::HeightField> heightfield;
   /// The height field's file as the scenario names it (empty: given inline).
   std::string heightfield_file;
   /// Seabed Coulomb friction μ of the tether on the seabed, flat or height field
-  /// (`"seabed": {"friction": μ}`; tether::TetherParameters::seabed_friction); -1: the tether's.
-  double seabed_friction = -1;
+  /// (`"seabed": {"friction": μ}`; tether::TetherParameters::seabed_friction); unset: the
+  /// tether's.
+  std::optional<double> seabed_friction;
   ///@}
   /// The thresholds of the tether's entanglement events (`"entanglement": {"wrap_threshold":
   /// rad, "wrap_hysteresis": rad, "contact_margin": m, "pin_slip_speed": m/s,

@@ -122,7 +122,7 @@ struct NavigationErrorsSummary {
 
 /// \brief What the controllers navigated by (`navigation`).
 struct NavigationSummary {
-  std::string mode = "perfect";                   ///< "perfect" or "sensors"
+  NavigationMode mode = NavigationMode::perfect;  ///< "perfect" or "sensors" (to_string)
   std::optional<NavigationErrorsSummary> errors;  ///< with "sensors"
 };
 

@@ -42,7 +42,7 @@ int main() {
     "output": {"log_rate": 5, "node_rate": 1}})";
 
   const kelp::sim::Scenario sc = kelp::sim::load_scenario(file);
-  check(sc.duration == 10.0 && sc.sea == "calm" && sc.segment_length == 1.0,
+  check(sc.duration == 10.0 && sc.sea == kelp::sim::Sea::calm && sc.segment_length == 1.0,
         "the scenario file was not read as written");
 
   kelp::sim::RunLog log(dir);

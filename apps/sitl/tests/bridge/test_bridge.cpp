@@ -53,7 +53,7 @@ struct Fixture {
   }
   static kelp::sim::Scenario calm() {
     kelp::sim::Scenario s;
-    s.sea = "calm";
+    s.sea = kelp::sim::Sea::calm;
     return s;
   }
   static BridgeSettings settings(bool together) {
@@ -293,7 +293,7 @@ TEST_CASE("calm start: the ROV resting in the default world reads about g in its
   CHECK(calm < 3.0);
   // The same at the surface (the default world's start before the ROV went 8 m down), where the
   // waves act most.
-  sc.auv_start = {-4.0, 0.0, 0.3};
+  sc.auv_start = kelp::Vector3<double>(-4.0, 0.0, 0.3);
   const double surface = worst(sc);
   INFO("worst |f - g| starting at the surface: " << surface << " m/s^2");
   CHECK(surface < 3.0);
