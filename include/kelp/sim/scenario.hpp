@@ -39,13 +39,14 @@ struct ChoiceName {
   const char* name;  ///< its name in scenario files
 };
 
-/// \brief The name of `value` in the table `names`, or nullptr when the table lacks it (a value
-/// cast from an integer).
+/// \brief The name of `value` in the table `names`, or `unknown` (by default nullptr) when the
+/// table lacks it (a value cast from an integer).
 template <class E, std::size_t N>
-constexpr const char* choice_name(E value, const ChoiceName<E> (&names)[N]) {
+constexpr const char* choice_name(E value, const ChoiceName<E> (&names)[N],
+                                  const char* unknown = nullptr) {
   for (const ChoiceName<E>& n : names)
     if (n.value == value) return n.name;
-  return nullptr;
+  return unknown;
 }
 
 /// \brief What the controllers navigate by (the scenario's `navigation.mode`).
@@ -114,32 +115,21 @@ inline constexpr ChoiceName<kelp::simd::KernelPath> kernel_path_names[] = {
 /// \brief A choice's name in scenario files ("invalid" for a value outside the enumeration).
 /// @{
 inline const char* to_string(NavigationMode x) {
-  const char* n = choice_name(x, navigation_mode_names);
-  return n ? n : "invalid";
+  return choice_name(x, navigation_mode_names, "invalid");
 }
-inline const char* to_string(Sea x) {
-  const char* n = choice_name(x, sea_names);
-  return n ? n : "invalid";
-}
-inline const char* to_string(TetherKind x) {
-  const char* n = choice_name(x, tether_kind_names);
-  return n ? n : "invalid";
-}
+inline const char* to_string(Sea x) { return choice_name(x, sea_names, "invalid"); }
+inline const char* to_string(TetherKind x) { return choice_name(x, tether_kind_names, "invalid"); }
 inline const char* to_string(ControlPreset x) {
-  const char* n = choice_name(x, control_preset_names);
-  return n ? n : "invalid";
+  return choice_name(x, control_preset_names, "invalid");
 }
 inline const char* to_string(kelp::tether::LineModel x) {
-  const char* n = choice_name(x, line_model_names);
-  return n ? n : "invalid";
+  return choice_name(x, line_model_names, "invalid");
 }
 inline const char* to_string(kelp::control::WinchStrategy x) {
-  const char* n = choice_name(x, winch_strategy_names);
-  return n ? n : "invalid";
+  return choice_name(x, winch_strategy_names, "invalid");
 }
 inline const char* to_string(kelp::simd::KernelPath x) {
-  const char* n = choice_name(x, kernel_path_names);
-  return n ? n : "invalid";
+  return choice_name(x, kernel_path_names, "invalid");
 }
 /// @}
 
