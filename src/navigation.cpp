@@ -1,5 +1,7 @@
 #include "kelp/sim/navigation.hpp"
 
+#include "kelp/sim/instantiation.hpp"  // the wave kernels: instantiated once, in instantiation.cpp
+
 #include <algorithm>
 #include <cmath>
 

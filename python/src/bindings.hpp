@@ -8,6 +8,10 @@
 // (learning.cpp), each defined there as an empty function until filled.
 #pragma once
 
+// The double-precision system, tether step and wave kernels the module binds are kelp::sim's,
+// compiled once in the library (declared extern here), not again in each of the module's units.
+#include "kelp/sim/instantiation.hpp"
+
 #include <pybind11/pybind11.h>
 
 namespace kelp_python {

@@ -1,16 +1,20 @@
 /// \file
 /// \brief The double-precision coupled system that kelp::sim runs, instantiated once in the
 /// compiled library (src/instantiation.cpp): a program on kelp::sim that calls
-/// `kelp::system::step`, `initial_state` or `energy` on doubles, or samples the sea's waves,
-/// links the library's code instead of compiling the system's templates and the wave kernel's
+/// `kelp::system::step`, `initial_state` or `energy` on doubles, steps a tether alone
+/// (`kelp::tether::step`, `advance`) in kelp's Environment, or samples the sea's waves, links the
+/// library's code instead of compiling the system's templates and the wave kernel's
 /// instruction sets again (Pinocchio's explicit-instantiation pattern; the classes' inline
 /// members are left to the compiler). kelp::kelp stays header-only for every scalar: these
 /// declarations are kelp::sim's, seen only by its consumers, who link it.
 #pragma once
 
+#include "kelp/environment/environment.hpp"
 #include "kelp/environment/wave_kernels.hpp"
 #include "kelp/sim/export.hpp"
 #include "kelp/system/system.hpp"
+#include "kelp/tether/driver.hpp"
 
 KELP_WAVE_KERNEL_INSTANCES(extern template KELP_SIM_API)
 KELP_SYSTEM_INSTANCES(extern template KELP_SIM_API)
+KELP_TETHER_INSTANCES(extern template KELP_SIM_API)

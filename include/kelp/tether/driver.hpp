@@ -135,3 +135,22 @@ using AdvanceOptionsd = AdvanceOptions<double>;  ///< AdvanceOptions<double>
 using AdvanceOptionsf = AdvanceOptions<float>;   ///< AdvanceOptions<float>
 
 }  // namespace kelp::tether
+
+/// \brief The double-precision tether step and sub-stepping driver in kelp's Environment, for a
+/// compiled layer that instantiates them once: `KELP_TETHER_INSTANCES(template)` in one unit,
+/// `KELP_TETHER_INSTANCES(extern template)` wherever they are called (kelp::sim does:
+/// kelp/sim/instantiation.hpp; the expansion needs kelp/environment/environment.hpp). `prefix`
+/// may carry attributes after `template`.
+#define KELP_TETHER_INSTANCES(prefix)                                                    \
+  prefix kelp::tether::StepReport<double>                                                \
+  kelp::tether::step<double, kelp::environment::Environment<double>>(                    \
+      const kelp::tether::TetherModel<double>&, kelp::tether::TetherWorkspace<double>&,  \
+      const kelp::environment::Environment<double>&, kelp::tether::TetherState<double>&, \
+      const kelp::tether::TetherBoundary<double>&, double,                               \
+      const kelp::tether::StepOptions<double>&);                                         \
+  prefix kelp::tether::StepReport<double>                                                \
+  kelp::tether::advance<double, kelp::environment::Environment<double>>(                 \
+      const kelp::tether::TetherModel<double>&, kelp::tether::TetherWorkspace<double>&,  \
+      const kelp::environment::Environment<double>&, kelp::tether::TetherState<double>&, \
+      const kelp::tether::TetherBoundary<double>&, double,                               \
+      const kelp::tether::AdvanceOptions<double>&);
