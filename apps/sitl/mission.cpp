@@ -23,10 +23,12 @@ int main(int argc, char** argv) {
   app.add_option("--sub", o.sub, "ArduSub link, tcp:HOST:PORT, or none")->capture_default_str();
   app.add_option("--rover", o.rover, "ArduRover (boat) link, tcp:HOST:PORT, or none")
       ->capture_default_str();
-  app.add_option("--depth", o.depth, "target depth, m")
+  app.add_option("--depth", o.depth,
+                 "target depth below the sea surface, m (ArduSub's altitude, negated)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  app.add_option("--depth-tolerance", o.depth_tolerance, "the dive ends this far above --depth, m")
+  app.add_option("--depth-tolerance", o.depth_tolerance,
+                 "the dive (or the rise from deeper) ends this far short of --depth, m")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--hold", o.hold, "time holding depth in ALT_HOLD, s")
@@ -70,7 +72,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--dive-throttle", o.dive_throttle,
-                 "MANUAL_CONTROL z while diving (0..499; 500 is neutral)")
+                 "MANUAL_CONTROL z while diving (0..499; 500 is neutral; 1000 minus it "
+                 "while rising to --depth from deeper)")
       ->capture_default_str()
       ->check(CLI::Range(0, 499));
   CLI11_PARSE(app, argc, argv);

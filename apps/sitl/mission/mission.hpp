@@ -12,7 +12,10 @@
 // an unexpected disarm or a mode change kelp-mission did not command (a failsafe, a pilot) ends
 // the mission with a message naming the vehicle, the command and the MAV_RESULT, an attempt to
 // leave both vehicles safe, and exit code 1. Failsafes (HEARTBEAT system_status CRITICAL or
-// EMERGENCY) are reported as they happen and counted in the summary printed at the end.
+// EMERGENCY once the vehicle was armed, or with a STATUSTEXT naming a failsafe) are reported as
+// they happen and counted in the summary printed at the end; the same states while disarmed
+// before the first arming are the autopilot's start-up (ArduSub's first seconds) and are
+// reported apart.
 //
 // Two clocks. A SITL runs at --speedup times real time (or slower, when the lockstep with the
 // physics cannot keep up), and its failsafes count in its own time: ArduRover's GCS failsafe
@@ -26,6 +29,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -50,8 +54,10 @@ namespace kelp_sitl::mission {
 struct Options {
   std::string sub = "tcp:127.0.0.1:5760";    // ArduSub SERIAL0; "none": no AUV
   std::string rover = "tcp:127.0.0.1:5770";  // ArduRover SERIAL0 (-I1); "none": no boat
-  double depth = 5.0;  // m, target depth (LOCAL_POSITION_NED z, down from the EKF origin)
-  double depth_tolerance = 0.05;  // m: the dive ends at depth - tolerance
+  // m below the sea surface, as ArduSub reports it (Vehicle::depth(): its altitude above mean
+  // sea level, negated; not LOCAL_POSITION_NED z, which counts from wherever its EKF started)
+  double depth = 5.0;
+  double depth_tolerance = 0.05;  // m: the dive ends this far short of --depth
   double hold = 60.0;             // s in ALT_HOLD at depth
   double survey_side = 10.0;      // m, side of the square (0: no survey)
   double survey_radius = 1.0;     // m: a corner counts as reached within this horizontal distance
@@ -65,7 +71,8 @@ struct Options {
   double leg_timeout = 120.0;       // s of the sub's clock per side of the square
   double retry_interval = 3.0;      // s between repeats of a refused or unanswered command
   double link_timeout = 5.0;        // wall s without HEARTBEAT during the mission: link lost
-  int dive_throttle = 300;          // MANUAL_CONTROL z while diving (0..1000, 500 neutral)
+  int dive_throttle = 300;  // MANUAL_CONTROL z while diving (0..1000, 500 neutral); 1000 minus
+                            // it while rising to --depth from below
 };
 
 struct MissionError : std::runtime_error {
@@ -99,8 +106,23 @@ struct Vehicle {
   std::vector<std::string> events;                // mode changes not commanded, failsafes
   int uncommanded_mode_changes = 0;
   int failsafes = 0;
+  // CRITICAL / EMERGENCY states reported while disarmed before kelp-mission first armed the
+  // vehicle and with no failsafe STATUSTEXT: start-up states, reported apart from failsafes.
+  int boot_states = 0;
+  std::vector<std::string> boot_events;
+  bool was_armed = false;  // armed by kelp-mission at least once
 
   bool armed() const { return (heartbeat.base_mode & mavlink::kModeFlagSafetyArmed) != 0; }
+  // Depth below the mean sea surface as the autopilot reports it, m (down positive), from
+  // GLOBAL_POSITION_INT's altitude above mean sea level. ArduSub's altitude is its depth sensor's
+  // (water pressure against BARO1_GND_PRESS, the surface pressure in params/), so this is the
+  // depth from the surface wherever the vehicle was when its EKF started; LOCAL_POSITION_NED z
+  // counts from that start (the EKF origin), which is under water after a submerged start. The
+  // home altitude must be 0, the sea surface (README).
+  std::optional<double> depth() const {
+    if (!global) return std::nullopt;
+    return -global->alt / 1000.0;
+  }
   bool is_sub() const { return heartbeat.type == mavlink::kTypeSubmarine; }
   // The vehicle's clock in s, or "?" while unknown (for messages).
   std::string clock_text() const {
@@ -304,16 +326,16 @@ class Mission {
             std::to_string(v->heartbeat.custom_mode) + (v->armed() ? ", armed" : ", disarmed"));
     }
     if (sub_) {
-      // ArduSub sends LOCAL_POSITION_NED only once its EKF has a position (after GPS lock, tens
-      // of seconds after boot; seen with ArduSub SITL). Without it the dive could not be stopped
-      // at the depth. Waiting before arming keeps the sub disarmed (floating at the surface)
-      // meanwhile, and the EKF origin (z = 0) is set at the surface.
-      phase("sub: waiting for a position estimate (LOCAL_POSITION_NED)");
-      wait_for([&] { return sub_->local.has_value(); }, opt_.position_timeout,
-               "sub: no LOCAL_POSITION_NED within " + fmt(opt_.position_timeout) +
-                   " s (no position estimate: GPS? EKF?)");
+      // ArduSub sends LOCAL_POSITION_NED and GLOBAL_POSITION_INT only once its EKF has a
+      // position (after GPS lock, tens of seconds after boot; seen with ArduSub SITL). Without
+      // them the dive could not be stopped at the depth nor the survey flown.
+      phase("sub: waiting for a position estimate (LOCAL_POSITION_NED, GLOBAL_POSITION_INT)");
+      wait_for([&] { return sub_->local && sub_->global; }, opt_.position_timeout,
+               "sub: no LOCAL_POSITION_NED and GLOBAL_POSITION_INT within " +
+                   fmt(opt_.position_timeout) + " s (no position estimate: GPS? EKF?)");
       phase("sub: position (" + fmt(sub_->local->x) + ", " + fmt(sub_->local->y) + ", " +
-            fmt(sub_->local->z) + ") m NED");
+            fmt(sub_->local->z) + ") m NED from its EKF origin; depth " + fmt(*sub_->depth()) +
+            " m");
     }
     for (Vehicle* v : vehicles()) {
       phase(v->name + ": arming");
@@ -327,20 +349,27 @@ class Mission {
     }
     if (!sub_) return;
 
-    phase("sub: diving to " + fmt(opt_.depth) + " m (ALT_HOLD, throttle " +
-          std::to_string(opt_.dive_throttle) + ")");
-    manual_z_ = static_cast<std::int16_t>(opt_.dive_throttle);
-    const double target = opt_.depth - opt_.depth_tolerance;
+    // Down with the stick below neutral, or up with it as far above when the sub is deeper than
+    // the target (a submerged start), until it is within the tolerance of the target.
+    const bool rise = *sub_->depth() > opt_.depth + opt_.depth_tolerance;
+    const int throttle = rise ? 1000 - opt_.dive_throttle : opt_.dive_throttle;
+    phase("sub: " + std::string(rise ? "rising" : "diving") + " to " + fmt(opt_.depth) +
+          " m from " + fmt(*sub_->depth()) + " m (ALT_HOLD, throttle " + std::to_string(throttle) +
+          ")");
+    manual_z_ = static_cast<std::int16_t>(throttle);
+    const auto arrived = [&] {
+      const double d = *sub_->depth();
+      return rise ? d <= opt_.depth + opt_.depth_tolerance : d >= opt_.depth - opt_.depth_tolerance;
+    };
     wait_for_clock(
-        *sub_, [&] { return sub_->local && sub_->local->z >= target; }, opt_.dive_timeout,
+        *sub_, arrived, opt_.dive_timeout,
         [&] {
           return "sub: did not reach " + fmt(opt_.depth) + " m within " + fmt(opt_.dive_timeout) +
-                 " s (depth " +
-                 (sub_->local ? fmt(sub_->local->z) + " m" : std::string("unknown")) + ")";
+                 " s (depth " + fmt(*sub_->depth()) + " m)";
         },
-        [&] { return "depth " + (sub_->local ? fmt(sub_->local->z) : "?") + " m"; });
+        [&] { return "depth " + fmt(*sub_->depth()) + " m"; });
     manual_z_ = kNeutralZ;
-    phase("sub: at " + fmt(sub_->local->z) + " m; holding depth for " + fmt(opt_.hold) + " s");
+    phase("sub: at " + fmt(*sub_->depth()) + " m; holding depth for " + fmt(opt_.hold) + " s");
     hold_depth(*sub_, opt_.hold);
 
     if (opt_.survey_side > 0.0) survey();
@@ -350,6 +379,9 @@ class Mission {
   void survey() {
     set_mode(*sub_, mavlink::sub_mode::kGuided, "GUIDED");
     const double x0 = sub_->local->x, y0 = sub_->local->y, s = opt_.survey_side;
+    // LOCAL_POSITION_NED counts from the EKF origin, which may lie under water: the target
+    // depth in that frame is --depth less the origin's depth (depth - local z, now).
+    const double local_z = opt_.depth - (*sub_->depth() - sub_->local->z);
     const std::array<std::array<double, 2>, 4> corners{
         {{x0 + s, y0}, {x0 + s, y0 + s}, {x0, y0 + s}, {x0, y0}}};
     double from_x = x0, from_y = y0;
@@ -363,7 +395,7 @@ class Mission {
       mavlink::SetPositionTargetLocalNed t;
       t.x = static_cast<float>(tx);
       t.y = static_cast<float>(ty);
-      t.z = static_cast<float>(opt_.depth);
+      t.z = static_cast<float>(local_z);
       t.yaw = yaw;
       t.type_mask = mavlink::kTypeMaskPositionYaw;
       t.coordinate_frame = mavlink::kFrameLocalNed;
@@ -434,6 +466,7 @@ class Mission {
              v.name + ": " + (on ? "arm" : "disarm") +
                  " was accepted but the HEARTBEAT does not show it");
     v.expect_armed = on;
+    v.was_armed = v.was_armed || on;
     v.armed_since = Clock::now();
   }
 
@@ -575,24 +608,24 @@ class Mission {
   }
 
   // Holds depth for `duration` s of the vehicle's own clock (time_boot_ms of its
-  // LOCAL_POSITION_NED), so that the hold lasts the same simulated time at any SITL --speedup;
+  // GLOBAL_POSITION_INT), so that the hold lasts the same simulated time at any SITL --speedup;
   // reports the depth range seen. Gives up after 10 × duration + 60 s of wall time (a SITL in
   // lockstep with a loaded machine may run well below real time; a lost link is caught sooner).
   void hold_depth(Vehicle& v, double duration) {
     const auto wall_end = Clock::now() + seconds(10.0 * duration + 60.0);
     auto next_status = Clock::now() + std::chrono::seconds(5);
-    const std::uint32_t t0 = v.local->time_boot_ms;
-    double lo = v.local->z, hi = v.local->z;
+    const std::uint32_t t0 = v.global->time_boot_ms;
+    double lo = *v.depth(), hi = lo;
     while (Clock::now() < wall_end) {
-      lo = std::min(lo, static_cast<double>(v.local->z));
-      hi = std::max(hi, static_cast<double>(v.local->z));
-      if (v.local->time_boot_ms - t0 >= static_cast<std::uint32_t>(duration * 1000.0)) {
+      lo = std::min(lo, *v.depth());
+      hi = std::max(hi, *v.depth());
+      if (v.global->time_boot_ms - t0 >= static_cast<std::uint32_t>(duration * 1000.0)) {
         phase(v.name + ": held depth between " + fmt(lo) + " and " + fmt(hi) + " m for " +
               fmt(duration) + " s of its clock");
         return;
       }
       if (Clock::now() >= next_status) {
-        phase("  depth " + fmt(v.local->z) + " m");
+        phase("  depth " + fmt(*v.depth()) + " m");
         next_status += std::chrono::seconds(5);
       }
       spin(std::min(wall_end, next_status));
@@ -729,11 +762,20 @@ class Mission {
     const std::string text =
         v.last_text.empty() ? "" : "; last STATUSTEXT: \"" + v.last_text + "\"";
     if (failsafe(v.heartbeat.system_status) && (first || !failsafe(before.system_status))) {
-      ++v.failsafes;
-      v.events.push_back(v.name + ": failsafe (HEARTBEAT system_status " +
-                         (v.heartbeat.system_status == 5 ? "CRITICAL" : "EMERGENCY") + ")" + at +
-                         text);
-      phase(v.events.back());
+      const std::string state = v.heartbeat.system_status == 5 ? "CRITICAL" : "EMERGENCY";
+      if (v.armed() || v.was_armed || failsafe_text(v.last_text)) {
+        ++v.failsafes;
+        v.events.push_back(v.name + ": failsafe (HEARTBEAT system_status " + state + ")" + at +
+                           text);
+        phase(v.events.back());
+      } else {
+        // Disarmed, never armed by kelp-mission, and no failsafe message: an autopilot's
+        // start-up state (ArduSub reports CRITICAL for its first seconds while its pilot-input
+        // failsafe, set at boot, and its EKF checks clear), not a failsafe.
+        ++v.boot_states;
+        v.boot_events.push_back(state + at + " (disarmed, before arming)" + text);
+        phase(v.name + ": " + state + " before arming" + at + " (a start-up state)" + text);
+      }
     }
     if (first || !v.commanded_mode || v.changing_mode) return;
     const std::uint32_t mode = v.heartbeat.custom_mode;
@@ -766,7 +808,21 @@ class Mission {
            << (v->clock_ms ? "; its clock at " + v->clock_text() + " s" : std::string())
            << std::endl;
       for (const std::string& e : v->events) out_ << "  " << e << std::endl;
+      if (v->boot_states > 0) {
+        out_ << v->name << ": " << v->boot_states
+             << " CRITICAL/EMERGENCY states at start-up, disarmed (not failsafes):" << std::endl;
+        for (const std::string& e : v->boot_events) out_ << "  " << e << std::endl;
+      }
     }
+  }
+
+  // A STATUSTEXT that names a failsafe (ArduPilot's are "Failsafe...", "... failsafe ...":
+  // ArduSub/failsafe.cpp, Rover/failsafe.cpp, GCS_Common.cpp).
+  static bool failsafe_text(const std::string& text) {
+    std::string lower(text);
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return lower.find("failsafe") != std::string::npos;
   }
 
   static std::string fmt(double x) {

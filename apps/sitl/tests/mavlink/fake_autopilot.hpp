@@ -52,6 +52,14 @@ struct FakeConfig {
   double gcs_failsafe_timeout = -1.0;   // s of its clock without GCS HEARTBEAT (< 0: none)
   double failsafe_after_guided = -1.0;  // s of its clock in GUIDED, then failsafe (< 0: never)
   std::uint32_t failsafe_mode = 4;      // Rover HOLD
+  // s of its clock during which it reports system_status CRITICAL while disarmed, with no
+  // STATUSTEXT, as ArduSub does at start-up (its pilot-input failsafe is set at boot).
+  double boot_critical = 0.0;
+  // Depth (m, down) where the vehicle starts, and where its EKF origin is: LOCAL_POSITION_NED z
+  // counts from the origin, GLOBAL_POSITION_INT's altitude from the sea surface (as ArduSub's,
+  // whose EKF origin is wherever the vehicle was when its EKF started).
+  double start_depth = 0.0;
+  double origin_depth = 0.0;
 };
 
 // What the fake received.
@@ -73,7 +81,7 @@ struct FakeRecord {
 
 class FakeAutopilot {
  public:
-  explicit FakeAutopilot(FakeConfig cfg) : cfg_(cfg), mode_(cfg.initial_mode) {
+  explicit FakeAutopilot(FakeConfig cfg) : cfg_(cfg), mode_(cfg.initial_mode), z_(cfg.start_depth) {
     listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     const int one = 1;
     ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
@@ -104,7 +112,7 @@ class FakeAutopilot {
     std::lock_guard<std::mutex> lock(mutex_);
     return record_;
   }
-  // The simulated position (NED m from the origin).
+  // The simulated position (NED m: north and east from the origin, z the true depth).
   std::array<double, 3> position() {
     std::lock_guard<std::mutex> lock(mutex_);
     return {x_, y_, z_};
@@ -153,6 +161,7 @@ class FakeAutopilot {
       step(cfg_.clock_speed * std::chrono::duration<double>(now - last).count());
       last = now;
       check_failsafes(clock(now));
+      clock_s_ = clock(now);
       if (now >= next_hb) {
         send_heartbeat();
         next_hb = now + std::chrono::duration_cast<Clock::duration>(
@@ -181,7 +190,8 @@ class FakeAutopilot {
     hb.type = cfg_.mav_type;
     hb.autopilot = mv::kAutopilotArdupilotmega;
     hb.base_mode = static_cast<std::uint8_t>(81 | (armed_ ? 128 : 0));
-    hb.system_status = failsafe_ ? 5 : armed_ ? 4 : 3;  // CRITICAL, ACTIVE, STANDBY
+    // CRITICAL, ACTIVE, STANDBY
+    hb.system_status = failsafe_ || (!armed_ && clock_s_ < cfg_.boot_critical) ? 5 : armed_ ? 4 : 3;
     send(hb);
   }
 
@@ -220,7 +230,7 @@ class FakeAutopilot {
       lp.time_boot_ms = gp.time_boot_ms = att.time_boot_ms = st.time_boot_ms = t_ms;
       lp.x = static_cast<float>(x_);
       lp.y = static_cast<float>(y_);
-      lp.z = static_cast<float>(z_);
+      lp.z = static_cast<float>(z_ - cfg_.origin_depth);
       const double deg_per_m = 1.0 / 111319.49;
       gp.lat = static_cast<std::int32_t>(std::lround((cfg_.origin_lat + x_ * deg_per_m) * 1e7));
       gp.lon = static_cast<std::int32_t>(std::lround(
@@ -248,7 +258,7 @@ class FakeAutopilot {
         x_ += dx / d * move;
         y_ += dy / d * move;
       }
-      if (sub) z_ += std::clamp(tz_ - z_, -cfg_.speed * dt, cfg_.speed * dt);
+      if (sub) z_ += std::clamp(tz_ + cfg_.origin_depth - z_, -cfg_.speed * dt, cfg_.speed * dt);
     }
   }
 
@@ -336,12 +346,14 @@ class FakeAutopilot {
   bool armed_ = false;
   int arm_refused_ = 0;
   std::int16_t manual_z_ = 500;
-  double x_ = 0, y_ = 0, z_ = 0, yaw_ = 0;
-  double tx_ = 0, ty_ = 0, tz_ = 0;
+  double x_ = 0, y_ = 0, yaw_ = 0;
+  double z_;                         // true depth, m
+  double tx_ = 0, ty_ = 0, tz_ = 0;  // tz_: in LOCAL_POSITION_NED's frame
   bool have_target_ = false;
   bool position_sent_ = false;
   bool failsafe_ = false;
   double last_gcs_heartbeat_ = -1.0;  // its clock, s
+  double clock_s_ = 0.0;              // its clock, s, at the last round
   double guided_since_ = -1.0;        // its clock at the last mode change, s
 };
 

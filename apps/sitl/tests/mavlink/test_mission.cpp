@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -146,7 +147,7 @@ TEST_CASE("kelp-mission flies the whole mission against fake autopilots", "[miss
   for (const auto& t : s.local_targets) {
     CHECK(t.coordinate_frame == mv::kFrameLocalNed);
     CHECK(t.type_mask == 2552);
-    CHECK(t.z == Approx(2.0f));
+    CHECK(t.z == Approx(2.0).margin(0.005));  // the depth, in mm in GLOBAL_POSITION_INT
     CHECK(t.target_system == 1);
     if (yaws.empty() || yaws.back() != t.yaw) yaws.push_back(t.yaw);
   }
@@ -356,4 +357,73 @@ TEST_CASE("kelp-mission's summary tells ignored message types from malformed fra
                    "length, 0 bad flags, ") != std::string::npos);
   CHECK(r.out.find("unknown messages") == std::string::npos);
   std::filesystem::remove_all(o.log_dir);
+}
+
+// ArduSub reports system_status CRITICAL for its first seconds after boot, disarmed and with no
+// STATUSTEXT (its pilot-input failsafe is set at start-up until a pilot is heard). That is not
+// a failsafe: the summary reports it apart, and the mission goes on. A CRITICAL state once the
+// vehicle is armed still is one (the test above).
+TEST_CASE("kelp-mission: CRITICAL at start-up, disarmed, is not a failsafe", "[mission]") {
+  FakeConfig sub_cfg;
+  sub_cfg.boot_critical = 1.0;   // s of its clock
+  sub_cfg.position_after = 1.5;  // arming waits for the position, after the start-up state
+  FakeAutopilot sub(sub_cfg);
+  Options o = short_options("boot");
+  o.sub = sub.endpoint();
+  o.rover = "none";
+  o.survey_side = 0.0;
+  const Run r = run_mission(o);
+  INFO(r.out);
+  INFO(r.err);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("sub: 0 mode changes not commanded by kelp-mission, 0 failsafes") !=
+        std::string::npos);
+  CHECK(r.out.find("sub: 1 CRITICAL/EMERGENCY states at start-up, disarmed (not failsafes)") !=
+        std::string::npos);
+  CHECK(r.out.find("CRITICAL before arming at ") != std::string::npos);
+  CHECK(r.out.find("failsafe (HEARTBEAT") == std::string::npos);
+  std::filesystem::remove_all(o.log_dir);
+}
+
+// ArduSub's LOCAL_POSITION_NED counts from its EKF origin, set wherever the ROV was when its EKF
+// started: 5.75 m down after a submerged start, the ROV having risen to 2.4 m by arming (as in a
+// live run). The dive, the hold and the survey's depth go by the depth below the surface, so the
+// ROV ends at the target depth, not 5.75 m deeper. From below the target it rises to it.
+TEST_CASE("kelp-mission dives to the depth below the surface, not below the EKF origin",
+          "[mission]") {
+  struct Case {
+    double start, origin;
+  };
+  for (const Case c : {Case{2.4, 5.75}, Case{8.0, 8.0}}) {
+    INFO("start " << c.start << " m, EKF origin " << c.origin << " m");
+    FakeConfig sub_cfg;
+    sub_cfg.start_depth = c.start;
+    sub_cfg.origin_depth = c.origin;
+    FakeAutopilot sub(sub_cfg);
+    Options o = short_options("origin");
+    o.sub = sub.endpoint();
+    o.rover = "none";
+    o.depth = 5.0;
+    o.depth_tolerance = 0.05;
+    const Run r = run_mission(o);
+    INFO(r.out);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find(c.start < 5.0 ? "sub: diving to 5 m from 2.40 m"
+                                   : "sub: rising to 5 m from 8 m") != std::string::npos);
+    // The depth held after the dive, and the survey flown at it (GUIDED targets in the EKF's
+    // frame: 5 m less the origin's depth).
+    const auto held = r.out.find("sub: held depth between ");
+    REQUIRE(held != std::string::npos);
+    double lo = 0, hi = 0;
+    REQUIRE(std::sscanf(r.out.c_str() + held, "sub: held depth between %lf and %lf", &lo, &hi) ==
+            2);
+    CHECK(lo >= 4.9);
+    CHECK(hi <= 5.1);
+    const auto rec = sub.record();
+    REQUIRE(rec.local_targets.size() >= 4);
+    for (const auto& t : rec.local_targets) CHECK(t.z == Approx(5.0 - c.origin).margin(0.1));
+    CHECK(sub.position()[2] == Approx(5.0).margin(0.1));
+    std::filesystem::remove_all(o.log_dir);
+  }
 }
