@@ -16,7 +16,8 @@
 //   COMMAND_ACK to arm/disarm and set-mode; a kinematic vehicle (ALT_HOLD follows
 //   MANUAL_CONTROL z, GUIDED goes to the last target); the GCS failsafe (HOLD for the boat,
 //   MANUAL for the sub, system_status CRITICAL, STATUSTEXT) after FS_GCS_TIMEOUT s of its clock
-//   without a GCS HEARTBEAT.
+//   without a GCS HEARTBEAT; the ROV's depth read as ArduSub reads SITL's pressure, with the
+//   BARO_SPEC_GRAV of the --defaults files (its true depth in true_depth.txt, for the test).
 //
 // The test alone gives --json-port / --mavlink-port (ephemeral ports: tests never take the
 // fixed SITL ports a running kelp-sitl may hold). It is not a flight model: the PWM it sends
@@ -115,7 +116,8 @@ Args parse(int argc, char** argv) {
 }
 
 // NAME VALUE lines, # comments (ArduPilot's parameter file format).
-void read_params(const std::string& file, double& fs_gcs_enable, double& fs_gcs_timeout) {
+void read_params(const std::string& file, double& fs_gcs_enable, double& fs_gcs_timeout,
+                 double& spec_grav) {
   std::ifstream in(file);
   if (!in) fail("cannot read --defaults file " + file);
   for (std::string line; std::getline(in, line);) {
@@ -125,13 +127,15 @@ void read_params(const std::string& file, double& fs_gcs_enable, double& fs_gcs_
     if (!(ls >> name) || name[0] == '#' || !(ls >> value)) continue;
     if (name == "FS_GCS_ENABLE") fs_gcs_enable = value;
     if (name == "FS_GCS_TIMEOUT") fs_gcs_timeout = value;
+    if (name == "BARO_SPEC_GRAV") spec_grav = value;
   }
 }
 
 class Fake {
  public:
   explicit Fake(const Args& a) : a_(a), mode_(a.sub ? 19u : 0u) {
-    for (const std::string& f : a.defaults) read_params(f, fs_gcs_enable_, fs_gcs_timeout_);
+    for (const std::string& f : a.defaults)
+      read_params(f, fs_gcs_enable_, fs_gcs_timeout_, spec_grav_);
     std::ofstream("eeprom.bin", std::ios::binary) << std::string(16384, '\0');
   }
 
@@ -268,7 +272,7 @@ class Fake {
         y_ += dy / d * move;
         yaw_ = std::atan2(dy, dx);
       }
-      if (a_.sub) z_ += std::clamp(target_[2] - z_, -dt, dt);
+      if (a_.sub) z_ += std::clamp(target_[2] / reading_per_metre() - z_, -dt, dt);
     }
     if (fs_gcs_enable_ != 0 && armed_ && !failsafe_ && last_gcs_ >= 0 &&
         t_ - last_gcs_ > fs_gcs_timeout_) {
@@ -288,6 +292,7 @@ class Fake {
     }
     if (t_ >= 1.0 && t_ >= next_state_) {
       next_state_ = t_ + 0.1;
+      if (a_.sub) std::ofstream("true_depth.txt") << z_ << "\n";  // for the test
       const auto ms = static_cast<std::uint32_t>(std::lround(t_ * 1000.0));
       mv::SystemTime st;
       st.time_boot_ms = ms;
@@ -300,14 +305,14 @@ class Fake {
       lp.time_boot_ms = ms;
       lp.x = static_cast<float>(x_);
       lp.y = static_cast<float>(y_);
-      lp.z = static_cast<float>(z_);
+      lp.z = static_cast<float>(depth_reading());
       send(lp);
       mv::GlobalPositionInt gp;
       gp.time_boot_ms = ms;
       gp.lat = static_cast<std::int32_t>(std::lround((a_.lat + x_ * kDegPerM) * 1e7));
       gp.lon = static_cast<std::int32_t>(
           std::lround((a_.lon + y_ * kDegPerM / std::cos(a_.lat * kPi / 180.0)) * 1e7));
-      gp.alt = gp.relative_alt = static_cast<std::int32_t>(-z_ * 1000.0);
+      gp.alt = gp.relative_alt = static_cast<std::int32_t>(-depth_reading() * 1000.0);
       gp.hdg = 65535;
       send(gp);
     }
@@ -318,6 +323,14 @@ class Fake {
   mv::Parser parser_;
   mv::Sender out_{1, mv::kCompAutopilot1};
   double fs_gcs_enable_ = 0, fs_gcs_timeout_ = 5;
+  double spec_grav_ = 1.0;  // BARO_SPEC_GRAV, ArduSub's default 1
+
+  // The depth as ArduSub reads it from SITL's pressure: SITL's water is 1024 kg/m^3 under
+  // 9.80665 m/s^2 (AP_Baro::SimpleUnderWaterAtmosphere, AP_Baro_HIL.cpp), ArduSub divides the
+  // pressure by 9800 Pa/m x BARO_SPEC_GRAV (AP_Baro.cpp): 2.5 % deep unless the parameter
+  // file sets the specific gravity. z_ is the true depth (the kinematics).
+  double reading_per_metre() const { return 1024.0 * 9.80665 / (9800.0 * spec_grav_); }
+  double depth_reading() const { return z_ * reading_per_metre(); }
   double t_ = 0, next_heartbeat_ = 0, next_state_ = 0, last_gcs_ = -1;
   std::uint32_t mode_;
   bool armed_ = false, failsafe_ = false, have_target_ = false;

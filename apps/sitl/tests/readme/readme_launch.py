@@ -208,6 +208,19 @@ def main():
     for f in ["local_position_ned.csv", "global_position_int.csv", "command_ack.csv"]:
         if not os.path.exists(os.path.join(run, "mission", "mission-run", f)):
             fail("kelp-mission's log %s is not in ~/kelp-sitl-run/mission/mission-run" % f)
+    # The depth: ArduSub reads SITL's sea water (1024 kg/m^3, g 9.80665) through BARO_SPEC_GRAV
+    # (9800 Pa/m x it); the params file must set it, and the fake ArduSub reads depth that way,
+    # so the mission's 5 m is 5 m of true depth only with the right value.
+    parm = os.path.join(prefix, "share", "kelp", "sitl", "params", "bluerov2-heavy.parm")
+    grav = re.search(r"^BARO_SPEC_GRAV\s+(\S+)", open(parm).read(), re.M)
+    if not grav:
+        fail("params/bluerov2-heavy.parm does not set BARO_SPEC_GRAV (ArduSub's depth 2.5 % deep)")
+    if abs(float(grav.group(1)) * 9800.0 / (1024.0 * 9.80665) - 1.0) > 2e-4:
+        fail("BARO_SPEC_GRAV %s does not match SITL's water (1024 x 9.80665 / 9800 = 1.0247)"
+             % grav.group(1))
+    true_depth = float(open(os.path.join(run, "sub", "true_depth.txt")).read())
+    if abs(true_depth - 5.0) > 0.1:
+        fail("the ROV ended at %.3f m of true depth for kelp-mission's 5 m" % true_depth)
     print("readme_launch: the README's launch lines ran: %.1f s of physics, %d frames per "
           "autopilot; the mission completed" % (s["physics_s"], s["ardusub"]["frames"]))
 
