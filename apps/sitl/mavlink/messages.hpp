@@ -122,6 +122,28 @@ struct SetMode {
   static constexpr void extension_fields(M&, F&&) {}
 };
 
+// PARAM_REQUEST_READ (common.xml). param_index -1: by param_id, NUL-padded.
+struct ParamRequestRead {
+  static constexpr std::uint32_t msg_id = 20;
+  static constexpr const char* name = "PARAM_REQUEST_READ";
+  static constexpr std::uint8_t crc_extra = 214;
+  static constexpr std::size_t min_length = 20;
+  static constexpr std::size_t length = 20;
+  std::int16_t param_index{-1};
+  std::uint8_t target_system{};
+  std::uint8_t target_component{};
+  std::array<char, 16> param_id{};
+  template <class M, class F>
+  static constexpr void base_fields(M& m, F&& f) {
+    f("param_index", m.param_index);
+    f("target_system", m.target_system);
+    f("target_component", m.target_component);
+    f("param_id", m.param_id);
+  }
+  template <class M, class F>
+  static constexpr void extension_fields(M&, F&&) {}
+};
+
 // PARAM_VALUE (common.xml).
 struct ParamValue {
   static constexpr std::uint32_t msg_id = 22;
@@ -773,9 +795,9 @@ struct Statustext {
 template <class... Ms>
 struct MessageList {};
 using AllMessages =
-    MessageList<Heartbeat, SysStatus, SystemTime, SetMode, ParamValue, ParamSet, GpsRawInt,
-                Attitude, LocalPositionNed, GlobalPositionInt, ServoOutputRaw, ManualControl,
-                RcChannelsOverride, MissionItemInt, VfrHud, CommandLong, CommandAck,
+    MessageList<Heartbeat, SysStatus, SystemTime, SetMode, ParamRequestRead, ParamValue, ParamSet,
+                GpsRawInt, Attitude, LocalPositionNed, GlobalPositionInt, ServoOutputRaw,
+                ManualControl, RcChannelsOverride, MissionItemInt, VfrHud, CommandLong, CommandAck,
                 SetPositionTargetLocalNed, PositionTargetLocalNed, SetPositionTargetGlobalInt,
                 Timesync, Statustext>;
 

@@ -21,7 +21,7 @@ namespace kelp_sitl::mission {
 
 class CsvLog {
  public:
-  // Creates dir (and parents) and the five files with their headers.
+  // Creates dir (and parents) and the six files with their headers.
   explicit CsvLog(const std::filesystem::path& dir) {
     std::filesystem::create_directories(dir);
     open(attitude_, dir / "attitude.csv",
@@ -31,6 +31,8 @@ class CsvLog {
          "t_s,vehicle,time_boot_ms,lat,lon,alt,relative_alt,vx,vy,vz,hdg");
     open(text_, dir / "statustext.csv", "t_s,vehicle,severity,text");
     open(ack_, dir / "command_ack.csv", "t_s,vehicle,command,result,result_name");
+    open(sys_status_, dir / "sys_status.csv",
+         "t_s,vehicle,voltage_battery_V,current_battery_A,battery_remaining_pct");
   }
 
   void write(double t, const std::string& v, const mavlink::Attitude& m) {
@@ -57,8 +59,16 @@ class CsvLog {
          << mavlink::result_name(m.result) << '\n';
   }
 
+  // The battery as the autopilot reports it (SYS_STATUS: mV, cA, %; -1 = unknown).
+  void write(double t, const std::string& v, const mavlink::SysStatus& m) {
+    sys_status_ << t << ',' << v << ',' << m.voltage_battery / 1000.0 << ','
+                << m.current_battery / 100.0 << ',' << static_cast<int>(m.battery_remaining)
+                << '\n';
+  }
+
   void flush() {
-    for (std::ofstream* f : {&attitude_, &local_, &global_, &text_, &ack_}) f->flush();
+    for (std::ofstream* f : {&attitude_, &local_, &global_, &text_, &ack_, &sys_status_})
+      f->flush();
   }
 
  private:
@@ -69,7 +79,7 @@ class CsvLog {
     f << header << '\n';
   }
 
-  std::ofstream attitude_, local_, global_, text_, ack_;
+  std::ofstream attitude_, local_, global_, text_, ack_, sys_status_;
 };
 
 }  // namespace kelp_sitl::mission

@@ -92,6 +92,11 @@ struct Vehicle {
   std::optional<mavlink::LocalPositionNed> local;
   std::optional<mavlink::GlobalPositionInt> global;
   std::optional<mavlink::Attitude> attitude;
+  std::optional<mavlink::SysStatus> sys_status;
+  std::optional<float> sim_batt_voltage;  // SITL's SIM_BATT_VOLTAGE, once read
+  // The battery as the autopilot reports it while armed: voltage range [V], peak current [A].
+  double battery_min_v = NAN, battery_max_v = NAN, battery_max_a = NAN;
+  std::string battery_note;                // the start-up check's verdict, for the summary
   std::optional<mavlink::CommandAck> ack;  // last COMMAND_ACK not yet consumed
   std::string last_text;                   // last STATUSTEXT
   bool expect_armed = false;
@@ -324,6 +329,7 @@ class Mission {
       phase(v->name + ": HEARTBEAT from sysid " + std::to_string(v->sysid) + ", MAV_TYPE " +
             std::to_string(v->heartbeat.type) + ", mode " +
             std::to_string(v->heartbeat.custom_mode) + (v->armed() ? ", armed" : ", disarmed"));
+      request_param(*v, "SIM_BATT_VOLTAGE");  // answered by a SITL only: check_battery()
     }
     if (sub_) {
       // ArduSub sends LOCAL_POSITION_NED and GLOBAL_POSITION_INT only once its EKF has a
@@ -337,6 +343,7 @@ class Mission {
             fmt(sub_->local->z) + ") m NED from its EKF origin; depth " + fmt(*sub_->depth()) +
             " m");
     }
+    for (Vehicle* v : vehicles()) check_battery(*v);
     for (Vehicle* v : vehicles()) {
       phase(v->name + ": arming");
       arm(*v, true);
@@ -455,6 +462,56 @@ class Mission {
       attempt(*boat_, [&] { set_mode(*boat_, mavlink::rover_mode::kHold, "HOLD", timeout); });
       attempt(*boat_, [&] { arm(*boat_, false, timeout); });
     }
+  }
+
+  // Whose battery the autopilot shows. kelp-sitl sends kelp's battery in its JSON replies
+  // ("battery": voltage, current), which ArduPilot's SIM_JSON reads since master ab03dc37
+  // (2025-07-28); older builds drop the key without a word and show their own SITL battery:
+  // SIM_BATT_VOLTAGE, less a drop with the thrusters' PWM (libraries/AP_HAL_SITL/
+  // SITL_State_common.cpp, update_voltage_current), i.e. exactly SIM_BATT_VOLTAGE while
+  // disarmed, when every PWM is neutral. kelp's battery at rest reads its open-circuit voltage,
+  // which equals that only by chance. So, disarmed: SYS_STATUS's voltage within 0.05 V of
+  // SIM_BATT_VOLTAGE is ArduPilot's own battery, and the user is told. Not a SITL (no
+  // SIM_BATT_VOLTAGE) or no SYS_STATUS within 3 s: nothing to check.
+  void check_battery(Vehicle& v) {
+    const auto wall_end = Clock::now() + std::chrono::seconds(3);
+    auto next_request = Clock::now() + std::chrono::seconds(1);
+    while ((!v.sys_status || !v.sim_batt_voltage) && Clock::now() < wall_end) {
+      if (!v.sim_batt_voltage && Clock::now() >= next_request) {
+        request_param(v, "SIM_BATT_VOLTAGE");
+        next_request += std::chrono::seconds(1);
+      }
+      spin(std::min(wall_end, next_request));
+    }
+    if (!v.sys_status || !v.sim_batt_voltage || v.sys_status->voltage_battery == 0xFFFF ||
+        v.armed())
+      return;
+    const double volts = v.sys_status->voltage_battery / 1000.0;
+    const double sim = *v.sim_batt_voltage;
+    if (std::fabs(volts - sim) <= 0.05) {
+      v.battery_note =
+          "the battery it reports (" + fmt(volts) +
+          " V) is ArduPilot's own SITL battery "
+          "(SIM_BATT_VOLTAGE " +
+          fmt(sim) +
+          " V), not kelp's: this ArduPilot ignores kelp-sitl's "
+          "JSON \"battery\" (read since ArduPilot master ab03dc37, 2025-07-28), so its battery "
+          "voltage, current and failsafes are not kelp's";
+    } else {
+      v.battery_note = "the battery it reports (" + fmt(volts) +
+                       " V) is kelp's, through the JSON "
+                       "\"battery\" (SITL's own SIM_BATT_VOLTAGE " +
+                       fmt(sim) + " V is unused)";
+    }
+    phase(v.name + ": " + v.battery_note);
+  }
+
+  void request_param(Vehicle& v, const std::string& id) {
+    mavlink::ParamRequestRead r;
+    r.target_system = v.sysid;
+    r.target_component = mavlink::kCompAutopilot1;
+    r.param_id = mavlink::to_chars<16>(id);
+    send(v, r);
   }
 
   // ---- commands ------------------------------------------------------------------------------
@@ -741,6 +798,19 @@ class Mission {
       log_->write(t, v.name, *a);
     } else if (auto st = mavlink::decode<mavlink::SystemTime>(f)) {
       v.clock_ms = st->time_boot_ms;
+    } else if (auto ss = mavlink::decode<mavlink::SysStatus>(f)) {
+      v.sys_status = *ss;
+      log_->write(t, v.name, *ss);
+      if (v.armed() && ss->voltage_battery != 0xFFFF) {
+        const double volts = ss->voltage_battery / 1000.0, amps = ss->current_battery / 100.0;
+        v.battery_min_v = std::isnan(v.battery_min_v) ? volts : std::min(v.battery_min_v, volts);
+        v.battery_max_v = std::isnan(v.battery_max_v) ? volts : std::max(v.battery_max_v, volts);
+        if (ss->current_battery != -1)
+          v.battery_max_a = std::isnan(v.battery_max_a) ? amps : std::max(v.battery_max_a, amps);
+      }
+    } else if (auto pv = mavlink::decode<mavlink::ParamValue>(f)) {
+      if (mavlink::to_string(pv->param_id) == "SIM_BATT_VOLTAGE")
+        v.sim_batt_voltage = pv->param_value;
     } else if (auto s = mavlink::decode<mavlink::Statustext>(f)) {
       v.last_text = mavlink::to_string(s->text);
       phase(v.name + " says (" + mavlink::severity_name(s->severity) + "): " + v.last_text);
@@ -808,6 +878,13 @@ class Mission {
            << (v->clock_ms ? "; its clock at " + v->clock_text() + " s" : std::string())
            << std::endl;
       for (const std::string& e : v->events) out_ << "  " << e << std::endl;
+      if (!std::isnan(v->battery_min_v))
+        out_ << v->name
+             << ": battery as it reports it while armed (SYS_STATUS): " << fmt(v->battery_min_v)
+             << "-" << fmt(v->battery_max_v) << " V"
+             << (std::isnan(v->battery_max_a) ? std::string()
+                                              : ", up to " + fmt(v->battery_max_a) + " A")
+             << (v->battery_note.empty() ? std::string() : "; " + v->battery_note) << std::endl;
       if (v->boot_states > 0) {
         out_ << v->name << ": " << v->boot_states
              << " CRITICAL/EMERGENCY states at start-up, disarmed (not failsafes):" << std::endl;

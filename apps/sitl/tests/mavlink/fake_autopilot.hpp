@@ -60,6 +60,10 @@ struct FakeConfig {
   // whose EKF origin is wherever the vehicle was when its EKF started).
   double start_depth = 0.0;
   double origin_depth = 0.0;
+  // The battery in SYS_STATUS [V], and SITL's SIM_BATT_VOLTAGE answered to PARAM_REQUEST_READ
+  // (< 0: no answer, not a SITL). Equal: an ArduPilot that shows its own SITL battery.
+  double battery_voltage = 16.5;
+  double sim_batt_voltage = 12.6;
 };
 
 // What the fake received.
@@ -239,10 +243,15 @@ class FakeAutopilot {
       gp.hdg = 65535;
       att.yaw = static_cast<float>(yaw_);
     }
+    mv::SysStatus ss;
+    ss.voltage_battery = static_cast<std::uint16_t>(std::lround(cfg_.battery_voltage * 1000.0));
+    ss.current_battery = static_cast<std::int16_t>(armed() ? 250 : 0);  // cA
+    ss.battery_remaining = 90;
     send(st);
     send(lp);
     send(gp);
     send(att);
+    send(ss);
   }
 
   // Simple kinematics.
@@ -315,6 +324,15 @@ class FakeAutopilot {
         lock.unlock();
         ack(c->command, mv::Result::Unsupported);
       }
+    } else if (auto pr = mv::decode<mv::ParamRequestRead>(f)) {
+      if (mv::to_string(pr->param_id) != "SIM_BATT_VOLTAGE" || cfg_.sim_batt_voltage < 0) return;
+      lock.unlock();
+      mv::ParamValue pv;
+      pv.param_id = pr->param_id;
+      pv.param_value = static_cast<float>(cfg_.sim_batt_voltage);
+      pv.param_type = 9;  // REAL32
+      pv.param_count = 1;
+      send(pv);
     } else if (auto lt = mv::decode<mv::SetPositionTargetLocalNed>(f)) {
       record_.local_targets.push_back(*lt);
       tx_ = lt->x;

@@ -427,3 +427,36 @@ TEST_CASE("kelp-mission dives to the depth below the surface, not below the EKF 
     std::filesystem::remove_all(o.log_dir);
   }
 }
+
+// Whose battery the autopilot shows: an ArduPilot that ignores kelp-sitl's JSON "battery" shows
+// its own SITL battery, exactly SIM_BATT_VOLTAGE while disarmed; kelp-mission says so before
+// arming, and otherwise that the battery is kelp's. The summary gives the range reported while
+// armed (SYS_STATUS, also in sys_status.csv).
+TEST_CASE("kelp-mission tells whether the autopilot shows kelp's battery or its own", "[mission]") {
+  for (const bool ignored : {false, true}) {
+    INFO((ignored ? "JSON battery ignored" : "JSON battery read"));
+    FakeConfig sub_cfg;
+    sub_cfg.sim_batt_voltage = 12.6;
+    sub_cfg.battery_voltage = ignored ? 12.6 : 16.42;
+    FakeAutopilot sub(sub_cfg);
+    Options o = short_options(ignored ? "battery-own" : "battery-kelp");
+    o.sub = sub.endpoint();
+    o.rover = "none";
+    o.survey_side = 0.0;
+    const Run r = run_mission(o);
+    INFO(r.out);
+    INFO(r.err);
+    CHECK(r.code == 0);
+    if (ignored) {
+      CHECK(r.out.find("sub: the battery it reports (12.60 V) is ArduPilot's own SITL battery "
+                       "(SIM_BATT_VOLTAGE 12.60 V), not kelp's") != std::string::npos);
+    } else {
+      CHECK(r.out.find("sub: the battery it reports (16.42 V) is kelp's") != std::string::npos);
+    }
+    CHECK(r.out.find(std::string("sub: battery as it reports it while armed (SYS_STATUS): ") +
+                     (ignored ? "12.60-12.60 V" : "16.42-16.42 V") + ", up to 2.50 A") !=
+          std::string::npos);
+    CHECK(count_lines(std::filesystem::path(o.log_dir) / "sys_status.csv") > 5);
+    std::filesystem::remove_all(o.log_dir);
+  }
+}
