@@ -54,8 +54,9 @@ namespace kelp_sitl::mission {
 struct Options {
   std::string sub = "tcp:127.0.0.1:5760";    // ArduSub SERIAL0; "none": no AUV
   std::string rover = "tcp:127.0.0.1:5770";  // ArduRover SERIAL0 (-I1); "none": no boat
-  // m below the sea surface, as ArduSub reports it (Vehicle::depth(): its altitude above mean
-  // sea level, negated; not LOCAL_POSITION_NED z, which counts from wherever its EKF started)
+  // m below the sea surface, as ArduSub reports it (Vehicle::depth(): its altitude relative to
+  // its home at the surface, negated; not LOCAL_POSITION_NED z, which counts from wherever its
+  // EKF started)
   double depth = 5.0;
   double depth_tolerance = 0.05;  // m: the dive ends this far short of --depth
   double hold = 60.0;             // s in ALT_HOLD at depth
@@ -118,15 +119,16 @@ struct Vehicle {
   bool was_armed = false;  // armed by kelp-mission at least once
 
   bool armed() const { return (heartbeat.base_mode & mavlink::kModeFlagSafetyArmed) != 0; }
-  // Depth below the mean sea surface as the autopilot reports it, m (down positive), from
-  // GLOBAL_POSITION_INT's altitude above mean sea level. ArduSub's altitude is its depth sensor's
-  // (water pressure against BARO1_GND_PRESS, the surface pressure in params/), so this is the
-  // depth from the surface wherever the vehicle was when its EKF started; LOCAL_POSITION_NED z
-  // counts from that start (the EKF origin), which is under water after a submerged start. The
-  // home altitude must be 0, the sea surface (README).
+  // Depth below the sea surface as the autopilot reports it, m (down positive): minus
+  // GLOBAL_POSITION_INT's relative_alt. ArduSub puts its home at the water's surface, the
+  // vehicle's position raised by its depth sensor's depth (ArduSub/commands.cpp,
+  // set_home_to_current_location), and reports the altitude relative to home (Sub::get_alt_rel;
+  // before home is set, the depth sensor's), so this is the depth from the surface wherever the
+  // vehicle was when its EKF started. LOCAL_POSITION_NED z counts from that start (the EKF
+  // origin), which is under water after a submerged start.
   std::optional<double> depth() const {
     if (!global) return std::nullopt;
-    return -global->alt / 1000.0;
+    return -global->relative_alt / 1000.0;
   }
   bool is_sub() const { return heartbeat.type == mavlink::kTypeSubmarine; }
   // The vehicle's clock in s, or "?" while unknown (for messages).
