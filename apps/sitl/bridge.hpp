@@ -249,7 +249,8 @@ class Bridge {
     if (is_sub && std::isfinite(model_.environment().seabed_depth()))
       r.rangefinder = std::max(0.0, model_.environment().seabed_depth() - x.position.z());
     // The battery's terminal voltage and current over the last step (ArduPilot's JSON backend
-    // takes them as "battery": {"voltage", "current"}: libraries/SITL/SIM_JSON.h keytable, master).
+    // takes them as "battery": {"voltage", "current"}: libraries/SITL/SIM_JSON.h keytable, since
+    // master ab03dc37, 2025-07-28; older builds ignore the key: README, "The battery").
     if (model_.auv_propulsion() != nullptr && is_sub) {
       r.battery_voltage = state_.auv_propulsion.battery.voltage;
       r.battery_current = state_.auv_propulsion.battery.current;

@@ -93,8 +93,9 @@ struct VehicleReply {
   kelp::Quaternion<double> attitude{1, 0, 0, 0};  ///< body → NED
   double rangefinder = NAN;                       ///< rng_1 [m]; NaN: not sent
   /// Battery terminal voltage [V] and current [A], sent as "battery": {"voltage", "current"}
-  /// (ArduPilot's JSON backend, libraries/SITL/SIM_JSON.h on master, feeds them to its simulated
-  /// battery monitor); NaN (before the first step, or no battery): not sent.
+  /// (ArduPilot's JSON backend, libraries/SITL/SIM_JSON.h since master ab03dc37 of 2025-07-28,
+  /// feeds them to its simulated analog battery monitor, BATT_MONITOR 4; older builds ignore
+  /// the key); NaN (before the first step, or no battery): not sent.
   double battery_voltage = NAN, battery_current = NAN;
 };
 
