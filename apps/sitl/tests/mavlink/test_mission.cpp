@@ -55,6 +55,15 @@ Options short_options(const std::string& log_name) {
   return o;
 }
 
+// The sub alone, no survey: for the checks that need only the start of the mission.
+Options sub_only_options(const std::string& log_name, const FakeAutopilot& sub) {
+  Options o = short_options(log_name);
+  o.sub = sub.endpoint();
+  o.rover = "none";
+  o.survey_side = 0.0;
+  return o;
+}
+
 FakeConfig boat_config() {
   FakeConfig c;
   c.mav_type = mv::kTypeSurfaceBoat;
@@ -346,10 +355,7 @@ TEST_CASE("kelp-mission reports a mode change it did not command and stops the m
 
 TEST_CASE("kelp-mission's summary tells ignored message types from malformed frames", "[mission]") {
   FakeAutopilot sub{FakeConfig{}};
-  Options o = short_options("summary");
-  o.sub = sub.endpoint();
-  o.rover = "none";
-  o.survey_side = 0.0;
+  Options o = sub_only_options("summary", sub);
   const Run r = run_mission(o);
   INFO(r.out);
   CHECK(r.code == 0);
@@ -368,10 +374,7 @@ TEST_CASE("kelp-mission: CRITICAL at start-up, disarmed, is not a failsafe", "[m
   sub_cfg.boot_critical = 1.0;   // s of its clock
   sub_cfg.position_after = 1.5;  // arming waits for the position, after the start-up state
   FakeAutopilot sub(sub_cfg);
-  Options o = short_options("boot");
-  o.sub = sub.endpoint();
-  o.rover = "none";
-  o.survey_side = 0.0;
+  Options o = sub_only_options("boot", sub);
   const Run r = run_mission(o);
   INFO(r.out);
   INFO(r.err);
@@ -439,10 +442,7 @@ TEST_CASE("kelp-mission tells whether the autopilot shows kelp's battery or its 
     sub_cfg.sim_batt_voltage = 12.6;
     sub_cfg.battery_voltage = ignored ? 12.6 : 16.42;
     FakeAutopilot sub(sub_cfg);
-    Options o = short_options(ignored ? "battery-own" : "battery-kelp");
-    o.sub = sub.endpoint();
-    o.rover = "none";
-    o.survey_side = 0.0;
+    Options o = sub_only_options(ignored ? "battery-own" : "battery-kelp", sub);
     const Run r = run_mission(o);
     INFO(r.out);
     INFO(r.err);
