@@ -327,6 +327,7 @@ void scenario_fields(V& v, Scenario& s) {
     o.number("mass_per_length", s.mass_per_length, 1e-4, 100, if_set);
     o.number("axial_stiffness", s.axial_stiffness, 1, 1e10, if_set);
     o.number("internal_damping", s.internal_damping, 0, 1e6, if_set);
+    o.number("internal_damping_ratio", s.internal_damping_ratio, 0, 1000, if_set);
     o.number("normal_drag", s.normal_drag, 0, 10, if_set);
     o.number("tangential_drag", s.tangential_drag, 0, 10, if_set);
     o.number("length", s.tether_length, 0.5, 1000);

@@ -27,7 +27,15 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (sc.diameter) tp.diameter = *sc.diameter;
   if (sc.mass_per_length) tp.mass_per_length = *sc.mass_per_length;
   if (sc.axial_stiffness) tp.axial_stiffness = *sc.axial_stiffness;
+  if (sc.internal_damping && sc.internal_damping_ratio)
+    throw kelp::invalid_argument(
+        "tether: internal_damping and internal_damping_ratio are both given: give BA [N s] or "
+        "the damping ratio, not both");
   if (sc.internal_damping) tp.internal_damping = *sc.internal_damping;
+  if (sc.internal_damping_ratio) {
+    tp.internal_damping = 0.0;  // the kind's BA gives way to the ratio
+    tp.internal_damping_ratio = *sc.internal_damping_ratio;
+  }
   if (sc.normal_drag) tp.normal_drag = *sc.normal_drag;
   if (sc.tangential_drag) tp.tangential_drag = *sc.tangential_drag;
   if (sc.breaking_strength) tp.breaking_strength = *sc.breaking_strength;

@@ -1,7 +1,10 @@
 // kelp.Tether (the lumped-mass tether on its own: model, state, step between prescribed ends)
 // and kelp.TetherState.
 #include <mutex>
+#include <optional>
 #include <string>
+
+#include <pybind11/stl.h>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
@@ -93,13 +96,20 @@ void bind_tether(py::module_& m) {
       "kelp.System couples it to the vehicles.")
       .def_static(
           "rov_tether",
-          [](double length, double max_segment_length) {
-            return std::make_unique<Tether>(kt::presets::rov_tether(length, max_segment_length));
+          [](double length, double max_segment_length, std::optional<double> ratio) {
+            kt::TetherParametersd p = kt::presets::rov_tether(length, max_segment_length);
+            if (ratio) {
+              p.internal_damping = 0.0;
+              p.internal_damping_ratio = *ratio;
+            }
+            return std::make_unique<Tether>(p);
           },
           py::arg("length"), py::arg("max_segment_length") = 0.25,
+          py::arg("internal_damping_ratio") = py::none(),
           "Fathom-class ROV tether (kelp/tether/presets.hpp: 7.6 mm, nearly neutrally buoyant "
           "in seawater, EA 2.92 kN, von Benzon et al. 2022) of `length` m in segments of at most "
-          "`max_segment_length` m.")
+          "`max_segment_length` m. `internal_damping_ratio`: the internal damping as a ratio of "
+          "critical (MoorDyn's BA/-zeta) instead of the preset's BA of 100 N s.")
       .def_static(
           "bead_chain",
           [](double length) { return std::make_unique<Tether>(kt::presets::bead_chain(length)); },
@@ -113,6 +123,10 @@ void bind_tether(py::module_& m) {
       .def_property_readonly(
           "segment_length", [](const Tether& t) { return t.model.segment_length(); },
           "Unstretched segment length [m].")
+      .def_property_readonly(
+          "internal_damping", [](const Tether& t) { return t.model.parameters().internal_damping; },
+          "Internal damping BA [N s] (from internal_damping_ratio when one was given: ratio * "
+          "segment_length * sqrt(EA * mass per length)).")
       .def(
           "weight_per_length",
           [](const Tether& t, const Env* env) {

@@ -307,3 +307,21 @@ def test_tether_bad_input():
     with pytest.raises(kelp.InvalidArgument, match="position: expected shape \\(21, 3\\)"):
         x.position = np.zeros((20, 3))
     np.testing.assert_array_equal(x.position, before.position)
+
+
+def test_tether_internal_damping_ratio():
+    # MoorDyn's BA/-zeta: BA = zeta * segment length * sqrt(EA * mass per length), the same
+    # damper BA/l for any segment length; the preset's own BA is 100 N s.
+    assert kelp.Tether.rov_tether(10.0, 0.5).internal_damping == 100.0
+    d = 7.6e-3
+    area = np.pi * d * d / 4
+    ea, mu = 6.437e7 * area, 1000.0 * area
+    dampers = []
+    for seg in (0.25, 0.5, 1.0):
+        t = kelp.Tether.rov_tether(10.0, seg, internal_damping_ratio=0.8)
+        assert t.internal_damping == pytest.approx(0.8 * t.segment_length * np.sqrt(ea * mu),
+                                                   rel=1e-12)
+        dampers.append(t.internal_damping / t.segment_length)
+    assert dampers == pytest.approx([dampers[0]] * 3, rel=1e-12)
+    with pytest.raises(kelp.InvalidArgument, match="internal_damping_ratio"):
+        kelp.Tether.rov_tether(10.0, 0.5, internal_damping_ratio=-1.0)

@@ -177,3 +177,25 @@ TEST_CASE("system::step reports a parting once, with coupling corrections, and r
   CHECK(partings >= 1);
   CHECK(s.tether.position.allFinite());
 }
+
+// The scenario's "internal_damping_ratio" (MoorDyn's BA/-zeta) replaces the kind's BA with
+// ratio * segment length * sqrt(EA * mass_per_length); with "internal_damping" too, it is refused.
+TEST_CASE("scenario: the tether's internal damping as a damping ratio", "[sim][scenario]") {
+  const ks::Scenario sc = ks::parse_scenario(
+      R"({"tether": {"length": 10, "segment_length": 0.5, "internal_damping_ratio": 0.8}})",
+      "ratio.json");
+  REQUIRE(sc.internal_damping_ratio);
+  const ks::WorldSetup w = ks::world_setup(sc, "ratio.json");
+  const kelp::tether::TetherModeld m(w.parameters.tether);
+  const auto& p = m.parameters();
+  CHECK(p.internal_damping ==
+        Approx(0.8 * m.segment_length() * std::sqrt(p.axial_stiffness * p.mass_per_length))
+            .epsilon(1e-12));
+  // The rov_tether's 100 N s is 34.8 times critical at 0.25 m segments, 17.4 at 0.5 m.
+  CHECK(p.internal_damping < 5.0);
+  // Written back, read the same.
+  CHECK(ks::parse_scenario(ks::scenario_json(sc), "again.json").internal_damping_ratio == 0.8);
+  const ks::Scenario both = ks::parse_scenario(
+      R"({"tether": {"internal_damping": 50, "internal_damping_ratio": 0.8}})", "both.json");
+  REQUIRE_THROWS_AS(ks::world_setup(both, "both.json"), kelp::invalid_argument);
+}

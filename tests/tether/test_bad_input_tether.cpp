@@ -80,6 +80,7 @@ TEST_CASE("Tether parameters: NaN, Inf, negative, zero and absurd values are ref
       {"mass_per_length", &P::mass_per_length, false},
       {"axial_stiffness", &P::axial_stiffness, false},
       {"internal_damping", &P::internal_damping, true},
+      {"internal_damping_ratio", &P::internal_damping_ratio, true},
       {"bending_stiffness", &P::bending_stiffness, true},
       {"normal_drag", &P::normal_drag, true},
       {"tangential_drag", &P::tangential_drag, true},

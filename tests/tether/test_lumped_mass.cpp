@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <type_traits>
 
 #include "kelp/environment/environment.hpp"
@@ -779,5 +780,50 @@ TEMPLATE_TEST_CASE("the surface band is centred on the node: a node at the surfa
       INFO("z = " << z0);
       CHECK(-(at(z0 + h) - at(z0 - h)) / (2 * h) == Approx(ws.force(2, 5)).epsilon(1e-5));
     }
+  }
+}
+
+// Internal damping as a ratio of critical, as MoorDyn's `BA/-zeta` input: MoorDyn sets the
+// material damping c = zeta * (L/N) * sqrt(E * rho) with E = EA/A and rho = w/A (Line.cpp) and
+// works with c * A; recomputed here that way, with MoorDyn's own line type example (nylon,
+// d 0.124 m, 13.76 kg/m, EA 2515288 N, BA/-zeta -0.8, its documentation's input file).
+TEST_CASE("Internal damping from a damping ratio equals MoorDyn's, for any N", "[tether]") {
+  const double d = 0.124, w = 13.76, ea = 2515288.0, zeta = 0.8, length = 100.0;
+  const double area = kelp::pi / 4.0 * d * d;
+  double damper_per_length = -1;
+  for (const int n : {10, 20, 40}) {
+    INFO("N = " << n);
+    kt::TetherParametersd p;
+    p.segments = n;
+    p.length = length;
+    p.diameter = d;
+    p.mass_per_length = w;
+    p.axial_stiffness = ea;
+    p.internal_damping_ratio = zeta;
+    const kt::TetherModeld m(p);
+    const double e = ea / area, rho = w / area;
+    const double moordyn_ba = zeta * length / n * std::sqrt(e * rho) * area;
+    CHECK(m.parameters().internal_damping == Approx(moordyn_ba).epsilon(1e-12));
+    CHECK(m.parameters().internal_damping_ratio == 0.0);  // resolved into BA
+    // 0.8 * 5 m * sqrt(2515288 * 13.76) N s/m = 23532.2 N s at N = 20.
+    if (n == 20) CHECK(m.parameters().internal_damping == Approx(23532.2).epsilon(1e-5));
+    // The segment's dashpot BA/l = zeta sqrt(EA w) does not depend on N; nor then the damping
+    // ratio of the highest axial mode (adjacent nodes in opposition: m a'' + 4 BA/l a' + 4 EA/l
+    // a = 0 with m = w l, whose ratio 4 BA/l / (2 sqrt(4 EA/l w l)) is zeta).
+    if (damper_per_length < 0) damper_per_length = m.axial_damper();
+    CHECK(m.axial_damper() == Approx(damper_per_length).epsilon(1e-12));
+    const double k = m.axial_spring(), node_mass = w * m.segment_length();
+    CHECK(4.0 * m.axial_damper() / (2.0 * std::sqrt(4.0 * k * node_mass)) ==
+          Approx(zeta).epsilon(1e-12));
+  }
+  // BA and a ratio together are refused, naming both.
+  kt::TetherParametersd both;
+  both.internal_damping = 10.0;
+  both.internal_damping_ratio = 0.5;
+  REQUIRE_THROWS_AS(kt::TetherModeld(both), kelp::invalid_argument);
+  try {
+    kt::TetherModeld m(both);
+  } catch (const kelp::invalid_argument& e) {
+    CHECK(std::string(e.what()).find("internal_damping_ratio") != std::string::npos);
   }
 }

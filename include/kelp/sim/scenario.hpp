@@ -187,6 +187,10 @@ struct Scenario {
   /// tether::TetherParameters for the units).
   ///@{
   std::optional<double> diameter, mass_per_length, axial_stiffness, internal_damping;
+  /// The internal damping as a ratio of critical (tether::TetherParameters::
+  /// internal_damping_ratio, MoorDyn's `BA/-zeta`); replaces the kind's BA; not with
+  /// internal_damping.
+  std::optional<double> internal_damping_ratio;
   std::optional<double> normal_drag, tangential_drag;
   /// The line model, "kelp" (default) or "moordyn" (MoorDyn v2's: kelp::tether::LineModel).
   kelp::tether::LineModel line_model = kelp::tether::LineModel::kelp;

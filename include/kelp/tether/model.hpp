@@ -93,6 +93,13 @@ struct TetherParameters {
   /// axial force EA·max(0, ε) + BA·ε̇ is clamped at zero, so a contracting segment never pushes
   /// (unless `compressive_damping`).
   Scalar internal_damping = Scalar(0);
+  /// Internal damping as a ratio ζ [-] of a segment's critical axial damping, as MoorDyn's
+  /// `BA/-zeta` input takes it (a negative BA read as −ζ, MoorDyn v2 Line.cpp): when > 0, the
+  /// model uses BA = ζ · (L/N) · sqrt(EA · μ) (internal_damping_from_ratio), so that each
+  /// segment's dashpot BA/l = ζ · sqrt(EA · μ) and the damping ratio do not change with the
+  /// number of segments. 0 (the default): `internal_damping` is BA. Give one or the other.
+  /// TetherModel::parameters() holds the BA it uses, with this field 0.
+  Scalar internal_damping_ratio = Scalar(0);
   /// When true, the internal dashpot acts in compression too, as in MoorDyn v2 (Line.cpp: the
   /// damping tension is added whether or not the segment is stretched, and the sum is not
   /// clamped): use it to reproduce MoorDyn. Default false: a cable cannot push, so the total
@@ -150,12 +157,24 @@ struct TetherParameters {
   Scalar end_point_mass = Scalar(0);
 };
 
+/// \brief Internal damping BA [N s] for the damping ratio ζ of MoorDyn's `BA/-zeta` input:
+/// BA = ζ · l · sqrt(EA · μ), with l the unstretched segment length, EA the axial stiffness and
+/// μ the mass per length in air (MoorDyn v2, Line.cpp: the material damping c = −BA_in · L/N ·
+/// sqrt(E ρ) with E = EA/A and ρ = μ/A, times A). The segment's dashpot BA/l = ζ sqrt(EA μ) is
+/// then the same for any number of segments.
+template <typename Scalar>
+Scalar internal_damping_from_ratio(const Scalar& ratio, const Scalar& segment_length,
+                                   const Scalar& axial_stiffness, const Scalar& mass_per_length) {
+  using std::sqrt;
+  return ratio * segment_length * sqrt(axial_stiffness * mass_per_length);
+}
+
 /// \brief Checks tether parameters.
 /// \throws kelp::invalid_argument naming the offending field: segments in [1, 100000]; length,
 /// diameter, mass_per_length, axial_stiffness, friction_velocity finite and > 0; the rest finite
 /// and ≥ 0 (breaking_strength may be +∞); every magnitude at most its bound in
-/// kelp::tether::limits; segments at least 1 µm long; end modes EndMode values; line_model a
-/// LineModel value.
+/// kelp::tether::limits; internal_damping and internal_damping_ratio not both > 0; segments at
+/// least 1 µm long; end modes EndMode values; line_model a LineModel value.
 template <typename Scalar>
 void validate(const TetherParameters<Scalar>& p) {
   // Each magnitude finite and of the right sign, then below a generous physical bound (far above
@@ -174,6 +193,10 @@ void validate(const TetherParameters<Scalar>& p) {
   bounded(p.mass_per_length, limits::max_mass_per_length, "mass_per_length", false);
   bounded(p.axial_stiffness, limits::max_axial_stiffness, "axial_stiffness", false);
   bounded(p.internal_damping, limits::max_axial_stiffness, "internal_damping", true);
+  bounded(p.internal_damping_ratio, limits::max_coefficient, "internal_damping_ratio", true);
+  KELP_CHECK(!(p.internal_damping > Scalar(0) && p.internal_damping_ratio > Scalar(0)),
+             "internal_damping and internal_damping_ratio are both set: give BA [N s] or the "
+             "damping ratio, not both");
   bounded(p.bending_stiffness, limits::max_bending_stiffness, "bending_stiffness", true);
   // +∞ is allowed (never parts), as is 0.
   KELP_CHECK(!(p.breaking_strength < Scalar(0)) && p.breaking_strength == p.breaking_strength,
@@ -223,7 +246,13 @@ class TetherModel {
     l_ = p.length / N;
     inv_l_ = Scalar(1) / l_;
     ea_over_l_ = p.axial_stiffness / l_;
-    ba_over_l_ = p.internal_damping / l_;
+    // A damping ratio becomes BA here, once, so that every reader of parameters() sees BA.
+    if (p.internal_damping_ratio > Scalar(0)) {
+      p_.internal_damping = internal_damping_from_ratio(p.internal_damping_ratio, l_,
+                                                        p.axial_stiffness, p.mass_per_length);
+      p_.internal_damping_ratio = Scalar(0);
+    }
+    ba_over_l_ = p_.internal_damping / l_;
     fade_length_ = p.line_model == LineModel::kelp ? kDashpotFadeFraction * l_ : Scalar(0);
     inv_fade_length_ = fade_length_ > Scalar(0) ? Scalar(1) / fade_length_ : Scalar(0);
     area_ = Scalar(kelp::pi) * p.diameter * p.diameter / Scalar(4);

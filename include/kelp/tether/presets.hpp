@@ -30,6 +30,10 @@ namespace kelp::tether::presets {
 /// (−0.011 N/m); EA = E π d²/4 = 2.92 kN with von Benzon et al.'s E = 6.437e7 Pa; Cdn 1.2,
 /// Cdt 0.01, internal damping 100 N s (von Benzon et al. 2022, Table A1); Can 1, Cat 0;
 /// breaking strength 1557 N (350 lbf, Blue Robotics' Fathom ROV Tether R2 documentation).
+/// The internal damping as a damping ratio (TetherParameters::internal_damping_ratio, MoorDyn's
+/// `BA/-zeta`): ζ = BA / (l sqrt(EA μ)) with sqrt(EA μ) = 11.51 N s/m, i.e. 34.8 at the default
+/// 0.25 m segments and 8.7 at 1 m: the axial mode is far above critical damping at any
+/// practical segment length.
 /// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m, a segment length not
 /// finite and > 0, or more than 100000 segments.
 template <typename Scalar>
