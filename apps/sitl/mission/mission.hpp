@@ -830,7 +830,8 @@ class Mission {
   // vehicle_system_status()) is reported with the last STATUSTEXT and counted.
   void watch(Vehicle& v, bool first, const mavlink::Heartbeat& before) {
     const auto failsafe = [](std::uint8_t status) { return status == 5 || status == 6; };
-    const std::string at = " at " + v.clock_text() + " s of its clock";
+    const std::string at = v.clock_ms ? " at " + v.clock_text() + " s of its clock"
+                                      : " at boot (before it reported its clock)";
     const std::string text =
         v.last_text.empty() ? "" : "; last STATUSTEXT: \"" + v.last_text + "\"";
     if (failsafe(v.heartbeat.system_status) && (first || !failsafe(before.system_status))) {
