@@ -490,21 +490,16 @@ class Mission {
       return;
     const double volts = v.sys_status->voltage_battery / 1000.0;
     const double sim = *v.sim_batt_voltage;
-    if (std::fabs(volts - sim) <= 0.05) {
-      v.battery_note =
-          "the battery it reports (" + fmt(volts) +
-          " V) is ArduPilot's own SITL battery "
-          "(SIM_BATT_VOLTAGE " +
-          fmt(sim) +
-          " V), not kelp's: this ArduPilot ignores kelp-sitl's "
-          "JSON \"battery\" (read since ArduPilot master ab03dc37, 2025-07-28), so its battery "
-          "voltage, current and failsafes are not kelp's";
-    } else {
-      v.battery_note = "the battery it reports (" + fmt(volts) +
-                       " V) is kelp's, through the JSON "
-                       "\"battery\" (SITL's own SIM_BATT_VOLTAGE " +
+    const std::string reports = "the battery it reports (" + fmt(volts) + " V) is ";
+    if (std::fabs(volts - sim) <= 0.05)
+      v.battery_note = reports + "ArduPilot's own SITL battery (SIM_BATT_VOLTAGE " + fmt(sim) +
+                       " V), not kelp's: this ArduPilot ignores kelp-sitl's JSON \"battery\" "
+                       "(read since ArduPilot master ab03dc37, 2025-07-28), so its battery "
+                       "voltage, current and failsafes are not kelp's";
+    else
+      v.battery_note = reports +
+                       "kelp's, through the JSON \"battery\" (SITL's own SIM_BATT_VOLTAGE " +
                        fmt(sim) + " V is unused)";
-    }
     phase(v.name + ": " + v.battery_note);
   }
 
@@ -805,10 +800,10 @@ class Mission {
       log_->write(t, v.name, *ss);
       if (v.armed() && ss->voltage_battery != 0xFFFF) {
         const double volts = ss->voltage_battery / 1000.0, amps = ss->current_battery / 100.0;
-        v.battery_min_v = std::isnan(v.battery_min_v) ? volts : std::min(v.battery_min_v, volts);
-        v.battery_max_v = std::isnan(v.battery_max_v) ? volts : std::max(v.battery_max_v, volts);
-        if (ss->current_battery != -1)
-          v.battery_max_a = std::isnan(v.battery_max_a) ? amps : std::max(v.battery_max_a, amps);
+        // fmin/fmax take the other operand when one is NaN (nothing seen yet).
+        v.battery_min_v = std::fmin(v.battery_min_v, volts);
+        v.battery_max_v = std::fmax(v.battery_max_v, volts);
+        if (ss->current_battery != -1) v.battery_max_a = std::fmax(v.battery_max_a, amps);
       }
     } else if (auto pv = mavlink::decode<mavlink::ParamValue>(f)) {
       if (mavlink::to_string(pv->param_id) == "SIM_BATT_VOLTAGE")
