@@ -604,7 +604,7 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
   Peaks boat, rov;
   ks::SystemInputsd in;
   double tension_max = 0, f_end_max = 0, residual_max = 0, depth_min = 1e9, depth_max = -1e9;
-  double span_max = 0;
+  double span_max = 0, boat_peak_time = 0, boat_peak_force = 0, boat_peak_height = 0;
   int unconverged = 0, nonfinite = 0;
   ks::SolverStatsd solver;
   bool threw = false;
@@ -631,7 +631,13 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
         ++nonfinite;
         break;
       }
+      const double boat_tw = boat.through_water;
       track(boat, model.asv(), s.asv, half_draft);
+      if (boat.through_water > boat_tw) {
+        boat_peak_time = s.time;
+        boat_peak_force = r.force_on_asv.norm();
+        boat_peak_height = -env.surface_elevation(s.asv.position.x(), s.asv.position.y(), s.time);
+      }
       track(rov, model.auv(), s.auv, 0.0);
       tension_max = std::max(tension_max, workspace.tether.tension.maxCoeff());
       f_end_max = std::max({f_end_max, r.force_on_asv.norm(), r.force_on_auv.norm()});
@@ -661,7 +667,9 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
   INFO("boat: peak kinetic energy "
        << boat.kinetic << " J (bound " << boat.kinetic_bound << "), speed " << boat.speed
        << " m/s, water speed " << boat.water << " m/s, through the water " << boat.through_water
-       << " m/s, rate " << boat.rate << " rad/s");
+       << " m/s, rate " << boat.rate
+       << " rad/s; fastest through the water at t = " << boat_peak_time << " s, tether force on it "
+       << boat_peak_force << " N, surface elevation there " << boat_peak_height << " m (NED)");
   INFO("ROV: peak kinetic energy "
        << rov.kinetic << " J (bound " << rov.kinetic_bound << "), speed " << rov.speed
        << " m/s, water speed " << rov.water << " m/s, through the water " << rov.through_water

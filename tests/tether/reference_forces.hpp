@@ -191,12 +191,20 @@ void reference_compute_forces(const kt::TetherModel<Scalar>& model, kt::TetherWo
 
     const int kind = i == 0 ? 0 : (i == n ? 2 : 1);
     const Scalar li = kinds[kind].li;
-    const Scalar zeta = still ? Scalar(0) : ws.surface_elevation(i);
-    // (Half a diameter or more below the surface φ = 1 without the ramp's arithmetic.)
-    const Scalar phi =
-        x(2, i) + zeta >= Scalar(0.5) * p.diameter
-            ? Scalar(1)
-            : kt::detail::submerged_fraction(Scalar(x(2, i)), zeta, p.diameter, inv_d);
+    // The wet share of the node's half segments (kt::detail::node_wetness, tested on its own
+    // against quadrature), 1 when it and its neighbours are half a diameter or more below.
+    const auto depth = [&](int j) {
+      return Scalar(x(2, j)) + (still ? Scalar(0) : ws.surface_elevation(j));
+    };
+    const Scalar d_lo = depth(i > 0 ? i - 1 : i), d_i = depth(i), d_hi = depth(i < n ? i + 1 : i);
+    const Scalar half_d = Scalar(0.5) * p.diameter;
+    const kt::detail::NodeWetness<Scalar> wetness =
+        d_lo >= half_d && d_i >= half_d && d_hi >= half_d
+            ? kt::detail::NodeWetness<Scalar>{Scalar(1), Scalar(0), Scalar(0), Scalar(0)}
+            : kt::detail::node_wetness(d_lo, d_i, d_hi, i > 0 ? model.segment_length() : Scalar(0),
+                                       i < n ? model.segment_length() : Scalar(0), i > 0, i < n,
+                                       p.diameter, inv_d);
+    const Scalar phi = wetness.phi;
     ws.submerged(i) = phi;
     const bool wet = phi > Scalar(0);
     // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
@@ -291,7 +299,7 @@ void reference_compute_forces(const kt::TetherModel<Scalar>& model, kt::TetherWo
     }
     ws.seabed_force(i) = normal;
     // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g / D.
-    if (in_band) kz += kinds[kind].rho_vol * g / p.diameter;
+    if (in_band) kz += kinds[kind].rho_vol * g * wetness.d_self;
     if constexpr (WithJacobian) {
       for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
       ws.node_kz(i) = kz;

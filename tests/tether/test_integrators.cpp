@@ -218,8 +218,11 @@ TEST_CASE("waves sampled once per implicit step agree with waves sampled at ever
        << rel << ", node positions up to " << dx << " m apart; 10 ms vs 5 ms: " << rel_dt << " and "
        << dx_dt << " m; force evaluations " << r_held.force_evaluations << " vs "
        << r_exact.force_evaluations);
-  // Holding the water costs less accuracy than the step's own truncation error.
-  CHECK(rel <= 0.5 * rel_dt);
+  // Holding the water costs less accuracy than the step's own truncation error. (0.58 of it
+  // since the segments' wet lengths are exact: the buoyancy of a segment that pierces the surface
+  // depends on the elevation at both its nodes, which the held water takes at the predicted
+  // positions; 0.5 before.)
+  CHECK(rel <= 0.7 * rel_dt);
   CHECK(dx <= 2 * dx_dt);
   CHECK(r_held.force_evaluations <= r_exact.force_evaluations + 100);
 }
@@ -364,12 +367,12 @@ TEST_CASE("round-off is not a physical failure", "[tether][implicit][roundoff]")
                                             Vector3<double>(5000, 0, 2500), s);
     INFO("iterations " << r.iterations << ", residual " << r.residual << " N");
     CHECK(r.converged);
-    // The vertical end loads carry the line's submerged weight, and the start node, at the
-    // surface, is half wet: half its buoyancy is missing.
+    // The vertical end loads carry the line's submerged weight: the start node is at the
+    // surface, but its half segment runs down into the water and is wet but for the first half
+    // diameter (the segments' wet lengths are exact).
     const double w = model.submerged_weight_per_length(env.rho, env.g);
-    const double dry_half = 0.5 * env.rho * model.node_volume(0) * env.g;
     CHECK(ws.end_forces.on_start.z() + ws.end_forces.on_end.z() ==
-          Approx(w * p.length + dry_half).epsilon(1e-3));
+          Approx(w * p.length).epsilon(1e-3));
   }
 }
 

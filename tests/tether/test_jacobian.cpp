@@ -71,7 +71,7 @@ kt::TetherParameters<double> test_line(const Config& c) {
 }
 
 // A random state of the line: a wavy line of segments 0.85 … 1.15 l long (taut and slack),
-// nodes 0–2 in air or in the surface band, the last three on the seabed (penetration inside
+// nodes 0–3 in air or in the surface band, the last three on the seabed (penetration inside
 // and beyond the damper's ramp), random velocities (some nodes on the bed below the friction
 // velocity), random water velocity, acceleration and surface elevation, held.
 struct Scene {
@@ -110,10 +110,11 @@ struct Scene {
       const Vector3<double> dir = (x.col(6) - x.col(5)).normalized();
       v.col(6) += (0.3 + 0.2 * std::abs(u(rng)) - dir.dot(v.col(6) - v.col(5))) * dir;
     }
-    // Surface: node 0 in air, nodes 1 and 2 in the band (well inside it), node 3 deeper.
-    const double zeta0 = ws.surface_elevation(0);
-    x(2, 0) = -zeta0 - diam * (0.6 + 0.3 * std::abs(u(rng)));
-    for (int i : {1, 2}) x(2, i) = -ws.surface_elevation(i) + 0.3 * diam * u(rng);
+    // Surface: nodes 0 and 1 in air (node 0's half segment wholly dry), nodes 2 and 3 in the band
+    // (well inside it), node 4 deeper: segments 1 to 3 are partly wet, and the wet share of nodes
+    // 1 to 4 depends on their neighbours' depths.
+    for (int i : {0, 1}) x(2, i) = -ws.surface_elevation(i) - diam * (0.6 + 0.3 * std::abs(u(rng)));
+    for (int i : {2, 3}) x(2, i) = -ws.surface_elevation(i) + 0.3 * diam * u(rng);
     // Seabed: the last three nodes lie on it, one inside the damper's ramp.
     const double depth = model.parameters().seabed_damping_depth;
     x(2, n - 2) = env.bed + depth * (1.5 + std::abs(u(rng)));

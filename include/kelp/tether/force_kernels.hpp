@@ -185,10 +185,11 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
   }
 }
 
-/// Interior nodes i … i + lanes − 1 (1 ≤ i, i + lanes ≤ N) when all of them are below the
-/// surface band (at least half a diameter deep) and off the seabed (returns false, writing nothing,
-/// otherwise): tangent, node force without the added-mass coupling to the neighbours, that coupling
-/// term w_i, masses and the Jacobian terms. The same arithmetic as node_general for such nodes.
+/// Interior nodes i … i + lanes − 1 (1 ≤ i, i + lanes ≤ N) when all of them and their neighbours
+/// are below the surface band (at least half a diameter deep: their half segments are wholly wet)
+/// and they are off the seabed (returns false, writing nothing, otherwise): tangent, node force
+/// without the added-mass coupling to the neighbours, that coupling term w_i, masses and the
+/// Jacobian terms. The same arithmetic as node_general for such nodes.
 template <bool WithJacobian, bool Wide, typename Scalar>
 EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
                                         const PackedConstants<Scalar, Wide>& pc,
@@ -197,13 +198,19 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   const P zero = pc.zero;
   const Scalar* a = c.x + i * c.xs;
   const P z = P::gather(a + 2, c.xs);
-  // Wholly wet (at least half a diameter under the surface, φ = 1) and off the seabed.
-  if (c.still) {
-    if (simd::any(simd::less(z, pc.half_d) || simd::greater(z - pc.bed, zero))) return false;
-  } else {
-    const P zeta = P::load(&ws.surface_elevation(i));
-    if (simd::any(simd::less(z + zeta, pc.half_d) || simd::greater(z - pc.bed, zero))) return false;
+  // Wholly wet (the node and its neighbours at least half a diameter under the surface: φ = 1)
+  // and off the seabed.
+  const P z_lo = P::gather(a - c.xs + 2, c.xs), z_hi = P::gather(a + c.xs + 2, c.xs);
+  P d = z, d_lo = z_lo, d_hi = z_hi;
+  if (!c.still) {
+    const Scalar* zeta = &ws.surface_elevation(i);
+    d += P::load(zeta);
+    d_lo += P::load(zeta - 1);
+    d_hi += P::load(zeta + 1);
   }
+  if (simd::any(simd::less(d, pc.half_d) || simd::less(d_lo, pc.half_d) ||
+                simd::less(d_hi, pc.half_d) || simd::greater(z - pc.bed, zero)))
+    return false;
   const P c0 = P::gather(a + c.xs, c.xs) - P::gather(a - c.xs, c.xs);
   const P c1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a - c.xs + 1, c.xs);
   const P c2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a - c.xs + 2, c.xs);

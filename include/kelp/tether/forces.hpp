@@ -110,13 +110,14 @@ NodeTangent<Scalar> node_tangent(const Eigen::MatrixBase<DX>& x, int i, int n,
   return t;
 }
 
-/// Submerged fraction φ of a node at NED depth z [m] under a free surface at elevation ζ [m]:
-/// the cable's cross-section of diameter D goes under over one diameter centred on the node,
-/// taken as a linear ramp φ = clamp((z + ζ)/D + ½, 0, 1): ½ for a node exactly at the surface,
-/// 1 (wet) at least half a diameter below it, 0 (in air) at least half a diameter above it. This
+/// Submerged fraction φ of the cable's cross-section at NED depth z [m] under a free surface at
+/// elevation ζ [m]: the cross-section of diameter D goes under over one diameter centred on the
+/// line, taken as a linear ramp φ = clamp((z + ζ)/D + ½, 0, 1): ½ exactly at the surface, 1
+/// (wet) at least half a diameter below it, 0 (in air) at least half a diameter above it. This
 /// is the convention of the vehicles, whose band of one hull height is centred on the centre of
-/// buoyancy (vehicle::submerged_fraction). Buoyancy, drag, fluid inertia and added mass scale
-/// with φ, so the node forces are continuous in the positions (an on/off switch at the surface
+/// buoyancy (vehicle::submerged_fraction). Integrated along each segment (segment_wetness), it
+/// gives the nodes' submerged fractions, by which buoyancy, drag, fluid inertia and added mass
+/// scale, so the node forces are continuous in the positions (an on/off switch at the surface
 /// would leave Newton's method no solution to converge to when a floating line rests at the
 /// surface).
 template <typename Scalar>
@@ -136,6 +137,166 @@ Scalar submerged_depth_integral(Scalar z, Scalar zeta, Scalar diameter) {
   if (d >= half) return d;
   if (d <= -half) return Scalar(0);
   return (d + half) * (d + half) / (Scalar(2) * diameter);
+}
+
+/// How much of one straight segment is under the surface, lumped on its two nodes: with the depth
+/// d(s) = d_a + s (d_b − d_a) along it (s ∈ [0, 1], d = z + ζ at each node, the surface taken as
+/// straight between the nodes) and φ(d) the cross-section's submerged fraction
+/// (submerged_fraction), a = ∫₀¹ (1 − s) φ ds goes to node a and b = ∫₀¹ s φ ds to node b, the
+/// linear shape functions' weights. a + b is the segment's exact submerged fraction, which the
+/// crossing point decides and not the nodes' own depths; the buoyancy so lumped is −∂/∂z of the
+/// segment's potential (segment_depth_integral), and a level segment gives a = b = φ/2, the node
+/// rule of a line lying on the surface. The derivatives daa = ∂a/∂d_a, dab = ∂a/∂d_b = ∂b/∂d_a,
+/// dbb = ∂b/∂d_b [1/m] are the integrals of φ' = 1/D over the band against (1 − s)², s (1 − s) and
+/// s² (zero in air and in the wholly wet water). Integrated in closed form over the pieces of
+/// [0, 1] where φ is 0, linear or 1.
+template <typename Scalar>
+struct SegmentWetness {
+  Scalar a, b, daa, dab, dbb;
+};
+
+template <typename Scalar>
+SegmentWetness<Scalar> segment_wetness(Scalar da, Scalar db, Scalar diameter, Scalar inv_d) {
+  using std::abs;
+  const Scalar half = Scalar(0.5) * diameter, zero(0), one(1);
+  SegmentWetness<Scalar> w{zero, zero, zero, zero, zero};
+  if (da >= half && db >= half) {
+    w.a = w.b = Scalar(0.5);
+    return w;
+  }
+  if (da <= -half && db <= -half) return w;
+  const Scalar delta = db - da;
+  if (abs(delta) <= Scalar(1e-6) * diameter) {
+    // Level to a millionth of the band: φ and φ' of the mid-depth all along.
+    const Scalar mid = Scalar(0.5) * (da + db);
+    const Scalar phi = submerged_fraction(mid, zero, diameter, inv_d);
+    w.a = w.b = Scalar(0.5) * phi;
+    if (phi > zero && phi < one) {
+      w.daa = w.dbb = inv_d / Scalar(3);
+      w.dab = inv_d / Scalar(6);
+    }
+    return w;
+  }
+  const auto clamp01 = [&](Scalar s) { return s <= zero ? zero : (s >= one ? one : s); };
+  const Scalar inv_delta = one / delta;
+  const Scalar s_air = clamp01((-half - da) * inv_delta);  // where d = −D/2
+  const Scalar s_wet = clamp01((half - da) * inv_delta);   // where d = +D/2
+  // Wholly wet beyond s_wet on the deeper side.
+  const Scalar w0 = delta > zero ? s_wet : zero, w1 = delta > zero ? one : s_wet;
+  w.b = Scalar(0.5) * (w1 * w1 - w0 * w0);
+  w.a = (w1 - w0) - w.b;
+  // The band between s_air and s_wet: φ = α + β s.
+  const Scalar r0 = delta > zero ? s_air : s_wet, r1 = delta > zero ? s_wet : s_air;
+  if (r1 > r0) {
+    const Scalar alpha = da * inv_d + Scalar(0.5), beta = delta * inv_d;
+    const Scalar m0 = r1 - r0, m1 = Scalar(0.5) * (r1 * r1 - r0 * r0),
+                 m2 = (r1 * r1 * r1 - r0 * r0 * r0) / Scalar(3);
+    const Scalar i0 = alpha * m0 + beta * m1, i1 = alpha * m1 + beta * m2;
+    w.a += i0 - i1;
+    w.b += i1;
+    const Scalar u0 = one - r0, u1 = one - r1;
+    w.daa = inv_d * (u0 * u0 * u0 - u1 * u1 * u1) / Scalar(3);
+    w.dab = inv_d * (m1 - m2);
+    w.dbb = inv_d * m2;
+  }
+  return w;
+}
+
+/// ∫₀¹ Φ(d_a + s (d_b − d_a)) ds, Φ = submerged_depth_integral: the buoyancy potential of a
+/// segment is ρ g A l times it (A the cross-section, l the unstretched length), and its
+/// derivatives in d_a and d_b are segment_wetness's a and b. Simpson's rule on each piece where Φ
+/// is 0, quadratic or linear, which it integrates exactly.
+template <typename Scalar>
+Scalar segment_depth_integral(Scalar da, Scalar db, Scalar diameter) {
+  using std::abs;
+  const Scalar half = Scalar(0.5) * diameter, zero(0), one(1);
+  const Scalar delta = db - da;
+  const auto big_phi = [&](Scalar s) {
+    return submerged_depth_integral(da + s * delta, zero, diameter);
+  };
+  if (abs(delta) <= Scalar(1e-6) * diameter) return big_phi(Scalar(0.5));
+  const auto clamp01 = [&](Scalar s) { return s <= zero ? zero : (s >= one ? one : s); };
+  Scalar cut[2] = {clamp01((-half - da) / delta), clamp01((half - da) / delta)};
+  if (cut[1] < cut[0]) std::swap(cut[0], cut[1]);
+  const Scalar edges[4] = {zero, cut[0], cut[1], one};
+  Scalar sum(0);
+  for (int k = 0; k < 3; ++k) {
+    const Scalar p = edges[k], q = edges[k + 1];
+    if (q > p)
+      sum += (q - p) / Scalar(6) *
+             (big_phi(p) + Scalar(4) * big_phi(Scalar(0.5) * (p + q)) + big_phi(q));
+  }
+  return sum;
+}
+
+/// Node i's submerged fraction φ_i (its share of line under the surface) and its derivatives
+/// with respect to the depths d_{i−1}, d_i, d_{i+1}: the wet parts of its half segments,
+/// (l_before b_{i−1} + l_after a_i) / ((l_before + l_after)/2) with segment_wetness's a and b,
+/// l_before and l_after the unstretched lengths of the segments before and after it (zero at an
+/// end). A segment that has parted (`joined_*` false) no longer spans a straight line between
+/// its nodes: each node keeps its half at its own depth.
+template <typename Scalar>
+struct NodeWetness {
+  Scalar phi, d_lo, d_self, d_hi;
+};
+
+template <typename Scalar>
+NodeWetness<Scalar> node_wetness(Scalar d_lo, Scalar d, Scalar d_hi, Scalar l_before,
+                                 Scalar l_after, bool joined_before, bool joined_after,
+                                 Scalar diameter, Scalar inv_d) {
+  const Scalar zero(0), half(0.5);
+  NodeWetness<Scalar> w{zero, zero, zero, zero};
+  // A half segment held at the node's own depth: φ(d)/2 of it, ∂/∂d = φ'(d)/2.
+  const Scalar phi_own = submerged_fraction(d, zero, diameter, inv_d);
+  const Scalar dphi_own = phi_own > zero && phi_own < Scalar(1) ? inv_d : zero;
+  if (l_before > zero) {
+    if (joined_before) {
+      const SegmentWetness<Scalar> s = segment_wetness(d_lo, d, diameter, inv_d);
+      w.phi += l_before * s.b;
+      w.d_lo += l_before * s.dab;
+      w.d_self += l_before * s.dbb;
+    } else {
+      w.phi += half * l_before * phi_own;
+      w.d_self += half * l_before * dphi_own;
+    }
+  }
+  if (l_after > zero) {
+    if (joined_after) {
+      const SegmentWetness<Scalar> s = segment_wetness(d, d_hi, diameter, inv_d);
+      w.phi += l_after * s.a;
+      w.d_self += l_after * s.daa;
+      w.d_hi += l_after * s.dab;
+    } else {
+      w.phi += half * l_after * phi_own;
+      w.d_self += half * l_after * dphi_own;
+    }
+  }
+  const Scalar inv_h = Scalar(2) / (l_before + l_after);
+  w.phi *= inv_h;
+  w.d_lo *= inv_h;
+  w.d_self *= inv_h;
+  w.d_hi *= inv_h;
+  return w;
+}
+
+/// node_wetness of node i of a pass: its neighbours' depths, its segments' rest lengths (segment 0
+/// at a winch: TetherWorkspace::winch_length) and whether they have parted.
+template <typename Scalar>
+NodeWetness<Scalar> node_wetness_in_pass(const ForcePass<Scalar>& c,
+                                         const TetherWorkspace<Scalar>& ws, int i) {
+  const int n = c.n;
+  const auto depth = [&](int j) {
+    return c.still ? c.X(2, j) : c.X(2, j) + ws.surface_elevation(j);
+  };
+  const auto rest = [&](int s) { return c.winch && s == 0 ? ws.winch_length : c.l; };
+  const bool joined_before = i > 0 && !(c.parted && c.parted[i - 1]);
+  const bool joined_after = i < n && !(c.parted && c.parted[i]);
+  const Scalar d = depth(i);
+  const Scalar d_lo = joined_before ? depth(i - 1) : d, d_hi = joined_after ? depth(i + 1) : d;
+  if (d >= c.half_d && d_lo >= c.half_d && d_hi >= c.half_d)
+    return {Scalar(1), Scalar(0), Scalar(0), Scalar(0)};
+  return node_wetness(d_lo, d, d_hi, i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
+                      joined_before, joined_after, c.p->diameter, c.inv_d);
 }
 
 /// Node i, any kind and state (end node, surface band, in air, on the seabed): tangent, node
@@ -167,10 +328,10 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
   const int kind = i == 0 ? 0 : (i == n ? 2 : (i == 1 && c.winch ? 3 : 1));
   const Scalar li = c.kinds[kind].li;
   const Scalar z = c.X(2, i);
-  const Scalar zeta = c.still ? Scalar(0) : ws.surface_elevation(i);
-  // (Half a diameter or more below the surface φ = 1 without the ramp's arithmetic.)
-  const Scalar phi =
-      z + zeta >= c.half_d ? Scalar(1) : submerged_fraction(z, zeta, p.diameter, c.inv_d);
+  // The wet share of the node's half segments (φ = 1 without arithmetic when it and its
+  // neighbours are half a diameter or more below the surface).
+  const NodeWetness<Scalar> wetness = node_wetness_in_pass(c, ws, i);
+  const Scalar phi = wetness.phi;
   ws.submerged(i) = phi;
   const bool wet = phi > Scalar(0);
   // A node in the surface band (0 < φ < 1) scales its wet constants by φ.
@@ -267,9 +428,11 @@ void node_general(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws, int i
   ws.seabed_force(i) = normal;
   ws.mass_iso_inv(i) = Scalar(1) / ws.mass_iso(i);
   ws.mass_tan_ratio(i) = ws.mass_tan(i) / (ws.mass_iso(i) + ws.mass_tan(i));
-  // In the surface band the buoyancy −φ ρ V g grows with depth (∂φ/∂z = 1/D): a restoring
-  // spring ρ V g / D.
-  if (in_band) kz += c.kinds[kind].rho_vol * c.g / p.diameter;
+  // In the surface band the buoyancy −φ ρ V g grows with depth: a restoring spring ρ V g ∂φ_i/∂z_i.
+  // (φ_i depends on the neighbours' depths too; the symmetric Jacobian keeps its diagonal only:
+  // its off-diagonal blocks are the segments'. Lumping the row's sum on the diagonal instead took
+  // the static solver 2-4 times as many iterations on a floating line.)
+  if (in_band) kz += c.kinds[kind].rho_vol * c.g * wetness.d_self;
   if constexpr (WithJacobian) {
     for (int k = 0; k < 6; ++k) ws.node_dv(k, i) = dv[k];
     ws.node_kz(i) = kz;
@@ -558,8 +721,12 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 ///   axial force and no bending moment, and the nodes beside it are the ends of their pieces
 ///   (their tangent is their own segment: kelp/tether/failure.hpp);
 /// - buoyancy, drag, fluid inertia and added mass scale with the node's submerged fraction φ_i,
-///   which goes from 1 to 0 as the node rises through the free surface over one cable diameter
-///   centred on the surface, ½ at the surface (detail::submerged_fraction): nodes in air get none.
+///   the wet share of its two half segments: each segment's wet length is exact where it pierces
+///   the surface (the crossing between its nodes, the surface straight between them, a cable
+///   cross-section going under over one diameter), lumped on its nodes by the linear shape
+///   functions, so that the buoyancy is the gradient of the line's potential and a line crossing
+///   the surface converges with the segment length (detail::segment_wetness, node_wetness). A line
+///   lying level on the surface has φ = ½ at the surface, 1 half a diameter below, 0 above.
 /// Evaluated in passes over SIMD packets (kelp/core/simd.hpp): the segments, then the interior
 /// nodes of the wet line a packet at a time (the ends and nodes in the surface band, in air or
 /// on the seabed one by one, with every branch), then the added-mass coupling of neighbours and
@@ -567,7 +734,8 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// \tparam WithJacobian also fill the ingredients of the symmetric block-tridiagonal Jacobian
 /// of the implicit steps (`ws.seg_*`, `ws.node_dv`, `ws.node_kz`), which leaves out the tangent's
 /// dependence on the positions in drag, forcing and added mass, the added-mass rate terms, the
-/// surface band's scaling of the fluid forces, the dashpot's direction and bending; the whole
+/// surface band's scaling of the fluid forces, the dashpot's direction and bending, and the
+/// buoyancy's dependence on the neighbours' depths (it keeps ∂φ_i/∂z_i only); the whole
 /// Jacobian, every term exact, is kelp/tether/jacobian.hpp's force_jacobian.
 /// \param[in] model the tether \param[in,out] ws workspace \param[in] env environment
 /// \param[in] t time [s] \param[in] x node positions 3×(N+1) [m] \param[in] v velocities [m/s]
@@ -642,8 +810,9 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
 }
 
 /// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
-/// the weight −Σ mᵢ g zᵢ (NED z down) and of the buoyancy Σ ρVᵢ g Φ(zᵢ + ζ) (Φ the depth of a
-/// wet node, see detail::submerged_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
+/// the weight −Σ mᵢ g zᵢ (NED z down) and of the buoyancy ρ g A Σ_s l_s ∫₀¹ Φ(d(σ)) dσ over the
+/// segments (Φ the depth of wet line, d the depth along the segment, see
+/// detail::segment_depth_integral) + elastic ½ EA/l Σ (l_s − l)² over
 /// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
 /// tangents and wetness itself.
 /// \throws kelp::invalid_argument when the state does not fit the model or is not finite.
@@ -677,12 +846,35 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
       if (na > Scalar(0) && nb > Scalar(0))
         e += p.bending_stiffness / l * (Scalar(1) - a.dot(b) / (na * nb));
     }
+  // Depth under the surface of node i and rest length of segment s.
+  const auto depth = [&](int i) {
+    return state.position(2, i) +
+           Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
+  };
+  const auto rest = [&](int s) { return s == 0 ? lw : l; };
+  const Scalar inv_d = Scalar(1) / p.diameter;
+  // Buoyancy: ρ g A l Σ_s ∫ Φ over each joined segment, the halves of a parted one at their nodes'
+  // depths (detail::segment_wetness).
+  for (int s = 0; s < n; ++s) {
+    const Scalar da = depth(s), db = depth(s + 1);
+    const Scalar integral =
+        parted && parted[s]
+            ? Scalar(0.5) * (detail::submerged_depth_integral(da, Scalar(0), p.diameter) +
+                             detail::submerged_depth_integral(db, Scalar(0), p.diameter))
+            : detail::segment_depth_integral(da, db, p.diameter);
+    e += rho * g * model.area() * rest(s) * integral;
+  }
   for (int i = 0; i <= n; ++i) {
     const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n, parted).q;
-    const Scalar zeta =
-        Scalar(env.surface_elevation(state.position(0, i), state.position(1, i), state.time));
     const Scalar z = state.position(2, i);
-    const Scalar phi = detail::submerged_fraction(z, zeta, p.diameter);
+    const bool joined_before = i > 0 && !(parted && parted[i - 1]);
+    const bool joined_after = i < n && !(parted && parted[i]);
+    const Scalar d = depth(i);
+    const Scalar phi =
+        detail::node_wetness(joined_before ? depth(i - 1) : d, d, joined_after ? depth(i + 1) : d,
+                             i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
+                             joined_before, joined_after, p.diameter, inv_d)
+            .phi;
     const Scalar extra = detail::winch_extra_length(model, state.winch_length, i);
     const Scalar m = model.node_mass(i) + p.mass_per_length * extra;
     const Scalar vol = model.node_volume(i) + model.area() * extra;
@@ -691,7 +883,7 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
     const Scalar vq = vi.dot(q);
     e += Scalar(0.5) * ((m + rv * p.normal_added_mass) * vi.squaredNorm() +
                         rv * (p.tangential_added_mass - p.normal_added_mass) * vq * vq);
-    e -= m * g * z - rho * vol * g * detail::submerged_depth_integral(z, zeta, p.diameter);
+    e -= m * g * z;
   }
   return e;
 }

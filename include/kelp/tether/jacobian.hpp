@@ -199,8 +199,33 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     const Scalar li = node_length_at(model, ws, i), vol = node_volume_at(model, ws, i);
     const Scalar phi = ws.submerged(i);
     const bool wet = phi > Scalar(0);
-    // ∂φ/∂z in the surface band.
-    const Scalar dphi = wet && phi < Scalar(1) ? inv_diam : Scalar(0);
+    // ∂φ_i/∂z_j in the surface band, j = i − 1, i, i + 1 (detail::node_wetness; the surface
+    // elevation held, as the water is).
+    Scalar dphi_at[3] = {Scalar(0), Scalar(0), Scalar(0)};
+    if (wet && phi < Scalar(1)) {
+      const bool joined_before = i > 0 && !ws.is_parted(i - 1);
+      const bool joined_after = i < n && !ws.is_parted(i);
+      const auto depth = [&](int j) { return Scalar(x(2, j)) + ws.surface_elevation(j); };
+      const auto rest = [&](int s) {
+        return s == 0 && has_winch_segment(ws) ? ws.winch_length : model.segment_length();
+      };
+      const Scalar di = depth(i);
+      const NodeWetness<Scalar> nw =
+          node_wetness(joined_before ? depth(i - 1) : di, di, joined_after ? depth(i + 1) : di,
+                       i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0), joined_before,
+                       joined_after, p.diameter, inv_diam);
+      dphi_at[0] = nw.d_lo;
+      dphi_at[1] = nw.d_self;
+      dphi_at[2] = nw.d_hi;
+    }
+    const Scalar dphi = dphi_at[1];
+    // The block with column z equal to `col` (∂/∂z_j of a term that scales with φ_i: col =
+    // ∂φ_i/∂z_j · term/φ).
+    const auto z_column = [](const V3& col) {
+      M3 b = M3::Zero();
+      b.col(2) = col;
+      return b;
+    };
     const Scalar rho_vol = rho * vol;
     // ∂F_i/∂x_i collects the z-derivatives (band, seabed) and, at the ends, the chord's.
     M3 fx_i = M3::Zero();
@@ -264,22 +289,21 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
         add_outer(wc, k2, V3(vn - s * q), vn);
         add_outer(wc, -k2 * s, vn, q);
         add_projector(wc, -k2 * s * s, q);
-        const V3 wz = (dphi * kappa0 * s) * vn;
+        const V3 wz = (kappa0 * s) * vn;
         for (int side = 0; side < 2; ++side) {
           const int t = side == 0 ? hi : lo;
           const Scalar sg = side == 0 ? Scalar(1) : Scalar(-1);
           sink.v(t, i, wvr, -sg);
           sink.x(t, hi, wc, sg);
           sink.x(t, lo, wc, -sg);
-          if (dphi != Scalar(0)) {
-            M3 z = M3::Zero();
-            z.col(2) = sg * wz;
-            sink.x(t, i, z, one);
-          }
+          for (int k = 0; k < 3; ++k)
+            if (dphi_at[k] != Scalar(0)) sink.x(t, i - 1 + k, z_column(dphi_at[k] * wz), sg);
         }
       }
       fvi -= dvr;
       fx_i.col(2) += dphi * dz;
+      for (int k = 0; k < 3; k += 2)
+        if (dphi_at[k] != Scalar(0)) sink.x(i, i - 1 + k, z_column(dphi_at[k] * dz), one);
     }
     // Seabed: normal force N = (pen kb d + ż cb d ramp) l_i while positive, friction
     // −μ N_f v_h / max(|v_h|, v_f) with N_f the frozen normal force or N.
@@ -333,7 +357,10 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
       const Scalar f_m = phi * b0 * inv_c;
       add_outer(mc, f_m, q, V3(di - qd * q));
       add_projector(mc, f_m * qd, q);
-      if (dphi != Scalar(0)) mz.col(2) = dphi * (rho_vol * can * di + (b0 * qd) * q);
+      const V3 m_phi = rho_vol * can * di + (b0 * qd) * q;  // ∂(M_i d_i)/∂φ
+      if (dphi != Scalar(0)) mz.col(2) = dphi * m_phi;
+      for (int k = 0; k < 3; k += 2)
+        if (dphi_at[k] != Scalar(0)) sink.m(i, i - 1 + k, z_column(dphi_at[k] * m_phi), one);
     }
     sink.xvm(i, i, fx_i, fvi, mz, one);
     sink.xvm(i, hi, fc, gdc, mc, one);
@@ -406,9 +433,10 @@ struct ForceJacobian {
 /// tangent's dependence on the chord (q = c/|c|, ∂q/∂c = P/|c|), Froude–Krylov and added-mass
 /// forcing, the added-mass rate terms (G_i on node i, w_i on the chord's nodes, which reach
 /// i ± 2: the Jacobian is block-pentadiagonal and not symmetric), the surface band (buoyancy,
-/// drag, forcing, added mass scale with φ, ∂φ/∂z = 1/D for 0 < φ < 1), seabed spring, ramped
-/// damper and friction (through the normal force unless TetherWorkspace::frozen_friction). At a
-/// kink (segment at its rest length or force at zero, φ at 0 or 1, seabed touch, |v_n| = 0,
+/// drag, forcing, added mass scale with φ_i, which depends on z_{i−1}, z_i and z_{i+1} through
+/// the segments' wet lengths, detail::node_wetness; the surface elevation is held), seabed spring,
+/// ramped damper and friction (through the normal force unless TetherWorkspace::frozen_friction).
+/// At a kink (segment at its rest length or force at zero, φ at 0 or 1, seabed touch, |v_n| = 0,
 /// |v_h| = v_f) it is the derivative of the branch compute_forces took.
 /// \param[in] model the tether \param[in] ws the workspace of the last compute_forces, which
 /// must have been at (x, v) \param[in] env the environment (density, gravity, seabed depth)
