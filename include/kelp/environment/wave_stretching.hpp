@@ -22,9 +22,10 @@ enum class WaveStretching {
   /// the mean level, under a crest and under a trough alike; at the seabed z' = h. Below the
   /// mean level it changes them too: under a crest (ζ > 0) a point reads the profile of a deeper
   /// point (smaller kinematics than linear theory's at z), under a trough that of a shallower
-  /// one (larger). The elevation at each point is summed first, so a query costs about twice
-  /// the vertical method's. The velocity gradient of a single-point query is linear theory's at
-  /// z' (the terms from the stretching itself, O(k ζ) smaller, are left out).
+  /// one (larger). The elevation at each point is summed first (a second pass of the kernel):
+  /// a query costs about 1.7 times the vertical method's (41 points of the moderate sea's 64
+  /// components: 6.2 → 10.5 µs). The velocity gradient of a single-point query is linear
+  /// theory's at z' (the terms from the stretching itself, O(k ζ) smaller, are left out).
   wheeler,
 };
 
