@@ -286,6 +286,22 @@ void navigation_fields(V& v, NavigationSettings& n) {
   });
 }
 
+/// A regular wave of a custom sea (`"sea": {"regular": {...}}`): its height and exactly one of
+/// period and wavelength (the breaking limit is the environment's check, in world_setup).
+template <class V>
+void regular_wave_fields(V& v, RegularWaveScenario& x) {
+  v.on_read([&] { x.enabled = true; });
+  v.check([](const Reader& r, const std::string& p, const nlohmann::json& b) {
+    if (b.contains("period") == b.contains("wavelength"))
+      r.fail(p, "expected \"period\" or \"wavelength\" (exactly one)");
+  });
+  v.number("height", x.height, 0, 30, required);
+  v.number("period", x.period, 0.5, 60, if_set);
+  v.number("wavelength", x.wavelength, 0.5, 5000, if_set);
+  v.number("direction", x.direction, -10, 10);
+  v.number("phase", x.phase, -10, 10);
+}
+
 /// A vehicle's battery (`"battery": {"asv": {...}, "auv": {...}}`).
 template <class V>
 void battery_fields(V& v, BatteryScenario& b) {
@@ -319,6 +335,10 @@ void scenario_fields(V& v, Scenario& s) {
     o.number("current_speed", s.current_speed, 0, 5);
     o.number("current_direction", s.current_direction, -10, 10);
     o.whole("wave_components", s.wave_components, 1, 4096);
+    o.object("regular", s.regular_wave.enabled,
+             [&](auto& r) { regular_wave_fields(r, s.regular_wave); });
+    o.choice("stretching", s.wave_stretching, wave_stretching_names,
+             unless(kelp::environment::WaveStretching::vertical));
   });
   // The cable properties are written when set (unset: keep the kind's).
   v.object("tether", true, [&](auto& o) {

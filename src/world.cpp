@@ -2,6 +2,7 @@
 #include "kelp/sim/world.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/environment/sea_state.hpp"
@@ -51,6 +52,8 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     refuse("/tether/kind", static_cast<int>(sc.tether_kind));
   if (!choice_name(sc.sea, sea_names)) refuse("/sea", static_cast<int>(sc.sea));
   if (!choice_name(sc.kernel, kernel_path_names)) refuse("/kernel", static_cast<int>(sc.kernel));
+  if (!choice_name(sc.wave_stretching, wave_stretching_names))
+    refuse("/sea/stretching", static_cast<int>(sc.wave_stretching));
   tp.line_model = sc.line_model;
   if (sc.winch.enabled) {
     kelp::tether::WinchParameters<double> w;
@@ -98,6 +101,24 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
     sea.wave_direction = sc.wave_direction;
     sea.wind_direction = sc.wind_direction;
     sea.current_direction = sc.current_direction;
+    sea_options.stretching = sc.wave_stretching;
+    if (sc.regular_wave.enabled) {
+      const RegularWaveScenario& r = sc.regular_wave;
+      ke::RegularWave w;
+      w.height = r.height;
+      w.period = r.period.value_or(0.0);
+      w.wavelength = r.wavelength.value_or(0.0);
+      w.direction = r.direction;
+      w.phase = r.phase;
+      // The environment's checks (exactly one of period and wavelength, the breaking limit),
+      // in deep water as the scenario's waves are, named as the file's error.
+      try {
+        ke::validate(w, kelp::standard_gravity, std::numeric_limits<double>::infinity());
+      } catch (const kelp::invalid_argument& e) {
+        throw scenario_error(file + ": /sea/regular: " + e.what());
+      }
+      sea.regular_waves.push_back(w);
+    }
   }
   sp::StartPoses<double> start = sp::paper_start(sc.tether_length);
   if (sc.auv_start) start.auv.position = *sc.auv_start;

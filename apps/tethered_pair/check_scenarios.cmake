@@ -29,6 +29,12 @@ set(bad_winch [=[{"tether": {"length": 10, "winch": {"strategy": "yank"}}}]=])
 set(path_winch "/tether/winch/strategy")
 set(bad_winch_range [=[{"tether": {"length": 10, "winch": {"min_length": 12}}}]=])
 set(path_winch_range "/tether/length")
+set(bad_regular_height [=[{"sea": {"regular": {"height": -1, "period": 6}}}]=])
+set(path_regular_height "/sea/regular/height")
+set(bad_regular_both [=[{"sea": {"regular": {"height": 1, "period": 6, "wavelength": 50}}}]=])
+set(path_regular_both "/sea/regular")
+set(bad_regular_steep [=[{"sea": {"regular": {"height": 4, "wavelength": 25}}}]=])
+set(path_regular_steep "/sea/regular")
 set(bad_not_json [=[{"duration": 10,]=])
 set(path_not_json "not valid JSON")
 # Nested 100000 levels deep (found by fuzz/fuzz_scenario): refused before parsing; it used to
@@ -39,7 +45,8 @@ set(bad_too_deep "{\"vehicles\": {\"asv_attachment\": ${open}${close}}}")
 set(path_too_deep "nested more than 64 levels")
 
 foreach(kind unknown_key wrong_type out_of_range non_finite empty_waypoints short_tether choice
-             vector gains winch winch_range not_json too_deep)
+             vector gains winch winch_range regular_height regular_both regular_steep not_json
+             too_deep)
   set(file "${OUT}/${kind}.json")
   file(WRITE "${file}" "${bad_${kind}}")
   file(REMOVE_RECURSE "${OUT}/${kind}_out")

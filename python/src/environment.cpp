@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
@@ -17,14 +18,65 @@ namespace {
 using Env = kelp::environment::Environmentd;
 namespace ke = kelp::environment;
 
+ke::WaveStretching stretching_of(const std::string& name) {
+  if (name == "vertical") return ke::WaveStretching::vertical;
+  if (name == "wheeler") return ke::WaveStretching::wheeler;
+  kelp::detail::throw_invalid_argument("stretching: expected \"vertical\" or \"wheeler\", got \"" +
+                                       name + "\"");
+}
+
 Env make(const ke::SeaState& sea, std::uint64_t seed, int wave_components, double ramp,
-         double seabed_depth) {
+         double seabed_depth, const std::string& stretching = "vertical") {
   ke::SeaStateOptions o;
   o.seed = seed;
   o.wave_components = wave_components;
   o.ramp = ramp;
   o.seabed_depth = seabed_depth;
+  o.stretching = stretching_of(stretching);
   return ke::make_environment<double>(sea, o);
+}
+
+/// One regular wave from a dict with the scenario's keys: "height", "period" or "wavelength",
+/// "direction", "phase" (the environment checks the values).
+ke::RegularWave regular_wave(py::handle h) {
+  if (!py::isinstance<py::dict>(h))
+    kelp::detail::throw_invalid_argument(
+        "regular: expected a dict {\"height\": m, \"period\": s (or \"wavelength\": m), "
+        "\"direction\": rad, \"phase\": rad} or a list of them");
+  ke::RegularWave w;
+  for (const auto& item : py::reinterpret_borrow<py::dict>(h)) {
+    const std::string key = py::str(item.first);
+    const double value = item.second.cast<double>();
+    if (key == "height")
+      w.height = value;
+    else if (key == "period")
+      w.period = value;
+    else if (key == "wavelength")
+      w.wavelength = value;
+    else if (key == "direction")
+      w.direction = value;
+    else if (key == "phase")
+      w.phase = value;
+    else
+      kelp::detail::throw_invalid_argument(
+          "regular: unknown key \"" + key +
+          "\" (expected height, period, wavelength, direction, phase)");
+  }
+  return w;
+}
+
+/// None, one dict, or a list of dicts: the regular waves.
+std::vector<ke::RegularWave> regular_waves(py::handle h) {
+  std::vector<ke::RegularWave> out;
+  if (h.is_none()) return out;
+  if (py::isinstance<py::dict>(h)) {
+    out.push_back(regular_wave(h));
+  } else if (py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h)) {
+    for (py::handle w : h) out.push_back(regular_wave(w));
+  } else {
+    regular_wave(h);  // throws, saying what is expected
+  }
+  return out;
 }
 
 ke::SeaState preset(const std::string& sea) {
@@ -54,21 +106,26 @@ void bind_environment(py::module_& m) {
       .def_static(
           "preset",
           [](const std::string& sea, std::uint64_t seed, int wave_components, double ramp,
-             double seabed_depth) {
-            return make(preset(sea), seed, wave_components, ramp, seabed_depth);
+             double seabed_depth, const std::string& stretching) {
+            return make(preset(sea), seed, wave_components, ramp, seabed_depth, stretching);
           },
           py::arg("sea") = "moderate", py::arg("seed") = 1, py::arg("wave_components") = 64,
-          py::arg("ramp") = 0.0, py::arg("seabed_depth") = inf,
+          py::arg("ramp") = 0.0, py::arg("seabed_depth") = inf, py::arg("stretching") = "vertical",
           "One of the paper's seas: 'calm' (nothing), 'moderate' (Hs 3 m, wind 3 m/s, current "
           "0.5 m/s) or 'rough' (Hs 4.5 m, wind 4.5 m/s, current 1 m/s), Tp = 4.5 sqrt(Hs), "
           "its waves and gusts drawn from `seed`, brought in over `ramp` s, over a flat seabed "
-          "at `seabed_depth` m (default none).")
+          "at `seabed_depth` m (default none). `stretching`: the wave kinematics near the "
+          "surface, 'vertical' (those of the mean level above it; the default) or 'wheeler' "
+          "(Wheeler 1970: the wetted column stretched onto the mean one; docs/equations.md, "
+          "section 2).")
       .def_static(
           "sea_state",
           [](double hs, double tp, double gamma, double wave_direction, double wind_speed,
              double wind_direction, double current_speed, double current_direction,
-             std::uint64_t seed, int wave_components, double ramp, double seabed_depth) {
+             std::uint64_t seed, int wave_components, double ramp, double seabed_depth,
+             py::handle regular, const std::string& stretching) {
             ke::SeaState s;
+            s.regular_waves = regular_waves(regular);
             s.significant_height = hs;
             s.peak_period = tp;
             s.peak_enhancement =
@@ -78,17 +135,23 @@ void bind_environment(py::module_& m) {
             s.wind_direction = wind_direction;
             s.current_speed = current_speed;
             s.current_direction = current_direction;
-            return make(s, seed, wave_components, ramp, seabed_depth);
+            return make(s, seed, wave_components, ramp, seabed_depth, stretching);
           },
           py::arg("significant_height") = 0.0, py::arg("peak_period") = 8.0,
           py::arg("peak_enhancement") = std::numeric_limits<double>::quiet_NaN(),
           py::arg("wave_direction") = 0.0, py::arg("wind_speed") = 0.0,
           py::arg("wind_direction") = 0.0, py::arg("current_speed") = 0.0,
           py::arg("current_direction") = 0.0, py::arg("seed") = 1, py::arg("wave_components") = 64,
-          py::arg("ramp") = 0.0, py::arg("seabed_depth") = inf,
+          py::arg("ramp") = 0.0, py::arg("seabed_depth") = inf, py::arg("regular") = py::none(),
+          py::arg("stretching") = "vertical",
           "Any sea: JONSWAP waves of significant height Hs [m] and peak period Tp [s] (peak "
           "enhancement gamma: default DNV's for Hs, Tp), travelling towards `wave_direction` "
-          "(NED azimuth [rad]); mean wind [m/s] and current [m/s] towards their directions.")
+          "(NED azimuth [rad]); mean wind [m/s] and current [m/s] towards their directions. "
+          "`regular`: a regular (Airy) wave, a dict {'height': m, 'period': s (or "
+          "'wavelength': m, not both), 'direction': rad, 'phase': rad}, or a list of them, on "
+          "top of the JONSWAP sea (alone with significant_height=0): elevation "
+          "height/2 cos(k (x cos(direction) + y sin(direction)) - omega t + phase), dispersion "
+          "for `seabed_depth`. `stretching`: 'vertical' (default) or 'wheeler' (see preset).")
       .def_property_readonly("water_density", &Env::water_density, "rho [kg/m^3].")
       .def_property_readonly("air_density", &Env::air_density, "rho_air [kg/m^3].")
       .def_property_readonly("gravity", &Env::gravity, "g [m/s^2].")

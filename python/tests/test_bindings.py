@@ -130,6 +130,58 @@ def test_environment_presets_and_errors():
         waves.surface_elevation([0.0, 0.0], math.nan)
 
 
+def test_environment_regular_wave_is_airy():
+    # A regular wave alone: elevation A cos(k x - w t) at a probe, velocity the closed form.
+    for depth in (math.inf, 12.0):
+        env = kelp.Environment.sea_state(
+            regular={"height": 1.0, "period": 5.0}, seabed_depth=depth)
+        w = 2 * math.pi / 5.0
+        k = w * w / 9.80665
+        if math.isfinite(depth):  # w^2 = g k tanh(k h), by fixed-point iteration
+            for _ in range(200):
+                k = w * w / (9.80665 * math.tanh(k * depth))
+        t = np.linspace(0.0, 20.0, 81)
+        zeta = [env.surface_elevation([7.0, 0.0, 0.0], ti) for ti in t]
+        np.testing.assert_allclose(zeta, 0.5 * np.cos(k * 7.0 - w * t), atol=1e-9)
+        z, ti = 2.0, 1.3
+        th = k * 7.0 - w * ti
+        if math.isinf(depth):
+            fh = fv = math.exp(-k * z)
+        else:
+            fh = math.cosh(k * (depth - z)) / math.sinh(k * depth)
+            fv = math.sinh(k * (depth - z)) / math.sinh(k * depth)
+        s = env.sample([7.0, 0.0, z], ti, with_wind=False)
+        np.testing.assert_allclose(
+            s["wave_velocity"], [0.5 * w * fh * math.cos(th), 0.0, -0.5 * w * fv * math.sin(th)],
+            atol=1e-9)
+    # On a JONSWAP sea, by wavelength, in several directions; Wheeler stretching at a trough's
+    # surface gives the mean-level velocity.
+    both = kelp.Environment.sea_state(
+        significant_height=1.0, peak_period=6.0,
+        regular=[{"height": 0.4, "wavelength": 30.0, "direction": 0.5, "phase": 1.0},
+                 {"height": 0.2, "period": 4.0}],
+        stretching="wheeler")
+    assert np.isfinite(both.surface_elevation([1.0, 2.0, 0.0], 3.0))
+    lone = kelp.Environment.sea_state(regular={"height": 1.0, "period": 6.0}, stretching="wheeler")
+    w = 2 * math.pi / 6.0
+    trough_t = math.pi / w  # cos(-w t) = -1 at x = 0
+    top = lone.sample([0.0, 0.0, 0.5 + 1e-12], trough_t, with_wind=False)
+    np.testing.assert_allclose(top["wave_velocity"], [-0.5 * w, 0.0, 0.0], atol=1e-9)
+    # Bad input, named.
+    with pytest.raises(kelp.InvalidArgument, match="regular.height"):
+        kelp.Environment.sea_state(regular={"height": -1.0, "period": 5.0})
+    with pytest.raises(kelp.InvalidArgument, match="exactly one of regular.period"):
+        kelp.Environment.sea_state(regular={"height": 1.0, "period": 5.0, "wavelength": 40.0})
+    with pytest.raises(kelp.InvalidArgument, match="breaking limit"):
+        kelp.Environment.sea_state(regular={"height": 9.0, "wavelength": 40.0})
+    with pytest.raises(kelp.InvalidArgument, match='unknown key "amplitude"'):
+        kelp.Environment.sea_state(regular={"amplitude": 1.0, "period": 5.0})
+    with pytest.raises(kelp.InvalidArgument, match="expected a dict"):
+        kelp.Environment.sea_state(regular=3.0)
+    with pytest.raises(kelp.InvalidArgument, match="stretching"):
+        kelp.Environment.preset("moderate", stretching="delta")
+
+
 # ---- catenary ---------------------------------------------------------------------------------
 
 def test_catenary_solves_the_papers_equations():

@@ -112,6 +112,67 @@ TEST_CASE("bad input: wave spectrum parameters out of their physical bounds",
   CHECK(WaveField<double>(peaked).variance() > 0.0);
 }
 
+TEST_CASE("bad input: regular waves", "[environment][bad_input][regular]") {
+  RegularWave good;
+  good.height = 1.0;
+  good.period = 6.0;
+  const auto field = [](const RegularWave& w, double hs = 0.0) {
+    WaveFieldParameters p = sea(hs == 0.0 ? 0.0 : hs, 7.0);
+    p.regular = {w};
+    return WaveField<double>(p);
+  };
+  REQUIRE(field(good).size() == 1);
+  REQUIRE(field(good, 2.0).size() == 33);
+  const auto refused = [&](RegularWave w, const char* field_name) {
+    INFO(field_name);
+    REQUIRE_THROWS_AS(field(w), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(field(w), Catch::Contains(field_name));
+  };
+  for (const double h : {-1.0, 101.0, kNan, kInf}) {
+    RegularWave w = good;
+    w.height = h;
+    refused(w, "regular.height");
+  }
+  RegularWave both = good;
+  both.wavelength = 50.0;  // period and wavelength
+  refused(both, "exactly one of regular.period and regular.wavelength");
+  RegularWave neither = good;
+  neither.period = 0.0;
+  refused(neither, "exactly one of regular.period and regular.wavelength");
+  for (const double t : {-6.0, kNan}) {
+    RegularWave w = good;
+    w.period = t;
+    refused(w, "regular.period");
+  }
+  for (const double t : {0.01, 1e4, kInf}) {
+    RegularWave w = good;
+    w.period = t;
+    refused(w, "regular.period");
+  }
+  for (const double l : {-5.0, kInf, 1e7}) {
+    RegularWave w = good;
+    w.period = 0.0;
+    w.wavelength = l;
+    refused(w, "regular.wavelength");
+  }
+  RegularWave w = good;
+  w.direction = kNan;
+  refused(w, "regular.direction");
+  w = good;
+  w.phase = kInf;
+  refused(w, "regular.phase");
+  // Steeper than the breaking limit H/λ = 1/7: λ = g T²/2π ≈ 56.2 m for T = 6 s (deep water).
+  w = good;
+  w.height = 8.1;
+  refused(w, "breaking limit");
+  w.height = 7.9;
+  CHECK(field(w).size() == 1);
+  // The stretching enum out of range.
+  WaveFieldParameters p = sea();
+  p.stretching = static_cast<WaveStretching>(7);
+  REQUIRE_THROWS_WITH(WaveField<double>(p), Catch::Contains("stretching"));
+}
+
 TEST_CASE("bad input: spectra and dispersion as pure functions", "[environment][bad_input]") {
   const double hs = 3.0, tp = 8.0, w = 0.9;
   // Tp = 0 and γ = 0 used to give NaN.

@@ -65,6 +65,43 @@ TEST_CASE("wave kinematics: Jet derivatives match finite differences", "[environ
   }
 }
 
+TEST_CASE(
+    "Wheeler-stretched regular and spectral waves: Jet derivatives match finite "
+    "differences",
+    "[environment][jet][stretching]") {
+  for (const double depth : {std::numeric_limits<double>::infinity(), 15.0}) {
+    WaveFieldParameters p;
+    p.spectrum.significant_height = 1.5;
+    p.spectrum.peak_period = 6.0;
+    p.n_components = 16;
+    p.depth = depth;
+    p.stretching = WaveStretching::wheeler;
+    RegularWave w;
+    w.height = 1.0;
+    w.period = 5.0;
+    w.direction = 0.3;
+    p.regular = {w};
+    const WaveField<Jet> wj(p);
+    const WaveField<double> wd(p);
+    const Vector3<double> x0(2.0, 1.0, 1.5);
+    const Vector3<Jet> xj(Jet(x0(0), 0), Jet(x0(1), 1), Jet(x0(2), 2));
+    for (const double t : {0.0, 2.7}) {
+      const auto kj = wj.kinematics(xj, t);
+      const double h = 1e-6;
+      for (int d = 0; d < 3; ++d) {
+        Vector3<double> e = Vector3<double>::Zero();
+        e(d) = h;
+        const Vector3<double> dv =
+            (wd.kinematics(x0 + e, t).velocity - wd.kinematics(x0 - e, t).velocity) / (2 * h);
+        for (int r = 0; r < 3; ++r) {
+          CHECK(kj.velocity(r).a == Approx(wd.kinematics(x0, t).velocity(r)).margin(1e-12));
+          CHECK(kj.velocity(r).v(d) == Approx(dv(r)).margin(1e-7));
+        }
+      }
+    }
+  }
+}
+
 TEST_CASE("environment sample with Jets: current profile derivative", "[environment][jet]") {
   Environment<Jet> env = make_environment<Jet>(presets::moderate());
   CurrentParameters cp;

@@ -202,6 +202,82 @@ TEST_CASE("the tether's line_model: parsed, written back, passed to the tether, 
   CHECK_THROWS_AS(ks::world_setup(bad, "f.json"), ks::scenario_error);
 }
 
+TEST_CASE("a custom sea's regular wave and stretching: parsed, written back, in the sea",
+          "[sim][regular]") {
+  // A regular wave alone (no significant_height): H 1.2 m, T 6 s, travelling east.
+  const ks::Scenario sc = ks::parse_scenario(
+      R"({"sea": {"regular": {"height": 1.2, "period": 6, "direction": 1.5707963267948966,
+          "phase": 0.25}, "stretching": "wheeler"}})",
+      "r.json");
+  CHECK(sc.sea == ks::Sea::custom);
+  CHECK(sc.regular_wave.enabled);
+  CHECK(sc.regular_wave.height == 1.2);
+  CHECK(sc.regular_wave.period == 6.0);
+  CHECK_FALSE(sc.regular_wave.wavelength.has_value());
+  CHECK(sc.wave_stretching == kelp::environment::WaveStretching::wheeler);
+  const ks::WorldSetup w = ks::world_setup(sc, "r.json");
+  const auto& waves = w.environment.waves();
+  REQUIRE(waves.size() == 1);
+  CHECK(waves.amplitude(0) == 0.6);
+  CHECK(waves.omega(0) == Approx(2.0 * kelp::pi / 6.0));
+  CHECK(waves.parameters().stretching == kelp::environment::WaveStretching::wheeler);
+  // ζ at a probe 10 m east: A cos(k y − ω t + φ), deep water (the wave field's: the environment
+  // brings it in over the scenario's start ramp).
+  const double omega = 2.0 * kelp::pi / 6.0, k = omega * omega / kelp::standard_gravity;
+  for (const double t : {0.0, 1.0, 2.5})
+    CHECK(waves.elevation(0.0, 10.0, t) ==
+          Approx(0.6 * std::cos(k * 10.0 - omega * t + 0.25)).margin(1e-9));
+  // Written back (the summary's echo) and read again to the same wave.
+  const std::string echo = kelp_test::json_of(sc).dump();
+  INFO(echo);
+  const ks::Scenario again = ks::parse_scenario(echo, "echo");
+  CHECK(again.regular_wave.enabled);
+  CHECK(again.regular_wave.height == 1.2);
+  CHECK(again.regular_wave.period == 6.0);
+  CHECK(again.regular_wave.phase == 0.25);
+  CHECK(again.wave_stretching == kelp::environment::WaveStretching::wheeler);
+  // Not written when absent; by wavelength on top of a JONSWAP sea.
+  const ks::Scenario plain = ks::parse_scenario(R"({"sea": {"significant_height": 1}})", "p.json");
+  CHECK_FALSE(plain.regular_wave.enabled);
+  CHECK_FALSE(kelp_test::json_of(plain).at("sea").contains("regular"));
+  CHECK_FALSE(kelp_test::json_of(plain).at("sea").contains("stretching"));
+  const ks::Scenario both = ks::parse_scenario(
+      R"({"sea": {"significant_height": 1, "regular": {"height": 0.5, "wavelength": 40}}})",
+      "b.json");
+  CHECK(ks::world_setup(both, "b.json").environment.waves().size() == 65);
+}
+
+TEST_CASE("bad regular waves are refused naming the JSON path", "[sim][regular][bad_input]") {
+  const auto refused = [](const char* text, const char* path) {
+    INFO(text);
+    try {
+      const ks::Scenario sc = ks::parse_scenario(text, "bad.json");
+      (void)ks::world_setup(sc, "bad.json");
+      FAIL("accepted");
+    } catch (const ks::scenario_error& e) {
+      CHECK_THAT(e.what(), Catch::StartsWith(std::string("bad.json: ") + path));
+    }
+  };
+  refused(R"({"sea": {"regular": {"height": -1, "period": 6}}})", "/sea/regular/height");
+  refused(R"({"sea": {"regular": {"period": 6}}})", "/sea/regular");  // no height
+  refused(R"({"sea": {"regular": {"height": 1, "period": 6, "wavelength": 50}}})",
+          "/sea/regular: expected \"period\" or \"wavelength\"");
+  refused(R"({"sea": {"regular": {"height": 1}}})", "/sea/regular: expected");
+  refused(R"({"sea": {"regular": {"height": 1, "period": 0}}})", "/sea/regular/period");
+  refused(R"({"sea": {"regular": {"height": 1, "wavelength": -3}}})", "/sea/regular/wavelength");
+  refused(R"({"sea": {"regular": {"height": 1, "period": 6, "colour": 1}}})",
+          "/sea/regular/colour");
+  refused(R"({"sea": {"regular": {"height": 1, "period": "6"}}})", "/sea/regular/period");
+  // Steeper than the breaking limit (λ = 25 m): the environment's check, named by the world.
+  refused(R"({"sea": {"regular": {"height": 4, "wavelength": 25}}})",
+          "/sea/regular: regular.height must be at most the breaking limit");
+  refused(R"({"sea": {"stretching": "delta"}})", "/sea/stretching");
+  ks::Scenario cast;
+  cast.sea = ks::Sea::custom;
+  cast.wave_stretching = static_cast<kelp::environment::WaveStretching>(9);
+  CHECK_THROWS_AS(ks::world_setup(cast, "f.json"), ks::scenario_error);
+}
+
 TEST_CASE("a closed-loop step allocates nothing", "[sim][malloc]") {
   ks::ClosedLoop loop(short_calm_run());
   loop.run_for(0.1);  // past the first controller updates

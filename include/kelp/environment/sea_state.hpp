@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
@@ -51,6 +52,9 @@ struct SeaState {
   double wind_direction = 0.0;      ///< NED azimuth the wind blows towards [rad]
   double current_speed = 0.0;       ///< surface current [m/s]
   double current_direction = 0.0;   ///< NED azimuth the current flows towards [rad]
+  /// Regular (Airy) waves on top of the JONSWAP sea, or alone when significant_height = 0
+  /// (WaveFieldParameters::regular; none by default).
+  std::vector<RegularWave> regular_waves;
 };
 
 /// \brief How `make_environment` discretises a sea state.
@@ -64,6 +68,9 @@ struct SeaStateOptions {
   /// Start-up ramp T [s]: waves, current and wind come in over [0, T] (Environment::set_ramp;
   /// 0: the full sea from t = 0).
   double ramp = 0.0;
+  /// Kinematics near the free surface, for the spectral and the regular waves alike
+  /// (WaveFieldParameters::stretching: vertical extrapolation by default, or Wheeler's).
+  WaveStretching stretching = WaveStretching::vertical;
 };
 
 namespace presets {
@@ -93,8 +100,8 @@ inline SeaState rough() { return paper_sea_state(4.5, 4.5, 1.0); }
 
 }  // namespace presets
 
-/// \brief An environment for a sea state: JONSWAP waves, wind with gusts and a constant,
-/// depth-uniform current, in seawater with standard gravity.
+/// \brief An environment for a sea state: JONSWAP waves (and any regular waves), wind with
+/// gusts and a constant, depth-uniform current, in seawater with standard gravity.
 /// \throws kelp::invalid_argument naming the bad field.
 template <typename Scalar>
 Environment<Scalar> make_environment(const SeaState& s, const SeaStateOptions& o = {}) {
@@ -112,6 +119,8 @@ Environment<Scalar> make_environment(const SeaState& s, const SeaStateOptions& o
   w.spreading = o.spreading;
   w.depth = o.seabed_depth;
   w.gravity = kelp::standard_gravity;
+  w.regular = s.regular_waves;
+  w.stretching = o.stretching;
   env.set_waves(WaveField<Scalar>(w));
   WindParameters wp;
   wp.speed = s.wind_speed;

@@ -21,12 +21,19 @@
 /// F_v = sinh(k(h − z))/sinh(k h) in water of depth h.
 ///
 /// Assumptions (linear theory): small steepness; velocities are summed component by component;
-/// between the mean level and a crest (−ζ ≤ z < 0) the kinematics are those at z = 0 (constant
-/// extrapolation, no Wheeler stretching); above the free surface (z < −ζ) velocity and
-/// acceleration are zero; below a finite seabed they are those at the seabed. Acceleration is the
-/// local (Eulerian) ∂v/∂t; the single-point query also returns the velocity gradient ∇v, from
-/// which a body forms the convective part (v·∇)v of the material acceleration (second order in
-/// the wave amplitude, but with a non-zero mean: vehicle::surroundings uses it).
+/// near the free surface the profiles are taken as `WaveFieldParameters::stretching` says: by
+/// default (`WaveStretching::vertical`) between the mean level and a crest (−ζ ≤ z < 0) the
+/// kinematics are those at z = 0 (vertical extrapolation) and below it linear theory's; with
+/// `WaveStretching::wheeler` the wetted column is stretched onto [0, h] (Wheeler 1970, see the
+/// enum); above the free surface (z < −ζ) velocity and acceleration are zero; below a finite
+/// seabed they are those at the seabed. Acceleration is the local (Eulerian) ∂v/∂t; the
+/// single-point query also returns the velocity gradient ∇v, from which a body forms the convective
+/// part (v·∇)v of the material acceleration (second order in the wave amplitude, but with a
+/// non-zero mean: vehicle::surroundings uses it).
+///
+/// Regular waves (`RegularWave`: height, period or wavelength, direction, phase) are components
+/// like the spectrum's, appended after them (`WaveFieldParameters::regular`): alone, or on top of
+/// a spectral sea. A regular wave of height H has ζ = (H/2) cos θ with the θ above.
 #pragma once
 
 #include <Eigen/Core>
@@ -48,11 +55,73 @@
 #include "kelp/environment/limits.hpp"
 #include "kelp/environment/spectra.hpp"
 #include "kelp/environment/wave_kernels.hpp"
+#include "kelp/environment/wave_stretching.hpp"
 
 namespace kelp {
 namespace environment {
 
-/// \brief How a wave spectrum becomes a sum of regular components.
+/// \brief A regular (Airy) wave of given height, period or wavelength, direction and phase:
+/// ζ = (H/2) cos(k (x cos β + y sin β) − ω t + φ), with ω² = g k tanh(k h) (deep water: ω² = g k)
+/// for the wave field's depth h and gravity g.
+struct RegularWave {
+  double height = 0.0;      ///< crest-to-trough height H = 2 A [m] (0 ≤ H ≤ 100; 0: no wave)
+  double period = 0.0;      ///< period T = 2π/ω [s], or 0 when `wavelength` is given
+  double wavelength = 0.0;  ///< wavelength λ = 2π/k [m], or 0 when `period` is given
+  /// Direction the wave travels TOWARDS, NED azimuth from north, clockwise [rad] (the spectral
+  /// components' convention).
+  double direction = 0.0;
+  double phase = 0.0;  ///< phase φ [rad]: the crest is at the origin when φ − ω t = 0
+};
+
+/// \brief Wave number k [rad/m] of a regular wave in water of depth h (+∞: deep) and gravity g:
+/// 2π/λ, or the root of the dispersion relation for ω = 2π/T (`wave_number`).
+inline double regular_wave_number(const RegularWave& w, double g, double depth) {
+  if (w.wavelength > 0.0) return 2.0 * kelp::pi / w.wavelength;
+  return wave_number(2.0 * kelp::pi / w.period, g, depth);
+}
+
+/// \brief Angular frequency ω [rad/s] of a regular wave: 2π/T, or ω = √(g k tanh(k h)) for
+/// k = 2π/λ (`wave_frequency`).
+inline double regular_wave_frequency(const RegularWave& w, double g, double depth) {
+  if (w.wavelength > 0.0) return wave_frequency(2.0 * kelp::pi / w.wavelength, g, depth);
+  return 2.0 * kelp::pi / w.period;
+}
+
+/// \brief Throws `kelp::invalid_argument` naming the offending field (`regular.height` and so
+/// on) unless the wave is one linear theory describes in water of depth h and gravity g.
+///
+/// \throws kelp::invalid_argument when height is not in [0, 100] m, not exactly one of period
+/// (finite, in [0.1, 1000] s) and wavelength (finite, in (0, 1e6] m) is given (> 0; the other
+/// 0), direction or phase is not finite, or the wave is steeper than the breaking limit
+/// H/λ = 1/7 (Michell 1893; linear theory is meaningless beyond).
+inline void validate(const RegularWave& w, double g, double depth) {
+  detail::check_in_range(w.height, 0.0, limits::max_significant_height, "regular.height",
+                         "finite and in [0, 100] m");
+  KELP_CHECK(!std::isnan(w.period) && !std::isnan(w.wavelength) &&
+                 (w.period > 0.0) != (w.wavelength > 0.0) && w.period >= 0.0 && w.wavelength >= 0.0,
+             "regular: give exactly one of regular.period and regular.wavelength (> 0; the "
+             "other 0), got period = " +
+                 std::to_string(w.period) + " s and wavelength = " + std::to_string(w.wavelength) +
+                 " m");
+  if (w.period > 0.0)
+    detail::check_in_range(w.period, limits::min_peak_period, limits::max_peak_period,
+                           "regular.period", "finite and in [0.1, 1000] s");
+  else
+    detail::check_positive_at_most(w.wavelength, 1e6, "regular.wavelength",
+                                   "finite and in (0, 1e6] m");
+  check_finite(w.direction, "regular.direction");
+  check_finite(w.phase, "regular.phase");
+  const double lambda = 2.0 * kelp::pi / regular_wave_number(w, g, depth);
+  if (!(w.height <= lambda / 7.0)) {
+    std::ostringstream msg;
+    msg.precision(9);
+    msg << "regular.height must be at most the breaking limit wavelength / 7 = " << lambda / 7.0
+        << " m (got " << w.height << " m for a wavelength of " << lambda << " m)";
+    ::kelp::detail::throw_invalid_argument(msg.str());
+  }
+}
+
+/// \brief How a wave spectrum (and any regular waves) becomes a sum of regular components.
 struct WaveFieldParameters {
   /// Spectrum (shape, Hs, Tp, γ). Hs = 0 gives a calm sea with no components.
   WaveSpectrum spectrum;
@@ -77,6 +146,11 @@ struct WaveFieldParameters {
   double depth = std::numeric_limits<double>::infinity();
   /// Gravitational acceleration [m/s²].
   double gravity = kelp::standard_gravity;
+  /// Regular waves added to the spectrum's components, after them (none by default). With
+  /// spectrum.significant_height = 0 they alone make the sea. Each uses `depth` and `gravity`.
+  std::vector<RegularWave> regular;
+  /// Kinematics near the free surface (`WaveStretching`; vertical extrapolation by default).
+  WaveStretching stretching = WaveStretching::vertical;
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the offending field of `p` (and its value
@@ -109,6 +183,11 @@ inline void validate(const WaveFieldParameters& p) {
                             "such that the highest wave number (omega_max_factor 2 pi / "
                             "peak_period)^2 / gravity is finite",
                             p.omega_max_factor);
+  KELP_CHECK(p.stretching == WaveStretching::vertical || p.stretching == WaveStretching::wheeler,
+             "stretching must be WaveStretching::vertical or WaveStretching::wheeler");
+  KELP_CHECK(p.regular.size() <= static_cast<std::size_t>(limits::max_components),
+             "regular: at most 1048576 regular waves");
+  for (const RegularWave& w : p.regular) validate(w, p.gravity, p.depth);
 }
 
 /// \brief Elevation and orbital kinematics at one point.
@@ -152,71 +231,61 @@ class WaveField {
   /// wave number is 0.
   explicit WaveField(const WaveFieldParameters& p) : params_(p) {
     validate(p);
-    if (p.spectrum.significant_height == 0.0) return;
-    const auto n = static_cast<std::size_t>(p.n_components);
-    std::mt19937_64 rng(p.seed);
-    auto uniform = [&rng]() { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
-    const double wp = 2.0 * kelp::pi / p.spectrum.peak_period;
-    const double w_lo = p.omega_min_factor * wp, w_hi = p.omega_max_factor * wp;
-    const double dw = (w_hi - w_lo) / static_cast<double>(n);
+    const std::size_t n_spectral =
+        p.spectrum.significant_height == 0.0 ? 0 : static_cast<std::size_t>(p.n_components);
+    std::size_t n = n_spectral;
+    for (const RegularWave& w : p.regular) n += w.height > 0.0 ? 1 : 0;
+    if (n == 0) return;
     for (auto* v :
          {&omega_, &k_,   &amp_,  &phase_, &dir_, &kx_,  &ky_,  &cosb_, &sinb_, &aw_, &aw2_,
           &awc_,   &aws_, &aw2c_, &aw2s_,  &q_,   &e2h_, &gcc_, &gcs_,  &gss_,  &gc_, &gs_})
       v->resize(n);
-    for (std::size_t j = 0; j < n; ++j) {
-      const double u = p.jitter ? uniform() : 0.5;
-      const double w = w_lo + (static_cast<double>(j) + u) * dw;
-      const double a =
-          std::sqrt(2.0 * bin_energy(p.spectrum, w_lo + static_cast<double>(j) * dw, dw));
-      const double phase = 2.0 * kelp::pi * uniform();
-      double beta = p.direction;
-      if (p.spreading > 0.0) {
-        // Rejection sampling of D(θ) ∝ cos^{2s}(θ) on (−π/2, π/2).
-        for (int tries = 0; tries < 100000; ++tries) {
-          const double th = (uniform() - 0.5) * kelp::pi;
-          if (uniform() <= std::pow(std::cos(th), 2.0 * p.spreading)) {
-            beta += th;
-            break;
+    if (n_spectral > 0) {
+      std::mt19937_64 rng(p.seed);
+      auto uniform = [&rng]() { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+      const double wp = 2.0 * kelp::pi / p.spectrum.peak_period;
+      const double w_lo = p.omega_min_factor * wp, w_hi = p.omega_max_factor * wp;
+      const double dw = (w_hi - w_lo) / static_cast<double>(n_spectral);
+      for (std::size_t j = 0; j < n_spectral; ++j) {
+        const double u = p.jitter ? uniform() : 0.5;
+        const double w = w_lo + (static_cast<double>(j) + u) * dw;
+        const double a =
+            std::sqrt(2.0 * bin_energy(p.spectrum, w_lo + static_cast<double>(j) * dw, dw));
+        const double phase = 2.0 * kelp::pi * uniform();
+        double beta = p.direction;
+        if (p.spreading > 0.0) {
+          // Rejection sampling of D(θ) ∝ cos^{2s}(θ) on (−π/2, π/2).
+          for (int tries = 0; tries < 100000; ++tries) {
+            const double th = (uniform() - 0.5) * kelp::pi;
+            if (uniform() <= std::pow(std::cos(th), 2.0 * p.spreading)) {
+              beta += th;
+              break;
+            }
           }
         }
+        set_component(j, w, wave_number(w, p.gravity, p.depth), a, phase, beta);
       }
-      const double k = wave_number(w, p.gravity, p.depth);
-      omega_[j] = w;
-      k_[j] = k;
-      amp_[j] = a;
-      phase_[j] = phase;
-      dir_[j] = beta;
-      cosb_[j] = std::cos(beta);
-      sinb_[j] = std::sin(beta);
-      kx_[j] = k * cosb_[j];
-      ky_[j] = k * sinb_[j];
-      aw_[j] = a * w;
-      aw2_[j] = a * w * w;
-      awc_[j] = aw_[j] * cosb_[j];
-      aws_[j] = aw_[j] * sinb_[j];
-      aw2c_[j] = aw2_[j] * cosb_[j];
-      aw2s_[j] = aw2_[j] * sinb_[j];
-      gc_[j] = k * awc_[j];
-      gs_[j] = k * aws_[j];
-      gcc_[j] = gc_[j] * cosb_[j];
-      gcs_[j] = gc_[j] * sinb_[j];
-      gss_[j] = gs_[j] * sinb_[j];
-      // 1 / (1 − e^{−2kh}): the common factor of cosh/sinh ratios written with decaying
-      // exponentials only (no overflow for large k h).
-      q_[j] = std::isinf(p.depth) ? 1.0 : 1.0 / (-std::expm1(-2.0 * k * p.depth));
-      e2h_[j] = std::isinf(p.depth) ? 0.0 : std::exp(-2.0 * k * p.depth);
     }
+    std::size_t j = n_spectral;
+    for (const RegularWave& w : p.regular)
+      if (w.height > 0.0)
+        set_component(j++, regular_wave_frequency(w, p.gravity, p.depth),
+                      regular_wave_number(w, p.gravity, p.depth), 0.5 * w.height, w.phase,
+                      w.direction);
     finite_depth_ = !std::isinf(p.depth);
     double amp_sum = 0.0;
     for (double a : amp_) amp_sum += a;
     trough_bound_ = amp_sum * (1.0 + 1e-9);
-    z_exp_limit_ = 700.0 / k_.back();  // k grows with j: k_.back() is the largest
+    // The spectrum's k and ω grow with j; a regular wave may exceed them: the largest of all.
+    const double k_max = *std::max_element(k_.begin(), k_.end());
+    const double omega_max = *std::max_element(omega_.begin(), omega_.end());
+    z_exp_limit_ = 700.0 / k_max;
     check_derived();
     // The kernel's accurate range, checked once per query: |φ_j − ω_j t| ≤ 2π + ω_max |t| within
     // wrap_two_pi's exact range, |k_j (x cos β + y sin β) + α| ≤ k_max (|x| + |y|) + π within
-    // fast_sincos's. ω and k grow with j.
-    time_fast_limit_ = (simd::kWrapTwoPiLimit - 8.0) / omega_.back();
-    position_fast_limit_ = (simd::kFastSinCosLimit - 8.0) / k_.back();
+    // fast_sincos's. (A regular wave's phase φ may be any finite number: reduced first.)
+    time_fast_limit_ = (simd::kWrapTwoPiLimit - 8.0) / omega_max;
+    position_fast_limit_ = (simd::kFastSinCosLimit - 8.0) / k_max;
   }
 
   /// \brief True for a calm sea (no components).
@@ -461,18 +530,23 @@ class WaveField {
   /// `exact_block` (C library sin/cos after an exact phase reduction: slower, but as accurate as
   /// std::cos for any t and position).
   void run_block(Block& b, int m, double t) const {
-    const double h = params_.depth;
     bool fast = std::fabs(t) <= time_fast_limit_;
     for (int i = 0; i < m; ++i) {
-      double z = b.z[i] < 0.0 ? 0.0 : b.z[i];  // crest region: kinematics of z = 0
-      if (finite_depth_ && z > h) z = h;       // below the seabed: those at the seabed
-      if (z > z_exp_limit_) z = z_exp_limit_;  // e^{−k z} < 1e-304 beyond: keeps k z ≤ 700
-      b.ze[i] = z;                             // the kernel writes b's sums: no zeroing here
+      b.ze[i] = profile_depth(b.z[i]);  // the kernel writes b's sums: no zeroing here
       fast &= std::fabs(b.x[i]) + std::fabs(b.y[i]) <= position_fast_limit_;  // NaN: false
     }
     if (!fast) {
       exact_block(b, m, t);
       return;
+    }
+    if (params_.stretching == WaveStretching::wheeler) {
+      // First pass for the elevation above every point (the profiles' depth is irrelevant to
+      // it), then the profiles at the stretched depths.
+      const bool need_zeta = b.need_zeta;
+      b.need_zeta = true;
+      detail::wave_accumulate(view(), b, m, t, finite_depth_, active_kernel());
+      b.need_zeta = need_zeta;
+      for (int i = 0; i < m; ++i) b.ze[i] = profile_depth(wheeler_depth(b.z[i], b.zeta[i]));
     }
     detail::wave_accumulate(view(), b, m, t, finite_depth_, active_kernel());
     for (int i = 0; i < m; ++i) {
@@ -480,6 +554,56 @@ class WaveField {
         b.vx[i] = b.vy[i] = b.vz[i] = b.ax[i] = b.ay[i] = b.az[i] = 0.0;
       }
     }
+  }
+
+  /// Component j's constants from its frequency w, wave number k, amplitude a, phase and
+  /// direction beta [rad].
+  void set_component(std::size_t j, double w, double k, double a, double phase, double beta) {
+    omega_[j] = w;
+    k_[j] = k;
+    amp_[j] = a;
+    phase_[j] = phase;
+    dir_[j] = beta;
+    cosb_[j] = std::cos(beta);
+    sinb_[j] = std::sin(beta);
+    kx_[j] = k * cosb_[j];
+    ky_[j] = k * sinb_[j];
+    aw_[j] = a * w;
+    aw2_[j] = a * w * w;
+    awc_[j] = aw_[j] * cosb_[j];
+    aws_[j] = aw_[j] * sinb_[j];
+    aw2c_[j] = aw2_[j] * cosb_[j];
+    aw2s_[j] = aw2_[j] * sinb_[j];
+    gc_[j] = k * awc_[j];
+    gs_[j] = k * aws_[j];
+    gcc_[j] = gc_[j] * cosb_[j];
+    gcs_[j] = gc_[j] * sinb_[j];
+    gss_[j] = gs_[j] * sinb_[j];
+    // 1 / (1 − e^{−2kh}): the common factor of cosh/sinh ratios written with decaying
+    // exponentials only (no overflow for large k h).
+    q_[j] = std::isinf(params_.depth) ? 1.0 : 1.0 / (-std::expm1(-2.0 * k * params_.depth));
+    e2h_[j] = std::isinf(params_.depth) ? 0.0 : std::exp(-2.0 * k * params_.depth);
+  }
+
+  /// The depth at which the kernel takes the profiles for a point at depth z (or at a stretched
+  /// depth): the crest region reads z = 0, a point below the seabed the seabed, and k z stays
+  /// ≤ 700 (e^{−k z} < 1e-304 beyond).
+  double profile_depth(double z) const {
+    if (z < 0.0) z = 0.0;                                       // crest region: z = 0's
+    if (finite_depth_ && z > params_.depth) z = params_.depth;  // below the seabed: the seabed's
+    if (z > z_exp_limit_) z = z_exp_limit_;
+    return z;
+  }
+
+  /// Wheeler's stretched depth z' = (z + ζ) h / (h + ζ) (deep water: z + ζ) of a point at depth
+  /// z under a surface of elevation ζ (see WaveStretching::wheeler); a column with no water
+  /// (h + ζ ≤ 0) reads the seabed's.
+  template <typename T>
+  T wheeler_depth(const T& z, const T& zeta) const {
+    if (!finite_depth_) return z + zeta;
+    const T column = T(params_.depth) + zeta;
+    if (!(value_of(column) > 0.0)) return T(params_.depth);
+    return (z + zeta) * (T(params_.depth) / column);
   }
 
   /// Throws `kelp::invalid_argument` naming the spectrum's parameters unless every derived
@@ -561,6 +685,12 @@ class WaveField {
     using std::sin;
     check_time(t);
     T z = p(2);
+    if (params_.stretching == WaveStretching::wheeler) {
+      T zeta(0);
+      for (std::size_t j = 0; j < omega_.size(); ++j)
+        zeta += T(amp_[j]) * cos(T(kx_[j]) * p(0) + T(ky_[j]) * p(1) + T(time_phase(j, t)));
+      z = wheeler_depth(z, zeta);
+    }
     if (value_of(z) < 0.0) z = T(0);
     if (finite_depth_ && value_of(z) > params_.depth) z = T(params_.depth);
     out = WaveKinematics<T>();

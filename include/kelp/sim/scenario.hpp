@@ -21,6 +21,7 @@
 #include "kelp/core/kernel_path.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/obstacles.hpp"
+#include "kelp/environment/wave_stretching.hpp"
 #include "kelp/sim/entanglement.hpp"
 #include "kelp/sim/export.hpp"
 #include "kelp/sim/navigation.hpp"
@@ -89,6 +90,10 @@ inline constexpr ChoiceName<Sea> sea_names[] = {{Sea::calm, "calm"},
                                                 {Sea::moderate, "moderate"},
                                                 {Sea::rough, "rough"},
                                                 {Sea::custom, "custom"}};
+/// \brief The names of environment::WaveStretching (`sea.stretching`).
+inline constexpr ChoiceName<kelp::environment::WaveStretching> wave_stretching_names[] = {
+    {kelp::environment::WaveStretching::vertical, "vertical"},
+    {kelp::environment::WaveStretching::wheeler, "wheeler"}};
 /// \brief The names of TetherKind (`tether.kind`).
 inline constexpr ChoiceName<TetherKind> tether_kind_names[] = {
     {TetherKind::rov_tether, "rov_tether"}, {TetherKind::bead_chain, "bead_chain"}};
@@ -131,6 +136,9 @@ inline const char* to_string(kelp::control::WinchStrategy x) {
 inline const char* to_string(kelp::simd::KernelPath x) {
   return choice_name(x, kernel_path_names, "invalid");
 }
+inline const char* to_string(kelp::environment::WaveStretching x) {
+  return choice_name(x, wave_stretching_names, "invalid");
+}
 /// @}
 
 /// \brief What the controllers navigate by (the scenario's `navigation` object): the true state
@@ -164,6 +172,17 @@ struct WinchScenario {
   double extra_length = 3, length_per_depth = 1, length_per_offset = 1, length_gain = 0.5;
 };
 
+/// \brief A regular (Airy) wave of a custom sea (`"sea": {"regular": {...}}`;
+/// environment::RegularWave): on top of the JONSWAP sea, or alone when significant_height is 0.
+/// Exactly one of period and wavelength; deep water, like the scenario's spectral waves.
+struct RegularWaveScenario {
+  bool enabled = false;                      ///< a `regular` object was given
+  double height = 0;                         ///< crest-to-trough height H [m]
+  std::optional<double> period, wavelength;  ///< T [s] or λ [m]
+  double direction = 0;                      ///< NED azimuth it travels towards [rad]
+  double phase = 0;  ///< φ [rad]: ζ = (H/2) cos(k (x cos β + y sin β) − ω t + φ)
+};
+
 /// \brief One run of the tethered pair, as a scenario file describes it (every field has the
 /// embedded default run's value until a file sets it). Angles in rad, lengths in m, NED.
 struct Scenario {
@@ -176,6 +195,10 @@ struct Scenario {
   double significant_height = 0, peak_period = 0, wave_direction = 0;
   double wind_speed = 0, wind_direction = 0, current_speed = 0, current_direction = 0;
   int wave_components = 64;
+  /// A regular wave of the custom sea (unused for a preset).
+  RegularWaveScenario regular_wave;
+  /// Kinematics near the free surface of the custom sea's waves (unused for a preset).
+  kelp::environment::WaveStretching wave_stretching = kelp::environment::WaveStretching::vertical;
   ///@}
   /// \name Tether: its length, its kind ("rov_tether" or "bead_chain") and segment length [m].
   ///@{

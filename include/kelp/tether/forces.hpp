@@ -49,10 +49,36 @@ struct has_batch_surface<
         std::declval<const Matrix3X<Scalar>&>(), 0.0, std::declval<Matrix3X<Scalar>&>(),
         std::declval<Matrix3X<Scalar>&>(), std::declval<VectorX<Scalar>&>()))>> : std::true_type {};
 
+/// Converts to any lvalue reference: the probe of `has_five_argument_sample_water` (declared
+/// only; never called).
+struct AnySampleWaterArgument {
+  template <typename T>
+  operator T&() const;
+};
+
+/// True for environments with a `sample_water` of five parameters of any types, const or not:
+/// with `has_batch_surface` false, a near miss of the five-argument signature (which the
+/// tether would otherwise pass over silently for the per-node elevation queries).
+template <typename Env, typename = void>
+struct has_five_argument_sample_water : std::false_type {};
+template <typename Env>
+struct has_five_argument_sample_water<
+    Env, std::void_t<decltype(std::declval<Env&>().sample_water(
+             AnySampleWaterArgument{}, AnySampleWaterArgument{}, AnySampleWaterArgument{},
+             AnySampleWaterArgument{}, AnySampleWaterArgument{}))>> : std::true_type {};
+
 /// Water velocity, acceleration and surface elevation at the points `x` into the workspace.
 template <typename Scalar, typename Env, typename DX>
 void sample_water_at_nodes(const Env& env, const Eigen::MatrixBase<DX>& x, double t,
                            TetherWorkspace<Scalar>& ws) {
+  static_assert(
+      has_batch_surface<Env, Scalar>::value || !has_five_argument_sample_water<Env>::value,
+      "kelp::tether: the environment's five-argument sample_water cannot be called "
+      "as the tether calls it; it must be `void sample_water(const "
+      "Eigen::Ref<const kelp::Matrix3X<Scalar>>& points, double t, "
+      "Eigen::Ref<kelp::Matrix3X<Scalar>> velocity, Eigen::Ref<kelp::Matrix3X<Scalar>> "
+      "acceleration, Eigen::Ref<kelp::VectorX<Scalar>> elevation) const` with the "
+      "tether's Scalar (docs/custom-environment.md)");
   if constexpr (has_batch_surface<Env, Scalar>::value) {
     env.sample_water(x, t, ws.water_velocity, ws.water_acceleration, ws.surface_elevation);
   } else {

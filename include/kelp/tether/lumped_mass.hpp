@@ -16,7 +16,8 @@
 /// Environments are duck-typed (`Env`): anything with `water_density()`, `gravity()`,
 /// `seabed_depth()`, `surface_elevation(x, y, t)` and `sample_water(points, t, vel, acc)` as
 /// `kelp::environment::Environment` has (its `sample_water(points, t, vel, acc, elevation)`, when
-/// present, saves the per-node elevation queries).
+/// present, saves the per-node elevation queries; a five-argument one of another signature is a
+/// compile error). docs/custom-environment.md gives the exact signatures and an example.
 ///
 /// This header gathers the parts: kelp/tether/model.hpp (parameters and model),
 /// kelp/tether/state.hpp (state, boundary, workspace), kelp/tether/forces.hpp (force evaluation,
