@@ -113,6 +113,7 @@ struct RunOptions {
   bool quiet = false, no_plot = false;
   bool keep_series = false;  // runs/<hash>/: timeseries.csv, nodes.csv, summary.json
   bool mcap = false;         // each run's ROS 2 bag, runs/<hash>.mcap
+  bool dry_run = false;      // list the runs (JSON lines on stdout); run and write nothing
 };
 
 int run(const RunOptions& o) {
@@ -121,6 +122,22 @@ int run(const RunOptions& o) {
       o.sweep_file.empty() ? paper_sweep::parse_sweep(paper_sweep::default_sweep_json().dump(),
                                                       "(embedded paper sweep)")
                            : paper_sweep::load_sweep(o.sweep_file);
+  if (o.dry_run) {
+    // One JSON object per run: what would run, with the scenario exactly as it would be used
+    // (the same text whose hash names the run), so that a sweep file's grid can be checked
+    // without running it.
+    for (const paper_sweep::Run& r : s.runs) {
+      const json line = {{"index", r.index},
+                         {"hash", r.hash},
+                         {"point", paper_sweep::point_values(s, r.point)},
+                         {"seed", r.seed},
+                         {"scenario", json::parse(kelp::sim::scenario_json(r.scenario))}};
+      std::printf("%s\n", line.dump().c_str());
+    }
+    std::printf("kelp-sweep: %zu runs (%zu grid points x %zu seeds); dry run, nothing ran\n",
+                s.runs.size(), s.points, s.seeds.size());
+    return 0;
+  }
   std::size_t shard = 0, shards = 1;
   if (!o.shard.empty()) {
     unsigned long i = 0, n = 0;
@@ -277,6 +294,9 @@ int main(int argc, char** argv) {
   app.add_flag("--mcap", o.mcap,
                "also write each run as a ROS 2 bag, runs/<hash>.mcap (off by default: a bag is "
                "a few MB a simulated minute, a sweep has many runs)");
+  app.add_flag("--dry-run", o.dry_run,
+               "check and expand the sweep, print its runs (one JSON object a line: index, "
+               "hash, grid point, seed, scenario as used) and exit; runs and writes nothing");
   CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
   std::vector<std::string> dirs;
   std::string merged = "kelp-sweep-merged";
