@@ -315,7 +315,11 @@ TEST_CASE("the sub-stepping driver equals the same steps taken by hand", "[tethe
   CHECK((s1.position - s2.position).cwiseAbs().maxCoeff() < 1e-12);
   CHECK(s1.time == Approx(0.005));
   CHECK((s1.position.col(10) - (b.end.position + 0.005 * b.end.velocity)).norm() < 1e-12);
-  CHECK((w1.end_forces.on_end - w2.end_forces.on_end).norm() < 1e-12);
+  // (advance() moves an explicit scheme's sub-step boundaries on one sub-step at a time, p + h v
+  // each time, which rounds differently from p + k h v: EA/l = 1e5 N/m turns the last bit of a
+  // position into 1e-11 N.)
+  CHECK((w1.end_forces.on_end - w2.end_forces.on_end).norm() <=
+        1e-10 * w2.end_forces.on_end.norm());
   CHECK_THROWS_AS(kt::advance(model, w1, env, s1, b, 0.0, {0.01, kt::Integrator::rk4}),
                   kelp::invalid_argument);
 }

@@ -147,10 +147,6 @@ TEST_CASE("a smaller dt is never less accurate, at a cost linear in 1/dt",
       r.evaluations +=
           kt::step(model, ws, env, s, boundary_at(s.time), dt, {integ}).force_evaluations;
       if (k % every) continue;
-      if (!kt::is_implicit(integ)) {  // explicit schemes report the start of the step
-        kt::compute_forces(model, ws, env, s.time, s.position, s.velocity);
-        ws.end_forces = kt::end_forces_from_workspace(model, ws, boundary_at(s.time));
-      }
       r.start.push_back(ws.end_forces.on_start.norm());
       r.end.push_back(ws.end_forces.on_end.norm());
     }
@@ -178,6 +174,84 @@ TEST_CASE("a smaller dt is never less accurate, at a cost linear in 1/dt",
   CHECK(e_end[1] <= e_end[0]);
   // Ten times the steps for at most 1.5 × ten times the work.
   CHECK(fine.evaluations <= 15 * coarse.evaluations);
+}
+
+// End forces mean one thing whatever the scheme: the force on each attachment point at the end
+// of the step (the state the step returns), with the end node's inertia taken off
+// (ws.end_forces, F_node − M_node a_end) and without it (ws.end_node_forces, F_node): both
+// recomputed here from a fresh force evaluation at the returned state. The start end accelerates
+// (constant acceleration, so that the step's end motion and the boundary at its end agree), in a
+// current, so that every term of the end node's force is there.
+TEST_CASE("end forces: every integrator reports them at the end of the step",
+          "[tether][end_forces]") {
+  kelp_test::TestWater<double> env;
+  env.current = Vector3<double>(0.3, 0.1, 0.0);
+  const kt::TetherModeld model(kelp_test::benchmark_line<double>(20));
+  const int n = model.segments();
+  const Vector3<double> a(0, 0, 0.5), b(10, 0, 5);
+  kt::TetherStated s0;
+  {
+    kt::TetherWorkspaced ws(model);
+    REQUIRE(kt::static_initial_state(model, ws, env, a, b, s0).converged);
+  }
+  const Vector3<double> v0(0.2, -0.1, 0.1), acc(0.8, -0.4, 0.3);
+  const auto boundary_at = [&](double t) {
+    kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(a, b);
+    bnd.start.position = a + t * v0 + 0.5 * t * t * acc;
+    bnd.start.velocity = v0 + t * acc;
+    bnd.start.acceleration = acc;
+    return bnd;
+  };
+  const kt::Integrator schemes[] = {kt::Integrator::symplectic_euler, kt::Integrator::rk2,
+                                    kt::Integrator::rk4, kt::Integrator::implicit_euler,
+                                    kt::Integrator::bdf2};
+  for (const kt::Integrator integ : schemes) {
+    INFO(kt::integrator_name(integ));
+    const bool implicit = kt::is_implicit(integ);
+    const double dt = implicit ? 0.01 : 2e-4;
+    kt::TetherWorkspaced ws(model);
+    auto s = s0;
+    for (int k = 0; k < 5; ++k) kt::step(model, ws, env, s, boundary_at(s.time), dt, {integ});
+    // A fresh evaluation at the state the last step returned.
+    kt::TetherWorkspaced fresh(model);
+    kt::compute_forces(model, fresh, env, s.time, s.position, s.velocity);
+    const kt::EndForces<double> expected =
+        kt::end_forces_from_workspace(model, fresh, boundary_at(s.time));
+    // Explicit: the same evaluation; implicit: the final Newton iterate's, within its tolerance.
+    const double tol = implicit ? 1e-5 : 1e-12;
+    const double scale = expected.on_start.norm() + expected.on_end.norm();
+    CHECK((ws.end_forces.on_start - expected.on_start).norm() <= tol * scale);
+    CHECK((ws.end_forces.on_end - expected.on_end).norm() <= tol * scale);
+    // Without the inertia: the end nodes' net force.
+    CHECK((ws.end_node_forces.on_start - fresh.force.col(0)).norm() <= tol * scale);
+    CHECK((ws.end_node_forces.on_end - fresh.force.col(n)).norm() <= tol * scale);
+    // The two differ by the accelerating start node's inertia M_0 a (the far end is fixed).
+    const Vector3<double> q = fresh.tangent.col(0);
+    const Vector3<double> inertia = fresh.mass_iso(0) * acc + fresh.mass_tan(0) * q.dot(acc) * q;
+    CHECK((ws.end_node_forces.on_start - ws.end_forces.on_start - inertia).norm() <= tol * scale);
+    CHECK(inertia.norm() > 1e-3 * scale);
+    CHECK(ws.end_node_forces.on_end == ws.end_forces.on_end);
+  }
+  // advance() takes an explicit sub-step's end evaluation as the next one's first stage: the
+  // same end forces as separate steps, one evaluation per sub-step fewer.
+  for (const kt::Integrator integ :
+       {kt::Integrator::symplectic_euler, kt::Integrator::rk2, kt::Integrator::rk4}) {
+    INFO(kt::integrator_name(integ));
+    kt::TetherWorkspaced ws_a(model), ws_s(model);
+    auto sa = s0, ss = s0;
+    const auto r = kt::advance(model, ws_a, env, sa, boundary_at(0.0), 10 * 2e-4, {2e-4, integ});
+    int separate = 0;
+    kt::TetherBoundaryd sub = boundary_at(0.0);
+    for (int k = 0; k < 10; ++k) {
+      if (k > 0) sub = sub.after(2e-4);
+      separate += kt::step(model, ws_s, env, ss, sub, 2e-4, {integ}).force_evaluations;
+    }
+    CHECK(std::memcmp(sa.position.data(), ss.position.data(),
+                      sizeof(double) * std::size_t(sa.position.size())) == 0);
+    CHECK(ws_a.end_forces.on_start == ws_s.end_forces.on_start);
+    CHECK(ws_a.end_forces.on_end == ws_s.end_forces.on_end);
+    CHECK(r.force_evaluations == separate - 9);
+  }
 }
 
 TEST_CASE("waves sampled once per implicit step agree with waves sampled at every iterate",

@@ -86,14 +86,19 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
     ::kelp::detail::throw_invalid_argument("integrator is not a kelp::tether::Integrator value");
   };
   StepReport<Scalar> report = dispatch();
-  if (part_if_overloaded(model, state, report.failure)) report.partings = 1;
+  if (part_if_overloaded(model, state, report.failure)) {
+    report.partings = 1;
+    ws.end_evaluated = false;  // evaluated on the unparted line
+  }
   return report;
 }
 
 /// \brief Sub-stepping driver: advances `state` by `duration` [s] in n = ⌈duration/max_dt⌉ equal
 /// steps of the chosen integrator (`options`); the kinematic ends follow `boundary` (given at the
-/// current time) through the interval. `ws.end_forces` holds the forces of the last sub-step,
-/// `ws.end_impulse` the impulse on the ends summed over all of them. If any
+/// current time) through the interval. `ws.end_forces` holds the forces at the end of the last
+/// sub-step, `ws.end_impulse` the impulse on the ends summed over all of them. An explicit scheme's
+/// sub-step takes its predecessor's evaluation at the end state as its first stage (each sub-step's
+/// boundary is then its predecessor's moved on by one sub-step, so that they meet exactly). If any
 /// sub-step fails (after its own retries, for the implicit schemes) or throws for any other reason
 /// the state is restored to its value at entry, history included, and the error rethrown. No heap
 /// allocation. \returns the sum of the sub-steps' reports (committed steps, Newton iterations,
@@ -115,16 +120,22 @@ StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Sca
   ws.entry_backup.save(state);
   StepReport<Scalar> report;
   EndForces<Scalar> impulse;
+  const bool chained = !is_implicit(options.integrator);
+  TetherBoundary<Scalar> sub = boundary.after(Scalar(0));
   try {
     for (int k = 0; k < n; ++k) {
-      report += step(model, ws, env, state, boundary.after(Scalar(k * h)), h, step_options);
+      if (k > 0) sub = chained ? sub.after(Scalar(h)) : boundary.after(Scalar(k * h));
+      ws.reuse_end_evaluation = k > 0;
+      report += step(model, ws, env, state, sub, h, step_options);
       impulse.on_start += ws.end_impulse.on_start;
       impulse.on_end += ws.end_impulse.on_end;
     }
   } catch (...) {
+    ws.reuse_end_evaluation = false;
     ws.entry_backup.restore(state);
     throw;
   }
+  ws.reuse_end_evaluation = false;
   ws.end_impulse = impulse;
   return report;
 }

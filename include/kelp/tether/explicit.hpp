@@ -1,12 +1,14 @@
 /// \file
 /// \brief The explicit tether steps: semi-implicit (symplectic) Euler, explicit midpoint (RK2)
-/// and classical RK4. End forces are those at the start of the step. See
-/// kelp/tether/stable_dt.hpp for the largest stable step.
+/// and classical RK4. Each ends with one more force evaluation at the state it returns, for the
+/// end forces (TetherWorkspace::end_forces), which advance() reuses as the next sub-step's first
+/// stage. See kelp/tether/stable_dt.hpp for the largest stable step.
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -22,9 +24,54 @@
 
 namespace kelp::tether {
 
+namespace detail {
+
+/// The first stage of an explicit step: the forces and M⁻¹F at (state.time, x0, v0) into the
+/// workspace (`acceleration`, the kinematic ends' rows the boundary's), unless advance() lets
+/// this step take the evaluation its predecessor made at its end
+/// (TetherWorkspace::reuse_end_evaluation) and x0, v0 (the state with the boundary applied) are
+/// exactly that state. \returns whether it evaluated the forces.
+template <typename Scalar, typename Env>
+bool first_stage(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                 const TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary) {
+  const double t = state.time;
+  const auto same = [](const Matrix3X<Scalar>& a, const Matrix3X<Scalar>& b) {
+    return a.size() == b.size() &&
+           std::memcmp(a.data(), b.data(), sizeof(Scalar) * std::size_t(a.size())) == 0;
+  };
+  const bool reuse = ws.reuse_end_evaluation && ws.end_evaluated && ws.end_evaluation_time == t &&
+                     same(ws.x0, state.position) && same(ws.v0, state.velocity);
+  ws.end_evaluated = false;
+  if (!reuse) {
+    derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
+    return true;
+  }
+  const int n = model.segments();
+  if (model.first_free_node() == 1) ws.acceleration.col(0) = boundary.start.acceleration;
+  if (model.last_free_node() == n - 1) ws.acceleration.col(n) = boundary.end.acceleration;
+  return false;
+}
+
+/// The end of an explicit step, after it committed its result to `state`: the forces at that
+/// state and time into TetherWorkspace::end_forces and end_node_forces (the ends moving as
+/// `boundary` has them h later), kept for the next sub-step of advance() (first_stage).
+template <typename Scalar, typename Env>
+void end_evaluation(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
+                    const TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
+                    Scalar h) {
+  const TetherBoundary<Scalar> end = boundary.after(h);
+  derivative(model, ws, env, state.time, end, state.position, state.velocity, ws.acceleration);
+  ws.end_forces = end_forces_from_workspace(model, ws, end);
+  set_end_node_forces(model, ws, end);
+  ws.end_evaluated = true;
+  ws.end_evaluation_time = state.time;
+}
+
+}  // namespace detail
+
 /// \brief One semi-implicit (symplectic) Euler step of length `dt` [s]:
 /// v_{n+1} = v_n + h M⁻¹F(x_n, v_n), x_{n+1} = x_n + h v_{n+1}. Stable for h ω_max < 2.
-/// End forces (`ws.end_forces`) are those at the start of the step.
+/// End forces (`ws.end_forces`) are those at the end of the step (TetherWorkspace::end_forces).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
 /// the result is not finite.
 template <typename Scalar, typename Env>
@@ -33,23 +80,23 @@ StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
                                          TetherState<Scalar>& state,
                                          const TetherBoundary<Scalar>& boundary, double dt) {
   detail::begin_explicit_step(model, ws, state, boundary, dt);
-  const double t = state.time;
   const Scalar h = Scalar(dt);
-  detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
-  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
-  ws.end_impulse = {h * ws.end_forces.on_start, h * ws.end_forces.on_end};
+  const bool evaluated = detail::first_stage(model, ws, env, state, boundary);
+  const EndForces<Scalar> f0 = end_forces_from_workspace(model, ws, boundary);
+  ws.end_impulse = {h * f0.on_start, h * f0.on_end};
   ws.v1.noalias() = ws.v0 + h * ws.acceleration;
   ws.x1.noalias() = ws.x0 + h * ws.v1;
   detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
   detail::commit(state, ws.x1, ws.v1, dt, "step_symplectic_euler");
+  detail::end_evaluation(model, ws, env, state, boundary, h);
   StepReport<Scalar> r;
   r.substeps = 1;
-  r.force_evaluations = 1;
+  r.force_evaluations = 1 + int(evaluated);
   return r;
 }
 
-/// \brief One explicit-midpoint (RK2) step of length `dt` [s]. End forces are those at the start
-/// of the step. \throws as step_symplectic_euler.
+/// \brief One explicit-midpoint (RK2) step of length `dt` [s]. End forces are those at the end of
+/// the step. \throws as step_symplectic_euler.
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
@@ -57,8 +104,7 @@ StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Sc
   detail::begin_explicit_step(model, ws, state, boundary, dt);
   const double t = state.time;
   const Scalar h = Scalar(dt), h2 = Scalar(0.5) * h;
-  detail::derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
-  ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  const bool evaluated = detail::first_stage(model, ws, env, state, boundary);
   ws.xs.noalias() = ws.x0 + h2 * ws.v0;
   ws.vs.noalias() = ws.v0 + h2 * ws.acceleration;
   detail::apply_boundary(model, boundary, h2, ws.xs, ws.vs);
@@ -68,9 +114,10 @@ StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Sc
   ws.v1.noalias() = ws.v0 + h * ws.acceleration;
   detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
   detail::commit(state, ws.x1, ws.v1, dt, "step_rk2");
+  detail::end_evaluation(model, ws, env, state, boundary, h);
   StepReport<Scalar> r;
   r.substeps = 1;
-  r.force_evaluations = 2;
+  r.force_evaluations = 2 + int(evaluated);
   return r;
 }
 
@@ -108,10 +155,10 @@ void rk4_stage_update(TetherWorkspace<Scalar>& ws, const Matrix3X<Scalar>& vs, S
 
 }  // namespace detail
 
-/// \brief One classical RK4 step of length `dt` [s]. End forces are those at the start of the
-/// step. Four force evaluations (each also giving the accelerations M⁻¹F in its last pass), each
-/// followed by one vectorised pass for the stage's state update. \throws as
-/// step_symplectic_euler.
+/// \brief One classical RK4 step of length `dt` [s]. End forces are those at the end of the step.
+/// Four force evaluations (each also giving the accelerations M⁻¹F in its last pass), each
+/// followed by one vectorised pass for the stage's state update, and the end state's (which the
+/// next sub-step of advance() takes as its first). \throws as step_symplectic_euler.
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
@@ -122,11 +169,14 @@ StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Sc
   const Scalar c[4] = {Scalar(0), Scalar(0.5), Scalar(0.5), Scalar(1)};
   const Scalar w[4] = {h / Scalar(6), h / Scalar(3), h / Scalar(3), h / Scalar(6)};
   const double tc[4] = {t, t + 0.5 * dt, t + 0.5 * dt, t + dt};
+  bool evaluated = false;
   for (int k = 0; k < 4; ++k) {
     const Matrix3X<Scalar>& xk = k == 0 ? ws.x0 : ws.xs;
     const Matrix3X<Scalar>& vk = k == 0 ? ws.v0 : ws.vs;
-    detail::evaluate_forces<false>(model, ws, env, tc[k], xk, vk, ws.acceleration.data());
-    if (k == 0) ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+    if (k == 0)
+      evaluated = detail::first_stage(model, ws, env, state, boundary);
+    else
+      detail::evaluate_forces<false>(model, ws, env, tc[k], xk, vk, ws.acceleration.data());
     detail::add_end_impulse(model, ws, boundary, w[k]);
     const bool last = k == 3;
     detail::rk4_stage_update(ws, vk, w[k], last ? Scalar(0) : c[k + 1] * h, k == 0, last);
@@ -134,9 +184,10 @@ StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Sc
   }
   detail::apply_boundary(model, boundary, h, ws.x1, ws.v1);
   detail::commit(state, ws.x1, ws.v1, dt, "step_rk4");
+  detail::end_evaluation(model, ws, env, state, boundary, h);
   StepReport<Scalar> r;
   r.substeps = 1;
-  r.force_evaluations = 4;
+  r.force_evaluations = 4 + int(evaluated);
   return r;
 }
 

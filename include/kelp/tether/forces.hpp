@@ -835,6 +835,24 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
   return out;
 }
 
+namespace detail {
+/// Sets ws.end_node_forces from ws.end_forces: F_node = end force + M_node a_end.
+template <typename Scalar>
+void set_end_node_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
+                         const TetherBoundary<Scalar>& boundary) {
+  const int n = model.segments();
+  const auto inertia = [&](int i, const Vector3<Scalar>& a) -> Vector3<Scalar> {
+    const Vector3<Scalar> q = ws.tangent.col(i);
+    return ws.mass_iso(i) * a + ws.mass_tan(i) * q.dot(a) * q;
+  };
+  ws.end_node_forces = EndForces<Scalar>{};
+  if (model.parameters().start_mode == EndMode::kinematic)
+    ws.end_node_forces.on_start = ws.end_forces.on_start + inertia(0, boundary.start.acceleration);
+  if (model.parameters().end_mode == EndMode::kinematic)
+    ws.end_node_forces.on_end = ws.end_forces.on_end + inertia(n, boundary.end.acceleration);
+}
+}  // namespace detail
+
 /// \brief Total mechanical energy [J]: kinetic ½ Σ vᵢᵀ Mᵢ vᵢ (with added mass) + potential of
 /// the weight −Σ mᵢ g zᵢ (NED z down) and of the buoyancy ρ g A Σ_s l_s ∫₀¹ Φ(d(σ)) dσ over the
 /// segments (Φ the depth of wet line, d the depth along the segment, see

@@ -349,6 +349,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
         ws.end_forces.on_start += segment_block(ws, 0, Scalar(1), gh) * ws.delta.col(1);
       if (f1 == n - 1 && n >= 2)
         ws.end_forces.on_end += segment_block(ws, n - 1, Scalar(1), gh) * ws.delta.col(n - 1);
+      set_end_node_forces(model, ws, boundary);
       accept();
       return true;
     }
@@ -430,6 +431,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     return false;
   }
   ws.end_forces = end_forces_from_workspace(model, ws, boundary);
+  set_end_node_forces(model, ws, boundary);
   accept();
   return true;
 }

@@ -5,8 +5,9 @@
 /// (ImplicitOptions::jacobian, O(N) block LU); an explicit stable-dt estimate,
 /// a sub-stepping driver and a static-equilibrium solve.
 ///
-/// Kinematic ends follow the prescribed EndMotion within a step (p + vτ + ½aτ²). Explicit schemes
-/// report the end forces at the start of the step, implicit ones at its end.
+/// Kinematic ends follow the prescribed EndMotion within a step (p + vτ + ½aτ²). Every scheme
+/// reports the end forces at the end of the step, with the end nodes' inertia taken off
+/// (TetherWorkspace::end_forces) and without it (TetherWorkspace::end_node_forces).
 ///
 /// Every step works in preallocated workspace buffers (no heap allocation) and commits the new
 /// state only when it is finite and, for the implicit schemes, when Newton's method met its

@@ -387,7 +387,27 @@ struct TetherWorkspace {
   /// water_acceleration and surface_elevation, sampled at the step's predicted node positions
   /// at t + h, instead of querying the environment at every Newton iterate.
   bool water_frozen = false;
-  EndForces<Scalar> end_forces;  ///< forces on the attachment points after the last step
+  /// Forces the tether exerts on its kinematic attachment points at the end of the last step
+  /// (the state it returned, at t + h), NED [N], whatever the scheme: the force on the end node
+  /// (segment tension, weight, buoyancy, drag and fluid forces) less its inertia along the
+  /// prescribed motion, F_node − M_node a_end, which is the force that holds the end node on its
+  /// path, what a body carrying the end feels. The implicit schemes take it at their final iterate
+  /// (to the Newton tolerance); the explicit ones evaluate the forces once more at the end state
+  /// (advance() reuses that evaluation as the next sub-step's first stage). Zero for a free end.
+  /// end_forces_from_workspace gives the same after a compute_forces.
+  EndForces<Scalar> end_forces;
+  /// The same instant's force on the end nodes without the inertia term, F_node [N] (end_forces
+  /// + M_node a_end): for a coupling that carries the end node's mass with the body itself, or a
+  /// comparison with a code that reports the end node's net force.
+  EndForces<Scalar> end_node_forces;
+  /// Set by advance() between its own sub-steps: an explicit step may take the evaluation its
+  /// predecessor made at the end state (end_evaluated) as its first stage when it starts from
+  /// exactly that state.
+  bool reuse_end_evaluation = false;
+  /// The force buffers and `acceleration` hold the evaluation at (end_evaluation_time, x1, v1)
+  /// that an explicit step made at its end.
+  bool end_evaluated = false;
+  double end_evaluation_time = 0.0;
   /// Impulse the tether delivered to its attachment points over the last step (the step
   /// functions) or the last `advance` (summed over its sub-steps) [N s]: the end force weighted
   /// as the integrator weights the node forces in its momentum update (symplectic Euler h F(t),

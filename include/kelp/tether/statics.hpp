@@ -136,6 +136,7 @@ template <typename Scalar, typename Env>
     throw;
   }
   ws.end_forces = end_forces_from_workspace(model, ws, b);
+  detail::set_end_node_forces(model, ws, b);
   return result;
 }
 
