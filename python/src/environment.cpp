@@ -46,7 +46,12 @@ ke::RegularWave regular_wave(py::handle h) {
   ke::RegularWave w;
   for (const auto& item : py::reinterpret_borrow<py::dict>(h)) {
     const std::string key = py::str(item.first);
-    const double value = item.second.cast<double>();
+    double value = 0.0;
+    try {
+      value = item.second.cast<double>();
+    } catch (const py::cast_error&) {
+      kelp::detail::throw_invalid_argument("regular." + key + " must be a number");
+    }
     if (key == "height")
       w.height = value;
     else if (key == "period")

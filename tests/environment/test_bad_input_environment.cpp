@@ -167,6 +167,21 @@ TEST_CASE("bad input: regular waves", "[environment][bad_input][regular]") {
   refused(w, "breaking limit");
   w.height = 7.9;
   CHECK(field(w).size() == 1);
+  // In shallow water Miche's limit H/λ = tanh(k h)/7 is lower: 2 m of water and T = 7 s give
+  // λ = 30.0 m (k = 0.2094 rad/m from ω² = g k tanh(k h)) and a limit of 4.29 · tanh(0.419) =
+  // 1.70 m; Michell's deep-water λ/7 let 4.2 m through, a trough below the seabed.
+  w = good;
+  w.period = 7.0;
+  const auto shallow = [](const RegularWave& r) {
+    WaveFieldParameters p = sea(0.0, 7.0);
+    p.depth = 2.0;
+    p.regular = {r};
+    return WaveField<double>(p);
+  };
+  w.height = 1.75;
+  REQUIRE_THROWS_WITH(shallow(w), Catch::Contains("breaking limit"));
+  w.height = 1.65;
+  CHECK(shallow(w).size() == 1);
   // The stretching enum out of range.
   WaveFieldParameters p = sea();
   p.stretching = static_cast<WaveStretching>(7);

@@ -171,6 +171,16 @@ TEST_CASE("regular wave: the elevation at a probe is A cos(k x - omega t)",
       env.sample_water(probe, t, vel, acc, zeta);
       CHECK(zeta(0) == Approx(want).margin(1e-12));
     }
+    // A phase far beyond 2π is reduced exactly before the kernel's fast path: 0.7 + 1e6 · 2π
+    // reads as 0.7 (to the rounding of that sum, ~1e-10 rad).
+    {
+      RegularWave far = w, near = w;
+      near.phase = 0.7;
+      far.phase = 0.7 + 1e6 * (2.0 * kelp::pi);
+      const WaveField<double> f_near(regular_only(near, depth)), f_far(regular_only(far, depth));
+      for (const double t : {0.0, 3.3, 1000.0})
+        CHECK(f_far.elevation(x, 0.0, t) == Approx(f_near.elevation(x, 0.0, t)).margin(1e-8));
+    }
     // A direction turns it: travelling east, the probe's phase is k y.
     w.direction = 0.5 * kelp::pi;
     const WaveField<double> east(regular_only(w, depth));

@@ -28,7 +28,9 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -72,6 +74,24 @@ struct EnvironmentSample {
   Vector3<Scalar> wind = Vector3<Scalar>::Zero();
 };
 
+namespace detail {
+/// A number unique to each object and value: drawn anew on construction, copy and assignment
+/// (a move copies: the moved-from object keeps its own).
+struct InstanceId {
+  std::uint64_t value = next();
+  InstanceId() = default;
+  InstanceId(const InstanceId&) : value(next()) {}
+  InstanceId& operator=(const InstanceId&) {
+    value = next();
+    return *this;
+  }
+  static std::uint64_t next() {
+    static std::atomic<std::uint64_t> counter{0};
+    return ++counter;
+  }
+};
+}  // namespace detail
+
 /// \brief The sea a simulation runs in: fluid constants, seabed, current, waves and wind.
 ///
 /// A default-constructed environment is still water (`calm()`): seawater of 1025 kg/m³, air of
@@ -91,6 +111,11 @@ class Environment {
 
   /// \brief Still water: no current, no waves, no wind, seawater, standard gravity, no seabed.
   static Environment calm() { return Environment(); }
+
+  /// \brief An id of this object's value, new for every environment made, copied or assigned: a
+  /// step that kept results computed in an environment (the explicit tether steps' last
+  /// evaluation) can tell it is still the same.
+  std::uint64_t instance_id() const { return id_.value; }
 
   /// \brief Water density ρ [kg/m³].
   Scalar water_density() const { return water_density_; }
@@ -367,6 +392,7 @@ class Environment {
   WaveField<Scalar> waves_;
   WindField<Scalar> wind_;
   std::shared_ptr<const ObstacleSet> obstacles_;
+  detail::InstanceId id_;
 };
 
 /// \brief Throws `kelp::invalid_argument` unless a model's water density and gravity are those of

@@ -93,7 +93,8 @@ inline double regular_wave_frequency(const RegularWave& w, double g, double dept
 /// \throws kelp::invalid_argument when height is not in [0, 100] m, not exactly one of period
 /// (finite, in [0.1, 1000] s) and wavelength (finite, in (0, 1e6] m) is given (> 0; the other
 /// 0), direction or phase is not finite, or the wave is steeper than the breaking limit
-/// H/λ = 1/7 (Michell 1893; linear theory is meaningless beyond).
+/// H/λ = tanh(k h)/7 (Miche 1944; Michell's 1893 deep-water 1/7 when h is infinite; linear
+/// theory is meaningless beyond).
 inline void validate(const RegularWave& w, double g, double depth) {
   detail::check_in_range(w.height, 0.0, limits::max_significant_height, "regular.height",
                          "finite and in [0, 100] m");
@@ -111,12 +112,16 @@ inline void validate(const RegularWave& w, double g, double depth) {
                                    "finite and in (0, 1e6] m");
   check_finite(w.direction, "regular.direction");
   check_finite(w.phase, "regular.phase");
-  const double lambda = 2.0 * kelp::pi / regular_wave_number(w, g, depth);
-  if (!(w.height <= lambda / 7.0)) {
+  // Miche's limit H/λ ≤ tanh(k h)/7: Michell's 1/7 in deep water, lower in shallow water, where
+  // a wave that tall would put its trough below the seabed.
+  const double k = regular_wave_number(w, g, depth);
+  const double lambda = 2.0 * kelp::pi / k;
+  const double limit = lambda / 7.0 * (std::isinf(depth) ? 1.0 : std::tanh(k * depth));
+  if (!(w.height <= limit)) {
     std::ostringstream msg;
     msg.precision(9);
-    msg << "regular.height must be at most the breaking limit wavelength / 7 = " << lambda / 7.0
-        << " m (got " << w.height << " m for a wavelength of " << lambda << " m)";
+    msg << "regular.height must be at most the breaking limit (wavelength / 7) tanh(k depth) = "
+        << limit << " m (got " << w.height << " m for a wavelength of " << lambda << " m)";
     ::kelp::detail::throw_invalid_argument(msg.str());
   }
 }
@@ -270,8 +275,8 @@ class WaveField {
     for (const RegularWave& w : p.regular)
       if (w.height > 0.0)
         set_component(j++, regular_wave_frequency(w, p.gravity, p.depth),
-                      regular_wave_number(w, p.gravity, p.depth), 0.5 * w.height, w.phase,
-                      w.direction);
+                      regular_wave_number(w, p.gravity, p.depth), 0.5 * w.height,
+                      simd::reduce_phase_exact(w.phase), w.direction);
     finite_depth_ = !std::isinf(p.depth);
     double amp_sum = 0.0;
     for (double a : amp_) amp_sum += a;

@@ -98,7 +98,7 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
 /// current time) through the interval. `ws.end_forces` holds the forces at the end of the last
 /// sub-step, `ws.end_impulse` the impulse on the ends summed over all of them. An explicit scheme's
 /// sub-step takes its predecessor's evaluation at the end state as its first stage (each sub-step's
-/// boundary is then its predecessor's moved on by one sub-step, so that they meet exactly). If any
+/// boundary is its predecessor's moved on by one sub-step, so that they meet exactly). If any
 /// sub-step fails (after its own retries, for the implicit schemes) or throws for any other reason
 /// the state is restored to its value at entry, history included, and the error rethrown. No heap
 /// allocation. \returns the sum of the sub-steps' reports (committed steps, Newton iterations,
@@ -125,17 +125,14 @@ StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Sca
   try {
     for (int k = 0; k < n; ++k) {
       if (k > 0) sub = chained ? sub.after(Scalar(h)) : boundary.after(Scalar(k * h));
-      ws.reuse_end_evaluation = k > 0;
       report += step(model, ws, env, state, sub, h, step_options);
       impulse.on_start += ws.end_impulse.on_start;
       impulse.on_end += ws.end_impulse.on_end;
     }
   } catch (...) {
-    ws.reuse_end_evaluation = false;
     ws.entry_backup.restore(state);
     throw;
   }
-  ws.reuse_end_evaluation = false;
   ws.end_impulse = impulse;
   return report;
 }

@@ -1,16 +1,20 @@
 /// \file
 /// \brief The explicit tether steps: semi-implicit (symplectic) Euler, explicit midpoint (RK2)
 /// and classical RK4. Each ends with one more force evaluation at the state it returns, for the
-/// end forces (TetherWorkspace::end_forces), which advance() reuses as the next sub-step's first
-/// stage. See kelp/tether/stable_dt.hpp for the largest stable step.
+/// end forces (TetherWorkspace::end_forces), which the next explicit step takes as its first
+/// stage when it starts from that state. See kelp/tether/stable_dt.hpp for the largest stable
+/// step.
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
@@ -26,24 +30,43 @@ namespace kelp::tether {
 
 namespace detail {
 
+/// kelp's Environment and any environment with `std::uint64_t instance_id() const`: the id of
+/// that object's value (0 for others).
+template <typename Env, typename = void>
+struct has_instance_id : std::false_type {};
+template <typename Env>
+struct has_instance_id<
+    Env, std::void_t<decltype(std::uint64_t(std::declval<const Env&>().instance_id()))>>
+    : std::true_type {};
+template <typename Env>
+std::uint64_t instance_id_of(const Env& env) {
+  if constexpr (has_instance_id<Env>::value)
+    return env.instance_id();
+  else
+    return 0;
+}
+
 /// The first stage of an explicit step: the forces and M⁻¹F at (state.time, x0, v0) into the
-/// workspace (`acceleration`, the kinematic ends' rows the boundary's), unless advance() lets
-/// this step take the evaluation its predecessor made at its end
-/// (TetherWorkspace::reuse_end_evaluation) and x0, v0 (the state with the boundary applied) are
-/// exactly that state. \returns whether it evaluated the forces.
+/// workspace (`acceleration`, the kinematic ends' rows the boundary's), unless the previous
+/// explicit step evaluated exactly that at its end (TetherWorkspace::end_evaluated: the same
+/// time, bitwise the same x0 and v0, the same model, environment and winch length). \returns
+/// whether it evaluated the forces.
 template <typename Scalar, typename Env>
 bool first_stage(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                  const TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary) {
-  const double t = state.time;
   const auto same = [](const Matrix3X<Scalar>& a, const Matrix3X<Scalar>& b) {
     return a.size() == b.size() &&
            std::memcmp(a.data(), b.data(), sizeof(Scalar) * std::size_t(a.size())) == 0;
   };
-  const bool reuse = ws.reuse_end_evaluation && ws.end_evaluated && ws.end_evaluation_time == t &&
-                     same(ws.x0, state.position) && same(ws.v0, state.velocity);
+  const bool reuse = ws.end_evaluated && ws.end_evaluation_time == state.time &&
+                     ws.end_model == static_cast<const void*>(&model) &&
+                     ws.end_environment == static_cast<const void*>(&env) &&
+                     ws.end_environment_id == instance_id_of(env) &&
+                     ws.end_winch_length == state.winch_length && same(ws.x0, ws.end_position) &&
+                     same(ws.v0, ws.end_velocity);
   ws.end_evaluated = false;
   if (!reuse) {
-    derivative(model, ws, env, t, boundary, ws.x0, ws.v0, ws.acceleration);
+    derivative(model, ws, env, state.time, boundary, ws.x0, ws.v0, ws.acceleration);
     return true;
   }
   const int n = model.segments();
@@ -54,7 +77,7 @@ bool first_stage(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, 
 
 /// The end of an explicit step, after it committed its result to `state`: the forces at that
 /// state and time into TetherWorkspace::end_forces and end_node_forces (the ends moving as
-/// `boundary` has them h later), kept for the next sub-step of advance() (first_stage).
+/// `boundary` has them h later), kept for the next explicit step (first_stage).
 template <typename Scalar, typename Env>
 void end_evaluation(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                     const TetherState<Scalar>& state, const TetherBoundary<Scalar>& boundary,
@@ -65,6 +88,12 @@ void end_evaluation(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
   set_end_node_forces(model, ws, end);
   ws.end_evaluated = true;
   ws.end_evaluation_time = state.time;
+  ws.end_model = &model;
+  ws.end_environment = &env;
+  ws.end_environment_id = instance_id_of(env);
+  ws.end_winch_length = state.winch_length;
+  ws.end_position = state.position;
+  ws.end_velocity = state.velocity;
 }
 
 }  // namespace detail
@@ -158,7 +187,7 @@ void rk4_stage_update(TetherWorkspace<Scalar>& ws, const Matrix3X<Scalar>& vs, S
 /// \brief One classical RK4 step of length `dt` [s]. End forces are those at the end of the step.
 /// Four force evaluations (each also giving the accelerations M⁻¹F in its last pass), each
 /// followed by one vectorised pass for the stage's state update, and the end state's (which the
-/// next sub-step of advance() takes as its first). \throws as step_symplectic_euler.
+/// next step takes as its first). \throws as step_symplectic_euler.
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,

@@ -305,24 +305,31 @@ NodeWetness<Scalar> node_wetness(Scalar d_lo, Scalar d, Scalar d_hi, Scalar l_be
   return w;
 }
 
-/// node_wetness of node i of a pass: its neighbours' depths, its segments' rest lengths (segment 0
-/// at a winch: TetherWorkspace::winch_length) and whether they have parted.
+/// node_wetness of node i of a line of n segments: `depth(j)` the depth under the surface of
+/// node j, `rest(s)` the unstretched length of segment s, `parted(s)` whether segment s has
+/// parted; φ = 1 without arithmetic when the node and its neighbours are half a diameter or more
+/// below the surface.
+template <typename Scalar, typename Depth, typename Rest, typename Parted>
+NodeWetness<Scalar> node_wetness_of(int i, int n, const Depth& depth, const Rest& rest,
+                                    const Parted& parted, Scalar diameter, Scalar inv_d) {
+  const bool joined_before = i > 0 && !parted(i - 1);
+  const bool joined_after = i < n && !parted(i);
+  const Scalar d = depth(i), half_d = Scalar(0.5) * diameter;
+  const Scalar d_lo = joined_before ? depth(i - 1) : d, d_hi = joined_after ? depth(i + 1) : d;
+  if (d >= half_d && d_lo >= half_d && d_hi >= half_d)
+    return {Scalar(1), Scalar(0), Scalar(0), Scalar(0)};
+  return node_wetness(d_lo, d, d_hi, i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
+                      joined_before, joined_after, diameter, inv_d);
+}
+
+/// node_wetness_of node i of a force pass (segment 0 at a winch: TetherWorkspace::winch_length).
 template <typename Scalar>
 NodeWetness<Scalar> node_wetness_in_pass(const ForcePass<Scalar>& c,
                                          const TetherWorkspace<Scalar>& ws, int i) {
-  const int n = c.n;
-  const auto depth = [&](int j) {
-    return c.still ? c.X(2, j) : c.X(2, j) + ws.surface_elevation(j);
-  };
-  const auto rest = [&](int s) { return c.winch && s == 0 ? ws.winch_length : c.l; };
-  const bool joined_before = i > 0 && !(c.parted && c.parted[i - 1]);
-  const bool joined_after = i < n && !(c.parted && c.parted[i]);
-  const Scalar d = depth(i);
-  const Scalar d_lo = joined_before ? depth(i - 1) : d, d_hi = joined_after ? depth(i + 1) : d;
-  if (d >= c.half_d && d_lo >= c.half_d && d_hi >= c.half_d)
-    return {Scalar(1), Scalar(0), Scalar(0), Scalar(0)};
-  return node_wetness(d_lo, d, d_hi, i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
-                      joined_before, joined_after, c.p->diameter, c.inv_d);
+  return node_wetness_of<Scalar>(
+      i, c.n, [&](int j) { return c.still ? c.X(2, j) : c.X(2, j) + ws.surface_elevation(j); },
+      [&](int s) { return c.winch && s == 0 ? ws.winch_length : c.l; },
+      [&](int s) { return c.parted && c.parted[s]; }, c.p->diameter, c.inv_d);
 }
 
 /// Node i, any kind and state (end node, surface band, in air, on the seabed): tangent, node
@@ -812,6 +819,16 @@ void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace
   if (model.last_free_node() == n - 1) acc.col(n) = a_end;
 }
 
+namespace detail {
+/// M_i a of node i from the last compute_forces: its isotropic and tangential mass (with the
+/// added mass) times the acceleration `a`.
+template <typename Scalar>
+Vector3<Scalar> node_inertia(const TetherWorkspace<Scalar>& ws, int i, const Vector3<Scalar>& a) {
+  const Vector3<Scalar> q = ws.tangent.col(i);
+  return ws.mass_iso(i) * a + ws.mass_tan(i) * q.dot(a) * q;
+}
+}  // namespace detail
+
 /// \brief Forces the tether exerts on its kinematic attachment points from the last
 /// `compute_forces`: F_end = F_node − M_node a_end (the negative of the constraint force that
 /// holds the end node on its prescribed path), NED [N]. Zero for a free end.
@@ -824,14 +841,10 @@ EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
   check_boundary(boundary);
   EndForces<Scalar> out;
   const int n = model.segments();
-  const auto inertia = [&](int i, const Vector3<Scalar>& a) -> Vector3<Scalar> {
-    const Vector3<Scalar> q = ws.tangent.col(i);
-    return ws.mass_iso(i) * a + ws.mass_tan(i) * q.dot(a) * q;
-  };
   if (model.parameters().start_mode == EndMode::kinematic)
-    out.on_start = ws.force.col(0) - inertia(0, boundary.start.acceleration);
+    out.on_start = ws.force.col(0) - detail::node_inertia(ws, 0, boundary.start.acceleration);
   if (model.parameters().end_mode == EndMode::kinematic)
-    out.on_end = ws.force.col(n) - inertia(n, boundary.end.acceleration);
+    out.on_end = ws.force.col(n) - detail::node_inertia(ws, n, boundary.end.acceleration);
   return out;
 }
 
@@ -841,15 +854,13 @@ template <typename Scalar>
 void set_end_node_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                          const TetherBoundary<Scalar>& boundary) {
   const int n = model.segments();
-  const auto inertia = [&](int i, const Vector3<Scalar>& a) -> Vector3<Scalar> {
-    const Vector3<Scalar> q = ws.tangent.col(i);
-    return ws.mass_iso(i) * a + ws.mass_tan(i) * q.dot(a) * q;
-  };
   ws.end_node_forces = EndForces<Scalar>{};
   if (model.parameters().start_mode == EndMode::kinematic)
-    ws.end_node_forces.on_start = ws.end_forces.on_start + inertia(0, boundary.start.acceleration);
+    ws.end_node_forces.on_start =
+        ws.end_forces.on_start + node_inertia(ws, 0, boundary.start.acceleration);
   if (model.parameters().end_mode == EndMode::kinematic)
-    ws.end_node_forces.on_end = ws.end_forces.on_end + inertia(n, boundary.end.acceleration);
+    ws.end_node_forces.on_end =
+        ws.end_forces.on_end + node_inertia(ws, n, boundary.end.acceleration);
 }
 }  // namespace detail
 
@@ -911,13 +922,9 @@ Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
   for (int i = 0; i <= n; ++i) {
     const Vector3<Scalar> q = detail::node_tangent<Scalar>(state.position, i, n, parted).q;
     const Scalar z = state.position(2, i);
-    const bool joined_before = i > 0 && !(parted && parted[i - 1]);
-    const bool joined_after = i < n && !(parted && parted[i]);
-    const Scalar d = depth(i);
     const Scalar phi =
-        detail::node_wetness(joined_before ? depth(i - 1) : d, d, joined_after ? depth(i + 1) : d,
-                             i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
-                             joined_before, joined_after, p.diameter, inv_d)
+        detail::node_wetness_of<Scalar>(
+            i, n, depth, rest, [&](int s) { return parted && parted[s]; }, p.diameter, inv_d)
             .phi;
     const Scalar extra = detail::winch_extra_length(model, state.winch_length, i);
     const Scalar m = model.node_mass(i) + p.mass_per_length * extra;

@@ -203,17 +203,12 @@ void force_jacobian_blocks(const TetherModel<Scalar>& model, const TetherWorkspa
     // elevation held, as the water is).
     Scalar dphi_at[3] = {Scalar(0), Scalar(0), Scalar(0)};
     if (wet && phi < Scalar(1)) {
-      const bool joined_before = i > 0 && !ws.is_parted(i - 1);
-      const bool joined_after = i < n && !ws.is_parted(i);
-      const auto depth = [&](int j) { return Scalar(x(2, j)) + ws.surface_elevation(j); };
-      const auto rest = [&](int s) {
-        return s == 0 && has_winch_segment(ws) ? ws.winch_length : model.segment_length();
-      };
-      const Scalar di = depth(i);
-      const NodeWetness<Scalar> nw =
-          node_wetness(joined_before ? depth(i - 1) : di, di, joined_after ? depth(i + 1) : di,
-                       i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0), joined_before,
-                       joined_after, p.diameter, inv_diam);
+      const NodeWetness<Scalar> nw = node_wetness_of<Scalar>(
+          i, n, [&](int j) { return Scalar(x(2, j)) + ws.surface_elevation(j); },
+          [&](int s) {
+            return s == 0 && has_winch_segment(ws) ? ws.winch_length : model.segment_length();
+          },
+          [&](int s) { return ws.is_parted(s); }, p.diameter, inv_diam);
       dphi_at[0] = nw.d_lo;
       dphi_at[1] = nw.d_self;
       dphi_at[2] = nw.d_hi;

@@ -392,22 +392,29 @@ struct TetherWorkspace {
   /// (segment tension, weight, buoyancy, drag and fluid forces) less its inertia along the
   /// prescribed motion, F_node − M_node a_end, which is the force that holds the end node on its
   /// path, what a body carrying the end feels. The implicit schemes take it at their final iterate
-  /// (to the Newton tolerance); the explicit ones evaluate the forces once more at the end state
-  /// (advance() reuses that evaluation as the next sub-step's first stage). Zero for a free end.
+  /// (to the Newton tolerance); the explicit ones evaluate the forces once more at the end state,
+  /// which the next explicit step takes as its first stage when it starts from exactly that state
+  /// (end_evaluated). Zero for a free end.
   /// end_forces_from_workspace gives the same after a compute_forces.
   EndForces<Scalar> end_forces;
   /// The same instant's force on the end nodes without the inertia term, F_node [N] (end_forces
   /// + M_node a_end): for a coupling that carries the end node's mass with the body itself, or a
   /// comparison with a code that reports the end node's net force.
   EndForces<Scalar> end_node_forces;
-  /// Set by advance() between its own sub-steps: an explicit step may take the evaluation its
-  /// predecessor made at the end state (end_evaluated) as its first stage when it starts from
-  /// exactly that state.
-  bool reuse_end_evaluation = false;
-  /// The force buffers and `acceleration` hold the evaluation at (end_evaluation_time, x1, v1)
-  /// that an explicit step made at its end.
+  /// The force buffers and `acceleration` hold the evaluation an explicit step made at its end:
+  /// at time end_evaluation_time, positions end_position and velocities end_velocity, for the
+  /// model and environment at end_model and end_environment (and the environment's instance id,
+  /// when it has one: kelp's Environment does, a new one for every copy or assignment). The next
+  /// explicit step takes it as its first stage when it starts from exactly that (bitwise equal
+  /// state, same objects, same winch length). Set it false to force a fresh evaluation, e.g.
+  /// after changing a custom environment in place between two steps.
   bool end_evaluated = false;
   double end_evaluation_time = 0.0;
+  const void* end_model = nullptr;
+  const void* end_environment = nullptr;
+  std::uint64_t end_environment_id = 0;
+  Scalar end_winch_length = Scalar(0);
+  Matrix3X<Scalar> end_position, end_velocity;
   /// Impulse the tether delivered to its attachment points over the last step (the step
   /// functions) or the last `advance` (summed over its sub-steps) [N s]: the end force weighted
   /// as the integrator weights the node forces in its momentum update (symplectic Euler h F(t),
@@ -436,6 +443,7 @@ struct TetherWorkspace {
     water_is_zero = true;
     any_parted = false;
     any_contact = false;
+    end_evaluated = false;
     segment_obstacle.setConstant(-1);
     clamp_start.setZero();
     clamp_end.setZero();
@@ -457,9 +465,26 @@ struct TetherWorkspace {
   template <typename Self, typename F>
   static void for_each_buffer(Self& w, int nodes, F&& f) {
     const Eigen::Index n = nodes, s = nodes - 1;
-    for (auto* m : {&w.force, &w.bending, &w.acceleration, &w.tangent, &w.water_velocity,
-                    &w.water_acceleration, &w.rhs, &w.rhs_true, &w.delta, &w.x0, &w.v0, &w.x1,
-                    &w.v1, &w.xs, &w.vs, &w.x_eval, &w.v_eval, &w.contact_force})
+    for (auto* m : {&w.force,
+                    &w.bending,
+                    &w.acceleration,
+                    &w.tangent,
+                    &w.water_velocity,
+                    &w.water_acceleration,
+                    &w.rhs,
+                    &w.rhs_true,
+                    &w.delta,
+                    &w.x0,
+                    &w.v0,
+                    &w.x1,
+                    &w.v1,
+                    &w.xs,
+                    &w.vs,
+                    &w.x_eval,
+                    &w.v_eval,
+                    &w.contact_force,
+                    &w.end_position,
+                    &w.end_velocity})
       f(*m, 3, n);
     for (auto* v : {&w.mass_iso, &w.mass_tan, &w.mass_iso_inv, &w.mass_tan_ratio, &w.seabed_force,
                     &w.friction_normal, &w.submerged, &w.node_kz, &w.surface_elevation})
