@@ -8,7 +8,8 @@ namespace kelp {
 namespace environment {
 
 /// \brief How the orbital kinematics are taken near the free surface, where linear theory (valid
-/// up to the mean level z = 0) says nothing (DNV-RP-C205 (2010) lists these methods with its wave kinematics).
+/// up to the mean level z = 0) says nothing (DNV-RP-C205 (2010) lists these methods with its wave
+/// kinematics).
 enum class WaveStretching {
   /// Vertical extrapolation (the default, and kelp's only method before regular waves came):
   /// below the mean level the linear profiles at the point's depth z; between the mean level and
