@@ -269,6 +269,11 @@ TEST_CASE("end forces: every integrator reports them at the end of the step",
     CHECK(next(other) == stages + 1);
     ss.time += 1e-3;
     CHECK(next(other) == stages + 1);
+    // Nor after another evaluation in the same workspace: a compute_forces elsewhere, a failed
+    // implicit step.
+    CHECK(next(other) == stages);
+    kt::compute_forces(model, ws_s, other, ss.time, s0.position, s0.velocity);
+    CHECK(next(other) == stages + 1);
   }
   // kelp's Environment tells a copy or an assignment from the original (a new instance id).
   kelp::environment::Environmentd e1;

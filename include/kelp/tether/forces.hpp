@@ -630,6 +630,9 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
                      Scalar* acc) {
   const TetherParameters<Scalar>& p = model.parameters();
   const int n = model.segments();
+  // Any evaluation overwrites what an explicit step kept from its end (TetherWorkspace::
+  // end_evaluated; that step sets it again after its own).
+  ws.end_evaluated = false;
   ForcePass<Scalar> c;
   c.p = &p;
   c.n = n;
