@@ -24,6 +24,26 @@ template class kelp::environment::CurrentModel<Jet>;
 template class kelp::environment::WindField<Jet>;
 template class kelp::environment::Environment<Jet>;
 
+namespace {
+// The Jet kinematics' velocity `kj` at x0, t equals the double field's, and its derivatives equal
+// the double field's central differences.
+template <typename K>
+void check_velocity_derivatives(const WaveField<double>& wd, const K& kj, const Vector3<double>& x0,
+                                double t) {
+  const double h = 1e-6;
+  for (int d = 0; d < 3; ++d) {
+    Vector3<double> e = Vector3<double>::Zero();
+    e(d) = h;
+    const Vector3<double> dv =
+        (wd.kinematics(x0 + e, t).velocity - wd.kinematics(x0 - e, t).velocity) / (2 * h);
+    for (int r = 0; r < 3; ++r) {
+      CHECK(kj.velocity(r).a == Approx(wd.kinematics(x0, t).velocity(r)).margin(1e-12));
+      CHECK(kj.velocity(r).v(d) == Approx(dv(r)).margin(1e-7));
+    }
+  }
+}
+}  // namespace
+
 TEST_CASE("wave kinematics: Jet derivatives match finite differences", "[environment][jet]") {
   for (const double depth : {std::numeric_limits<double>::infinity(), 18.0}) {
     WaveFieldParameters p;
@@ -38,17 +58,7 @@ TEST_CASE("wave kinematics: Jet derivatives match finite differences", "[environ
     const double t = 5.0;
     const Vector3<Jet> xj(Jet(x0(0), 0), Jet(x0(1), 1), Jet(x0(2), 2));
     const auto kj = wj.kinematics(xj, t);
-    const double h = 1e-6;
-    for (int d = 0; d < 3; ++d) {
-      Vector3<double> e = Vector3<double>::Zero();
-      e(d) = h;
-      const Vector3<double> dv =
-          (wd.kinematics(x0 + e, t).velocity - wd.kinematics(x0 - e, t).velocity) / (2 * h);
-      for (int r = 0; r < 3; ++r) {
-        CHECK(kj.velocity(r).a == Approx(wd.kinematics(x0, t).velocity(r)).margin(1e-12));
-        CHECK(kj.velocity(r).v(d) == Approx(dv(r)).margin(1e-7));
-      }
-    }
+    check_velocity_derivatives(wd, kj, x0, t);
     // The generic path's velocity gradient: the Jet derivative of the velocity, and the double
     // (SIMD) path's gradient.
     const auto kd = wd.kinematics(x0, t);
@@ -87,17 +97,7 @@ TEST_CASE(
     const Vector3<Jet> xj(Jet(x0(0), 0), Jet(x0(1), 1), Jet(x0(2), 2));
     for (const double t : {0.0, 2.7}) {
       const auto kj = wj.kinematics(xj, t);
-      const double h = 1e-6;
-      for (int d = 0; d < 3; ++d) {
-        Vector3<double> e = Vector3<double>::Zero();
-        e(d) = h;
-        const Vector3<double> dv =
-            (wd.kinematics(x0 + e, t).velocity - wd.kinematics(x0 - e, t).velocity) / (2 * h);
-        for (int r = 0; r < 3; ++r) {
-          CHECK(kj.velocity(r).a == Approx(wd.kinematics(x0, t).velocity(r)).margin(1e-12));
-          CHECK(kj.velocity(r).v(d) == Approx(dv(r)).margin(1e-7));
-        }
-      }
+      check_velocity_derivatives(wd, kj, x0, t);
     }
   }
 }

@@ -275,28 +275,23 @@ NodeWetness<Scalar> node_wetness(Scalar d_lo, Scalar d, Scalar d_hi, Scalar l_be
   // A half segment held at the node's own depth: φ(d)/2 of it, ∂/∂d = φ'(d)/2.
   const Scalar phi_own = submerged_fraction(d, zero, diameter, inv_d);
   const Scalar dphi_own = phi_own > zero && phi_own < Scalar(1) ? inv_d : zero;
-  if (l_before > zero) {
-    if (joined_before) {
-      const SegmentWetness<Scalar> s = segment_wetness(d_lo, d, diameter, inv_d);
-      w.phi += l_before * s.b;
-      w.d_lo += l_before * s.dab;
-      w.d_self += l_before * s.dbb;
-    } else {
-      w.phi += half * l_before * phi_own;
-      w.d_self += half * l_before * dphi_own;
+  // The half segment of length l before (the node is the segment's end b) or after it (its end
+  // a), d_other the depth of the segment's other node.
+  const auto add_half = [&](Scalar l, bool joined, Scalar d_other, bool before) {
+    if (!(l > zero)) return;
+    if (!joined) {
+      w.phi += half * l * phi_own;
+      w.d_self += half * l * dphi_own;
+      return;
     }
-  }
-  if (l_after > zero) {
-    if (joined_after) {
-      const SegmentWetness<Scalar> s = segment_wetness(d, d_hi, diameter, inv_d);
-      w.phi += l_after * s.a;
-      w.d_self += l_after * s.daa;
-      w.d_hi += l_after * s.dab;
-    } else {
-      w.phi += half * l_after * phi_own;
-      w.d_self += half * l_after * dphi_own;
-    }
-  }
+    const SegmentWetness<Scalar> s = before ? segment_wetness(d_other, d, diameter, inv_d)
+                                            : segment_wetness(d, d_other, diameter, inv_d);
+    w.phi += l * (before ? s.b : s.a);
+    (before ? w.d_lo : w.d_hi) += l * s.dab;
+    w.d_self += l * (before ? s.dbb : s.daa);
+  };
+  add_half(l_before, joined_before, d_lo, true);
+  add_half(l_after, joined_after, d_hi, false);
   const Scalar inv_h = Scalar(2) / (l_before + l_after);
   w.phi *= inv_h;
   w.d_lo *= inv_h;
