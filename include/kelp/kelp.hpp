@@ -19,6 +19,7 @@
 #include "kelp/nav/filter.hpp"
 #include "kelp/nav/random.hpp"
 #include "kelp/nav/sensors.hpp"
+#include "kelp/system/fleet.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/solver_stats.hpp"
 #include "kelp/system/system.hpp"

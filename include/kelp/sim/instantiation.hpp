@@ -1,7 +1,8 @@
 /// \file
 /// \brief The double-precision coupled system that kelp::sim runs, instantiated once in the
 /// compiled library (src/instantiation.cpp): a program on kelp::sim that calls
-/// `kelp::system::step`, `initial_state` or `energy` on doubles, steps a tether alone
+/// `kelp::system::step`, `initial_state` or `energy` on doubles (the pair's or a fleet's:
+/// kelp/system/fleet.hpp), steps a tether alone
 /// (`kelp::tether::step`, `advance`) in kelp's Environment, or samples the sea's waves, links the
 /// library's code instead of compiling the system's templates and the wave kernel's
 /// instruction sets again (Pinocchio's explicit-instantiation pattern; the classes' inline
@@ -12,9 +13,11 @@
 #include "kelp/environment/environment.hpp"
 #include "kelp/environment/wave_kernels.hpp"
 #include "kelp/sim/export.hpp"
+#include "kelp/system/fleet.hpp"
 #include "kelp/system/system.hpp"
 #include "kelp/tether/driver.hpp"
 
 KELP_WAVE_KERNEL_INSTANCES(extern template KELP_SIM_API)
 KELP_SYSTEM_INSTANCES(extern template KELP_SIM_API)
+KELP_FLEET_INSTANCES(extern template KELP_SIM_API)
 KELP_TETHER_INSTANCES(extern template KELP_SIM_API)

@@ -399,11 +399,19 @@ vehicle::Surroundings<Scalar> lerp(const vehicle::Surroundings<Scalar>& a,
   return s;
 }
 
-/// One RK4 step of a vehicle in the environment under constant body wrenches `tau` and a
-/// constant force `f_ned` fixed in NED at the body point r (its wrench follows the stage
-/// attitudes). Returns the last stage's ν̇ (the predictor of the next step); commits only a
-/// finite state. With a hull (`hull` not null), its contact wrench with the environment's seabed
-/// and obstacles (hull_contact()) is added at every stage, from the stage's state.
+/// A force fixed in NED [N] applied at a body point r [m] of a vehicle (a tether's end).
+template <typename Scalar>
+struct PointLoad {
+  Vector3<Scalar> r = Vector3<Scalar>::Zero();  ///< body frame [m]
+  Vector3<Scalar> f = Vector3<Scalar>::Zero();  ///< NED [N]
+};
+
+/// One RK4 step of a vehicle in the environment under constant body wrenches `tau` and `n`
+/// constant forces fixed in NED at body points (`loads`; their wrenches follow the stage
+/// attitudes, summed in order). Returns the last stage's ν̇ (the predictor of the next step);
+/// commits only a finite state. With a hull (`hull` not null), its contact wrench with the
+/// environment's seabed and obstacles (hull_contact()) is added at every stage, from the stage's
+/// state.
 ///
 /// The surroundings (water, free surface, wind) are sampled twice per step, at the vehicle's
 /// position at t and at its predicted position p + R v h at t + h, and taken linearly in time
@@ -415,8 +423,8 @@ template <typename Scalar, typename Env>
 Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
                              vehicle::VehicleWorkspace<Scalar>& ws,
                              vehicle::VehicleState<Scalar>& x, const Env& env, double t, double dt,
-                             const vehicle::VehicleInputs<Scalar>& in, const Vector3<Scalar>& r,
-                             const Vector3<Scalar>& f_ned,
+                             const vehicle::VehicleInputs<Scalar>& in,
+                             const PointLoad<Scalar>* loads, int n,
                              const HullContact<Scalar>* hull = nullptr) {
   const vehicle::Surroundings<Scalar> s0 = vehicle::surroundings(model, env, x, t);
   vehicle::VehicleState<Scalar> ahead = x;
@@ -427,7 +435,8 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
              [&](const vehicle::VehicleState<Scalar>& s, double c) {
                vehicle::StateDerivative<Scalar> d;
                d.pose = vehicle::pose_rate(s.attitude, s.nu);
-               Vector6<Scalar> tau_ext = in.tau_ext + wrench_of_force(s, r, f_ned);
+               Vector6<Scalar> tau_ext = in.tau_ext;
+               for (int k = 0; k < n; ++k) tau_ext += wrench_of_force(s, loads[k].r, loads[k].f);
                if (hull) tau_ext += hull_contact(*hull, env, s).wrench;
                d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.tau, tau_ext,
                                                     lerp(s0, s1, Scalar(c)));
@@ -435,6 +444,74 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
              },
              "system::step (vehicle)")
       .nu_dot;
+}
+
+/// step_vehicle under one tether force `f_ned` at the body point r.
+template <typename Scalar, typename Env>
+Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
+                             vehicle::VehicleWorkspace<Scalar>& ws,
+                             vehicle::VehicleState<Scalar>& x, const Env& env, double t, double dt,
+                             const vehicle::VehicleInputs<Scalar>& in, const Vector3<Scalar>& r,
+                             const Vector3<Scalar>& f_ned,
+                             const HullContact<Scalar>* hull = nullptr) {
+  const PointLoad<Scalar> load{r, f_ned};
+  return step_vehicle(model, ws, x, env, t, dt, in, &load, 1, hull);
+}
+
+/// One pass of a tether over a system step: tether::advance with `options`; when an implicit
+/// scheme fails and `fallback` allows it, the same step redone by RK4 in sub-steps of the
+/// line's stable explicit step (counted in `fallbacks`). Returns the committed advance's report.
+/// (With a winch, segment 0 may be as short as r·l (r = remove_ratio): node 1's springs
+/// EA/(r l) + EA/l over its mass μ(1 + r) l/2 give a frequency 1/√r times the uniform line's,
+/// hence the factor √r on the stable step.)
+template <typename Scalar, typename Env>
+tether::StepReport<Scalar> advance_tether(const tether::TetherModel<Scalar>& line,
+                                          const tether::WinchModel<Scalar>* winch,
+                                          tether::TetherWorkspace<Scalar>& ws, const Env& env,
+                                          tether::TetherState<Scalar>& state,
+                                          const tether::TetherBoundary<Scalar>& ends, double dt,
+                                          const tether::AdvanceOptions<Scalar>& options,
+                                          bool fallback, int& fallbacks) {
+  try {
+    return tether::advance(line, ws, env, state, ends, dt, options);
+  } catch (const kelp::numerical_error&) {
+    if (!fallback || !tether::is_implicit(options.integrator)) throw;
+    // The failed step left the tether as it was: redo it explicitly.
+    using std::sqrt;
+    const Scalar h =
+        tether::estimate_stable_dt(line, tether::Integrator::rk4, env.water_density()) *
+        (winch ? sqrt(winch->winch().remove_ratio) : Scalar(1));
+    tether::AdvanceOptions<Scalar> explicit_options = options;
+    explicit_options.max_dt = std::min(options.max_dt, double(value_of(h)));
+    explicit_options.integrator = tether::Integrator::rk4;
+    tether::StepReport<Scalar> r =
+        tether::advance(line, ws, env, state, ends, dt, explicit_options);
+    ++fallbacks;
+    return r;
+  }
+}
+
+/// A vehicle's propulsion over a step (none: its commands must be empty): advances `x` under
+/// the commands `u` and adds the mean thrust's wrench to `in.tau`; `r` reports it.
+template <typename Scalar>
+void propel(const vehicle::PropulsionModel<Scalar>* m, vehicle::PropulsionState<Scalar>& x,
+            const vehicle::ThrusterVector<Scalar>& u, vehicle::VehicleInputs<Scalar>& in,
+            vehicle::PropulsionStep<Scalar>& r, double dt, const std::string& which,
+            const char* state_name) {
+  if (m == nullptr) {
+    KELP_CHECK(u.size() == 0,
+               "inputs." + which + "_commands: the system has no propulsion for the " + which);
+    return;
+  }
+  vehicle::check_state(*m, x, state_name);
+  r = vehicle::advance(*m, x, u, dt);
+  in.tau += r.wrench;
+}
+
+/// The coupling corrector: end motion `m` keeps its start and reaches `target` after h.
+template <typename Scalar>
+void reach(tether::EndMotion<Scalar>& m, const Vector3<Scalar>& target, const Scalar& h) {
+  m.acceleration = Scalar(2) * (target - m.position - h * m.velocity) / (h * h);
 }
 
 /// The small parts of a state (all but the tether), saved to restore after a failed step.
@@ -497,24 +574,10 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
   vehicle::PropulsionState<Scalar> asv_prop = state.asv_propulsion;
   vehicle::PropulsionState<Scalar> auv_prop = state.auv_propulsion;
   SystemReport<Scalar> report;
-  const auto propel = [dt](const vehicle::PropulsionModel<Scalar>* m,
-                           vehicle::PropulsionState<Scalar>& x,
-                           const vehicle::ThrusterVector<Scalar>& u,
-                           vehicle::VehicleInputs<Scalar>& in, vehicle::PropulsionStep<Scalar>& r,
-                           const char* which) {
-    if (m == nullptr) {
-      KELP_CHECK(u.size() == 0, std::string("inputs.") + which +
-                                    "_commands: the system has no propulsion for the " + which);
-      return;
-    }
-    vehicle::check_state(*m, x, which[1] == 's' ? "state.asv_propulsion" : "state.auv_propulsion");
-    r = vehicle::advance(*m, x, u, dt);
-    in.tau += r.wrench;
-  };
-  propel(model.asv_propulsion(), asv_prop, inputs.asv_commands, asv_in, report.asv_propulsion,
-         "asv");
-  propel(model.auv_propulsion(), auv_prop, inputs.auv_commands, auv_in, report.auv_propulsion,
-         "auv");
+  detail::propel(model.asv_propulsion(), asv_prop, inputs.asv_commands, asv_in,
+                 report.asv_propulsion, dt, "asv", "state.asv_propulsion");
+  detail::propel(model.auv_propulsion(), auv_prop, inputs.auv_commands, auv_in,
+                 report.auv_propulsion, dt, "auv", "state.auv_propulsion");
   const SystemParameters<Scalar>& p = model.parameters();
   const auto& env = model.environment();
   const double t = state.time;
@@ -536,26 +599,10 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     // with its tether state.
     tether::StepReport<Scalar> pass_report;
     for (int pass = 0;; ++pass) {
-      try {
-        pass_report = tether::advance(line, ws.tether, env, state.tether, ends, dt, tether_options);
-        report.tether += pass_report;
-      } catch (const kelp::numerical_error&) {
-        if (!p.explicit_fallback || !tether::is_implicit(p.tether_integrator)) throw;
-        // The failed step left the tether as it was: redo it explicitly.
-        // (With a winch, segment 0 may be as short as r·l (r = remove_ratio): node 1's springs
-        // EA/(r l) + EA/l over its mass μ(1 + r) l/2 give a frequency 1/√r times the uniform
-        // line's, hence the factor √r.)
-        using std::sqrt;
-        const Scalar h =
-            tether::estimate_stable_dt(line, tether::Integrator::rk4, env.water_density()) *
-            (model.winch() ? sqrt(model.winch()->winch().remove_ratio) : Scalar(1));
-        tether::AdvanceOptions<Scalar> fallback = tether_options;
-        fallback.max_dt = std::min(p.max_tether_dt, double(value_of(h)));
-        fallback.integrator = tether::Integrator::rk4;
-        pass_report = tether::advance(line, ws.tether, env, state.tether, ends, dt, fallback);
-        report.tether += pass_report;
-        ++report.tether_fallbacks;
-      }
+      pass_report =
+          detail::advance_tether(line, model.winch(), ws.tether, env, state.tether, ends, dt,
+                                 tether_options, p.explicit_fallback, report.tether_fallbacks);
+      report.tether += pass_report;
       // The impulse the tether's integrator delivered to its ends, as a mean force.
       report.force_on_asv = ws.tether.end_impulse.on_start / Scalar(dt);
       report.force_on_auv = ws.tether.end_impulse.on_end / Scalar(dt);
@@ -567,12 +614,8 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
                                report.force_on_auv, p.auv_hull ? &*p.auv_hull : nullptr);
       if (pass >= p.coupling_corrections) break;
       // Corrector: the end paths that start as before and reach the actual attachment points.
-      const Scalar h(dt);
-      const auto reach = [&](tether::EndMotion<Scalar>& m, const Vector3<Scalar>& target) {
-        m.acceleration = Scalar(2) * (target - m.position - h * m.velocity) / (h * h);
-      };
-      reach(ends.start, state.asv.point_position(p.asv_attachment));
-      reach(ends.end, state.auv.point_position(p.auv_attachment));
+      detail::reach(ends.start, state.asv.point_position(p.asv_attachment), Scalar(dt));
+      detail::reach(ends.end, state.auv.point_position(p.auv_attachment), Scalar(dt));
       backup.restore(state.tether);
       state.asv = before.asv;
       state.auv = before.auv;
