@@ -14,10 +14,18 @@
 //                         query of water and surface at the nodes, as each tether step makes) and
 //                         vehicle_water_us (2 vehicles × 2 samples of their surroundings)
 //   BM_SystemStepCorrected one step with one corrector pass (coupling_corrections = 1)
+//   BM_FleetPairStep      the same pair as a fleet (kelp/system/fleet.hpp, system::fleet_of):
+//                         what the graph's generality costs against BM_SystemStep
+//   BM_ShipTmsRovStep     a work-class configuration in the rough sea: the ship's sheave (an
+//                         anchor at the surface), a 60 m armoured umbilical (60 segments) to a
+//                         TMS (a 400 kg point mass at ~50 m), a 30 m ROV tether (60 segments) on
+//                         the TMS's winch to a BlueROV2 Heavy holding a constant thrust: 90 m
+//                         of line; realtime_factor as BM_SystemStep
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 
+#include "kelp/system/fleet.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
 
@@ -112,8 +120,73 @@ void BM_SystemStepSplit(benchmark::State& st, ks::presets::Sea sea) {
   st.counters["vehicle_water_us"] = vehicle_water / n;
 }
 
+// Fleet steps of `model` from `state` under `inputs` (settled in for 2 s first).
+void run_fleet(benchmark::State& st, const ks::FleetModeld& model, ks::FleetStated state,
+               const ks::FleetInputsd& inputs) {
+  ks::FleetWorkspaced ws(model);
+  for (int k = 0; k < 200; ++k) ks::step(model, ws, state, inputs, 0.01);
+  double newton = 0;
+  for (auto _ : st) {
+    newton += ks::step(model, ws, state, inputs, 0.01).tether.newton_iterations;
+    benchmark::DoNotOptimize(state.vehicles.back().position.data());
+  }
+  const double iters = static_cast<double>(st.iterations());
+  st.counters["realtime_factor"] = benchmark::Counter(0.01 * iters, benchmark::Counter::kIsRate);
+  st.counters["newton_per_step"] = newton / iters;
+}
+
+void BM_FleetPairStep(benchmark::State& st, ks::presets::Sea sea) {
+  const ks::presets::PaperWorld<double> w(10.0, sea);
+  const ks::FleetModeld model(ks::fleet_of(w.model.parameters()), w.model.environment());
+  ks::FleetWorkspaced ws(model);
+  const ks::FleetStated s = ks::initial_state(model, ws, {w.state.asv, w.state.auv});
+  ks::FleetInputsd in(model);
+  in.vehicles[1].tau << 10, 0, 0, 0, 0, 0;
+  in.vehicles[0].tau << 5, 0, 0, 0, 0, 0;
+  run_fleet(st, model, s, in);
+}
+
+void BM_ShipTmsRovStep(benchmark::State& st) {
+  ks::FleetParametersd p;
+  p.vehicles.push_back({"rov", kv::bluerov2_heavy<double>().parameters, {}, {}});
+  ks::PointMassParametersd tms;
+  tms.name = "tms";
+  tms.mass = 400;
+  tms.volume = 0.2;
+  tms.drag_area = 1.0;
+  p.point_masses.push_back(tms);
+  kt::TetherParametersd umbilical = kt::presets::rov_tether(60.0, 1.0);
+  umbilical.diameter = 0.025;
+  umbilical.mass_per_length = 1.2;
+  umbilical.axial_stiffness = 3e6;
+  umbilical.internal_damping = 0;
+  umbilical.internal_damping_ratio = 0.5;
+  umbilical.breaking_strength = 0;
+  kt::WinchParametersd winch;
+  winch.min_length = 5;
+  winch.max_length = 60;
+  p.tethers.push_back({"umbilical",
+                       umbilical,
+                       ks::TetherEnd<double>::at_anchor({0, 0, 0}),
+                       ks::TetherEnd<double>::on_point_mass(0),
+                       {}});
+  p.tethers.push_back(
+      {"tether", kt::presets::rov_tether(30.0, 0.5), ks::TetherEnd<double>::on_point_mass(0),
+       ks::TetherEnd<double>::on_vehicle(0, ks::presets::bluerov2_attachment<double>()), winch});
+  const ks::FleetModeld model(p, ks::presets::environment<double>(ks::presets::Sea::rough));
+  ks::FleetWorkspaced ws(model);
+  std::vector<kv::VehicleStated> rov(1);
+  rov[0].position = Vector3<double>(20, 0, 60);
+  const ks::FleetStated s = ks::initial_state(model, ws, rov, {Vector3<double>(8, 0, 50)});
+  ks::FleetInputsd in(model);
+  in.vehicles[0].tau << 10, 0, 0, 0, 0, 0;
+  run_fleet(st, model, s, in);
+}
+
 }  // namespace
 
+BENCHMARK_CAPTURE(BM_FleetPairStep, rough, ks::presets::Sea::rough)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ShipTmsRovStep)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_SystemStep, moderate, ks::presets::Sea::moderate)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_SystemStep, rough, ks::presets::Sea::rough)->Unit(benchmark::kMicrosecond);
