@@ -34,7 +34,69 @@ const char* hydrostatics_name(vehicle::Hydrostatics h) {
   return "submerged";
 }
 
-using ojson = nlohmann::ordered_json;
+// The writer builds nlohmann::json (one instantiation of the library in this unit: an
+// ordered_json beside it costs seconds of compile time) and orders the keys when printing.
+using ojson = json;
+
+// The order of the keys in a written file (the reader's table, object by object).
+const std::vector<std::string>& key_order() {
+  static const std::vector<std::string> order = {"name",
+                                                 "mass_kg",
+                                                 "inertia_kg_m2",
+                                                 "center_of_gravity_m",
+                                                 "center_of_buoyancy_m",
+                                                 "displaced_volume_m3",
+                                                 "water_density_kg_m3",
+                                                 "gravity_m_s2",
+                                                 "added_mass",
+                                                 "linear_damping",
+                                                 "quadratic_damping",
+                                                 "hydrostatics",
+                                                 "hull_height_m",
+                                                 "waterplane_area_m2",
+                                                 "gm_transverse_m",
+                                                 "gm_longitudinal_m",
+                                                 "wind_areas",
+                                                 "frontal_area_m2",
+                                                 "lateral_area_m2",
+                                                 "length_overall_m",
+                                                 "wind_coefficients",
+                                                 "cx",
+                                                 "cy",
+                                                 "cn",
+                                                 "attachment_m",
+                                                 "hull",
+                                                 "center_m",
+                                                 "half_extents_m",
+                                                 "stiffness_n_per_m",
+                                                 "damping_n_s_per_m",
+                                                 "damping_depth_m",
+                                                 "seabed_friction",
+                                                 "friction_velocity_m_s",
+                                                 "pwm",
+                                                 "min_us",
+                                                 "neutral_us",
+                                                 "max_us",
+                                                 "deadband_us",
+                                                 "propulsion",
+                                                 "time_constant_s",
+                                                 "thrusters",
+                                                 "position_m",
+                                                 "direction",
+                                                 "facing",
+                                                 "model",
+                                                 "curve",
+                                                 "battery",
+                                                 "capacity_ah",
+                                                 "cells_in_series",
+                                                 "internal_resistance_ohm",
+                                                 "initial_soc",
+                                                 "hotel_current_a",
+                                                 "ocv",
+                                                 "soc",
+                                                 "cell_voltage_v"};
+  return order;
+}
 
 ojson vec(const Eigen::Ref<const Eigen::VectorXd>& v) {
   ojson a = ojson::array();
@@ -323,10 +385,9 @@ void check_vehicle(const VehicleDescription& d, const std::string& file) {
       vehicle::validate(*d.propulsion);
       KELP_CHECK(d.thrust_curves.size() == std::size_t(d.propulsion->positions.cols()),
                  "thrust_curves must have one curve per thruster");
-      // The allocation (B and its pseudo-inverse) must build.
-      const vehicle::ThrusterAllocation<double> a(d.propulsion->positions,
-                                                  d.propulsion->directions);
-      (void)a;
+      // The allocation must build (its pseudo-inverse is left to the model: a rank-deficient
+      // thruster layout is allowed).
+      (void)vehicle::allocation_matrix(d.propulsion->positions, d.propulsion->directions);
     } else {
       KELP_CHECK(d.thrust_curves.empty(), "thrust_curves must be empty without propulsion");
     }
@@ -371,11 +432,13 @@ void pretty(const ojson& j, int indent, std::string& out) {
   if (j.is_object() && !j.empty()) {
     out += "{\n";
     std::size_t i = 0;
-    for (auto it = j.begin(); it != j.end(); ++it, ++i) {
-      out += pad + ojson(it.key()).dump() + ": ";
-      pretty(it.value(), indent + 2, out);
-      out += i + 1 < j.size() ? ",\n" : "\n";
+    for (const std::string& key : key_order()) {
+      if (!j.contains(key)) continue;
+      out += pad + ojson(key).dump() + ": ";
+      pretty(j.at(key), indent + 2, out);
+      out += ++i < j.size() ? ",\n" : "\n";
     }
+    KELP_ASSERT(i == j.size());  // every key the writer writes is in key_order()
     out += std::string(std::size_t(indent), ' ') + "}";
   } else if (j.is_array() && !j.empty() && !flat(j)) {
     out += "[\n";
