@@ -39,13 +39,14 @@ RUN targets=$(cmake --build build/image --target help | sed -n 's/^\.\.\. //p' |
 FROM ${BASE}
 ENV DEBIAN_FRONTEND=noninteractive
 # Runtime only: Python with numpy (the kelp package) and matplotlib (the plotting scripts).
-# The programs need libstdc++ and libgcc (in every Debian base) and nothing else.
+# The programs need libstdc++ and libgcc (in every Debian base) and tinyxml2's shared library
+# (kelp::sim's SDF importer; Debian ships no static one).
 # python3-munkres: Debian 12's python3-fonttools (a dependency of matplotlib) needs
 # "python3-scipy | python3-munkres"; left to itself apt takes SciPy, which brings Pythran, GCC,
 # Boost and OpenBLAS's headers: ~900 MB and a compiler in the image.
 RUN apt-get update \
     && apt-get install -y --no-install-recommends python3 python3-numpy python3-matplotlib \
-       python3-munkres libstdc++6 libgcc-s1 \
+       python3-munkres libstdc++6 libgcc-s1 libtinyxml2-9 \
     && apt-get clean && rm -rf /var/lib/apt/lists/* /usr/share/man/* \
     && find /usr/share/doc -type f ! -name copyright -delete
 # The installed tree: /usr/local/bin/kelp-*, /usr/local/share/kelp (plot_run.py, plot_sweep.py,

@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "kelp/core/types.hpp"
 #include "kelp/sim/scenario_reader.hpp"
@@ -91,6 +92,32 @@ class Reader {
              "expected a finite number within ±1e4, got " + v[i].dump());
       out(i) = v[i].get<double>();
     }
+    return out;
+  }
+  /// The value of a key the object must have (a missing key fails naming it).
+  const nlohmann::json& require(const nlohmann::json& j, const std::string& path,
+                                const std::string& key) const {
+    if (!j.contains(key)) fail(path + "/" + key, "missing (required)");
+    return j.at(key);
+  }
+  /// A finite number within ±`bound` at `p`.
+  double finite(const nlohmann::json& v, const std::string& p, double bound = 1e12) const {
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || std::abs(v.get<double>()) > bound)
+      fail(p, "expected a finite number within ±" + fmt(bound) + ", got " + v.dump());
+    return v.get<double>();
+  }
+  /// An array of finite numbers at `p`, of one of the sizes allowed (none given: any size).
+  std::vector<double> numbers(const nlohmann::json& v, const std::string& p,
+                              const std::set<std::size_t>& sizes = {}) const {
+    if (!v.is_array() || (!sizes.empty() && !sizes.count(v.size()))) {
+      std::string n;
+      for (std::size_t s : sizes) n += (n.empty() ? "" : " or ") + std::to_string(s);
+      fail(p, "expected an array of " + (n.empty() ? std::string("numbers") : n + " numbers") +
+                  ", got " + v.dump());
+    }
+    std::vector<double> out;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      out.push_back(finite(v[i], p + "/" + std::to_string(i)));
     return out;
   }
   void gains(const nlohmann::json& j, const std::string& path, const std::string& key,
