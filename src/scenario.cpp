@@ -312,6 +312,80 @@ void battery_fields(V& v, BatteryScenario& b) {
   v.number("hotel_current", b.hotel_current, 0.0, 1000.0);
 }
 
+void parse_fleet(const nlohmann::json& fleet, const Reader& r, Scenario& s);
+nlohmann::json fleet_json(Scenario& s);
+
+/// A fleet vehicle (`name`, `vehicle` and the controller's `target` are read by the list).
+template <class V>
+void fleet_vehicle_fields(V& v, FleetVehicleScenario& x) {
+  v.key("name");
+  v.key("vehicle");
+  v.vec3("start", x.start);
+  v.number("heading", x.heading, -10, 10);
+  v.object("controller", true, [&](auto& o) {
+    FleetControllerScenario& c = x.controller;
+    o.choice("type", c.type, fleet_control_names, required);
+    o.vec3("position", c.position);
+    o.number("heading", c.heading, -10, 10);
+    o.vec3_list("waypoints", c.waypoints, if_set);
+    o.number("leg_speed", c.leg_speed, 0.01, 10);
+    o.key("target");
+    o.vec3("offset", c.offset);
+  });
+}
+
+/// A fleet point mass (`name` read by the list).
+template <class V>
+void fleet_point_mass_fields(V& v, FleetPointMassScenario& x) {
+  v.key("name");
+  v.number("mass", x.mass, 1e-3, 1e7, required);
+  v.number("volume", x.volume, 0, 1e4);
+  v.number("added_mass_coefficient", x.added_mass_coefficient, 0, 10);
+  v.number("drag_area", x.drag_area, 0, 1e4);
+  v.vec3("start", x.start, required);
+}
+
+/// A fleet anchor (`name` read by the list).
+template <class V>
+void fleet_anchor_fields(V& v, FleetAnchorScenario& x) {
+  v.key("name");
+  v.vec3("position", x.position, required);
+}
+
+/// A fleet tether (`name`, `from` and `to` read by the list).
+template <class V>
+void fleet_tether_fields(V& v, FleetTetherScenario& x) {
+  v.key("name");
+  v.key("from");
+  v.key("to");
+  v.vec3("from_point", x.from_point, if_set);
+  v.vec3("to_point", x.to_point, if_set);
+  v.number("length", x.length, 0.5, 10000, required);
+  v.number("segment_length", x.segment_length, 0.05, 100);
+  v.number("diameter", x.diameter, 1e-4, 0.5, if_set);
+  v.number("mass_per_length", x.mass_per_length, 1e-4, 1000, if_set);
+  v.number("axial_stiffness", x.axial_stiffness, 1, 1e11, if_set);
+  v.number("internal_damping_ratio", x.internal_damping_ratio, 0, 1000, if_set);
+  v.number("normal_drag", x.normal_drag, 0, 10, if_set);
+  v.number("tangential_drag", x.tangential_drag, 0, 10, if_set);
+  v.number("breaking_strength", x.breaking_strength, 0, 1e9, if_set);
+  v.object("winch", x.winch.enabled, [&](auto& o) {
+    FleetWinchScenario& w = x.winch;
+    o.on_read([&] { w.enabled = true; });
+    o.number("max_speed", w.max_speed, 0.01, 10);
+    o.number("max_acceleration", w.max_acceleration, 0.01, 100);
+    o.number("max_pull", w.max_pull, 1, 1e7);
+    o.number("min_length", w.min_length, 0.5, 10000);
+    o.number("max_length", w.max_length, 0.5, 10000);
+    o.number("payout_rate", w.payout_rate, -10, 10);
+    o.check([&](const Reader& r, const std::string& p) {
+      if (w.max_length < w.min_length) r.fail(p + "/max_length", "expected at least min_length");
+      if (x.length < w.min_length || x.length > w.max_length)
+        r.fail(p, "the tether's length must be within [min_length, max_length]");
+    });
+  });
+}
+
 void parse_obstacles(const nlohmann::json& list, const Reader& r, Scenario& s);
 nlohmann::json obstacles_json(Scenario& s);
 
@@ -421,6 +495,13 @@ void scenario_fields(V& v, Scenario& s) {
       },
       [&] { return obstacles_json(s); });
   v.object("seabed", non_empty, [&](auto& o) { seabed_fields(o, s); });
+  // Any fleet instead of the pair: only when the scenario has one.
+  v.custom(
+      "fleet",
+      [&](const nlohmann::json& fleet, const Reader& r, const std::string&) {
+        parse_fleet(fleet, r, s);
+      },
+      [&] { return fleet_json(s); });
   // Entanglement thresholds: only when they differ from the defaults (the JSON of a scenario
   // without them, and kelp-sweep's run hashes, stay as they were).
   v.object("entanglement", unless_default, [&](auto& o) {
@@ -506,6 +587,146 @@ void parse_obstacles(const nlohmann::json& list, const Reader& r, Scenario& s) {
 }
 
 /// The obstacles as JSON (cylinders, then boxes); null when there are none.
+namespace {
+/// A non-empty string at o[key] (or `fallback` when absent and allowed).
+std::string fleet_string(const Reader& r, const nlohmann::json& o, const std::string& p,
+                         const char* key, bool required_key) {
+  if (!o.contains(key)) {
+    if (required_key) r.fail(p, std::string("missing \"") + key + "\"");
+    return {};
+  }
+  const auto& v = o.at(key);
+  if (!v.is_string() || v.get<std::string>().empty())
+    r.fail(p + "/" + key, "expected a non-empty string");
+  return v.get<std::string>();
+}
+
+/// Parses `list` (an array at `path`) element by element with `one(element, path)`.
+template <class F>
+void fleet_list(const Reader& r, const nlohmann::json& fleet, const char* key, F&& one) {
+  const std::string p = std::string("/fleet/") + key;
+  if (!fleet.contains(key)) return;
+  const auto& list = fleet.at(key);
+  if (!list.is_array()) r.fail(p, "expected an array");
+  if (list.size() > 1000) r.fail(p, "at most 1000 entries");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string q = p + "/" + std::to_string(i);
+    if (!list[i].is_object()) r.fail(q, "expected an object");
+    one(list[i], q);
+  }
+}
+}  // namespace
+
+void parse_fleet(const nlohmann::json& fleet, const Reader& r, Scenario& s) {
+  r.object(fleet, "/fleet", {"vehicles", "point_masses", "anchors", "tethers"});
+  FleetScenario f;
+  std::set<std::string> names;  // every vehicle, point mass and anchor: the tethers' ends
+  const auto unique = [&](const std::string& name, const std::string& p) {
+    if (name == "free") r.fail(p + "/name", "\"free\" names a free tether end");
+    if (!names.insert(name).second) r.fail(p + "/name", "\"" + name + "\" names another part");
+  };
+  fleet_list(r, fleet, "vehicles", [&](const nlohmann::json& o, const std::string& p) {
+    FleetVehicleScenario x;
+    x.name = fleet_string(r, o, p, "name", true);
+    unique(x.name, p);
+    x.vehicle = fleet_string(r, o, p, "vehicle", true);
+    auto fields = [&](auto& v) { fleet_vehicle_fields(v, x); };
+    parse_object(r, o, p, fields);
+    if (o.contains("controller"))
+      x.controller.target = fleet_string(r, o.at("controller"), p + "/controller", "target",
+                                         x.controller.type == FleetControl::follow);
+    if (x.controller.type == FleetControl::waypoints && x.controller.waypoints.empty())
+      r.fail(p + "/controller/waypoints", "expected at least one waypoint");
+    f.vehicles.push_back(std::move(x));
+  });
+  if (f.vehicles.empty() && !fleet.contains("point_masses"))
+    r.fail("/fleet/vehicles", "expected at least one vehicle or point mass");
+  fleet_list(r, fleet, "point_masses", [&](const nlohmann::json& o, const std::string& p) {
+    FleetPointMassScenario x;
+    x.name = fleet_string(r, o, p, "name", true);
+    unique(x.name, p);
+    auto fields = [&](auto& v) { fleet_point_mass_fields(v, x); };
+    parse_object(r, o, p, fields);
+    f.point_masses.push_back(x);
+  });
+  fleet_list(r, fleet, "anchors", [&](const nlohmann::json& o, const std::string& p) {
+    FleetAnchorScenario x;
+    x.name = fleet_string(r, o, p, "name", true);
+    unique(x.name, p);
+    auto fields = [&](auto& v) { fleet_anchor_fields(v, x); };
+    parse_object(r, o, p, fields);
+    f.anchors.push_back(x);
+  });
+  // The follow targets name vehicles.
+  for (std::size_t i = 0; i < f.vehicles.size(); ++i) {
+    const auto& c = f.vehicles[i].controller;
+    if (c.type != FleetControl::follow) continue;
+    const bool found = std::any_of(f.vehicles.begin(), f.vehicles.end(),
+                                   [&](const auto& v) { return v.name == c.target; });
+    if (!found || c.target == f.vehicles[i].name)
+      r.fail("/fleet/vehicles/" + std::to_string(i) + "/controller/target",
+             "\"" + c.target + "\" is not another vehicle of the fleet");
+  }
+  std::set<std::string> tether_names;
+  fleet_list(r, fleet, "tethers", [&](const nlohmann::json& o, const std::string& p) {
+    FleetTetherScenario x;
+    x.name = fleet_string(r, o, p, "name", true);
+    if (!tether_names.insert(x.name).second)
+      r.fail(p + "/name", "\"" + x.name + "\" names another tether");
+    x.from = fleet_string(r, o, p, "from", true);
+    x.to = fleet_string(r, o, p, "to", true);
+    for (const char* end : {"from", "to"}) {
+      const std::string& n = end[0] == 'f' ? x.from : x.to;
+      if (n != "free" && !names.count(n))
+        r.fail(p + "/" + end, "\"" + n + "\" is not a vehicle, point mass or anchor of the fleet");
+    }
+    if (x.from == "free" && x.to == "free") r.fail(p + "/to", "at most one end may be free");
+    auto fields = [&](auto& v) { fleet_tether_fields(v, x); };
+    parse_object(r, o, p, fields);
+    if (x.winch.enabled && x.from == "free")
+      r.fail(p + "/winch", "a winch needs a fixed start end");
+    f.tethers.push_back(std::move(x));
+  });
+  s.fleet = std::move(f);
+}
+
+nlohmann::json fleet_json(Scenario& s) {
+  if (!s.fleet) return nullptr;
+  nlohmann::json out = nlohmann::json::object();
+  const auto list = [&](const char* key, auto& items, auto&& fields, auto&& strings) {
+    if (items.empty()) return;
+    nlohmann::json a = nlohmann::json::array();
+    for (auto& x : items) {
+      nlohmann::json o = write_object([&](auto& v) { fields(v, x); });
+      strings(o, x);
+      a.push_back(o);
+    }
+    out[key] = a;
+  };
+  list(
+      "vehicles", s.fleet->vehicles, [](auto& v, auto& x) { fleet_vehicle_fields(v, x); },
+      [](nlohmann::json& o, const FleetVehicleScenario& x) {
+        o["name"] = x.name;
+        o["vehicle"] = x.vehicle;
+        if (!x.controller.target.empty()) o["controller"]["target"] = x.controller.target;
+      });
+  list(
+      "point_masses", s.fleet->point_masses,
+      [](auto& v, auto& x) { fleet_point_mass_fields(v, x); },
+      [](nlohmann::json& o, const FleetPointMassScenario& x) { o["name"] = x.name; });
+  list(
+      "anchors", s.fleet->anchors, [](auto& v, auto& x) { fleet_anchor_fields(v, x); },
+      [](nlohmann::json& o, const FleetAnchorScenario& x) { o["name"] = x.name; });
+  list(
+      "tethers", s.fleet->tethers, [](auto& v, auto& x) { fleet_tether_fields(v, x); },
+      [](nlohmann::json& o, const FleetTetherScenario& x) {
+        o["name"] = x.name;
+        o["from"] = x.from;
+        o["to"] = x.to;
+      });
+  return out;
+}
+
 nlohmann::json obstacles_json(Scenario& s) {
   if (s.cylinders.empty() && s.boxes.empty()) return nullptr;
   nlohmann::json list = nlohmann::json::array();

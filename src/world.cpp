@@ -16,73 +16,21 @@
 namespace kelp {
 namespace sim {
 
-WorldSetup world_setup(const Scenario& sc, const std::string& file) {
-  namespace sp = kelp::system::presets;
+namespace {
+// A Scenario built by hand may hold a value cast from an integer: named as the file's error.
+[[noreturn]] void refuse(const std::string& file, const char* path, int value) {
+  throw scenario_error(file + ": " + path + ": " + std::to_string(value) +
+                       " is not one of its choices");
+}
+}  // namespace
+
+kelp::environment::Environmentd scenario_environment(const Scenario& sc, const std::string& file) {
   namespace ke = kelp::environment;
-  const sp::TetherKind kind = sc.tether_kind == TetherKind::bead_chain ? sp::TetherKind::bead_chain
-                                                                       : sp::TetherKind::rov_tether;
-  kelp::system::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
-  if (kind == sp::TetherKind::rov_tether)
-    params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
-  auto& tp = params.tether;
-  if (sc.diameter) tp.diameter = *sc.diameter;
-  if (sc.mass_per_length) tp.mass_per_length = *sc.mass_per_length;
-  if (sc.axial_stiffness) tp.axial_stiffness = *sc.axial_stiffness;
-  if (sc.internal_damping && sc.internal_damping_ratio)
-    throw kelp::invalid_argument(
-        "tether: internal_damping and internal_damping_ratio are both given: give BA [N s] or "
-        "the damping ratio, not both");
-  if (sc.internal_damping) tp.internal_damping = *sc.internal_damping;
-  if (sc.internal_damping_ratio) {
-    tp.internal_damping = 0.0;  // the kind's BA gives way to the ratio
-    tp.internal_damping_ratio = *sc.internal_damping_ratio;
-  }
-  if (sc.normal_drag) tp.normal_drag = *sc.normal_drag;
-  if (sc.tangential_drag) tp.tangential_drag = *sc.tangential_drag;
-  if (sc.breaking_strength) tp.breaking_strength = *sc.breaking_strength;
-  params.explicit_fallback = sc.explicit_fallback;
-  // A Scenario built by hand may hold a value cast from an integer: named as the file's error.
-  const auto refuse = [&](const char* path, int value) {
-    throw scenario_error(file + ": " + path + ": " + std::to_string(value) +
-                         " is not one of its choices");
-  };
-  if (!choice_name(sc.line_model, line_model_names))
-    refuse("/tether/line_model", static_cast<int>(sc.line_model));
-  if (!choice_name(sc.tether_kind, tether_kind_names))
-    refuse("/tether/kind", static_cast<int>(sc.tether_kind));
-  if (!choice_name(sc.sea, sea_names)) refuse("/sea", static_cast<int>(sc.sea));
-  if (!choice_name(sc.kernel, kernel_path_names)) refuse("/kernel", static_cast<int>(sc.kernel));
+  if (!choice_name(sc.sea, sea_names)) refuse(file, "/sea", static_cast<int>(sc.sea));
+  if (!choice_name(sc.kernel, kernel_path_names))
+    refuse(file, "/kernel", static_cast<int>(sc.kernel));
   if (!choice_name(sc.wave_stretching, wave_stretching_names))
-    refuse("/sea/stretching", static_cast<int>(sc.wave_stretching));
-  tp.line_model = sc.line_model;
-  if (sc.winch.enabled) {
-    kelp::tether::WinchParameters<double> w;
-    w.max_speed = sc.winch.max_speed;
-    w.max_acceleration = sc.winch.max_acceleration;
-    w.max_pull = sc.winch.max_pull;
-    w.min_length = sc.winch.min_length;
-    w.max_length = sc.winch.max_length;
-    params.winch = w;
-  }
-  params.asv_attachment = sc.asv_attachment;
-  params.auv_attachment = sc.auv_attachment;
-  // Propulsion: the paper preset's (thrusters, batteries) with the scenario's lag and batteries,
-  // or none.
-  if (!sc.propulsion) {
-    params.asv_propulsion.reset();
-    params.auv_propulsion.reset();
-  } else {
-    const auto apply = [&](kelp::vehicle::PropulsionParametersd& p, const BatteryScenario& b) {
-      p.time_constant = sc.thruster_lag ? sc.thruster_time_constant : 0.0;
-      p.battery.capacity_ah = b.capacity_ah;
-      p.battery.cells_in_series = b.cells_in_series;
-      p.battery.internal_resistance = b.internal_resistance;
-      p.battery.initial_soc = b.initial_soc;
-      p.battery.hotel_current = b.hotel_current;
-    };
-    apply(*params.asv_propulsion, sc.asv_battery);
-    apply(*params.auv_propulsion, sc.auv_battery);
-  }
+    refuse(file, "/sea/stretching", static_cast<int>(sc.wave_stretching));
   ke::SeaStateOptions sea_options;
   sea_options.seed = sc.seed;
   sea_options.wave_components = sc.wave_components;
@@ -120,15 +68,6 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
       sea.regular_waves.push_back(w);
     }
   }
-  sp::StartPoses<double> start = sp::paper_start(sc.tether_length);
-  if (sc.auv_start) start.auv.position = *sc.auv_start;
-  const double span = (start.auv.point_position(params.auv_attachment) -
-                       start.asv.point_position(params.asv_attachment))
-                          .norm();
-  if (span > sc.tether_length)
-    throw scenario_error(file + ": /tether/length: " + std::to_string(sc.tether_length) +
-                         " m is shorter than the initial distance between its ends (" +
-                         std::to_string(span) + " m)");
   ke::Environmentd env = ke::make_environment<double>(sea, sea_options);
   // The wave kernel's instruction path: pinned by the scenario (a path this CPU lacks is named
   // as the file's error), else the process' policy (a bad KELP_KERNEL throws
@@ -146,8 +85,85 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   // Seabed and obstacles (kelp/environment/obstacles.hpp; the tether touches them through the
   // environment, kelp/tether/contact.hpp).
   if (std::isfinite(sc.seabed_depth)) env.set_seabed_depth(sc.seabed_depth);
-  if (sc.seabed_friction) tp.seabed_friction = *sc.seabed_friction;
   env.set_obstacles(obstacle_set(sc));
+  return env;
+}
+
+WorldSetup world_setup(const Scenario& sc, const std::string& file) {
+  if (sc.fleet)
+    throw scenario_error(file +
+                         ": /fleet: a fleet scenario runs with kelp-tethered-pair "
+                         "(kelp::sim::run_fleet), not in the tethered pair's world");
+  namespace sp = kelp::system::presets;
+  namespace ke = kelp::environment;
+  const sp::TetherKind kind = sc.tether_kind == TetherKind::bead_chain ? sp::TetherKind::bead_chain
+                                                                       : sp::TetherKind::rov_tether;
+  kelp::system::SystemParametersd params = sp::paper_system(sc.tether_length, kind);
+  if (kind == sp::TetherKind::rov_tether)
+    params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
+  auto& tp = params.tether;
+  if (sc.diameter) tp.diameter = *sc.diameter;
+  if (sc.mass_per_length) tp.mass_per_length = *sc.mass_per_length;
+  if (sc.axial_stiffness) tp.axial_stiffness = *sc.axial_stiffness;
+  if (sc.internal_damping && sc.internal_damping_ratio)
+    throw kelp::invalid_argument(
+        "tether: internal_damping and internal_damping_ratio are both given: give BA [N s] or "
+        "the damping ratio, not both");
+  if (sc.internal_damping) tp.internal_damping = *sc.internal_damping;
+  if (sc.internal_damping_ratio) {
+    tp.internal_damping = 0.0;  // the kind's BA gives way to the ratio
+    tp.internal_damping_ratio = *sc.internal_damping_ratio;
+  }
+  if (sc.normal_drag) tp.normal_drag = *sc.normal_drag;
+  if (sc.tangential_drag) tp.tangential_drag = *sc.tangential_drag;
+  if (sc.breaking_strength) tp.breaking_strength = *sc.breaking_strength;
+  params.explicit_fallback = sc.explicit_fallback;
+  // A Scenario built by hand may hold a value cast from an integer: named as the file's error.
+  if (!choice_name(sc.line_model, line_model_names))
+    refuse(file, "/tether/line_model", static_cast<int>(sc.line_model));
+  if (!choice_name(sc.tether_kind, tether_kind_names))
+    refuse(file, "/tether/kind", static_cast<int>(sc.tether_kind));
+  // (the sea's choices: scenario_environment)
+  tp.line_model = sc.line_model;
+  if (sc.winch.enabled) {
+    kelp::tether::WinchParameters<double> w;
+    w.max_speed = sc.winch.max_speed;
+    w.max_acceleration = sc.winch.max_acceleration;
+    w.max_pull = sc.winch.max_pull;
+    w.min_length = sc.winch.min_length;
+    w.max_length = sc.winch.max_length;
+    params.winch = w;
+  }
+  params.asv_attachment = sc.asv_attachment;
+  params.auv_attachment = sc.auv_attachment;
+  // Propulsion: the paper preset's (thrusters, batteries) with the scenario's lag and batteries,
+  // or none.
+  if (!sc.propulsion) {
+    params.asv_propulsion.reset();
+    params.auv_propulsion.reset();
+  } else {
+    const auto apply = [&](kelp::vehicle::PropulsionParametersd& p, const BatteryScenario& b) {
+      p.time_constant = sc.thruster_lag ? sc.thruster_time_constant : 0.0;
+      p.battery.capacity_ah = b.capacity_ah;
+      p.battery.cells_in_series = b.cells_in_series;
+      p.battery.internal_resistance = b.internal_resistance;
+      p.battery.initial_soc = b.initial_soc;
+      p.battery.hotel_current = b.hotel_current;
+    };
+    apply(*params.asv_propulsion, sc.asv_battery);
+    apply(*params.auv_propulsion, sc.auv_battery);
+  }
+  sp::StartPoses<double> start = sp::paper_start(sc.tether_length);
+  if (sc.auv_start) start.auv.position = *sc.auv_start;
+  const double span = (start.auv.point_position(params.auv_attachment) -
+                       start.asv.point_position(params.asv_attachment))
+                          .norm();
+  if (span > sc.tether_length)
+    throw scenario_error(file + ": /tether/length: " + std::to_string(sc.tether_length) +
+                         " m is shorter than the initial distance between its ends (" +
+                         std::to_string(span) + " m)");
+  ke::Environmentd env = scenario_environment(sc, file);
+  if (sc.seabed_friction) tp.seabed_friction = *sc.seabed_friction;
   // The hulls against the seabed and the obstacles (kelp/system/hull_contact.hpp), when there is
   // something to touch: in open water without a seabed a run is as it was.
   if (env.obstacles() != nullptr || std::isfinite(env.seabed_depth())) {

@@ -121,3 +121,24 @@ if(longest LESS 30 OR length1 GREATER 15 OR waypoints LESS 4 OR NOT fallbacks EQ
                       "(<= 15), ${inserted} insertions (>= 40), ${waypoints} waypoints (4), "
                       "${fallbacks} fallbacks (0)")
 endif()
+
+# A fleet scenario runs through the same program (kelp/sim/fleet_run.hpp): the ROV's return to
+# its dock writes its three outputs, and the summary names the fleet's parts.
+file(REMOVE_RECURSE "${OUT}/fleet")
+execute_process(COMMAND "${PROGRAM}" --scenario "${SCENARIOS}/rov_docking.json" --out "${OUT}/fleet"
+                        --duration 20 --quiet --no-plots
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "rov_docking failed: ${out} ${err}")
+endif()
+foreach(f timeseries.csv nodes.csv summary.json)
+  if(NOT EXISTS "${OUT}/fleet/${f}")
+    message(FATAL_ERROR "rov_docking: no ${f}")
+  endif()
+endforeach()
+file(READ "${OUT}/fleet/summary.json" summary)
+string(JSON simulated GET "${summary}" simulated_s)
+string(JSON rope GET "${summary}" tethers tether to)
+if(NOT simulated EQUAL 20 OR NOT rope STREQUAL "rov")
+  message(FATAL_ERROR "rov_docking: simulated ${simulated} s (20), tether to \"${rope}\" (rov)")
+endif()

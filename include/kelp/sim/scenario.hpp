@@ -183,6 +183,95 @@ struct RegularWaveScenario {
   double phase = 0;  ///< φ [rad]: ζ = (H/2) cos(k (x cos β + y sin β) − ω t + φ)
 };
 
+/// \brief What a fleet vehicle's controller does (`"controller": {"type": ...}`).
+enum class FleetControl {
+  none,       ///< no controller: its thrusters stay at 0 (an external controller's vehicle)
+  hold,       ///< hold `position` and `heading` (an underwater vehicle: AUV controller; a
+              ///< surface vehicle: station keeping)
+  waypoints,  ///< follow `waypoints` along the legs at `leg_speed`, then hold the last
+  follow,     ///< a surface vehicle following another vehicle (`target`) at `offset`
+};
+
+/// \brief The names of FleetControl in a scenario file.
+inline constexpr ChoiceName<FleetControl> fleet_control_names[] = {
+    {FleetControl::none, "none"},
+    {FleetControl::hold, "hold"},
+    {FleetControl::waypoints, "waypoints"},
+    {FleetControl::follow, "follow"}};
+
+/// \brief A fleet vehicle's controller. Units: m, rad, m/s; NED.
+struct FleetControllerScenario {
+  FleetControl type = FleetControl::none;                          ///< what it does
+  kelp::Vector3<double> position = kelp::Vector3<double>::Zero();  ///< hold: the point
+  double heading = 0;                                              ///< hold: the heading [rad]
+  std::vector<kelp::Vector3<double>> waypoints;                    ///< waypoints: NED [m]
+  double leg_speed = 0.5;                                          ///< waypoints [m/s]
+  std::string target;                                              ///< follow: a vehicle's name
+  kelp::Vector3<double> offset = kelp::Vector3<double>::Zero();    ///< follow: NED offset [m]
+};
+
+/// \brief A vehicle of a fleet scenario (`"fleet": {"vehicles": [...]}`).
+struct FleetVehicleScenario {
+  std::string name;  ///< unique; names its columns, topics and tether ends
+  /// A preset's name ("bluerov2_heavy", "blueboat": sim::vehicle_preset) or a vehicle file
+  /// (`.json`, docs/vehicle-files.md) or a Gazebo model (`.sdf`), relative to the scenario file.
+  std::string vehicle;
+  kelp::Vector3<double> start = kelp::Vector3<double>::Zero();  ///< NED position of the CO [m]
+  double heading = 0;                                           ///< start heading [rad]
+  FleetControllerScenario controller;                           ///< its controller
+};
+
+/// \brief A free point mass of a fleet scenario (kelp::system::PointMassParameters).
+struct FleetPointMassScenario {
+  std::string name;                                             ///< unique
+  double mass = 0, volume = 0, added_mass_coefficient = 0.5;    ///< [kg], [m³], [-]
+  double drag_area = 0;                                         ///< C_d A [m²]
+  kelp::Vector3<double> start = kelp::Vector3<double>::Zero();  ///< NED [m]
+};
+
+/// \brief A fixed anchor of a fleet scenario: a named NED point [m] tethers end on (a dock on
+/// the seabed, a ship's sheave held still).
+struct FleetAnchorScenario {
+  std::string name;                                                ///< unique
+  kelp::Vector3<double> position = kelp::Vector3<double>::Zero();  ///< NED [m]
+};
+
+/// \brief A winch at a fleet tether's start end, paying out or reeling in at a constant
+/// commanded rate within its limits (kelp::tether::WinchParameters).
+struct FleetWinchScenario {
+  bool enabled = false;                                            ///< a `winch` object was given
+  double max_speed = 0.5, max_acceleration = 0.5, max_pull = 400;  ///< [m/s], [m/s²], [N]
+  double min_length = 5, max_length = 60;                          ///< [m]
+  double payout_rate = 0;  ///< commanded [m/s] (positive: paying out; 0 at either limit)
+};
+
+/// \brief A tether of a fleet scenario, between two named ends (a vehicle, a point mass or an
+/// anchor; `"free"` for a free end).
+struct FleetTetherScenario {
+  std::string name;  ///< unique
+  std::string from;  ///< the start end's owner (the winch's side)
+  std::string to;    ///< the far end's owner
+  /// Attachment points on vehicles, body axes [m] (unset: the vehicle's file's attachment).
+  std::optional<kelp::Vector3<double>> from_point, to_point;
+  double length = 10;           ///< unstretched [m]
+  double segment_length = 0.5;  ///< [m]
+  /// The cable: the ROV tether preset (kelp::tether::presets::rov_tether) with these overrides.
+  std::optional<double> diameter, mass_per_length, axial_stiffness, internal_damping_ratio,
+      normal_drag, tangential_drag, breaking_strength;
+  FleetWinchScenario winch;  ///< a winch at the start end (when enabled)
+};
+
+/// \brief A fleet scenario's parts (`"fleet": {...}`): with it, a scenario runs these vehicles,
+/// point masses, anchors and tethers in its sea instead of the tethered pair (the pair's keys,
+/// `tether`, `vehicles`, `control`, `mission`, `navigation`, `thrusters`, `battery`, do not
+/// apply).
+struct FleetScenario {
+  std::vector<FleetVehicleScenario> vehicles;        ///< at least one
+  std::vector<FleetPointMassScenario> point_masses;  ///< any
+  std::vector<FleetAnchorScenario> anchors;          ///< any
+  std::vector<FleetTetherScenario> tethers;          ///< any
+};
+
 /// \brief One run of the tethered pair, as a scenario file describes it (every field has the
 /// embedded default run's value until a file sets it). Angles in rad, lengths in m, NED.
 struct Scenario {
@@ -320,6 +409,8 @@ struct Scenario {
   /// rad, "wrap_hysteresis": rad, "contact_margin": m, "pin_slip_speed": m/s,
   /// "pin_tension_difference": N, "pin_hold_time": s}`; kelp/sim/entanglement.hpp).
   EntanglementSettings entanglement;
+  /// Any fleet instead of the pair (`"fleet"`; unset: the tethered pair).
+  std::optional<FleetScenario> fleet;
 };
 
 /// \brief The scenario's obstacles (cylinders, boxes, height-field seabed) as an ObstacleSet

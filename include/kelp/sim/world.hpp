@@ -27,6 +27,13 @@ struct WorldSetup {
   kelp::system::presets::StartPoses<double> start;  ///< the vehicles' initial states
 };
 
+/// \brief The sea of a scenario: its waves, wind and current (a preset or custom sea, seeded,
+/// with its start-up ramp and wave kernel), seabed and obstacles; `file` names the scenario in
+/// errors. What world_setup() and the fleet's world (kelp/sim/fleet_run.hpp) run in.
+/// \throws scenario_error naming the file and the JSON path.
+KELP_SIM_API kelp::environment::Environmentd scenario_environment(const Scenario& sc,
+                                                                  const std::string& file);
+
 /// \brief The system, the sea and the start poses of a scenario.
 /// \param[in] sc the scenario \param[in] file names the scenario in errors
 /// \throws scenario_error when the tether cannot span the start poses or the scenario's kernel

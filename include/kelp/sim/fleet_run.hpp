@@ -1,0 +1,72 @@
+/// \file
+/// \brief A fleet scenario's world and run (`"fleet"` in a scenario file: any vehicles, point
+/// masses, anchors and tethers in the scenario's sea; kelp/system/fleet.hpp is the physics).
+///
+/// fleet_world() builds the fleet's parameters, environment and start from a scenario (vehicles
+/// from presets, vehicle files or Gazebo models: kelp/sim/vehicle_file.hpp); run_fleet() runs it
+/// closed loop (each vehicle's controller on its true state: an underwater vehicle with the AUV
+/// controller, a surface vehicle with two thrusters with the ASV controller; winches at their
+/// commanded payout rates) and writes the run's outputs:
+/// - `timeseries.csv`: at the scenario's `output.log_rate`, the time and, per vehicle
+///   `<name>.x .y .z .roll .pitch .yaw .u .v .w` (NED [m], [rad], body [m/s]), per point mass
+///   `<name>.x .y .z`, per tether `<name>.tension_start .tension_end` (the force its ends
+///   delivered over the step [N]) and `<name>.length` (unstretched [m]);
+/// - `nodes.csv`: at `output.node_rate`, `t,tether,node,x,y,z` for every node of every tether;
+/// - `summary.json`: per vehicle, point mass and tether, the solver, the run's speed.
+/// The ROS 2 bag and the replay page are the pair's only (yet).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "kelp/environment/environment.hpp"
+#include "kelp/sim/export.hpp"
+#include "kelp/sim/instantiation.hpp"
+#include "kelp/sim/scenario.hpp"
+#include "kelp/sim/vehicle_file.hpp"
+#include "kelp/system/fleet.hpp"
+
+namespace kelp {
+namespace sim {
+
+/// \brief A fleet scenario's parts, ready to build a kelp::system::FleetModel.
+struct FleetWorld {
+  kelp::system::FleetParametersd parameters;            ///< vehicles, point masses, tethers
+  kelp::environment::Environmentd environment;          ///< the scenario's sea
+  std::vector<VehicleDescription> vehicles;             ///< each vehicle as loaded (file or preset)
+  std::vector<kelp::vehicle::VehicleStated> start;      ///< each vehicle's start state
+  std::vector<kelp::Vector3<double>> point_mass_start;  ///< each point mass's start [m]
+};
+
+/// \brief The fleet of `sc` (which must have one), `file` naming the scenario in errors and
+/// locating its vehicle files. \throws scenario_error naming the file and the JSON path (an
+/// unknown preset, a vehicle file's own errors, a vehicle whose water differs from the sea's,
+/// a tether shorter than the distance between its ends).
+KELP_SIM_API FleetWorld fleet_world(const Scenario& sc, const std::string& file);
+
+/// \brief What a fleet run did (also in summary.json).
+struct FleetRunSummary {
+  double simulated_s = 0;       ///< simulated time [s]
+  double wall_s = 0;            ///< wall time of the loop [s]
+  long steps = 0;               ///< system steps of 10 ms
+  double newton_mean = 0;       ///< tether Newton iterations per step, all tethers
+  int newton_max = 0;           ///< most in one step
+  long retried_steps = 0;       ///< tether steps retried in sub-steps
+  long explicit_fallbacks = 0;  ///< tether steps redone by RK4
+  /// Per tether: largest end force [N], and the fraction of steps its far end was slack
+  /// (< 0.5 N).
+  std::vector<double> max_tension, slack_fraction;
+  /// Per controlled vehicle (NaN without a controller): the RMS distance to its controller's
+  /// target [m].
+  std::vector<double> rms_position_error;
+};
+
+/// \brief Runs the fleet scenario `sc` closed loop into the directory `out` (created), writing
+/// timeseries.csv, nodes.csv and summary.json. `file` names the scenario.
+/// \throws scenario_error as fleet_world(); kelp::error when a step fails (the outputs so far
+/// are closed whole).
+KELP_SIM_API FleetRunSummary run_fleet(const Scenario& sc, const std::string& file,
+                                       const std::string& out);
+
+}  // namespace sim
+}  // namespace kelp
