@@ -56,8 +56,8 @@ struct FleetRunSummary {
   /// Per tether: largest end force [N], and the fraction of steps its far end was slack
   /// (< 0.5 N).
   std::vector<double> max_tension, slack_fraction;
-  /// Per controlled vehicle (NaN without a controller): the RMS distance to its controller's
-  /// target [m].
+  /// Per vehicle (NaN without a controller): the RMS distance to the point its controller
+  /// steers to (its hold point, or the waypoint ahead during a survey) [m].
   std::vector<double> rms_position_error;
 };
 
