@@ -11,7 +11,7 @@ __all__ = ["run_scenario"]
 
 def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseries=False,
                  kernel=None, deterministic=False):
-    """Runs a scenario of the tethered pair to its end and returns its summary.
+    """Runs a scenario of the tethered pair, or of any fleet, to its end and returns its summary.
 
     This is what ``kelp-tethered-pair`` runs: the same scenario, duration and seed give the same
     numbers, bit for bit (``--scenario``, ``--duration``, ``--seed``, ``--out``, ``--kernel``,
@@ -33,7 +33,10 @@ def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseri
     timeseries : bool
         Also return the samples (the rows of timeseries.csv, at the scenario's log rate, at full
         precision instead of the CSV's 6 digits) as a dict of 1-D numpy arrays keyed by the CSV's
-        column names ("t", "asv_x", ..., "tension_auv", ...).
+        column names ("t", "asv_x", ..., "tension_auv", ...). A fleet scenario (one with a
+        ``"fleet"`` key: any vehicles, point masses, anchors and tethers) returns its own summary
+        and columns ("t", "rov.x", ..., "tether.tension_end", ...), read back from its CSV (6
+        significant digits).
     kernel : str, optional
         The wave kernel's instruction path: "auto", "portable", "avx2" or "avx512".
     deterministic : bool

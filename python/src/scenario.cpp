@@ -5,12 +5,18 @@
 
 #include <array>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "bindings.hpp"
 #include "kelp/core/rotation.hpp"
+#include "kelp/sim/fleet_run.hpp"
 #include "kelp/sim/run.hpp"
 
 namespace kelp_python {
@@ -23,6 +29,51 @@ const std::vector<std::string>& column_names() { return kelp::sim::timeseries_co
 
 void append_row(const kelp::sim::LogRow& r, std::vector<double>& out) {
   kelp::sim::for_each_value(r, [&](double v) { out.push_back(v); });
+}
+
+// A fleet scenario (kelp::sim::run_fleet) into `out`, or into a temporary directory removed
+// afterwards: (summary.json's text, timeseries.csv's columns or None).
+py::tuple run_fleet(const kelp::sim::Scenario& sc, const std::string& file,
+                    const std::optional<std::string>& out, bool timeseries) {
+  namespace fs = std::filesystem;
+  std::string dir;
+  if (out) {
+    dir = *out;
+  } else {
+    std::string pattern = (fs::temp_directory_path() / "kelp_fleet_XXXXXX").string();
+    KELP_CHECK(::mkdtemp(pattern.data()) != nullptr, "run_scenario: no temporary directory");
+    dir = pattern;
+  }
+  struct Cleanup {
+    std::string dir;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!dir.empty()) fs::remove_all(dir, ec);
+    }
+  } cleanup{out ? std::string() : dir};
+  {
+    py::gil_scoped_release release;
+    kelp::sim::run_fleet(sc, file, dir);
+  }
+  std::ifstream in(fs::path(dir) / "summary.json");
+  const std::string summary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!timeseries) return py::make_tuple(summary, py::none());
+  std::ifstream csv(fs::path(dir) / "timeseries.csv");
+  std::string line, cell;
+  std::getline(csv, line);
+  std::vector<std::string> names;
+  std::stringstream header(line);
+  while (std::getline(header, cell, ',')) names.push_back(cell);
+  std::vector<std::vector<double>> cols(names.size());
+  while (std::getline(csv, line)) {
+    std::stringstream row(line);
+    for (std::size_t j = 0; j < names.size() && std::getline(row, cell, ','); ++j)
+      cols[j].push_back(std::strtod(cell.c_str(), nullptr));
+  }
+  py::dict columns;
+  for (std::size_t j = 0; j < names.size(); ++j)
+    columns[py::str(names[j])] = py::array_t<double>(py::ssize_t(cols[j].size()), cols[j].data());
+  return py::make_tuple(summary, columns);
 }
 
 }  // namespace
@@ -56,6 +107,7 @@ void bind_scenario(py::module_& m) {
         if (kernel) ov.kernel = *kernel;
         ov.deterministic = deterministic;
         sc = kelp::sim::apply_overrides(sc, ov);
+        if (sc.fleet) return run_fleet(sc, ro.scenario_file, out, timeseries);
         if (out) ro.out = *out;
         ro.version = KELP_VERSION_STRING;
         const std::vector<std::string> names = column_names();
@@ -84,8 +136,9 @@ void bind_scenario(py::module_& m) {
       py::arg("file"), py::arg("text"), py::arg("duration"), py::arg("seed"), py::arg("kernel"),
       py::arg("deterministic"), py::arg("out"), py::arg("timeseries"),
       "kelp::sim::run_scenario on a scenario file (`file`), a scenario's JSON text (`text`) or "
-      "the embedded default (both None), with kelp-tethered-pair's overrides. Returns (the "
-      "summary as JSON text, the samples as a dict of columns or None). Use kelp.run_scenario.");
+      "the embedded default (both None), with kelp-tethered-pair's overrides; a fleet scenario "
+      "(\"fleet\") with kelp::sim::run_fleet. Returns (the summary as JSON text, the samples "
+      "as a dict of columns or None). Use kelp.run_scenario.");
 }
 
 }  // namespace kelp_python

@@ -110,3 +110,23 @@ def test_bad_scenarios_are_named():
         kelp.run_scenario(duration=1, seed=-2)
     with pytest.raises(kelp.InvalidArgument, match="deterministic"):
         kelp.run_scenario(duration=1, kernel="avx2", deterministic=True)
+
+
+def test_a_fleet_scenario_runs_and_returns_its_parts(scenarios_dir, tmp_path):
+    # The ROV returning to its dock, cut to 20 s: the summary names the fleet's parts, the
+    # columns are the program's CSV's, and the files are the program's (or none without `out`).
+    path = scenarios_dir / "rov_docking.json"
+    summary, columns = kelp.run_scenario(path, duration=20, timeseries=True)
+    assert summary["completed"] is True
+    assert summary["simulated_s"] == pytest.approx(20.0)
+    assert summary["tethers"]["tether"]["from"] == "dock"
+    assert set(summary["vehicles"]) == {"rov"}
+    assert columns["t"][-1] == pytest.approx(20.0)
+    # The ROV heads from 20 m down towards its dock at 28.5 m, and from x = 20 m towards 1 m.
+    assert columns["rov.z"][-1] > columns["rov.z"][0] + 1.0
+    assert columns["rov.x"][-1] < columns["rov.x"][0] - 1.0
+    with open(path) as f:
+        text = json.load(f)
+    again = kelp.run_scenario(text, duration=20, out=tmp_path)
+    assert again["vehicles"]["rov"]["final_position_m"] == summary["vehicles"]["rov"]["final_position_m"]
+    assert {p.name for p in tmp_path.iterdir()} == {"summary.json", "timeseries.csv", "nodes.csv"}
