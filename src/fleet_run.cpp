@@ -35,7 +35,8 @@ namespace {
 
 // A preset's name, or a vehicle file / Gazebo model relative to the scenario's directory.
 VehicleDescription load_vehicle(const std::string& spec, const std::string& file,
-                                const std::string& path) {
+                                const std::string& path,
+                                const kelp::environment::Environmentd& env) {
   for (const std::string& n : vehicle_preset_names())
     if (n == spec) return vehicle_preset(spec);
   fs::path p(spec);
@@ -46,7 +47,11 @@ VehicleDescription load_vehicle(const std::string& spec, const std::string& file
         file, path,
         "\"" + spec + "\" is neither a preset (bluerov2_heavy, blueboat) nor a .json or .sdf file");
   try {
-    return sdf ? import_sdf(p.string()).vehicle : read_vehicle_file(p.string());
+    // A Gazebo model that states no water density is in the scenario's sea.
+    SdfImportOptions o;
+    o.density_kg_m3 = env.water_density();
+    o.gravity_m_s2 = env.gravity();
+    return sdf ? import_sdf(p.string(), o).vehicle : read_vehicle_file(p.string());
   } catch (const kelp::error& e) {
     fail(file, path, e.what());
   }
@@ -96,7 +101,19 @@ FleetWorld fleet_world(const Scenario& sc, const std::string& file) {
   for (std::size_t i = 0; i < f.vehicles.size(); ++i) {
     const FleetVehicleScenario& v = f.vehicles[i];
     const std::string p = "/fleet/vehicles/" + std::to_string(i);
-    VehicleDescription d = load_vehicle(v.vehicle, file, p + "/vehicle");
+    VehicleDescription d = load_vehicle(v.vehicle, file, p + "/vehicle", w.environment);
+    // A Gazebo model's water is its world's (Buoyancy's fluid density, Hydrodynamics' water
+    // density), not the vehicle's: the model goes into the scenario's sea, and the run says so.
+    if (fs::path(v.vehicle).extension() == ".sdf" &&
+        (d.parameters.density != w.environment.water_density() ||
+         d.parameters.gravity != w.environment.gravity())) {
+      w.notes.push_back(p + "/vehicle: the Gazebo model's water (" +
+                        std::to_string(d.parameters.density) +
+                        " kg/m^3) is replaced by the scenario's sea (" +
+                        std::to_string(w.environment.water_density()) + " kg/m^3)");
+      d.parameters.density = w.environment.water_density();
+      d.parameters.gravity = w.environment.gravity();
+    }
     if (d.parameters.density != w.environment.water_density() ||
         d.parameters.gravity != w.environment.gravity())
       fail(file, p + "/vehicle",
@@ -311,6 +328,7 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     if (model.winch(k))
       in.winch_payout_rates[std::size_t(k)] = f.tethers[std::size_t(k)].winch.payout_rate;
   FleetRunSummary s;
+  s.notes = w.notes;
   s.max_tension.assign(std::size_t(m), 0.0);
   s.slack_fraction.assign(std::size_t(m), 0.0);
   long newton = 0;
@@ -373,6 +391,7 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
   j["simulated_s"] = s.simulated_s;
   j["wall_s"] = s.wall_s;
   j["realtime_factor"] = s.wall_s > 0 ? s.simulated_s / s.wall_s : 0.0;
+  if (!s.notes.empty()) j["notes"] = s.notes;
   for (int i = 0; i < n; ++i) {
     const auto& x = state.vehicles[std::size_t(i)];
     nlohmann::json v;

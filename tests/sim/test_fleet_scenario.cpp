@@ -162,6 +162,30 @@ TEST_CASE("one boat holds station over two ROVs heading for their piles", "[sim]
   fs::remove_all(out);
 }
 
+TEST_CASE("a Gazebo model flies in a fleet, in the scenario's sea", "[sim][fleet]") {
+  // The test's BlueROV2 Heavy SDF (13 kg, 0.01314 m³ of collision box) in still seawater, no
+  // controller: ρ V = 13.47 kg > 13 kg, so it rises.
+  const std::string text = R"({"duration": 5, "sea": "calm", "fleet": {"vehicles": [
+      {"name": "gz", "vehicle": "bluerov2_heavy.sdf", "start": [0, 0, 10]}]}})";
+  const std::string file = std::string(KELP_TEST_DATA_DIR) + "/fleet.json";
+  const sim::Scenario s = sim::parse_scenario(text, file);
+  const sim::FleetWorld w = sim::fleet_world(s, file);
+  REQUIRE(w.parameters.vehicles.size() == 1);
+  CHECK(w.parameters.vehicles[0].parameters.density == w.environment.water_density());
+  // (The file states Gazebo's fresh water; the run says it was replaced.)
+  REQUIRE(w.notes.size() == 1);
+  CHECK_THAT(w.notes[0], Catch::Contains("/fleet/vehicles/0/vehicle") && Catch::Contains("1000"));
+  const fs::path out = out_dir("sdf");
+  sim::run_fleet(s, file, out.string());
+  const Csv c = read_csv(out / "timeseries.csv");
+  const double rise =
+      c.rows.front()[std::size_t(c.column("gz.z"))] - c.rows.back()[std::size_t(c.column("gz.z"))];
+  INFO("rose " << rise << " m in 5 s");
+  CHECK(rise > 0.05);
+  CHECK(rise < 2.0);
+  fs::remove_all(out);
+}
+
 TEST_CASE("bad fleets are refused naming the JSON path", "[sim][fleet][bad_input]") {
   const auto refused = [](const std::string& fleet, const std::string& path) {
     const std::string text = "{\"fleet\": " + fleet + "}";

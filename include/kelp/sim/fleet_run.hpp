@@ -36,6 +36,9 @@ struct FleetWorld {
   std::vector<VehicleDescription> vehicles;             ///< each vehicle as loaded (file or preset)
   std::vector<kelp::vehicle::VehicleStated> start;      ///< each vehicle's start state
   std::vector<kelp::Vector3<double>> point_mass_start;  ///< each point mass's start [m]
+  /// What the world changed in what it loaded, one sentence each naming the JSON path (a
+  /// Gazebo model's water replaced by the scenario's sea: a model file's water is its world's).
+  std::vector<std::string> notes;
 };
 
 /// \brief The fleet of `sc` (which must have one), `file` naming the scenario in errors and
@@ -59,6 +62,7 @@ struct FleetRunSummary {
   /// Per vehicle (NaN without a controller): the RMS distance to the point its controller
   /// steers to (its hold point, or the waypoint ahead during a survey) [m].
   std::vector<double> rms_position_error;
+  std::vector<std::string> notes;  ///< FleetWorld::notes (also summary.json's `notes`)
 };
 
 /// \brief Runs the fleet scenario `sc` closed loop into the directory `out` (created), writing
