@@ -122,33 +122,6 @@ Scalar clamp_command(Scalar u) {
 }
 }  // namespace detail
 
-/// \brief Checks a thruster's curve. \param[in] field its name in messages, e.g.
-/// `propulsion.curves[3]`. \throws kelp::invalid_argument naming the field
-/// (`propulsion.curves[3].thrust must ...`): 2 to max_curve_points commands strictly ascending
-/// from −1 to 1, one finite thrust per command, no currents or one finite non-negative current
-/// per command. An empty curve (the T200) must have no thrusts and no currents either.
-inline void validate(const ThrustCurve& c, const std::string& field) {
-  const Eigen::Index m = c.command.size();
-  if (m == 0) {
-    KELP_CHECK(c.thrust.size() == 0 && c.current.size() == 0,
-               field + ": thrusts or currents without commands (an empty curve is the T200)");
-    return;
-  }
-  KELP_CHECK(m >= 2,
-             field + ".command must have 2 to " + std::to_string(max_curve_points) + " points");
-  KELP_CHECK(c.command(0) == -1.0 && c.command(m - 1) == 1.0,
-             field + ".command must run from -1 to 1");
-  for (Eigen::Index k = 1; k < m; ++k)
-    KELP_CHECK(c.command(k) > c.command(k - 1),
-               field + ".command must be strictly ascending (point " + std::to_string(k) + ")");
-  KELP_CHECK(c.thrust.size() == m, field + ".thrust must have one entry per command");
-  KELP_CHECK(c.thrust.allFinite(), field + ".thrust must be finite");
-  KELP_CHECK(c.current.size() == 0 || c.current.size() == m,
-             field + ".current must be empty or have one entry per command");
-  KELP_CHECK(c.current.allFinite() && (c.current.array() >= 0.0).all(),
-             field + ".current must be finite and >= 0");
-}
-
 /// \brief Thrust [N] of a thruster's curve at command u (clamped to [−1, 1]), linear between its
 /// points. \throws kelp::invalid_argument for an empty curve (the T200: t200_thrust).
 template <typename Scalar>
@@ -161,11 +134,12 @@ Scalar curve_thrust(const ThrustCurve& c, const Scalar& command) {
 /// \brief Current [A] a thruster on its curve draws at command u (clamped to [−1, 1]), linear
 /// between its points; 0 for a curve without currents. \throws kelp::invalid_argument for an
 /// empty curve (the T200: t200_current).
-inline double curve_current(const ThrustCurve& c, double command) {
+template <typename Scalar>
+Scalar curve_current(const ThrustCurve& c, const Scalar& command) {
   KELP_CHECK(c.command.size() >= 2,
              "curve_current: the curve has no points (a T200: "
              "t200_current)");
-  if (c.current.size() != c.command.size()) return 0.0;
+  if (c.current.size() != c.command.size()) return Scalar(0);
   return detail::curve_interpolate(c.command, c.current, detail::clamp_command(command));
 }
 
@@ -198,9 +172,11 @@ struct PropulsionParameters {
 };
 
 /// \brief Checks propulsion parameters. \throws kelp::invalid_argument naming the field
-/// (`propulsion.<field>`): shapes (1 … max_thrusters thrusters), facing ±1, the curves
-/// (`propulsion.curves[i]...`, validate(const ThrustCurve&, ...); empty from n on; facing +1 where
-/// set), a finite non-negative time constant, the battery's fields.
+/// (`propulsion.<field>`, e.g. `propulsion.curves[3].thrust must be finite`): shapes (1 …
+/// max_thrusters thrusters), facing ±1, each curve (none from n on; else empty, with no thrusts
+/// and no currents, or 2 to max_curve_points commands strictly ascending from −1 to 1, one finite
+/// thrust per command, no currents or one finite non-negative current per command; facing +1),
+/// a finite non-negative time constant, the battery's fields.
 template <typename Scalar>
 void validate(const PropulsionParameters<Scalar>& p) {
   KELP_CHECK(p.positions.cols() >= 1 && p.positions.cols() <= max_thrusters,
@@ -211,12 +187,28 @@ void validate(const PropulsionParameters<Scalar>& p) {
     KELP_CHECK(p.facing(i) == 1 || p.facing(i) == -1, "propulsion.facing entries must be +1 or -1");
   for (Eigen::Index i = 0; i < max_thrusters; ++i) {
     const ThrustCurve& c = p.curves[std::size_t(i)];
+    const Eigen::Index m = c.command.size();
     const std::string field = "propulsion.curves[" + std::to_string(i) + "]";
     KELP_CHECK(
         i < p.positions.cols() || c.empty(),
         field + " must be empty: there are " + std::to_string(p.positions.cols()) + " thrusters");
-    validate(c, field);
-    KELP_CHECK(c.empty() || p.facing.size() == 0 || p.facing(i) == 1,
+    KELP_CHECK(m > 0 || (c.thrust.size() == 0 && c.current.size() == 0),
+               field + ": thrusts or currents without commands (an empty curve is the T200)");
+    if (m == 0) continue;
+    KELP_CHECK(m >= 2,
+               field + ".command must have 2 to " + std::to_string(max_curve_points) + " points");
+    KELP_CHECK(c.command(0) == -1.0 && c.command(m - 1) == 1.0,
+               field + ".command must run from -1 to 1");
+    for (Eigen::Index k = 1; k < m; ++k)
+      KELP_CHECK(c.command(k) > c.command(k - 1),
+                 field + ".command must be strictly ascending (point " + std::to_string(k) + ")");
+    KELP_CHECK(c.thrust.size() == m, field + ".thrust must have one entry per command");
+    KELP_CHECK(c.thrust.allFinite(), field + ".thrust must be finite");
+    KELP_CHECK(c.current.size() == 0 || c.current.size() == m,
+               field + ".current must be empty or have one entry per command");
+    KELP_CHECK(c.current.allFinite() && (c.current.array() >= 0.0).all(),
+               field + ".current must be finite and >= 0");
+    KELP_CHECK(p.facing.size() == 0 || p.facing(i) == 1,
                "propulsion.facing[" + std::to_string(i) + "] must be +1: thruster " +
                    std::to_string(i) + " has a curve (measured as mounted, both directions)");
   }
