@@ -425,22 +425,25 @@ class SdfReader {
     std::snprintf(speed, sizeof speed, "%g", w_max);
     note("Thruster " + joint + ": command u in [-1, 1] is the propeller speed u*" + speed +
          " rad/s (from " + source + "); thrust Ct rho D^4 |omega| omega is tabulated at " +
-         std::to_string(o_.curve_points) + " commands");
+         std::to_string(o_.curve_points) + " commands; it draws no current from the battery");
     // Force commands: thrust along the axis (Ct's sign only turns the propeller the other way);
     // speed commands: Ct's sign turns the thrust.
     const Eigen::Vector3d dir = (angvel && ct < 0) ? Eigen::Vector3d(-ax) : ax;
-    ThrustCurve curve;
+    vehicle::ThrustCurve curve;  // no currents: Gazebo's Thruster has no electrical model
     const int n = o_.curve_points;
-    if (n < 3 || n % 2 == 0 || n > 10001)
-      throw invalid_argument("SdfImportOptions::curve_points must be odd, in [3, 10001]");
+    if (n < 3 || n % 2 == 0 || n > vehicle::max_curve_points)
+      throw invalid_argument("SdfImportOptions::curve_points must be odd, in [3, " +
+                             std::to_string(vehicle::max_curve_points - 1) + "]");
+    curve.command.resize(n);
+    curve.thrust.resize(n);
     for (int i = 0; i < n; ++i) {
       const double u = i == n - 1 ? 1.0 : -1.0 + 2.0 * i / (n - 1);
       double w = u * w_max;
       if (angvel) w = std::min(std::max(w, cmd_min), cmd_max);
       double f = k * std::abs(w) * w;
       if (!angvel) f = std::min(std::max(f, cmd_min), cmd_max);
-      curve.command.push_back(u);
-      curve.thrust_n.push_back(f);
+      curve.command(i) = u;
+      curve.thrust(i) = f;
     }
     // In the body link's frame, then FRD.
     const Pose X_bm = X_mb_.inverse();
@@ -482,7 +485,7 @@ class SdfReader {
     for (Eigen::Index i = 0; i < n; ++i) {
       prop.positions.col(i) = thrusters_[std::size_t(i)].position;
       prop.directions.col(i) = thrusters_[std::size_t(i)].direction;
-      d.thrust_curves.push_back(thrusters_[std::size_t(i)].curve);
+      prop.curves[std::size_t(i)] = thrusters_[std::size_t(i)].curve;
     }
     prop.esc_scale_forward = (d.pwm.max_us - d.pwm.neutral_us) / vehicle::t200_esc_half_range_us;
     prop.esc_scale_reverse = (d.pwm.neutral_us - d.pwm.min_us) / vehicle::t200_esc_half_range_us;
@@ -570,7 +573,7 @@ class SdfReader {
 
   struct Thruster {
     Eigen::Vector3d position, direction;
-    ThrustCurve curve;
+    vehicle::ThrustCurve curve;
   };
 
   std::string file_;

@@ -296,6 +296,7 @@ class VehicleReader {
       const std::string q = p + "/thrusters/" + std::to_string(i);
       const json& t = ts[std::size_t(i)];
       r_.object(t, q, {"position_m", "direction", "facing", "model"});
+      if (t.contains("model")) prop.curves[std::size_t(i)] = model(t.at("model"), q + "/model");
       prop.positions.col(i) = r_.vec3(r_.require(t, q, "position_m"), q + "/position_m");
       prop.directions.col(i) = r_.vec3(r_.require(t, q, "direction"), q + "/direction");
       if (!(prop.directions.col(i).norm() > 1e-12))
@@ -305,9 +306,11 @@ class VehicleReader {
         if (!f.is_number_integer() || (f.get<int>() != 1 && f.get<int>() != -1))
           r_.fail(q + "/facing", "expected 1 or -1, got " + f.dump());
         prop.facing(i) = f.get<int>();
+        if (prop.facing(i) != 1 && !prop.curves[std::size_t(i)].empty())
+          r_.fail(q + "/facing",
+                  "a thruster on a curve takes facing 1 (the curve gives its thrust as mounted, "
+                  "in both directions)");
       }
-      d.thrust_curves.push_back(t.contains("model") ? model(t.at("model"), q + "/model")
-                                                    : ThrustCurve{});
     }
     prop.esc_scale_forward = (d.pwm.max_us - d.pwm.neutral_us) / vehicle::t200_esc_half_range_us;
     prop.esc_scale_reverse = (d.pwm.neutral_us - d.pwm.min_us) / vehicle::t200_esc_half_range_us;
@@ -315,7 +318,9 @@ class VehicleReader {
     d.propulsion = prop;
   }
 
-  ThrustCurve model(const json& m, const std::string& p) const {
+  // A thruster's model: the T200 (an empty curve) or its own curve, points [u, thrust_N] or
+  // [u, thrust_N, current_A] (vehicle::ThrustCurve; the library's validate() runs after).
+  vehicle::ThrustCurve model(const json& m, const std::string& p) const {
     if (m.is_string() && m.get<std::string>() == "t200") return {};
     if (!m.is_object() || !m.contains("curve"))
       r_.fail(p, "unknown thruster model " + m.dump() +
@@ -323,18 +328,37 @@ class VehicleReader {
     r_.object(m, p, {"curve"});
     const json& c = m.at("curve");
     const std::string q = p + "/curve";
-    if (!c.is_array() || c.size() < 2)
-      r_.fail(q, "expected at least 2 points [command, thrust_N], got " + c.dump());
-    ThrustCurve out;
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      const std::vector<double> pt = r_.numbers(c[i], q + "/" + std::to_string(i), {2});
-      if (pt[0] < -1.0 || pt[0] > 1.0 || (i > 0 && !(pt[0] > out.command.back())))
-        r_.fail(q + "/" + std::to_string(i) + "/0",
-                "expected commands strictly ascending within [-1, 1], got " + c[i].dump());
-      out.command.push_back(pt[0]);
-      out.thrust_n.push_back(pt[1]);
+    constexpr int most = vehicle::max_curve_points;
+    if (!c.is_array() || c.size() < 2 || c.size() > std::size_t(most))
+      r_.fail(q, "expected 2 to " + std::to_string(most) +
+                     " points [command, thrust_N] or [command, thrust_N, current_A], got " +
+                     (c.is_array() ? std::to_string(c.size()) + " points" : c.dump()));
+    const std::vector<double> first = r_.numbers(c[0], q + "/0", {2, 3});
+    const std::size_t width = first.size();
+    const Eigen::Index n = Eigen::Index(c.size());
+    vehicle::ThrustCurve out;
+    out.command.resize(n);
+    out.thrust.resize(n);
+    if (width == 3) out.current.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const std::string pi = q + "/" + std::to_string(i);
+      const json& point = c[std::size_t(i)];
+      if (!point.is_array() || point.size() != width)
+        r_.fail(pi, "expected an array of " + std::to_string(width) + " numbers (every point " +
+                        (width == 3 ? "[command, thrust_N, current_A]" : "[command, thrust_N]") +
+                        " like the first), got " + point.dump());
+      const std::vector<double> pt = r_.numbers(point, pi, {width});
+      if (pt[0] < -1.0 || pt[0] > 1.0 || (i > 0 && !(pt[0] > out.command(i - 1))))
+        r_.fail(pi + "/0",
+                "expected commands strictly ascending within [-1, 1], got " + point.dump());
+      out.command(i) = pt[0];
+      out.thrust(i) = pt[1];
+      if (width == 3) {
+        if (pt[2] < 0.0) r_.fail(pi + "/2", "expected a current >= 0, got " + point[2].dump());
+        out.current(i) = pt[2];
+      }
     }
-    if (out.command.front() != -1.0 || out.command.back() != 1.0)
+    if (out.command(0) != -1.0 || out.command(n - 1) != 1.0)
       r_.fail(q, "expected the commands to run from -1 to 1");
     return out;
   }
@@ -383,13 +407,9 @@ void check_vehicle(const VehicleDescription& d, const std::string& file) {
     vehicle::validate(d.parameters);
     if (d.propulsion) {
       vehicle::validate(*d.propulsion);
-      KELP_CHECK(d.thrust_curves.size() == std::size_t(d.propulsion->positions.cols()),
-                 "thrust_curves must have one curve per thruster");
       // The allocation must build (its pseudo-inverse is left to the model: a rank-deficient
       // thruster layout is allowed).
       (void)vehicle::allocation_matrix(d.propulsion->positions, d.propulsion->directions);
-    } else {
-      KELP_CHECK(d.thrust_curves.empty(), "thrust_curves must be empty without propulsion");
     }
     if (d.hull) system::validate(*d.hull);
     vehicle::validate(d.pwm);
@@ -458,17 +478,6 @@ void pretty(const ojson& j, int indent, std::string& out) {
 }
 
 }  // namespace
-
-double curve_thrust(const ThrustCurve& c, double u) {
-  KELP_CHECK(!c.is_t200() && c.command.size() == c.thrust_n.size() && c.command.size() >= 2,
-             "curve_thrust needs a tabulated curve (the T200's is kelp/vehicle/t200.hpp's)");
-  check_finite(u, "thruster command u");
-  const double x = u < -1.0 ? -1.0 : (u > 1.0 ? 1.0 : u);
-  std::size_t i = 1;
-  while (i + 1 < c.command.size() && c.command[i] < x) ++i;
-  const double w = (x - c.command[i - 1]) / (c.command[i] - c.command[i - 1]);
-  return c.thrust_n[i - 1] + w * (c.thrust_n[i] - c.thrust_n[i - 1]);
-}
 
 VehicleDescription parse_vehicle(const std::string& text, const std::string& file) {
   if (json_depth(text, max_json_depth) > max_json_depth)
@@ -546,13 +555,16 @@ std::string write_vehicle_file(const VehicleDescription& d) {
       t["position_m"] = vec(prop.positions.col(i));
       t["direction"] = vec(prop.directions.col(i));
       t["facing"] = prop.facing.size() > 0 ? prop.facing(i) : 1;
-      const ThrustCurve& c = d.thrust_curves[std::size_t(i)];
-      if (c.is_t200()) {
+      const vehicle::ThrustCurve& c = prop.curves[std::size_t(i)];
+      if (c.empty()) {
         t["model"] = "t200";
       } else {
         ojson pts = ojson::array();
-        for (std::size_t k = 0; k < c.command.size(); ++k)
-          pts.push_back(ojson::array({c.command[k], c.thrust_n[k]}));
+        for (Eigen::Index k = 0; k < c.command.size(); ++k) {
+          ojson pt = ojson::array({c.command(k), c.thrust(k)});
+          if (c.current.size() > 0) pt.push_back(c.current(k));
+          pts.push_back(pt);
+        }
         t["model"] = {{"curve", pts}};
       }
       ts.push_back(t);
@@ -590,7 +602,6 @@ VehicleDescription vehicle_preset(const std::string& name) {
   d.parameters = preset.parameters;
   d.pwm = preset.pwm;
   d.propulsion = system::presets::propulsion_of(preset, battery);
-  d.thrust_curves.assign(std::size_t(preset.thruster_positions.cols()), ThrustCurve{});
   return d;
 }
 

@@ -1,8 +1,9 @@
 // Vehicle files and the SDF importer (kelp/sim/vehicle_file.hpp): the shipped preset files equal
 // the C++ presets bit for bit, a description round-trips exactly, bad files name their JSON
-// path, and the import of a BlueROV2 Heavy written in Gazebo's conventions reproduces a
-// hand-written kelp description (mass matrix, damping, thruster allocation) within 1e-12, with
-// the FLU → FRD conversion checked axis by axis.
+// path, a thruster's curve in a file or an SDF drives the propulsion's thrust and current, and
+// the import of a BlueROV2 Heavy written in Gazebo's conventions reproduces a hand-written kelp
+// description (mass matrix, damping, thruster allocation) within 1e-12, with the FLU → FRD
+// conversion checked axis by axis.
 #include <catch2/catch.hpp>
 
 #include "kelp/sim/vehicle_file.hpp"
@@ -80,12 +81,22 @@ void require_equal(const VehicleDescription& a, const VehicleDescription& b) {
       CHECK(s.battery.ocv.soc[i] == t.battery.ocv.soc[i]);
       CHECK(s.battery.ocv.cell_voltage[i] == t.battery.ocv.cell_voltage[i]);
     }
+    for (std::size_t i = 0; i < s.curves.size(); ++i) {
+      CHECK(s.curves[i].command == t.curves[i].command);
+      CHECK(s.curves[i].thrust == t.curves[i].thrust);
+      CHECK(s.curves[i].current == t.curves[i].current);
+    }
   }
-  REQUIRE(a.thrust_curves.size() == b.thrust_curves.size());
-  for (std::size_t i = 0; i < a.thrust_curves.size(); ++i) {
-    CHECK(a.thrust_curves[i].command == b.thrust_curves[i].command);
-    CHECK(a.thrust_curves[i].thrust_n == b.thrust_curves[i].thrust_n);
-  }
+}
+
+// The steady thrust and current of thruster i of `p` under command u on every thruster (the
+// lag's time constant set to 0: the first step's thrust is the static one).
+std::pair<double, double> steady(kelp::vehicle::PropulsionParametersd p, int i, double u) {
+  p.time_constant = 0.0;
+  const kelp::vehicle::PropulsionModeld m(p);
+  kelp::vehicle::PropulsionStated s = kelp::vehicle::initial_state(m);
+  kelp::vehicle::advance(m, s, kelp::vehicle::ThrusterVector<double>::Constant(m.size(), u), 0.01);
+  return {s.thrust(i), s.current(i)};
 }
 
 // The message of the scenario_error that `f` throws.
@@ -105,6 +116,13 @@ std::string rov_json(const std::string& extra) {
              "added_mass": [5, 5, 10, 0.1, 0.1, 0.1],
              "propulsion": {"thrusters": [{"position_m": [0, 0, 0], "direction": [1, 0, 0]}]})" +
          extra + "}";
+}
+
+// A vehicle with the given `propulsion` object (and `extra` keys after it).
+std::string rov_with(const std::string& propulsion, const std::string& extra = "") {
+  return R"({"name": "rov", "mass_kg": 10, "inertia_kg_m2": [0.2, 0.2, 0.3],
+             "added_mass": [5, 5, 10, 0.1, 0.1, 0.1], "propulsion": )" +
+         propulsion + extra + "}";
 }
 
 Eigen::Matrix<double, 6, Eigen::Dynamic> allocation(const Eigen::Matrix3Xd& r,
@@ -154,8 +172,14 @@ TEST_CASE("a vehicle description round-trips exactly, curves and full matrices i
   d.parameters.added_mass(0, 4) = d.parameters.added_mass(4, 0) = -0.3;
   d.parameters.damping.linear(0, 4) = d.parameters.damping.linear(4, 0) = 0.7;
   d.parameters.r_g << 1.0 / 3, -2.0 / 7, 0.011;
-  d.thrust_curves[2].command = {-1, -0.25, 0.5, 1};
-  d.thrust_curves[2].thrust_n = {-40.1, -3.3, 12.0 / 7, 51.2};
+  kelp::vehicle::ThrustCurve& c = d.propulsion->curves[2];
+  c.command.resize(4);
+  c.thrust.resize(4);
+  c.command << -1, -0.25, 0.5, 1;
+  c.thrust << -40.1, -3.3, 12.0 / 7, 51.2;
+  d.propulsion->curves[5] = c;
+  d.propulsion->curves[5].current = kelp::vehicle::CurveVector::Constant(4, 0.1 / 3);
+  d.propulsion->facing(2) = 1;
   d.propulsion->facing(3) = -1;
   d.propulsion->battery.ocv.size = 2;
   d.propulsion->battery.ocv.soc[1] = 1.0;
@@ -165,8 +189,40 @@ TEST_CASE("a vehicle description round-trips exactly, curves and full matrices i
   d.hull.reset();
   const std::string text = kelp::sim::write_vehicle_file(d);
   require_equal(kelp::sim::parse_vehicle(text, "d.json"), d);
-  CHECK(kelp::sim::curve_thrust(d.thrust_curves[2], 0.0) ==
-        Approx(-3.3 + (0.25 / 0.75) * (12.0 / 7 + 3.3)));
+}
+
+TEST_CASE("a vehicle file's thruster curve drives the propulsion's thrust and current",
+          "[vehicle_file]") {
+  const VehicleDescription d = kelp::sim::parse_vehicle(rov_with(R"({"thrusters": [
+        {"position_m": [0, 0, 0], "direction": [1, 0, 0]},
+        {"position_m": [0, 0.2, 0], "direction": [1, 0, 0],
+         "model": {"curve": [[-1, -28, 11], [-0.1, 0, 0.2], [0.1, 0, 0.2], [0.6, 21, 6.5],
+                             [1, 36, 15]]}}]})",
+                                                                 R"(, "pwm": {"max_us": 2000})"),
+                                                        "rov.json");
+  const kelp::vehicle::ThrustCurve& c = d.propulsion->curves[1];
+  REQUIRE(c.command.size() == 5);
+  CHECK(d.propulsion->curves[0].empty());  // no model: the T200
+  CHECK(c.current.size() == 5);
+  // u = 0.5 between the points 0.1 and 0.6 (w = 0.8): 0.2 · 0 + 0.8 · 21 N, 0.2 · 0.2 + 0.8 · 6.5
+  // A.
+  const auto [f, i] = steady(*d.propulsion, 1, 0.5);
+  CHECK(f == Approx(0.8 * 21.0).epsilon(1e-14));
+  CHECK(i == Approx(0.2 * 0.2 + 0.8 * 6.5).epsilon(1e-14));
+  // The file's pwm scales the T200 beside it (1.25 from 1900 µs on), not the curve: u = 0.8
+  // saturates the T200 and gives the curve's own 0.5 · 21 + 0.5 · 36 N.
+  CHECK(d.propulsion->esc_scale_forward == 1.25);
+  const auto [f1, i1] = steady(*d.propulsion, 1, 0.8);
+  CHECK(f1 == Approx(28.5).epsilon(1e-14));
+  kelp::vehicle::PropulsionParametersd stiff = *d.propulsion;  // the same voltage at any load
+  stiff.battery.internal_resistance = 0.0;
+  CHECK(steady(stiff, 0, 0.8).first == steady(stiff, 0, 1.0).first);
+  // Without currents the curve draws nothing.
+  const VehicleDescription q = kelp::sim::parse_vehicle(
+      rov_with(R"({"thrusters": [{"position_m": [0, 0, 0], "direction": [1, 0, 0],
+                                  "model": {"curve": [[-1, -10], [1, 10]]}}]})"),
+      "rov.json");
+  CHECK(steady(*q.propulsion, 0, 0.5) == std::pair<double, double>(5.0, 0.0));
 }
 
 TEST_CASE("bad vehicle files name the file and the JSON path", "[vehicle_file]") {
@@ -205,6 +261,29 @@ TEST_CASE("bad vehicle files name the file and the JSON path", "[vehicle_file]")
              Catch::StartsWith("rov.json: ") && Catch::Contains("quadratic_damping"));
   CHECK_THAT(error_of([] { kelp::sim::read_vehicle_file("/nonexistent/rov.json"); }),
              Catch::Equals("/nonexistent/rov.json: cannot be read"));
+  // Curves: measured as mounted (facing 1), points of one length, at most 64 of them.
+  const auto thruster = [](const std::string& t) {
+    return rov_with(R"({"thrusters": [{"position_m": [0, 0, 0], "direction": [1, 0, 0], )" + t +
+                    "}]}");
+  };
+  CHECK(error_of([&] {
+          parse_vehicle(thruster(R"("facing": -1, "model": {"curve": [[-1, -5], [1, 5]]})"), "r");
+        }) ==
+        "r: /propulsion/thrusters/0/facing: a thruster on a curve takes facing 1 (the curve "
+        "gives its thrust as mounted, in both directions)");
+  CHECK(error_of([&] {
+          parse_vehicle(thruster(R"("model": {"curve": [[-1, -5, 1], [1, 5]]})"), "r");
+        }) ==
+        "r: /propulsion/thrusters/0/model/curve/1: expected an array of 3 numbers "
+        "(every point [command, thrust_N, current_A] like the first), got [1,5]");
+  CHECK(error_of([&] {
+          parse_vehicle(thruster(R"("model": {"curve": [[-1, -5, -1], [1, 5, 2]]})"), "r");
+        }) == "r: /propulsion/thrusters/0/model/curve/0/2: expected a current >= 0, got -1");
+  std::string many = "[-1, 0]";
+  for (int k = 1; k < 65; ++k) many += ", [" + std::to_string(-1.0 + k / 32.0) + ", 0]";
+  CHECK_THAT(
+      error_of([&] { parse_vehicle(thruster(R"("model": {"curve": [)" + many + "]}"), "r"); }),
+      Catch::StartsWith("r: /propulsion/thrusters/0/model/curve: expected 2 to 64 points"));
 }
 
 TEST_CASE("the SDF import of a BlueROV2 Heavy equals its hand-written kelp description",
@@ -241,12 +320,32 @@ TEST_CASE("the SDF import of a BlueROV2 Heavy equals its hand-written kelp descr
   CHECK((allocation(prop.positions, prop.directions) - allocation(r, d)).cwiseAbs().maxCoeff() <=
         1e-12);
   // T = Ct ρ D⁴ ω|ω| with ω = 160 u rad/s (the joints' velocity limit): 51.2 N at u = 1.
-  REQUIRE(im.vehicle.thrust_curves.size() == 8);
-  for (const auto& c : im.vehicle.thrust_curves) {
-    CHECK(kelp::sim::curve_thrust(c, 1.0) == Approx(51.2).epsilon(1e-14));
-    CHECK(kelp::sim::curve_thrust(c, -0.5) == Approx(-12.8).epsilon(1e-14));
+  for (const auto& c : prop.curves) {
+    REQUIRE(c.command.size() == 41);
+    CHECK(c.current.size() == 0);  // Gazebo's thruster has no electrical model: draws nothing
+    CHECK(kelp::vehicle::curve_thrust(c, 1.0) == Approx(51.2).epsilon(1e-14));
+    CHECK(kelp::vehicle::curve_thrust(c, -0.5) == Approx(-12.8).epsilon(1e-14));
   }
   CHECK(prop.time_constant == 0.0);
+  // And the propulsion drives it: thrust = Ct ρ D⁴ |ω| ω at ω = u · 160 rad/s on every thruster,
+  // exactly at the tabulated commands (every 0.05), and between them the chord of the parabola,
+  // k ω² + k (ω − ω_lo)(ω_hi − ω) for ω > 0 (at most k (0.05 · 160)² / 4 = 0.032 N above it).
+  const double k = 0.02 * 1000.0 * std::pow(0.1, 4);
+  const kelp::vehicle::PropulsionModeld pm(prop);
+  for (double u : {-1.0, -0.5, 0.35, 0.5, 0.9, 0.33, -0.71}) {
+    INFO("u = " << u);
+    kelp::vehicle::PropulsionStated st = kelp::vehicle::initial_state(pm);
+    const kelp::vehicle::PropulsionStep<double> step =
+        kelp::vehicle::advance(pm, st, kelp::vehicle::ThrusterVector<double>::Constant(8, u), 0.01);
+    const double w = u * 160.0, exact = k * std::abs(w) * w;
+    const double lo = std::floor(u / 0.05 + 1e-9) * 0.05 * 160.0, hi = lo + 0.05 * 160.0;
+    const double chord_error = k * (w - lo) * (hi - w);  // chord minus parabola, same sign as ω
+    for (int i = 0; i < 8; ++i)
+      CHECK(st.thrust(i) == Approx(exact + (w >= 0 ? 1 : -1) * chord_error).epsilon(1e-12));
+    CHECK(step.current == 0.0);
+  }
+  // The chord's error at u = 0.33 (0.031 N) is what the tolerance above resolves: 1e-12 of 14 N.
+  CHECK(k * (0.33 * 160 - 0.30 * 160) * (0.35 * 160 - 0.33 * 160) == Approx(0.03072));
   // The hull: the collision box, 5 cm high, 2 cm above the link origin.
   REQUIRE(im.vehicle.hull.has_value());
   CHECK((im.vehicle.hull->half_extents - Eigen::Vector3d(0.2285, 0.2875, 0.025)).norm() <= 1e-15);
@@ -292,7 +391,7 @@ TEST_CASE("SDF frames: surge stays, sway and heave flip (FLU to FRD)", "[vehicle
   CHECK(D(0, 2) == -0.5);  // surge from heave: w flips, so the coupling's sign does
   CHECK(D(2, 0) == -0.5);
   // Force commands up to max_thrust_cmd: u = 1 gives 10 N along the direction.
-  CHECK(kelp::sim::curve_thrust(im.vehicle.thrust_curves[1], 1.0) == Approx(10.0));
+  CHECK(kelp::vehicle::curve_thrust(prop.curves[1], 1.0) == Approx(10.0));
 }
 
 TEST_CASE("SDF: what kelp cannot carry is listed, bad files are errors naming the file",

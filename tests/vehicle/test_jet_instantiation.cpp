@@ -10,6 +10,7 @@
 #include "kelp/vehicle/kinematics.hpp"
 #include "kelp/vehicle/model.hpp"
 #include "kelp/vehicle/presets.hpp"
+#include "kelp/vehicle/propulsion.hpp"
 #include "kelp/vehicle/state.hpp"
 #include "kelp/vehicle/thrusters.hpp"
 
@@ -27,6 +28,10 @@ template class ThrusterAllocation<Jet>;
 template class ThrusterChain<Jet>;
 template struct PwmMapping<Jet>;
 template struct VehiclePreset<Jet>;
+template struct PropulsionParameters<Jet>;
+template class PropulsionModel<Jet>;
+template struct PropulsionState<Jet>;
+template struct PropulsionStep<Jet>;
 }  // namespace kelp::vehicle
 
 namespace kv = kelp::vehicle;
@@ -122,4 +127,30 @@ TEST_CASE(
       CHECK(c.v(1) == Approx(-f.v(1) / f.v(0)).epsilon(1e-9));
     }
   }
+}
+
+TEST_CASE("Jet: a propulsion step on a thruster's curve and a T200, derivatives in the commands",
+          "[vehicle][jet][propulsion]") {
+  // Thruster 0 on a curve (slope 34/0.6 N between u = 0.4 and 1), thruster 1 a T200; no lag, a
+  // pack without resistance (the voltage does not depend on the commands).
+  kv::PropulsionParameters<Jet> p;
+  p.positions = kelp::Matrix3X<Jet>::Zero(3, 2);
+  p.directions = kelp::Matrix3X<Jet>::Zero(3, 2);
+  p.directions(0, 0) = p.directions(0, 1) = Jet(1.0);
+  p.time_constant = 0.0;
+  p.battery.internal_resistance = 0.0;
+  kv::ThrustCurve& c = p.curves[0];
+  c.command = kv::CurveVector::LinSpaced(3, -1.0, 1.0);
+  c.thrust.resize(3);
+  c.thrust << -30.0, 0.0, 40.0;
+  const kv::PropulsionModel<Jet> m(p);
+  kv::PropulsionState<Jet> s = kv::initial_state(m);
+  Eigen::Matrix<Jet, 2, 1> u(Jet(0.7, 0), Jet(0.6, 1));
+  const kv::PropulsionStep<Jet> r = kv::advance(m, s, u, 0.01);
+  CHECK(s.thrust(0).a == Approx(28.0).epsilon(1e-14));
+  CHECK(s.thrust(0).v(0) == Approx(40.0).epsilon(1e-14));  // dF/du of the segment
+  CHECK(s.thrust(0).v(1) == 0.0);
+  CHECK(s.thrust(1).v(1) == Approx(kv::t200_thrust_slope(0.6, r.voltage)).epsilon(1e-12));
+  CHECK(r.wrench(0).v(0) == Approx(40.0).epsilon(1e-14));
+  CHECK(kv::curve_thrust(c, Jet(-0.5, 2)).v(2) == Approx(30.0).epsilon(1e-14));
 }

@@ -1,6 +1,7 @@
 // Propulsion: the thrusters' first-order lag against von Benzon et al. 2022's T200 transfer
 // function and its exact exponential, the battery's energy balance, voltage sag under load and
-// with charge, thrust following the voltage, bad parameters, no heap in a step.
+// with charge, thrust following the voltage, thrusters on a curve of their own (thrust and
+// current tabulated, the same lag), bad parameters, no heap in a step.
 #include <Eigen/Core>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -26,6 +27,21 @@ PropulsionParametersd single_thruster(double time_constant) {
   p.battery.internal_resistance = 0.0;
   p.battery.capacity_ah = 1e12;
   return p;
+}
+
+// A measured-looking curve: 5 points, asymmetric, a dead band around 0, currents rising with
+// |thrust|.
+ThrustCurve test_curve(bool with_current) {
+  ThrustCurve c;
+  c.command.resize(5);
+  c.thrust.resize(5);
+  c.command << -1.0, -0.3, 0.0, 0.4, 1.0;
+  c.thrust << -30.0, -2.0, 0.0, 6.0, 40.0;
+  if (with_current) {
+    c.current.resize(5);
+    c.current << 12.0, 1.0, 0.1, 2.0, 17.0;
+  }
+  return c;
 }
 
 // Unit-step response of von Benzon et al. 2022 (J. Mar. Sci. Eng. 10(12):1898), T200 model
@@ -122,6 +138,181 @@ TEST_CASE("Thruster lag: exact exponential over a step, its mean is the impulse"
   CHECK(sr.thrust(0) > 0.0);
 }
 
+TEST_CASE("Thruster curve: the tabulated thrust at and between its points, ESC scales ignored",
+          "[propulsion][curve]") {
+  PropulsionParametersd p = single_thruster(0.05);
+  p.curves[0] = test_curve(false);
+  p.esc_scale_forward = 1.25;  // T200s only: a curve takes u itself
+  p.esc_scale_reverse = 0.8;
+  const PropulsionModeld m(p);
+  // u → the curve's value: its points exactly, halfway between them, and clamped beyond ±1.
+  const std::vector<std::pair<double, double>> cases = {{-1.0, -30.0},
+                                                        {-0.3, -2.0},
+                                                        {0.0, 0.0},
+                                                        {0.4, 6.0},
+                                                        {1.0, 40.0},
+                                                        {-0.65, -16.0},
+                                                        {0.2, 3.0},
+                                                        {0.7, 23.0},
+                                                        {-1.7, -30.0},
+                                                        {2.0, 40.0},
+                                                        {0.55, 6.0 + 34.0 * 0.25}};
+  for (const auto& [u, f] : cases) {
+    INFO("u = " << u);
+    CHECK(curve_thrust(p.curves[0], u) == Approx(f).epsilon(1e-14));
+    // After the lag settles (40 time constants: e^-40 ~ 4e-18 of the step is left).
+    PropulsionStated s = initial_state(m);
+    for (int k = 0; k < 200; ++k) advance(m, s, Eigen::Matrix<double, 1, 1>(u), 0.01);
+    CHECK(s.thrust(0) == Approx(f).epsilon(1e-14).margin(1e-14));
+  }
+  CHECK(curve_thrust(p.curves[0], 0.4) == 6.0);  // exactly at a point
+  CHECK(curve_thrust(p.curves[0], 0.5f) == Approx(6.0f + 34.0f / 6.0f));
+  // No battery effect on the thrust: the same with 90 % of the charge drawn.
+  PropulsionStated drained = initial_state(m);
+  drained.battery.charge_drawn = 0.9 * 3600.0 * p.battery.capacity_ah;
+  for (int k = 0; k < 200; ++k) advance(m, drained, Eigen::Matrix<double, 1, 1>(0.7), 0.01);
+  CHECK(drained.thrust(0) == Approx(23.0).epsilon(1e-14));
+}
+
+TEST_CASE("Thruster curve: the lag's exact response and impulse", "[propulsion][curve]") {
+  const double tc = 0.05, dt = 0.01;
+  PropulsionParametersd p = single_thruster(tc);
+  p.curves[0] = test_curve(false);
+  const PropulsionModeld m(p);
+  PropulsionStated s = initial_state(m);
+  // 0 → F*(0.7) = 23 N, then a reversal to F*(−0.65) = −16 N from where the first leg ends.
+  double impulse = 0.0;
+  for (int k = 1; k <= 10; ++k) {
+    impulse += advance(m, s, Eigen::Matrix<double, 1, 1>(0.7), dt).wrench(0) * dt;
+    const double t = k * dt;
+    CHECK(s.thrust(0) == Approx(23.0 * (1.0 - std::exp(-t / tc))).epsilon(1e-13));
+    CHECK(impulse == Approx(23.0 * (t - tc * (1.0 - std::exp(-t / tc)))).epsilon(1e-13));
+  }
+  const double f1 = s.thrust(0);
+  for (int k = 1; k <= 10; ++k) {
+    const PropulsionStep<double> r = advance(m, s, Eigen::Matrix<double, 1, 1>(-0.65), dt);
+    const double t = k * dt, a = std::exp(-t / tc), a0 = std::exp(-(t - dt) / tc);
+    CHECK(s.thrust(0) == Approx(-16.0 + (f1 + 16.0) * a).epsilon(1e-13));
+    // The mean over the step: −16 + (f₀ + 16)(T/h)(1 − e^{−h/T}) with f₀ the step's start.
+    CHECK(r.wrench(0) ==
+          Approx(-16.0 + (f1 + 16.0) * a0 * (tc / dt) * (1.0 - std::exp(-dt / tc))).epsilon(1e-13));
+  }
+  // The wrench is the allocation's: a thruster at (0, 0.5, 0) along +x gives N = −0.5 X.
+  PropulsionParametersd q = p;
+  q.positions = Eigen::Vector3d(0.0, 0.5, 0.0);
+  q.time_constant = 0.0;
+  const PropulsionModeld mq(q);
+  PropulsionStated sq = initial_state(mq);
+  const PropulsionStep<double> r = advance(mq, sq, Eigen::Matrix<double, 1, 1>(1.0), dt);
+  CHECK(r.wrench(0) == 40.0);
+  CHECK(r.wrench(5) == Approx(-20.0).epsilon(1e-15));
+}
+
+TEST_CASE("Thruster curve: its current is drawn from the battery; a T200 beside it unchanged",
+          "[propulsion][curve]") {
+  // Thruster 0 a T200 (reversed), thruster 1 on a curve with currents; a resistive pack.
+  PropulsionParametersd p;
+  p.positions = Eigen::Matrix<double, 3, 2>::Zero();
+  p.directions = Eigen::Matrix<double, 3, 2>::Zero();
+  p.directions.row(0).setOnes();
+  p.facing = ThrusterVector<int>(2);
+  p.facing << -1, 1;
+  p.time_constant = 0.0;
+  p.battery = battery_presets::bluerov2_battery();
+  p.battery.hotel_current = 0.5;
+  p.curves[1] = test_curve(true);
+  const PropulsionModeld m(p);
+  PropulsionStated s = initial_state(m);
+  const Eigen::Vector2d u(0.6, 0.7);
+  const double dt = 0.1;
+  const PropulsionStep<double> r = advance(m, s, u, dt);
+  const double i_curve = 0.5 * 2.0 + 0.5 * 17.0;  // halfway between 0.4 and 1
+  CHECK(curve_current(p.curves[1], 0.7) == Approx(i_curve).epsilon(1e-15));
+  CHECK(s.current(1) == Approx(i_curve).epsilon(1e-15));
+  CHECK(s.current(0) == t200_current(-0.6, r.voltage));
+  CHECK(r.current == Approx(0.5 + i_curve + s.current(0)).epsilon(1e-15));
+  // V = OCV − R I of the whole load, the battery drained by I h.
+  const double ocv = open_circuit_voltage(p.battery, 1.0);
+  CHECK(r.voltage == Approx(ocv - p.battery.internal_resistance * r.current).margin(1e-8));
+  CHECK(s.battery.charge_drawn == Approx(r.current * dt).epsilon(1e-15));
+  CHECK(s.battery.energy_drawn == Approx(r.voltage * r.current * dt).epsilon(1e-14));
+  // The curve's thrust is its table's; the T200's is the T200 model's at the solved voltage,
+  // bit for bit.
+  CHECK(s.thrust(1) == Approx(23.0).epsilon(1e-15));
+  CHECK(s.thrust(0) == -t200_thrust(-0.6, r.voltage));
+  // The curve's current makes the T200 weaker (the voltage sags more than without it).
+  PropulsionParametersd alone = p;
+  alone.curves[1].current.resize(0);  // draws nothing
+  const PropulsionModeld ma(alone);
+  PropulsionStated sa = initial_state(ma);
+  const PropulsionStep<double> ra = advance(ma, sa, u, dt);
+  CHECK(sa.current(1) == 0.0);
+  CHECK(ra.current == Approx(0.5 + sa.current(0)).epsilon(1e-15));
+  CHECK(ra.voltage - r.voltage ==
+        Approx(p.battery.internal_resistance * (r.current - ra.current)).margin(1e-8));
+  CHECK(sa.thrust(0) > s.thrust(0));
+  CHECK(sa.thrust(1) == s.thrust(1));  // a curve's thrust does not follow the voltage
+  // Idle: a curve draws its current at u = 0 (0.1 A here); empty commands are all 0.
+  PropulsionStated si = initial_state(m);
+  const PropulsionStep<double> ri = advance(m, si, Eigen::Vector2d::Zero(), dt);
+  CHECK(ri.current == Approx(0.5 + 0.1).epsilon(1e-15));
+  CHECK(si.thrust(1) == 0.0);
+}
+
+TEST_CASE("Thruster curve: bad curves name the field", "[propulsion][curve]") {
+  const auto message = [](const ThrustCurve& c, int at, int facing) -> std::string {
+    PropulsionParametersd p;
+    p.positions = Eigen::Matrix<double, 3, 4>::Zero();
+    p.directions = Eigen::Matrix<double, 3, 4>::Ones();
+    p.facing = ThrusterVector<int>::Constant(4, 1);
+    p.facing(3) = facing;
+    p.curves[std::size_t(at)] = c;
+    try {
+      validate(p);
+    } catch (const kelp::invalid_argument& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  ThrustCurve good = test_curve(true);
+  CHECK(message(good, 3, 1) == "no error");
+  CHECK(message(good, 3, -1) ==
+        "propulsion.facing[3] must be +1: thruster 3 has a curve (measured as mounted, both "
+        "directions)");
+  ThrustCurve c = good;
+  c.thrust(2) = std::nan("");
+  CHECK(message(c, 3, 1) == "propulsion.curves[3].thrust must be finite");
+  c = good;
+  c.thrust.resize(4);
+  CHECK(message(c, 3, 1) == "propulsion.curves[3].thrust must have one entry per command");
+  c = good;
+  c.current(0) = -1.0;
+  CHECK(message(c, 2, 1) == "propulsion.curves[2].current must be finite and >= 0");
+  c = good;
+  c.current.resize(2);
+  CHECK(message(c, 0, 1) ==
+        "propulsion.curves[0].current must be empty or have one entry per command");
+  c = good;
+  c.command(1) = c.command(2);
+  CHECK(message(c, 1, 1) == "propulsion.curves[1].command must be strictly ascending (point 2)");
+  c = good;
+  c.command(4) = 0.9;
+  CHECK(message(c, 1, 1) == "propulsion.curves[1].command must run from -1 to 1");
+  c = ThrustCurve{};
+  c.command = CurveVector::Constant(1, -1.0);
+  c.thrust = CurveVector::Zero(1);
+  CHECK(message(c, 1, 1) == "propulsion.curves[1].command must have 2 to 64 points");
+  c = ThrustCurve{};
+  c.thrust = CurveVector::Zero(3);
+  CHECK(message(c, 1, 1) ==
+        "propulsion.curves[1]: thrusts or currents without commands (an empty curve is the T200)");
+  // A curve for a thruster that does not exist (4 thrusters: 0 … 3).
+  CHECK(message(good, 5, 1) == "propulsion.curves[5] must be empty: there are 4 thrusters");
+  CHECK_THROWS_AS(curve_thrust(ThrustCurve{}, 0.5), kelp::invalid_argument);
+  CHECK_THROWS_AS(curve_current(ThrustCurve{}, 0.5), kelp::invalid_argument);
+  CHECK(curve_current(test_curve(false), 0.5) == 0.0);
+}
+
 TEST_CASE("Battery: energy balance over a constant-current discharge", "[battery]") {
   const BatteryParameters p = battery_presets::bluerov2_battery();
   BatteryState s;
@@ -213,6 +404,8 @@ TEST_CASE("Propulsion: no heap allocation in a step", "[propulsion]") {
   const auto rov = bluerov2_heavy<double>();
   p.positions = rov.thruster_positions;
   p.directions = rov.thruster_directions;
+  p.curves[2] = p.curves[5] = test_curve(true);  // T200s and curves in one step
+  p.facing = ThrusterVector<int>::Ones(8);
   const PropulsionModeld m(p);
   PropulsionStated s = initial_state(m);
   ThrusterVector<double> u = ThrusterVector<double>::LinSpaced(8, -1.0, 1.0);
@@ -275,6 +468,13 @@ TEST_CASE("Propulsion: float instantiation", "[propulsion]") {
   PropulsionStatef s = initial_state(m);
   for (int k = 0; k < 100; ++k) advance(m, s, Eigen::Matrix<float, 1, 1>(0.5f), 0.01);
   CHECK(s.thrust(0) == Approx(t200_thrust(0.5f, float(s.battery.voltage))).epsilon(1e-4));
+  PropulsionParametersf q = p;
+  q.curves[0] = test_curve(true);
+  const PropulsionModelf mc(q);
+  PropulsionStatef sc = initial_state(mc);
+  for (int k = 0; k < 100; ++k) advance(mc, sc, Eigen::Matrix<float, 1, 1>(0.7f), 0.01);
+  CHECK(sc.thrust(0) == Approx(23.0f).epsilon(1e-6));
+  CHECK(sc.current(0) == Approx(9.5).epsilon(1e-6));
 }
 
 // Every public propulsion class template for both floating-point scalars.

@@ -19,23 +19,6 @@
 namespace kelp {
 namespace sim {
 
-/// \brief A thruster's static thrust curve: empty for the Blue Robotics T200 datasheet curve
-/// (kelp/vehicle/t200.hpp, the one vehicle::PropulsionModel drives), else a table of thrust
-/// [N] along the thruster's direction against its normalised command u ∈ [−1, 1], linear in
-/// between (the SDF importer's Gazebo thrusters; a curve of the user's own thruster).
-struct ThrustCurve {
-  /// u, strictly ascending, from −1 to 1 (2 points at least when not empty).
-  std::vector<double> command;
-  /// Thrust [N] at each command (positive: along the thruster's direction).
-  std::vector<double> thrust_n;
-  /// \brief True for the T200 datasheet curve (no table).
-  bool is_t200() const { return command.empty(); }
-};
-
-/// \brief Thrust [N] of a tabulated curve at command u (clamped to [−1, 1]), linear between its
-/// points. \throws kelp::invalid_argument for the T200 curve (no table) or a non-finite u.
-KELP_SIM_API double curve_thrust(const ThrustCurve& curve, double command);
-
 /// \brief A vehicle as data: everything kelp's physics needs to simulate it.
 ///
 /// Frames and units are kelp's: body axes x forward, y starboard, z down (FRD) about the body
@@ -45,13 +28,10 @@ struct VehicleDescription {
   std::string name;
   /// Rigid body, added mass, damping, hydrostatics (vehicle::validate holds).
   vehicle::VehicleParameters<double> parameters;
-  /// Thrusters (positions, directions, facing, lag) and battery; std::nullopt: no thrusters.
-  /// Its ESC scales are those of `pwm` (as system::presets::propulsion_of derives them).
+  /// Thrusters (positions, directions, facing, each a T200 or on its own curve, lag) and
+  /// battery; std::nullopt: no thrusters. Its ESC scales are those of `pwm` (as
+  /// system::presets::propulsion_of derives them).
   std::optional<vehicle::PropulsionParameters<double>> propulsion;
-  /// One curve per thruster of `propulsion` (empty curve: the T200 datasheet); empty when there
-  /// is no propulsion. vehicle::PropulsionModel drives T200 curves only: a tabulated curve is
-  /// carried for the code that drives it.
-  std::vector<ThrustCurve> thrust_curves;
   /// PWM ↔ command mapping of the ESCs (ArduSub's 1100–1500–1900 µs by default).
   vehicle::PwmMapping<double> pwm;
   /// The hull box for contact with the seabed and obstacles; std::nullopt: none.
@@ -67,7 +47,8 @@ struct VehicleDescription {
 /// path, e.g. `rov.json: /propulsion/thrusters/3/model: unknown thruster model "t300" (allowed:
 /// "t200", {"curve": ...})`: a wrong type, an unknown key, a missing required key (`mass_kg`,
 /// `inertia_kg_m2`), a value out of range, a mass matrix M_RB + M_A that is not positive definite,
-/// or any error of the library's checks (prefixed with the file name).
+/// a thruster curve that is not one (vehicle::ThrustCurve; facing −1 on a curve), or any error of
+/// the library's checks (prefixed with the file name).
 KELP_SIM_API VehicleDescription parse_vehicle(const std::string& json_text,
                                               const std::string& name_for_errors);
 
@@ -99,7 +80,8 @@ struct SdfImportOptions {
   /// `<axis><limit><velocity>`, else the plugin's `<max_thrust_cmd>` (a thrust [N], or a speed
   /// with `<use_angvel_cmd>`). One of them is needed to normalise the command.
   double max_propeller_speed_rad_s = 0.0;
-  /// Points of each thruster's tabulated curve (odd, ≥ 3), evenly spaced in u ∈ [−1, 1].
+  /// Points of each thruster's curve (odd, 3 … 63: vehicle::max_curve_points), evenly spaced in
+  /// u ∈ [−1, 1].
   int curve_points = 41;
   /// Water density [kg/m³] when the file gives none (Buoyancy's `uniform_fluid_density`, else
   /// Hydrodynamics' `water_density`); 1000 is the Buoyancy system's default.

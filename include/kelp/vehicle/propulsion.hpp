@@ -1,14 +1,16 @@
 /// \file
-/// \brief A vehicle's propulsion as part of its state: T200 thrusters whose thrust follows
-/// their command through a first-order lag, drawing their current from a battery whose voltage
-/// sags with the load and falls with the charge drawn, the thrust following that voltage.
+/// \brief A vehicle's propulsion as part of its state: thrusters (T200s, or each on a curve of
+/// its own) whose thrust follows their command through a first-order lag, drawing their current
+/// from a battery whose voltage sags with the load and falls with the charge drawn, a T200's
+/// thrust following that voltage.
 ///
 /// **Thruster lag.** Each thruster's thrust f (along its direction d_i) obeys
 /// T ḟ = F*(u, V) − f, with F* the static thrust of its command u at the supply voltage V
-/// (t200_thrust). Over a step of length h with u and V held (the zero-order hold of a digital
-/// ESC command), the exact solution is f(h) = F* + (f₀ − F*) e^{−h/T}, and the thrust's mean
-/// over the step, the impulse per unit time that the step applies, is
-/// F* + (f₀ − F*) (T/h)(1 − e^{−h/T}) (both computed here, with expm1 for small h/T).
+/// (t200_thrust; or the thruster's own curve, below). Over a step of length h with u and V held
+/// (the zero-order hold of a digital ESC command), the exact solution is
+/// f(h) = F* + (f₀ − F*) e^{−h/T}, and the thrust's mean over the step, the impulse per unit time
+/// that the step applies, is F* + (f₀ − F*) (T/h)(1 − e^{−h/T}) (both computed here, with expm1
+/// for small h/T).
 ///
 /// Time constant: T = 20 ms (t200_time_constant), the first-order fit of the T200 model of von
 /// Benzon, Sørensen, Uth, Jouffroy, Liniger, Pedersen 2022, "An Open-Source Benchmark Simulator:
@@ -22,7 +24,7 @@
 /// slower, ~30 to ~110 ms to settle depending on the step's size and the ESC; set
 /// `time_constant` to study them; 0 turns the lag off (thrust = F* at once).
 ///
-/// **Current and voltage.** Each thruster draws t200_current(u, V) from the battery at once (an
+/// **Current and voltage.** Each T200 draws t200_current(u, V) from the battery at once (an
 /// ESC accelerating its propeller draws at least its steady current: the lag is on the thrust,
 /// not the current), plus the battery's hotel load. The terminal voltage V of the step solves
 /// V = OCV(SoC) − R I(V) within the step (solve_terminal_voltage: the loop gain R dI/dV of eight
@@ -41,11 +43,27 @@
 /// clamped to [−1, 1] (1 for the BlueROV2's 1100–1900 µs outputs, 1.25 for the BlueBoat's
 /// 1000–2000 µs: full thrust from 1900 µs on, as ThrusterChain does).
 ///
-/// No heap allocation in advance(): per-thruster vectors have a fixed capacity of max_thrusters.
+/// **A thruster's own curve.** `PropulsionParameters::curves[i]`, when not empty, replaces the
+/// T200 model for thruster i by its static curve as measured (a bollard-pull test, a datasheet,
+/// the SDF importer's Ct ρ D⁴ |ω| ω): F*(u) = thrust [N] along d_i and, optionally, I(u) = the
+/// current [A] it draws from the battery, tabulated at commands −1 = c_0 < c_1 < … < c_{m−1} = 1
+/// (2 ≤ m ≤ max_curve_points) and linear in between: for c_k ≤ u ≤ c_{k+1},
+/// w = (u − c_k)/(c_{k+1} − c_k) and F*(u) = (1 − w) F_k + w F_{k+1} (so F*(c_k) = F_k exactly).
+/// Its command is the vehicle's u itself, clamped to [−1, 1]: the curve was measured against
+/// that command, with the thruster as mounted, so the ESC scales do not apply, facing must be +1
+/// (validate() says so) and the thrust does not follow the voltage. The lag is the same: thrust
+/// f_i follows F*(u_i) through T ḟ = F* − f, integrated exactly as above. The current I(u_i)
+/// enters the battery's solve like a T200's (at once, not lagged); a curve without currents
+/// draws nothing from the battery (only the hotel load and the other thrusters then do).
+///
+/// No heap allocation in advance(): per-thruster vectors have a fixed capacity of max_thrusters,
+/// a curve's points of max_curve_points.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
+#include <string>
 
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
@@ -63,6 +81,68 @@ inline constexpr int max_thrusters = 8;
 template <typename Scalar>
 using ThrusterVector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1, 0, max_thrusters, 1>;
 
+/// \brief Most points a thruster's curve holds.
+inline constexpr int max_curve_points = 64;
+
+/// \brief A per-point vector of a thruster's curve, of fixed capacity max_curve_points (no heap).
+using CurveVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_curve_points, 1>;
+
+/// \brief A thruster's static curve as measured: thrust and, optionally, current against the
+/// normalised command u ∈ [−1, 1], linear between the points (see the file comment). Empty (no
+/// points, the default): the thruster is a T200.
+struct ThrustCurve {
+  /// u at each point: strictly ascending from −1 to 1, 2 to max_curve_points points.
+  CurveVector command;
+  /// Thrust [N] along the thruster's direction d_i at each point (negative: against it), finite.
+  CurveVector thrust;
+  /// Current [A] drawn from the battery at each point, finite and >= 0; empty: none drawn.
+  CurveVector current;
+  /// \brief True without points: the thruster is a T200.
+  bool empty() const { return command.size() == 0; }
+};
+
+namespace detail {
+// (1 − w) y_k + w y_{k+1} on the segment c_k ≤ x ≤ c_{k+1} of a checked curve `c` (bisection;
+// x within [c_0, c_{m−1}]): y_k exactly at x = c_k.
+template <typename Scalar>
+Scalar curve_interpolate(const CurveVector& c, const CurveVector& y, const Scalar& x) {
+  Eigen::Index lo = 0, hi = c.size() - 1;
+  while (hi - lo > 1) {
+    const Eigen::Index mid = (lo + hi) / 2;
+    (c(mid) <= value_of(x) ? lo : hi) = mid;
+  }
+  const Scalar w = (x - Scalar(c(lo))) / Scalar(c(hi) - c(lo));
+  return (Scalar(1) - w) * Scalar(y(lo)) + w * Scalar(y(hi));
+}
+template <typename Scalar>
+Scalar clamp_command(Scalar u) {
+  if (value_of(u) > 1.0) u = Scalar(1);
+  if (value_of(u) < -1.0) u = Scalar(-1);
+  return u;
+}
+}  // namespace detail
+
+/// \brief Thrust [N] of a thruster's curve at command u (clamped to [−1, 1]), linear between its
+/// points. \throws kelp::invalid_argument for an empty curve (the T200: t200_thrust).
+template <typename Scalar>
+Scalar curve_thrust(const ThrustCurve& c, const Scalar& command) {
+  KELP_CHECK(c.command.size() >= 2 && c.thrust.size() == c.command.size(),
+             "curve_thrust: the curve has no points (a T200: t200_thrust)");
+  return detail::curve_interpolate(c.command, c.thrust, detail::clamp_command(command));
+}
+
+/// \brief Current [A] a thruster on its curve draws at command u (clamped to [−1, 1]), linear
+/// between its points; 0 for a curve without currents. \throws kelp::invalid_argument for an
+/// empty curve (the T200: t200_current).
+template <typename Scalar>
+Scalar curve_current(const ThrustCurve& c, const Scalar& command) {
+  KELP_CHECK(c.command.size() >= 2,
+             "curve_current: the curve has no points (a T200: "
+             "t200_current)");
+  if (c.current.size() != c.command.size()) return Scalar(0);
+  return detail::curve_interpolate(c.command, c.current, detail::clamp_command(command));
+}
+
 /// \brief T200 thrust time constant [s]: the first-order fit of von Benzon et al. 2022's T200
 /// model (see the file comment).
 inline constexpr double t200_time_constant = 0.02;
@@ -75,11 +155,15 @@ struct PropulsionParameters {
   Matrix3X<Scalar> positions;
   /// d_i, 3×n, body axes: thrust direction of a positive command (normalised when built).
   Matrix3X<Scalar> directions;
-  /// ±1 per thruster (see the file comment); empty: all +1.
+  /// ±1 per thruster (see the file comment); empty: all +1. +1 for a thruster with a curve.
   ThrusterVector<int> facing;
+  /// Per thruster i < n: its own curve (see the file comment), or empty (the default): the T200
+  /// model. Entries from n on must be empty.
+  std::array<ThrustCurve, max_thrusters> curves;
   /// u_esc / u for positive commands ((max_us − neutral_us)/400 µs of the PWM mapping), > 0.
+  /// T200s only (a curve takes u itself).
   double esc_scale_forward = 1.0;
-  /// u_esc / u for negative commands ((neutral_us − min_us)/400 µs), > 0.
+  /// u_esc / u for negative commands ((neutral_us − min_us)/400 µs), > 0. T200s only.
   double esc_scale_reverse = 1.0;
   /// First-order lag of the thrust [s]; 0: no lag.
   double time_constant = t200_time_constant;
@@ -88,8 +172,11 @@ struct PropulsionParameters {
 };
 
 /// \brief Checks propulsion parameters. \throws kelp::invalid_argument naming the field
-/// (`propulsion.<field>`): shapes (1 … max_thrusters thrusters), facing ±1, a finite
-/// non-negative time constant, the battery's fields.
+/// (`propulsion.<field>`, e.g. `propulsion.curves[3].thrust must be finite`): shapes (1 …
+/// max_thrusters thrusters), facing ±1, each curve (none from n on; else empty, with no thrusts
+/// and no currents, or 2 to max_curve_points commands strictly ascending from −1 to 1, one finite
+/// thrust per command, no currents or one finite non-negative current per command; facing +1),
+/// a finite non-negative time constant, the battery's fields.
 template <typename Scalar>
 void validate(const PropulsionParameters<Scalar>& p) {
   KELP_CHECK(p.positions.cols() >= 1 && p.positions.cols() <= max_thrusters,
@@ -98,6 +185,33 @@ void validate(const PropulsionParameters<Scalar>& p) {
              "propulsion.facing must be empty or have one entry per thruster");
   for (Eigen::Index i = 0; i < p.facing.size(); ++i)
     KELP_CHECK(p.facing(i) == 1 || p.facing(i) == -1, "propulsion.facing entries must be +1 or -1");
+  for (Eigen::Index i = 0; i < max_thrusters; ++i) {
+    const ThrustCurve& c = p.curves[std::size_t(i)];
+    const Eigen::Index m = c.command.size();
+    const std::string field = "propulsion.curves[" + std::to_string(i) + "]";
+    KELP_CHECK(
+        i < p.positions.cols() || c.empty(),
+        field + " must be empty: there are " + std::to_string(p.positions.cols()) + " thrusters");
+    KELP_CHECK(m > 0 || (c.thrust.size() == 0 && c.current.size() == 0),
+               field + ": thrusts or currents without commands (an empty curve is the T200)");
+    if (m == 0) continue;
+    KELP_CHECK(m >= 2,
+               field + ".command must have 2 to " + std::to_string(max_curve_points) + " points");
+    KELP_CHECK(c.command(0) == -1.0 && c.command(m - 1) == 1.0,
+               field + ".command must run from -1 to 1");
+    for (Eigen::Index k = 1; k < m; ++k)
+      KELP_CHECK(c.command(k) > c.command(k - 1),
+                 field + ".command must be strictly ascending (point " + std::to_string(k) + ")");
+    KELP_CHECK(c.thrust.size() == m, field + ".thrust must have one entry per command");
+    KELP_CHECK(c.thrust.allFinite(), field + ".thrust must be finite");
+    KELP_CHECK(c.current.size() == 0 || c.current.size() == m,
+               field + ".current must be empty or have one entry per command");
+    KELP_CHECK(c.current.allFinite() && (c.current.array() >= 0.0).all(),
+               field + ".current must be finite and >= 0");
+    KELP_CHECK(p.facing.size() == 0 || p.facing(i) == 1,
+               "propulsion.facing[" + std::to_string(i) + "] must be +1: thruster " +
+                   std::to_string(i) + " has a curve (measured as mounted, both directions)");
+  }
   check_positive(p.esc_scale_forward, "propulsion.esc_scale_forward");
   check_positive(p.esc_scale_reverse, "propulsion.esc_scale_reverse");
   KELP_CHECK(std::isfinite(p.time_constant) && p.time_constant >= 0.0,
@@ -177,7 +291,8 @@ struct PropulsionStep {
 
 /// \brief Advances a propulsion by `dt` [s] under per-thruster commands u ∈ [−1, 1] (clamped;
 /// empty: all 0) held over the step (see the file comment): solves the terminal voltage,
-/// integrates the lag exactly, drains the battery. Allocation-free.
+/// integrates the lag exactly towards each thruster's static thrust (T200 or its curve), drains
+/// the battery. Allocation-free.
 /// \param[in,out] s advanced by dt (only once every check has passed).
 /// \returns the mean thrust's wrench and the step's voltage and current.
 /// \throws kelp::invalid_argument for a bad dt, a command vector of the wrong size or with a
@@ -200,17 +315,31 @@ PropulsionStep<Scalar> advance(const PropulsionModel<Scalar>& m, PropulsionState
     if (value_of(u) < -1.0) u = Scalar(-1);
     return u;
   };
+  // A curve's command: the vehicle's u itself (see the file comment).
+  const auto curve_command = [&](Eigen::Index i) {
+    return commands.size() == 0 ? Scalar(0) : detail::clamp_command(Scalar(commands(i)));
+  };
   const BatteryParameters& bp = m.parameters().battery;
   const ThrusterVector<int>& facing = m.facing();
+  const std::array<ThrustCurve, max_thrusters>& curves = m.parameters().curves;
   // The step's terminal voltage: the thrusters' current at V, in double (warm-started from the
-  // last step's voltage); the currents of the last evaluation, at the returned V, are kept.
+  // last step's voltage); the currents of the last evaluation, at the returned V, are kept. A
+  // curve's current does not depend on V: set once, before the solve.
   ThrusterVector<double> currents(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const ThrustCurve& c = curves[std::size_t(i)];
+    if (!c.empty())
+      currents(i) = c.current.size() == 0 ? 0.0
+                                          : detail::curve_interpolate(c.command, c.current,
+                                                                      value_of(curve_command(i)));
+  }
   const double v = solve_terminal_voltage(
       bp, s.battery,
       [&](double volts) {
         double sum = 0.0;
         for (Eigen::Index i = 0; i < n; ++i) {
-          currents(i) = t200_current(double(facing(i)) * value_of(command(i)), volts);
+          if (curves[std::size_t(i)].empty())
+            currents(i) = t200_current(double(facing(i)) * value_of(command(i)), volts);
           sum += currents(i);
         }
         return sum;
@@ -227,8 +356,14 @@ PropulsionStep<Scalar> advance(const PropulsionModel<Scalar>& m, PropulsionState
   const double decay = tc > 0.0 ? std::exp(-dt / tc) : 0.0;
   const double average = tc > 0.0 ? -std::expm1(-dt / tc) * (tc / dt) : 0.0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Scalar sign(facing(i));
-    const Scalar target = sign * t200_thrust(sign * command(i), Scalar(v));
+    const ThrustCurve& c = curves[std::size_t(i)];
+    Scalar target;
+    if (c.empty()) {
+      const Scalar sign(facing(i));
+      target = sign * t200_thrust(sign * command(i), Scalar(v));
+    } else {
+      target = detail::curve_interpolate(c.command, c.thrust, curve_command(i));
+    }
     const Scalar f0 = s.thrust(i);
     mean(i) = target + (f0 - target) * Scalar(average);
     s.thrust(i) = target + (f0 - target) * Scalar(decay);
