@@ -94,21 +94,14 @@ const kelp::system::SystemReportd& ClosedLoop::step() {
   // without, their wrench is applied directly.
   // The controllers' chains have the ESC's 1100–1900 µs mapping (their commands are the ESC's);
   // the propulsion takes the vehicle's PWM mapping's (e.g. the BlueBoat's 1000–2000 µs).
-  const auto to_vehicle = [](const kelp::vehicle::PropulsionModeld& pm, const auto& esc,
-                             kelp::vehicle::ThrusterVector<double>& u) {
-    const auto& pp = pm.parameters();
-    u.resize(esc.size());
-    for (Eigen::Index i = 0; i < esc.size(); ++i)
-      u(i) = esc(i) > 0.0 ? esc(i) / pp.esc_scale_forward : esc(i) / pp.esc_scale_reverse;
-  };
   const kelp::control::AuvCommand& auv = auv_override_ ? *auv_override_ : *auv_command_;
   if (const auto* pm = model_.auv_propulsion())
-    to_vehicle(*pm, auv.command, inputs_.auv_commands);
+    vehicle_commands(*pm, auv.command, inputs_.auv_commands);
   else
     inputs_.auv.tau = auv.wrench;
   const kelp::control::AsvCommand& asv = asv_override_ ? *asv_override_ : *asv_command_;
   if (const auto* pm = model_.asv_propulsion())
-    to_vehicle(*pm, asv.command, inputs_.asv_commands);
+    vehicle_commands(*pm, asv.command, inputs_.asv_commands);
   else
     inputs_.asv.tau = asv.wrench;
   if (winch_override_ && model_.winch()) inputs_.winch_payout_rate = *winch_override_;
@@ -204,20 +197,32 @@ kelp::control::AsvControllerSettings ClosedLoop::asv_settings(const Scenario& sc
   return s;
 }
 
+void vehicle_commands(const kelp::vehicle::PropulsionModeld& pm,
+                      const Eigen::Ref<const Eigen::VectorXd>& esc,
+                      kelp::vehicle::ThrusterVector<double>& u) {
+  const auto& pp = pm.parameters();
+  u.resize(esc.size());
+  for (Eigen::Index i = 0; i < esc.size(); ++i)
+    u(i) = esc(i) > 0.0 ? esc(i) / pp.esc_scale_forward : esc(i) / pp.esc_scale_reverse;
+}
+
+double controller_voltage(const kelp::vehicle::PropulsionModeld& pm,
+                          const kelp::vehicle::PropulsionStated& x) {
+  return std::isfinite(x.battery.voltage)
+             ? x.battery.voltage
+             : kelp::vehicle::open_circuit_voltage(
+                   pm.parameters().battery,
+                   kelp::vehicle::state_of_charge(pm.parameters().battery, x.battery));
+}
+
 void ClosedLoop::observe() {
   const double t = state_.time;
   // Propulsion: the controllers' inverse (command for a thrust) uses each battery's measured
   // voltage (the last step's; its open-circuit voltage before the first).
-  const auto volts = [](const kelp::vehicle::PropulsionModeld& pm,
-                        const kelp::vehicle::PropulsionStated& x) {
-    return std::isfinite(x.battery.voltage)
-               ? x.battery.voltage
-               : kelp::vehicle::open_circuit_voltage(
-                     pm.parameters().battery,
-                     kelp::vehicle::state_of_charge(pm.parameters().battery, x.battery));
-  };
-  if (const auto* pm = model_.auv_propulsion()) auv_.set_voltage(volts(*pm, state_.auv_propulsion));
-  if (const auto* pm = model_.asv_propulsion()) asv_.set_voltage(volts(*pm, state_.asv_propulsion));
+  if (const auto* pm = model_.auv_propulsion())
+    auv_.set_voltage(controller_voltage(*pm, state_.auv_propulsion));
+  if (const auto* pm = model_.asv_propulsion())
+    asv_.set_voltage(controller_voltage(*pm, state_.asv_propulsion));
   // What the controllers see: the true state, or the sensors' estimates (the boat takes the
   // ROV's position from the ROV's estimate, which it receives over the tether).
   if (navigation_) {

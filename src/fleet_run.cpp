@@ -16,6 +16,7 @@
 
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/angles.hpp"
+#include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
@@ -341,15 +342,20 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
       Controller& c = control[std::size_t(i)];
       const auto nav = kelp::control::navigation_of(state.vehicles[std::size_t(i)]);
       Vector3<double> error;
+      // The controllers' thrust inverse at the battery's voltage; their ESC commands to the
+      // vehicle's (as the pair's closed loop does).
+      const kv::PropulsionModeld* pm = model.propulsion(i);
       if (c.auv) {
+        c.auv->set_voltage(controller_voltage(*pm, state.propulsion[std::size_t(i)]));
         const auto& cmd = c.auv->update(nav, t);
-        in.commands[std::size_t(i)] = cmd.command;
+        vehicle_commands(*pm, cmd.command, in.commands[std::size_t(i)]);
         error = cmd.position_error;
       } else if (c.asv) {
+        c.asv->set_voltage(controller_voltage(*pm, state.propulsion[std::size_t(i)]));
         const Vector3<double> target =
             c.target >= 0 ? state.vehicles[std::size_t(c.target)].position : nav.position;
         const auto& cmd = c.asv->update(nav, target, t);
-        in.commands[std::size_t(i)] = cmd.command;
+        vehicle_commands(*pm, cmd.command, in.commands[std::size_t(i)]);
         error = cmd.position_error;
         error.z() = 0;
       } else {

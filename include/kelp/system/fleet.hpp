@@ -884,19 +884,13 @@ FleetState<Scalar> initial_state(const FleetModel<Scalar>& model, FleetWorkspace
     s.point_masses[j].position = point_masses[j];
   }
   s.point_mass_acceleration.assign(pm, Vector3<Scalar>::Zero());
-  environment::Environment<Scalar> still;
-  still.set_water_density(model.environment().water_density());
-  still.set_gravity(model.environment().gravity());
-  still.set_seabed_depth(model.environment().seabed_depth());
+  const environment::Environment<Scalar> still = detail::still_water(model.environment());
   s.tethers.resize(m);
   const auto& p = model.parameters();
   for (std::size_t k = 0; k < m; ++k) {
     const auto& line = model.tether(int(k));
     tether::StaticOptions<Scalar> o = options;
-    if (!(o.force_tolerance > Scalar(0))) {
-      const auto& tp = line.parameters();
-      o.force_tolerance = Scalar(1e-4) * tp.mass_per_length * tp.length * Scalar(still.gravity());
-    }
+    detail::default_static_tolerance(line, still, o);
     // The fixed ends where their bodies are; a free end starts hanging straight down from the
     // other (the solve lets it go).
     const TetherEnd<Scalar>&e0 = p.tethers[k].start, &e1 = p.tethers[k].end;

@@ -508,6 +508,28 @@ void propel(const vehicle::PropulsionModel<Scalar>* m, vehicle::PropulsionState<
   in.tau += r.wrench;
 }
 
+/// The still water of `env` (its density, gravity and seabed; no waves, current or wind): where
+/// an initial state's tethers find their static shape.
+template <typename Scalar>
+environment::Environment<Scalar> still_water(const environment::Environment<Scalar>& env) {
+  environment::Environment<Scalar> still;
+  still.set_water_density(env.water_density());
+  still.set_gravity(env.gravity());
+  still.set_seabed_depth(env.seabed_depth());
+  return still;
+}
+
+/// An initial state's static tolerance unless `o` gives one: 1e-4 × the line's weight in air
+/// (a neutrally buoyant slack line has no unique static shape, and a start state needs no more).
+template <typename Scalar>
+void default_static_tolerance(const tether::TetherModel<Scalar>& line,
+                              const environment::Environment<Scalar>& env,
+                              tether::StaticOptions<Scalar>& o) {
+  if (o.force_tolerance > Scalar(0)) return;
+  const tether::TetherParameters<Scalar>& tp = line.parameters();
+  o.force_tolerance = Scalar(1e-4) * tp.mass_per_length * tp.length * Scalar(env.gravity());
+}
+
 /// The coupling corrector: end motion `m` keeps its start and reaches `target` after h.
 template <typename Scalar>
 void reach(tether::EndMotion<Scalar>& m, const Vector3<Scalar>& target, const Scalar& h) {
@@ -663,15 +685,8 @@ SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorksp
   s.auv = auv;
   const Vector3<Scalar> a = asv.point_position(model.parameters().asv_attachment);
   const Vector3<Scalar> b = auv.point_position(model.parameters().auv_attachment);
-  environment::Environment<Scalar> still;
-  still.set_water_density(model.environment().water_density());
-  still.set_gravity(model.environment().gravity());
-  still.set_seabed_depth(model.environment().seabed_depth());
-  if (!(options.force_tolerance > Scalar(0))) {
-    const tether::TetherParameters<Scalar>& tp = model.tether().parameters();
-    options.force_tolerance =
-        Scalar(1e-4) * tp.mass_per_length * tp.length * Scalar(model.environment().gravity());
-  }
+  const environment::Environment<Scalar> still = detail::still_water(model.environment());
+  detail::default_static_tolerance(model.tether(), still, options);
   const tether::StaticResult<Scalar> r =
       tether::static_initial_state(model.tether(), ws.tether, still, a, b, s.tether, options);
   if (!r.converged)
