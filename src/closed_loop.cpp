@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "controller_io.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
@@ -522,3 +523,6 @@ RunSummary simulate(const Scenario& sc, const SimulateOptions& o) {
 
 }  // namespace sim
 }  // namespace kelp
+
+template class kelp::control::AuvControllerT<double>;
+template class kelp::control::AsvControllerT<double>;

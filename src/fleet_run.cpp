@@ -14,9 +14,9 @@
 #include <string>
 #include <utility>
 
+#include "controller_io.hpp"
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/angles.hpp"
-#include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"

@@ -35,17 +35,6 @@
 namespace kelp {
 namespace sim {
 
-/// \brief The vehicle's thruster commands u (PropulsionModel's) of a controller's ESC commands
-/// (kelp::control's thruster chain: u_esc = u · esc_scale, the scales of the PWM mapping).
-KELP_SIM_API void vehicle_commands(const kelp::vehicle::PropulsionModeld& pm,
-                                   const Eigen::Ref<const Eigen::VectorXd>& esc,
-                                   kelp::vehicle::ThrusterVector<double>& u);
-
-/// \brief The supply voltage a controller's thrust inverse uses: the battery's last measured
-/// terminal voltage, or its open-circuit voltage before the first step.
-KELP_SIM_API double controller_voltage(const kelp::vehicle::PropulsionModeld& pm,
-                                       const kelp::vehicle::PropulsionStated& x);
-
 /// \brief What an observer of the run sees after every step (ClosedLoopOptions::on_step).
 struct StepView {
   long step;                                  ///< steps taken so far (1 after the first)
