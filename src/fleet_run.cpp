@@ -10,7 +10,6 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <string>
 #include <utility>
 
@@ -20,6 +19,7 @@
 #include "kelp/sim/world.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
+#include "kelp/tether/winch.hpp"
 
 namespace kelp {
 namespace sim {
@@ -98,7 +98,6 @@ FleetWorld fleet_world(const Scenario& sc, const std::string& file) {
   w.environment = scenario_environment(sc, file);
   const bool touch =
       w.environment.obstacles() != nullptr || std::isfinite(w.environment.seabed_depth());
-  std::set<std::string> seen;
   for (std::size_t i = 0; i < f.vehicles.size(); ++i) {
     const FleetVehicleScenario& v = f.vehicles[i];
     const std::string p = "/fleet/vehicles/" + std::to_string(i);
@@ -123,9 +122,9 @@ FleetWorld fleet_world(const Scenario& sc, const std::string& file) {
                std::to_string(w.environment.water_density()) + ", " +
                std::to_string(w.environment.gravity()) + ")");
     ks::FleetVehicle<double> fv{v.name, d.parameters, d.propulsion, {}};
-    if (d.propulsion) {
-      fv.propulsion->time_constant = sc.thruster_lag ? sc.thruster_time_constant : 0.0;
-    }
+    // The thrusters' lag is the vehicle's own (its file's); the scenario's `thrusters.lag: false`
+    // turns it off.
+    if (d.propulsion && !sc.thruster_lag) fv.propulsion->time_constant = 0.0;
     // The hull touches the seabed and the obstacles when there are any (as the pair's).
     if (touch && d.hull) fv.hull = d.hull;
     w.parameters.vehicles.push_back(std::move(fv));
@@ -305,7 +304,9 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     for (int k = 0; k < m; ++k) {
       num(series, r ? r->force_at_start[std::size_t(k)].norm() : 0.0);
       num(series, r ? r->force_at_end[std::size_t(k)].norm() : 0.0);
-      num(series, model.tether_of(k, state.tethers[std::size_t(k)]).parameters().length);
+      num(series,
+          kelp::tether::unstretched_length(model.tether_of(k, state.tethers[std::size_t(k)]),
+                                           state.tethers[std::size_t(k)]));
     }
     series << '\n';
   };
@@ -418,7 +419,8 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     t["to"] = f.tethers[std::size_t(k)].to;
     t["max_tension_n"] = s.max_tension[std::size_t(k)];
     t["slack_fraction"] = s.slack_fraction[std::size_t(k)];
-    t["final_length_m"] = model.tether_of(k, state.tethers[std::size_t(k)]).parameters().length;
+    t["final_length_m"] = kelp::tether::unstretched_length(
+        model.tether_of(k, state.tethers[std::size_t(k)]), state.tethers[std::size_t(k)]);
     j["tethers"][f.tethers[std::size_t(k)].name] = t;
   }
   j["tether_solver"] = {{"newton_iterations_per_step_mean", s.newton_mean},
