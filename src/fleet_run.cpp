@@ -13,6 +13,7 @@
 #include <string>
 #include <utility>
 
+#include "cable.hpp"
 #include "controller_io.hpp"
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/angles.hpp"
@@ -60,16 +61,9 @@ VehicleDescription load_vehicle(const std::string& spec, const std::string& file
 
 kelp::tether::TetherParametersd line_of(const FleetTetherScenario& t) {
   kelp::tether::TetherParametersd p = kelp::tether::presets::rov_tether(t.length, t.segment_length);
-  if (t.diameter) p.diameter = *t.diameter;
-  if (t.mass_per_length) p.mass_per_length = *t.mass_per_length;
-  if (t.axial_stiffness) p.axial_stiffness = *t.axial_stiffness;
-  if (t.internal_damping_ratio) {
-    p.internal_damping = 0.0;
-    p.internal_damping_ratio = *t.internal_damping_ratio;
-  }
-  if (t.normal_drag) p.normal_drag = *t.normal_drag;
-  if (t.tangential_drag) p.tangential_drag = *t.tangential_drag;
-  if (t.breaking_strength) p.breaking_strength = *t.breaking_strength;
+  apply_cable({t.diameter, t.mass_per_length, t.axial_stiffness, std::nullopt,
+               t.internal_damping_ratio, t.normal_drag, t.tangential_drag, t.breaking_strength},
+              p);
   return p;
 }
 

@@ -1,6 +1,8 @@
 // The world of a scenario: its system, sea and start (kelp/sim/world.hpp).
 #include "kelp/sim/world.hpp"
 
+#include "cable.hpp"
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -23,6 +25,24 @@ namespace {
                        " is not one of its choices");
 }
 }  // namespace
+
+void apply_cable(const CableOverrides& c, kelp::tether::TetherParametersd& p) {
+  if (c.internal_damping && c.internal_damping_ratio)
+    throw kelp::invalid_argument(
+        "tether: internal_damping and internal_damping_ratio are both given: give BA [N s] or "
+        "the damping ratio, not both");
+  if (c.diameter) p.diameter = *c.diameter;
+  if (c.mass_per_length) p.mass_per_length = *c.mass_per_length;
+  if (c.axial_stiffness) p.axial_stiffness = *c.axial_stiffness;
+  if (c.internal_damping) p.internal_damping = *c.internal_damping;
+  if (c.internal_damping_ratio) {
+    p.internal_damping = 0.0;  // the kind's BA gives way to the ratio
+    p.internal_damping_ratio = *c.internal_damping_ratio;
+  }
+  if (c.normal_drag) p.normal_drag = *c.normal_drag;
+  if (c.tangential_drag) p.tangential_drag = *c.tangential_drag;
+  if (c.breaking_strength) p.breaking_strength = *c.breaking_strength;
+}
 
 kelp::environment::Environmentd scenario_environment(const Scenario& sc, const std::string& file) {
   namespace ke = kelp::environment;
@@ -102,21 +122,9 @@ WorldSetup world_setup(const Scenario& sc, const std::string& file) {
   if (kind == sp::TetherKind::rov_tether)
     params.tether = kelp::tether::presets::rov_tether(sc.tether_length, sc.segment_length);
   auto& tp = params.tether;
-  if (sc.diameter) tp.diameter = *sc.diameter;
-  if (sc.mass_per_length) tp.mass_per_length = *sc.mass_per_length;
-  if (sc.axial_stiffness) tp.axial_stiffness = *sc.axial_stiffness;
-  if (sc.internal_damping && sc.internal_damping_ratio)
-    throw kelp::invalid_argument(
-        "tether: internal_damping and internal_damping_ratio are both given: give BA [N s] or "
-        "the damping ratio, not both");
-  if (sc.internal_damping) tp.internal_damping = *sc.internal_damping;
-  if (sc.internal_damping_ratio) {
-    tp.internal_damping = 0.0;  // the kind's BA gives way to the ratio
-    tp.internal_damping_ratio = *sc.internal_damping_ratio;
-  }
-  if (sc.normal_drag) tp.normal_drag = *sc.normal_drag;
-  if (sc.tangential_drag) tp.tangential_drag = *sc.tangential_drag;
-  if (sc.breaking_strength) tp.breaking_strength = *sc.breaking_strength;
+  apply_cable({sc.diameter, sc.mass_per_length, sc.axial_stiffness, sc.internal_damping,
+               sc.internal_damping_ratio, sc.normal_drag, sc.tangential_drag, sc.breaking_strength},
+              tp);
   params.explicit_fallback = sc.explicit_fallback;
   // A Scenario built by hand may hold a value cast from an integer: named as the file's error.
   if (!choice_name(sc.line_model, line_model_names))
