@@ -17,6 +17,7 @@
 #include "controller_io.hpp"
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/angles.hpp"
+#include "kelp/core/rotation.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
@@ -75,13 +76,6 @@ struct Controller {
   double error_sq = 0;
   long samples = 0;
 };
-
-// Roll, pitch, yaw [rad] of an attitude (ZYX).
-Vector3<double> euler(const Eigen::Quaterniond& q) {
-  const Eigen::Matrix3d R = q.toRotationMatrix();
-  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::max(-1.0, std::min(1.0, -R(2, 0)))),
-          std::atan2(R(1, 0), R(0, 0))};
-}
 
 }  // namespace
 
@@ -288,7 +282,7 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     std::snprintf(buf, sizeof buf, "%.3f", state.time);
     series << buf;
     for (const auto& v : state.vehicles) {
-      const Vector3<double> e = euler(v.attitude);
+      const Vector3<double> e = kelp::euler_from_quaternion(v.attitude);
       for (int j = 0; j < 3; ++j) num(series, v.position(j));
       for (int j = 0; j < 3; ++j) num(series, e(j));
       for (int j = 0; j < 3; ++j) num(series, v.nu(j));
