@@ -8,7 +8,8 @@ if(NOT EXISTS "${replay_dir}/../node_modules/puppeteer-core/package.json")
   message(FATAL_ERROR "puppeteer-core is not installed in ${replay_dir}/../node_modules: "
                       "run scripts/install-deps test (or npm ci in apps/replay/page/)")
 endif()
-execute_process(COMMAND "${NODE}" "${SCRIPT}" "${HTML}" RESULT_VARIABLE rc)
+# ARGS: the script's further arguments (a ;-list), after the HTML file.
+execute_process(COMMAND "${NODE}" "${SCRIPT}" "${HTML}" ${ARGS} RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${SCRIPT} failed (${rc})")
 endif()
