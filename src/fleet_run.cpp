@@ -17,8 +17,11 @@
 #include "controller_io.hpp"
 #include "kelp/control/controllers.hpp"
 #include "kelp/core/angles.hpp"
+#include "kelp/core/constants.hpp"
 #include "kelp/core/rotation.hpp"
+#include "kelp/sim/ros2/fleet.hpp"
 #include "kelp/sim/world.hpp"
+#include "kelp/tether/failure.hpp"
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/presets.hpp"
 #include "kelp/tether/winch.hpp"
@@ -188,11 +191,9 @@ FleetWorld fleet_world(const Scenario& sc, const std::string& file) {
   return w;
 }
 
-FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std::string& out) {
-  FleetWorld w = fleet_world(sc, file);
-  const FleetScenario& f = *sc.fleet;
-  const ks::FleetModeld model(w.parameters, w.environment);
-  ks::FleetWorkspaced ws(model);
+ks::FleetStated fleet_start_state(const ks::FleetModeld& model, ks::FleetWorkspaced& ws,
+                                  const FleetWorld& w, const Scenario& sc,
+                                  const std::string& file) {
   ks::FleetStated state;
   try {
     state = ks::initial_state(model, ws, w.start, w.point_mass_start);
@@ -213,6 +214,16 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     for (int k = 0; k < model.tether_count(); ++k)
       kelp::tether::move_with_water(model.tether(k), env, state.tethers[std::size_t(k)]);
   }
+  return state;
+}
+
+FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std::string& out) {
+  FleetWorld w = fleet_world(sc, file);
+  const FleetScenario& f = *sc.fleet;
+  const ks::FleetModeld model(w.parameters, w.environment);
+  ks::FleetWorkspaced ws(model);
+  ks::FleetStated state = fleet_start_state(model, ws, w, sc, file);
+  const auto& env = model.environment();
   // The controllers.
   const int n = model.vehicle_count(), m = model.tether_count();
   std::vector<Controller> control(static_cast<std::size_t>(n));
@@ -309,6 +320,77 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
       }
     }
   };
+  // run.mcap (output.mcap, the default): the fleet's ROS 2 bag (kelp/sim/ros2/fleet.hpp), every
+  // logged sample, the markers at the node rate (as the pair's bag).
+  std::unique_ptr<ros2::FleetBagWriter> bag;
+  ros2::FleetSample sample;
+  ros2::FleetMessages messages;
+  std::vector<Eigen::VectorXd> tensions(static_cast<std::size_t>(m)),
+      commands(static_cast<std::size_t>(n));
+  double next_marker = 0;
+  if (sc.mcap) {
+    sample.gravity = env.gravity();
+    for (int i = 0; i < n; ++i) {
+      ros2::FleetVehicleSample v;
+      v.name = f.vehicles[std::size_t(i)].name;
+      v.state = &state.vehicles[std::size_t(i)];
+      const kv::PropulsionModeld* pm = model.propulsion(i);
+      v.thrusters = pm ? static_cast<int>(pm->size()) : 0;
+      commands[std::size_t(i)] = Eigen::VectorXd::Zero(v.thrusters);
+      v.thrust = state.propulsion[std::size_t(i)].thrust.data();
+      v.command = commands[std::size_t(i)].data();
+      if (const auto& h = w.vehicles[std::size_t(i)].hull) v.size = 2 * h->half_extents;
+      sample.vehicles.push_back(std::move(v));
+    }
+    for (int k = 0; k < m; ++k) {
+      const ks::FleetTether<double>& t = w.parameters.tethers[std::size_t(k)];
+      ros2::FleetTetherSample l;
+      l.name = t.name;
+      l.nodes = &state.tethers[std::size_t(k)].position;
+      l.tensions = &tensions[std::size_t(k)];
+      if (t.start.kind == ks::EndKind::vehicle) l.start_vehicle = t.start.index;
+      if (t.end.kind == ks::EndKind::vehicle) l.end_vehicle = t.end.index;
+      sample.tethers.push_back(std::move(l));
+    }
+    for (const ks::PointMassParametersd& p : w.parameters.point_masses) {
+      ros2::FleetPointMassSample q;
+      q.name = p.name;
+      q.diameter = p.volume > 0 ? std::cbrt(6 * p.volume / kelp::pi) : 0.3;
+      sample.point_masses.push_back(std::move(q));
+    }
+    bag = std::make_unique<ros2::FleetBagWriter>(fs::path(out) / "run.mcap", sample);
+  }
+  const auto record = [&](const ks::FleetReportd* r, const ks::FleetInputsd& inputs) {
+    if (!bag) return;
+    sample.time = state.time;
+    for (int i = 0; i < n; ++i) {
+      ros2::FleetVehicleSample& v = sample.vehicles[std::size_t(i)];
+      v.nu_dot = state.vehicle_nu_dot[std::size_t(i)];
+      const auto& u = inputs.commands[std::size_t(i)];
+      Eigen::VectorXd& c = commands[std::size_t(i)];
+      if (u.size() == c.size())
+        c = u;
+      else
+        c.setZero();
+    }
+    for (int k = 0; k < m; ++k) {
+      const auto& x = state.tethers[std::size_t(k)];
+      const auto& line = model.tether_of(k, x);
+      Eigen::VectorXd& ts = tensions[std::size_t(k)];
+      ts.resize(x.position.cols() - 1);
+      for (Eigen::Index i = 0; i + 1 < x.position.cols(); ++i)
+        ts(i) = kelp::tether::segment_axial_force(line, x, static_cast<int>(i));
+      ros2::FleetTetherSample& l = sample.tethers[std::size_t(k)];
+      l.force_at_start = r ? r->force_at_start[std::size_t(k)] : Vector3<double>::Zero();
+      l.force_at_end = r ? r->force_at_end[std::size_t(k)] : Vector3<double>::Zero();
+    }
+    for (std::size_t j = 0; j < state.point_masses.size(); ++j)
+      sample.point_masses[j].position = state.point_masses[j].position;
+    ros2::fill_fleet_messages(sample, messages);
+    const bool markers = state.time + 1e-9 >= next_marker;
+    if (markers) next_marker = state.time + 1.0 / sc.node_rate;
+    bag->write(messages, markers);
+  };
   const double dt = 0.01;
   const long steps = std::lround(sc.duration / dt);
   const long log_every = std::max(1L, std::lround(1.0 / (sc.log_rate * dt)));
@@ -324,6 +406,7 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
   long newton = 0;
   log_row(nullptr);
   log_nodes();
+  record(nullptr, in);
   const auto wall0 = std::chrono::steady_clock::now();
   for (long step = 1; step <= steps; ++step) {
     const double t = state.time;
@@ -365,7 +448,10 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
       if (b < 0.5 && f.tethers[std::size_t(k)].to != "free")
         s.slack_fraction[std::size_t(k)] += 1.0;
     }
-    if (step % log_every == 0) log_row(&r);
+    if (step % log_every == 0) {
+      log_row(&r);
+      record(&r, in);
+    }
     if (step % node_every == 0) log_nodes();
     s.steps = step;
   }
@@ -378,6 +464,7 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
                                                  : std::numeric_limits<double>::quiet_NaN());
   series.close();
   nodes.close();
+  if (bag) bag->close();
   // summary.json
   nlohmann::json j;
   j["source"] = "kelp-tethered-pair (fleet)";

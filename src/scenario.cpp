@@ -14,6 +14,7 @@
 
 #include "json_reader.hpp"
 #include "kelp/sim/heightfield_file.hpp"
+#include "kelp/sim/ros2/names.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "scenario_schema.hpp"
 
@@ -621,7 +622,15 @@ void parse_fleet(const nlohmann::json& fleet, const Reader& r, Scenario& s) {
   r.object(fleet, "/fleet", {"vehicles", "point_masses", "anchors", "tethers"});
   FleetScenario f;
   std::set<std::string> names;  // every vehicle, point mass and anchor: the tethers' ends
+  // A part's name becomes topics, frames (kelp/sim/ros2/fleet.hpp) and CSV column names.
+  const auto ros_name = [&](const std::string& name, const std::string& p) {
+    if (!ros2::is_ros_name(name))
+      r.fail(p + "/name", "\"" + name +
+                              "\" is not a ROS name (a letter, then letters, digits and single "
+                              "underscores, at most 64 characters)");
+  };
   const auto unique = [&](const std::string& name, const std::string& p) {
+    ros_name(name, p);
     if (name == "free") r.fail(p + "/name", "\"free\" names a free tether end");
     if (!names.insert(name).second) r.fail(p + "/name", "\"" + name + "\" names another part");
   };
@@ -671,6 +680,7 @@ void parse_fleet(const nlohmann::json& fleet, const Reader& r, Scenario& s) {
   fleet_list(r, fleet, "tethers", [&](const nlohmann::json& o, const std::string& p) {
     FleetTetherScenario x;
     x.name = fleet_string(r, o, p, "name", true);
+    ros_name(x.name, p);
     if (!tether_names.insert(x.name).second)
       r.fail(p + "/name", "\"" + x.name + "\" names another tether");
     x.from = fleet_string(r, o, p, "from", true);

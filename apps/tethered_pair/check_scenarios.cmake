@@ -123,7 +123,8 @@ if(longest LESS 30 OR length1 GREATER 15 OR waypoints LESS 4 OR NOT fallbacks EQ
 endif()
 
 # A fleet scenario runs through the same program (kelp/sim/fleet_run.hpp): the ROV's return to
-# its dock writes its three outputs, and the summary names the fleet's parts.
+# its dock writes its four outputs (run.mcap: checked by tests/ros2's ros2_mcap_node_check), and
+# the summary names the fleet's parts.
 file(REMOVE_RECURSE "${OUT}/fleet")
 execute_process(COMMAND "${PROGRAM}" --scenario "${SCENARIOS}/rov_docking.json" --out "${OUT}/fleet"
                         --duration 20 --quiet --no-plots
@@ -131,7 +132,7 @@ execute_process(COMMAND "${PROGRAM}" --scenario "${SCENARIOS}/rov_docking.json" 
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "rov_docking failed: ${out} ${err}")
 endif()
-foreach(f timeseries.csv nodes.csv summary.json)
+foreach(f timeseries.csv nodes.csv summary.json run.mcap)
   if(NOT EXISTS "${OUT}/fleet/${f}")
     message(FATAL_ERROR "rov_docking: no ${f}")
   endif()

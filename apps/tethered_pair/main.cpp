@@ -54,9 +54,9 @@ int run_fleet(const Options& o) {
   const kelp::sim::FleetRunSummary s = kelp::sim::run_fleet(o.scenario, o.scenario_file, o.out);
   std::printf(
       "kelp-tethered-pair: fleet of %zu vehicles and %zu tethers: %.0f s simulated in %.2f s "
-      "(%.0fx real time); outputs in %s (timeseries.csv, nodes.csv, summary.json)\n",
+      "(%.0fx real time); outputs in %s (timeseries.csv, nodes.csv, summary.json%s)\n",
       o.scenario.fleet->vehicles.size(), o.scenario.fleet->tethers.size(), s.simulated_s, s.wall_s,
-      s.simulated_s / std::max(s.wall_s, 1e-9), o.out.c_str());
+      s.simulated_s / std::max(s.wall_s, 1e-9), o.out.c_str(), o.scenario.mcap ? ", run.mcap" : "");
   std::printf(
       "kelp-tethered-pair: tether solver: %.2f Newton iterations per step on average, at most %d "
       "in one step; %ld retried steps, %ld explicit fallbacks\n",

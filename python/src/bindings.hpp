@@ -36,6 +36,10 @@ void bind_catenary(py::module_& m);
 /// bind_vehicle and bind_environment, whose types it returns).
 void bind_system(py::module_& m);
 
+/// kelp.Fleet, kelp.FleetState, kelp.FleetInputs, kelp.FleetReport (fleet.cpp; after
+/// bind_vehicle and bind_environment, whose types it returns).
+void bind_fleet(py::module_& m);
+
 /// kelp.run_scenario's C++ part, kelp._kelp._run_scenario (scenario.cpp).
 void bind_scenario(py::module_& m);
 

@@ -20,6 +20,7 @@ PYBIND11_MODULE(_kelp, m) {
   kelp_python::bind_catenary(m);
   kelp_python::bind_tether(m);
   kelp_python::bind_system(m);
+  kelp_python::bind_fleet(m);
   kelp_python::bind_timing(m);
   kelp_python::bind_scenario(m);
   kelp_python::bind_batch(m);

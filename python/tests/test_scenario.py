@@ -129,4 +129,5 @@ def test_a_fleet_scenario_runs_and_returns_its_parts(scenarios_dir, tmp_path):
         text = json.load(f)
     again = kelp.run_scenario(text, duration=20, out=tmp_path)
     assert again["vehicles"]["rov"]["final_position_m"] == summary["vehicles"]["rov"]["final_position_m"]
-    assert {p.name for p in tmp_path.iterdir()} == {"summary.json", "timeseries.csv", "nodes.csv"}
+    assert {p.name for p in tmp_path.iterdir()} == {"summary.json", "timeseries.csv", "nodes.csv",
+                                                     "run.mcap"}

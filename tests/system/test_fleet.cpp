@@ -212,6 +212,12 @@ TEST_CASE("the undamped chain keeps its energy with the corrector", "[system][fl
   ks::FleetEnergy<double> e = ws.report.energy;
   ks::energy(model, s, e);
   const double e0 = e.total();
+  // An energy not sized for the fleet, or another fleet's state, is refused (not written past).
+  ks::FleetEnergy<double> unsized;
+  CHECK_THROWS_AS(ks::energy(model, s, unsized), kelp::invalid_argument);
+  ks::FleetStated other = s;
+  other.tethers.pop_back();
+  CHECK_THROWS_AS(ks::energy(model, other, e), kelp::invalid_argument);
   const double kinetic0 =
       0.5 * s.vehicles[1].nu.dot(model.vehicle(1).mass_matrix() * s.vehicles[1].nu);
   const ks::FleetInputsd in(model);

@@ -12,8 +12,11 @@
 ///   `<name>.x .y .z`, per tether `<name>.tension_start .tension_end` (the force its ends
 ///   delivered over the step [N]) and `<name>.length` (unstretched [m]);
 /// - `nodes.csv`: at `output.node_rate`, `t,tether,node,x,y,z` for every node of every tether;
-/// - `summary.json`: per vehicle, point mass and tether, the solver, the run's speed.
-/// The ROS 2 bag and the replay page are the pair's only (yet).
+/// - `summary.json`: per vehicle, point mass and tether, the solver, the run's speed;
+/// - `run.mcap` (the scenario's `output.mcap`, the default): the run as a ROS 2 bag with topics
+///   per vehicle and per tether (kelp/sim/ros2/fleet.hpp), every logged sample, the markers at
+///   the node rate.
+/// The replay page and the plots are the pair's only (yet).
 #pragma once
 
 #include <string>
@@ -47,6 +50,16 @@ struct FleetWorld {
 /// a tether shorter than the distance between its ends).
 KELP_SIM_API FleetWorld fleet_world(const Scenario& sc, const std::string& file);
 
+/// \brief The state a fleet run starts from: every tether at its static shape between its ends
+/// (kelp::system::initial_state from the world's start poses), and, when the scenario says so
+/// (`start_with_water`, the default), every body and node moving with the water at t = 0.
+/// `model` is built from `w` (its parameters and environment); `file` names the scenario.
+/// \throws scenario_error naming `/fleet/tethers` when a tether's static shape cannot be found.
+KELP_SIM_API kelp::system::FleetStated fleet_start_state(const kelp::system::FleetModeld& model,
+                                                         kelp::system::FleetWorkspaced& ws,
+                                                         const FleetWorld& w, const Scenario& sc,
+                                                         const std::string& file);
+
 /// \brief What a fleet run did (also in summary.json).
 struct FleetRunSummary {
   double simulated_s = 0;       ///< simulated time [s]
@@ -66,7 +79,8 @@ struct FleetRunSummary {
 };
 
 /// \brief Runs the fleet scenario `sc` closed loop into the directory `out` (created), writing
-/// timeseries.csv, nodes.csv and summary.json. `file` names the scenario.
+/// timeseries.csv, nodes.csv, summary.json and (unless `sc.mcap` is false) run.mcap. `file`
+/// names the scenario.
 /// \throws scenario_error as fleet_world(); kelp::error when a step fails (the outputs so far
 /// are closed whole).
 KELP_SIM_API FleetRunSummary run_fleet(const Scenario& sc, const std::string& file,

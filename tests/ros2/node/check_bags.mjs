@@ -107,6 +107,92 @@ function rotZYX(phi, theta, psi) {
   ];
 }
 
+// A fleet's bag beside its timeseries.csv (columns `<part>.<quantity>`): every vehicle's
+// odometry (position, attitude from the Euler angles, body velocity), every point mass's /tf
+// translation and every tether's end forces (their magnitudes are the CSV's tensions), each
+// logged sample to the CSV's 6 significant digits. Returns the samples compared.
+function checkFleetCsv(file, csv, byTopic) {
+  const rows = readCsv(csv);
+  const head = Object.keys(rows[0] ?? {});
+  const parts = (suffix) => head.filter((h) => h.endsWith(suffix)).map((h) => h.slice(0, -suffix.length));
+  const vehicles = parts(".roll");
+  const tethers = parts(".tension_start");
+  const masses = parts(".x").filter((p) => !vehicles.includes(p));
+  const stamps = [...(byTopic.get("/clock")?.keys() ?? [])];
+  let compared = 0;
+  for (const name of vehicles) {
+    for (const topic of [`/${name}/odom`, `/${name}/imu`]) {
+      if (!byTopic.has(topic)) fail(file, `no messages on ${topic}`);
+    }
+  }
+  for (const name of tethers) {
+    if (!byTopic.has(`/${name}/end_forces`)) fail(file, `no messages on /${name}/end_forces`);
+  }
+  for (const msgs of byTopic.get("/markers")?.values() ?? []) {
+    for (const name of tethers) {
+      const line = msgs[0].markers.find((k) => k.ns === name && k.type === 4);
+      if (!line || line.points.length < 2 || line.colors.length !== line.points.length) {
+        fail(file, `/markers: no LINE_STRIP for tether ${name}`);
+      }
+    }
+  }
+  const one = (topic, ns) => byTopic.get(topic)?.get(ns);
+  for (const r of rows) {
+    let ns = stampNs(r.t);
+    let best = Infinity;
+    for (const s of stamps) {
+      const d = Math.abs(Number(s) * 1e-9 - r.t);
+      if (d < best) [best, ns] = [d, s];
+    }
+    const at = `at t = ${r.t}`;
+    if (!(best <= 6e-6 * Math.max(1, Math.abs(r.t)))) {
+      fail(file, `no sample ${at} (nearest ${best} s away)`);
+      continue;
+    }
+    for (const v of vehicles) {
+      const odom = one(`/${v}/odom`, ns);
+      if (!odom) {
+        fail(file, `/${v}/odom: nothing ${at}`);
+        continue;
+      }
+      const o = odom[0];
+      if (o.header.frame_id !== "world" || o.child_frame_id !== `${v}/base_link`) {
+        fail(file, `/${v}/odom frames ${o.header.frame_id} → ${o.child_frame_id}`);
+      }
+      csvNear(file, `/${v}/odom position ${at}`, v3(o.pose.pose.position),
+        enu([r[`${v}.x`], r[`${v}.y`], r[`${v}.z`]]));
+      const R = rotZYX(r[`${v}.roll`], r[`${v}.pitch`], r[`${v}.yaw`]);
+      const q = o.pose.pose.orientation;
+      near(file, `/${v}/odom orientation ${at}`, rot(q.w, q.x, q.y, q.z).flat(),
+        mul(mul(ENU_NED, R), FRD_FLU).flat(), 3e-5);
+      csvNear(file, `/${v}/odom twist ${at}`, v3(o.twist.twist.linear),
+        flu([r[`${v}.u`], r[`${v}.v`], r[`${v}.w`]]));
+    }
+    const tf = one("/tf", ns)?.[0]?.transforms ?? [];
+    for (const p of masses) {
+      const k = tf.find((x) => x.child_frame_id === p);
+      if (!k) {
+        fail(file, `/tf: no ${p} ${at}`);
+        continue;
+      }
+      csvNear(file, `/tf ${p} ${at}`, v3(k.transform.translation),
+        enu([r[`${p}.x`], r[`${p}.y`], r[`${p}.z`]]));
+    }
+    for (const l of tethers) {
+      const w = one(`/${l}/end_forces`, ns);
+      if (!w || w.length !== 2) {
+        fail(file, `/${l}/end_forces: not two ends ${at}`);
+        continue;
+      }
+      csvNear(file, `/${l}/end_forces |force| ${at}`,
+        w.map((x) => Math.hypot(...v3(x.wrench.force))), [r[`${l}.tension_start`], r[`${l}.tension_end`]]);
+    }
+    compared++;
+  }
+  if (compared === 0) fail(file, "timeseries.csv: nothing compared");
+  return compared;
+}
+
 async function checkBag(file) {
   const buf = fs.readFileSync(file);
   const bytes = new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
@@ -146,7 +232,8 @@ async function checkBag(file) {
     const msg = d.reader.readMessage(m.data);
     if (d.reader.lastReadHadTrailingBytes()) fail(file, `${d.topic}: trailing bytes`);
     const stamp = d.topic === "/clock" ? msg.clock : d.topic === "/tf" ? msg.transforms[0].header.stamp
-      : d.topic === "/tether/markers" ? msg.markers[0].header.stamp : msg.header.stamp;
+      : d.topic === "/tether/markers" || d.topic === "/markers" ? msg.markers[0].header.stamp
+      : msg.header.stamp;
     const ns = BigInt(stamp.sec) * 1000000000n + BigInt(stamp.nanosec);
     if (ns !== m.logTime) fail(file, `${d.topic}: stamp ${ns} != log time ${m.logTime}`);
     if (!byTopic.has(d.topic)) byTopic.set(d.topic, new Map());
@@ -164,8 +251,11 @@ async function checkBag(file) {
   for (let r; (r = stream.nextRecord()); ) if (r.type === "Message") streamed++;
   if (!stream.done()) fail(file, "stream reader did not reach the end");
   if (streamed !== count) fail(file, `stream read ${streamed} messages, indexed ${count}`);
-  for (const topic of ["/clock", "/tf", "/boat/odom", "/rov/odom", "/rov/imu", "/tether/end_forces",
-    "/tether/markers", "/rov/thrusters", "/boat/thrusters"]) {
+  // A fleet's bag (kelp/sim/ros2/fleet.hpp) has one /markers topic and topics per part.
+  const fleet = byTopic.has("/markers");
+  for (const topic of fleet ? ["/clock", "/tf", "/markers"] : ["/clock", "/tf", "/boat/odom",
+    "/rov/odom", "/rov/imu", "/tether/end_forces", "/tether/markers", "/rov/thrusters",
+    "/boat/thrusters"]) {
     if (!byTopic.has(topic)) fail(file, `no messages on ${topic}`);
   }
   for (const msgs of byTopic.get("/tether/markers")?.values() ?? []) {
@@ -234,6 +324,8 @@ async function checkBag(file) {
       compared++;
     }
     if (compared === 0) fail(file, "reference.csv: nothing compared");
+  } else if (fleet && fs.existsSync(path.join(dir, "timeseries.csv"))) {
+    compared = checkFleetCsv(file, path.join(dir, "timeseries.csv"), byTopic);
   } else if (fs.existsSync(path.join(dir, "timeseries.csv"))) {
     // The CSV's times have 6 significant digits too: each row takes the nearest stamp within that.
     const stamps = [...(byTopic.get("/rov/odom")?.keys() ?? [])];

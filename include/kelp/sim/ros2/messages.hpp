@@ -418,6 +418,7 @@ struct Marker {
       "texture\nUVCoordinate[] uv_coordinates\nstring text\nstring mesh_resource\nMeshFile "
       "mesh_file\nbool mesh_use_embedded_materials\n";
   static constexpr std::int32_t CUBE = 1;        ///< a box of size `scale`
+  static constexpr std::int32_t SPHERE = 2;      ///< an ellipsoid of diameters `scale`
   static constexpr std::int32_t LINE_STRIP = 4;  ///< a polyline through `points`
   static constexpr std::int32_t ADD = 0;         ///< add or replace (ns, id)
   std_msgs::Header header;                       ///< frame of `pose`
