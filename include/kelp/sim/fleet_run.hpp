@@ -13,7 +13,9 @@
 ///   delivered over the step [N]) and `<name>.length` (unstretched [m]);
 /// - `nodes.csv`: at `output.node_rate`, `t,tether,node,x,y,z` for every node of every tether;
 /// - `summary.json`: per vehicle, point mass and tether, the solver, the run's speed.
-/// The ROS 2 bag and the replay page are the pair's only (yet).
+/// The ROS 2 bag is the pair's only (yet); kelp-tethered-pair writes the replay page of every
+/// vehicle and tether from these files (kelp/sim/replay.hpp; summary.json also echoes the
+/// scenario as run and each vehicle's hull for it).
 #pragma once
 
 #include <string>
