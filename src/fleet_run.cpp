@@ -482,6 +482,11 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     v["final_position_m"] = {x.position.x(), x.position.y(), x.position.z()};
     if (std::isfinite(s.rms_position_error[std::size_t(i)]))
       v["rms_position_error_m"] = s.rms_position_error[std::size_t(i)];
+    // The hull box as loaded (file or preset): what the replay draws (kelp/sim/replay.hpp).
+    if (const auto& h = w.vehicles[std::size_t(i)].hull)
+      v["hull"] = {
+          {"center_m", {h->center.x(), h->center.y(), h->center.z()}},
+          {"half_extents_m", {h->half_extents.x(), h->half_extents.y(), h->half_extents.z()}}};
     j["vehicles"][f.vehicles[std::size_t(i)].name] = v;
   }
   for (std::size_t i = 0; i < f.point_masses.size(); ++i) {
@@ -502,6 +507,9 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
                         {"newton_iterations_per_step_max", s.newton_max},
                         {"retried_steps", s.retried_steps},
                         {"explicit_fallbacks", s.explicit_fallbacks}};
+  // The scenario as run, every field (as the pair's summary echoes it in `scenario`): what the
+  // replay rebuilds the sea and the fleet from when the scenario file is gone or changed.
+  j["scenario_echo"] = nlohmann::json::parse(scenario_json(sc));
   std::ofstream(fs::path(out) / "summary.json") << j.dump(2) << '\n';
   return s;
 }

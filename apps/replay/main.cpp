@@ -1,5 +1,5 @@
 // kelp-replay: the 3-D replay (replay.html, docs/replay.md) of an existing run directory:
-// kelp-tethered-pair's, kelp-sitl's, or a kelp-sweep run kept with --keep-series
+// kelp-tethered-pair's (a fleet's too), kelp-sitl's, or a kelp-sweep run kept with --keep-series
 // (<sweep>/runs/<hash>/). Reads timeseries.csv, nodes.csv and summary.json; writes replay.html
 // into the directory (or --out), or with --json the replay data alone.
 #include <CLI/CLI.hpp>

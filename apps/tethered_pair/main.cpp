@@ -18,6 +18,7 @@
 #include "common/progress.hpp"
 #include "common/replay_template.hpp"
 #include "kelp/sim/fleet_run.hpp"
+#include "kelp/sim/replay.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 
@@ -61,6 +62,14 @@ int run_fleet(const Options& o) {
       "kelp-tethered-pair: tether solver: %.2f Newton iterations per step on average, at most %d "
       "in one step; %ld retried steps, %ld explicit fallbacks\n",
       s.newton_mean, s.newton_max, s.retried_steps, s.explicit_fallbacks);
+  // The 3-D replay of every vehicle and tether, from the run directory (as the pair's).
+  const std::string page = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+  if (page.empty())
+    std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
+                 kelp_apps::replay_template_missing_note().c_str());
+  else
+    std::printf("kelp-tethered-pair: the 3-D replay: %s\n",
+                kelp::sim::write_replay(o.out, page).c_str());
   return 0;
 }
 

@@ -1,19 +1,25 @@
 // The 3-D replay's data (kelp/sim/replay.hpp): a run's replay data holds what the run logged
-// (vehicle poses, the tether's nodes and segment tensions), the sea exactly as kelp evaluates it,
-// survives the trip through the page's script element, stays small for a long run, and a
-// directory that is not a run is refused clearly.
+// (vehicle poses, the tether's nodes and segment tensions; a fleet's every vehicle, point mass,
+// anchor and tether), the sea exactly as kelp evaluates it, survives the trip through the page's
+// script element, stays small for a long run, and a directory that is not a run is refused
+// clearly.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "kelp/core/constants.hpp"
 #include "kelp/sim/closed_loop.hpp"
+#include "kelp/sim/fleet_run.hpp"
 #include "kelp/sim/replay.hpp"
 #include "kelp/sim/run_log.hpp"
+#include "kelp/sim/scenario.hpp"
 #include "kelp/tether/failure.hpp"
 #include "sim_test_support.hpp"
 
@@ -342,4 +348,183 @@ TEST_CASE("a run kept by kelp-sweep is told from its place in the sweep", "[repl
   const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK(html == ks::replay_html(tmpl, ks::replay_data_json(src, o)));
   CHECK(parse_script(html.substr(14, html.size() - 14 - 16))["title"] == "given");
+}
+
+namespace {
+
+// A CSV file as text cells (the fleet's nodes.csv has the tether's name in a column).
+std::vector<std::vector<std::string>> csv_cells(const fs::path& file) {
+  std::ifstream in(file);
+  REQUIRE(in);
+  std::vector<std::vector<std::string>> rows;
+  std::string line, cell;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::vector<std::string> row;
+    while (std::getline(ss, cell, ',')) row.push_back(cell);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("a fleet run's replay data holds every vehicle, point mass, anchor and tether as logged",
+          "[replay][fleet]") {
+  // The shipped ship - umbilical - TMS - tether - ROV (an anchor, a point mass, a winch that
+  // re-meshes its line) for 10 s, with a second ROV from a vehicle file (no model of its own on
+  // the page: its hull box) hanging free on no line.
+  const std::string file = std::string(KELP_SCENARIO_DIR) + "/ship_tms_rov.json";
+  ks::Scenario sc = ks::load_scenario(file);
+  sc.duration = 10;
+  ks::FleetVehicleScenario extra;
+  extra.name = "rov_file";
+  extra.vehicle = std::string(KELP_VEHICLE_DIR) + "/bluerov2_heavy.json";
+  extra.start = kelp::Vector3<double>(-6, 4, 30);
+  sc.fleet->vehicles.push_back(extra);
+  const fs::path dir = fresh_dir("test_replay_fleet");
+  ks::run_fleet(sc, file, dir.string());
+  const json d = replay_data(dir);
+  CHECK(d["format"] == "kelp-replay");
+  CHECK(d["version"] == 2);  // not the pair's version 1: no boat, no ROV, no single tether
+  CHECK(d["source"] == "kelp-tethered-pair");
+  CHECK(d["frame"] == "NED");
+  CHECK(d["duration"].get<double>() == Approx(10.0));
+  CHECK_THAT(d["title"].get<std::string>(), Catch::Contains("ship_tms_rov.json"));
+
+  // The time series against timeseries.csv, column by column.
+  const auto ts = csv_cells(dir / "timeseries.csv");
+  REQUIRE(ts.size() == 102);  // the header, 10 s at 10 Hz and t = 0
+  const auto column = [&](const std::string& name) {
+    const auto& h = ts.front();
+    const auto it = std::find(h.begin(), h.end(), name);
+    REQUIRE(it != h.end());
+    std::vector<double> v;
+    for (std::size_t r = 1; r < ts.size(); ++r)
+      v.push_back(std::stod(ts[r][static_cast<std::size_t>(it - h.begin())]));
+    return v;
+  };
+  const auto same = [&](const json& a, const std::vector<double>& logged, double margin,
+                        const std::string& what) {
+    INFO(what);
+    REQUIRE(a.size() == logged.size());
+    for (std::size_t i = 0; i < logged.size(); ++i)
+      CHECK(a[i].get<double>() == Approx(logged[i]).margin(margin));
+  };
+  same(d["series"]["t"], column("t"), 1e-6, "t");
+
+  // Every vehicle: name, model, hull box and pose (positions to 1 mm, angles to 1e-4 rad).
+  REQUIRE(d["vehicles"].size() == 2);
+  const auto hull = kelp::system::bluerov2_heavy_hull<double>();
+  for (const json& v : d["vehicles"]) {
+    const std::string name = v["name"];
+    CHECK(v["model"] == (name == "rov" ? "bluerov2_heavy" : "box"));
+    REQUIRE(v["hull"].is_object());  // the preset's, and the vehicle file's from the summary
+    for (int k = 0; k < 3; ++k)
+      CHECK(v["hull"]["half_extents"][k].get<double>() == hull.half_extents(k));
+    const char* ned[] = {"n", "e", "d"};
+    const char* xyz[] = {".x", ".y", ".z"};
+    for (int k = 0; k < 3; ++k) same(v[ned[k]], column(name + xyz[k]), 6e-4, name + xyz[k]);
+    for (const char* a : {"roll", "pitch", "yaw"}) same(v[a], column(name + "." + a), 6e-5, a);
+  }
+  CHECK(d["vehicles"][0]["waypoints"].size() == 6);  // the survey's
+  CHECK(d["vehicles"][1]["waypoints"].empty());      // no controller
+
+  // The point mass: a sphere of its 0.5 m³, where it was.
+  REQUIRE(d["point_masses"].size() == 1);
+  const json& tms = d["point_masses"][0];
+  CHECK(tms["name"] == "tms");
+  CHECK(tms["diameter"].get<double>() == Approx(std::cbrt(6 * 0.5 / kelp::pi)).margin(6e-4));
+  same(tms["n"], column("tms.x"), 6e-4, "tms.x");
+  same(tms["e"], column("tms.y"), 6e-4, "tms.y");
+  same(tms["d"], column("tms.z"), 6e-4, "tms.z");
+
+  // The anchor: the ship's sheave.
+  REQUIRE(d["anchors"].size() == 1);
+  CHECK(d["anchors"][0]["name"] == "ship");
+  CHECK(d["anchors"][0]["position"] == json::array({0.0, 0.0, -8.0}));
+
+  // Every tether: its ends, end forces, length, and every node of every snapshot of nodes.csv.
+  REQUIRE(d["tethers"].size() == 2);
+  const auto nodes = csv_cells(dir / "nodes.csv");
+  REQUIRE(nodes.front() == std::vector<std::string>{"t", "tether", "node", "x", "y", "z"});
+  double largest = 0;
+  for (const json& l : d["tethers"]) {
+    const std::string name = l["name"];
+    CHECK(l["from"] == (name == "umbilical" ? "ship" : "tms"));
+    CHECK(l["to"] == (name == "umbilical" ? "tms" : "rov"));
+    for (const std::string c : {"tension_start", "tension_end"}) {
+      same(l[c], column(name + "." + c), 6e-3, name + "." + c);
+      for (double v : column(name + "." + c)) largest = std::max(largest, v);
+    }
+    same(l["length"], column(name + ".length"), 6e-4, name + ".length");
+    // nodes.csv's rows of this line, snapshot by snapshot
+    std::vector<double> times;
+    std::vector<std::vector<double>> snapshots;
+    for (std::size_t r = 1; r < nodes.size(); ++r) {
+      if (nodes[r][1] != name) continue;
+      if (nodes[r][2] == "0") {
+        times.push_back(std::stod(nodes[r][0]));
+        snapshots.emplace_back();
+      }
+      for (int k = 3; k < 6; ++k) snapshots.back().push_back(std::stod(nodes[r][std::size_t(k)]));
+    }
+    REQUIRE(times.size() == 11);  // 1 Hz
+    same(l["nodes"]["t"], times, 1e-6, name + " snapshot times");
+    REQUIRE(l["nodes"]["position"].size() == snapshots.size());
+    for (std::size_t k = 0; k < snapshots.size(); ++k)
+      same(l["nodes"]["position"][k], snapshots[k], 6e-4, name + " nodes");
+    // The umbilical hangs from the anchor to the TMS: its first node at the sheave, its last at
+    // the TMS's logged position (a snapshot every tenth log row).
+    if (name == "umbilical") {
+      const json& last = l["nodes"]["position"].back();
+      const std::size_t n = last.size();
+      CHECK(last[0].get<double>() == Approx(0.0).margin(1e-3));
+      CHECK(last[2].get<double>() == Approx(-8.0).margin(1e-3));
+      CHECK(last[n - 1].get<double>() == Approx(column("tms.z").back()).margin(1e-3));
+    } else {  // the winch paid out 2 m: 4 more nodes of 0.5 m
+      CHECK(l["nodes"]["position"].back().size() > l["nodes"]["position"].front().size());
+    }
+  }
+  CHECK(d["tension_scale"]["max"].get<double>() >= largest);
+  CHECK(d["tension_scale"]["max"].get<double>() <= largest + 0.01 + 1e-9);
+
+  // The sea: the rough sea's components, kelp's own elevation samples match the formula; no
+  // seabed, no obstacles in this scenario.
+  CHECK(d["waves"]["components"]["amplitude"].size() > 10);
+  REQUIRE(d["elevation_check"].size() == 50);
+  for (const json& e : d["elevation_check"])
+    CHECK(page_elevation(d["waves"], e[0], e[1], e[2]) == Approx(e[3].get<double>()).margin(1e-9));
+  CHECK(d["seabed"].is_null());
+  CHECK(d["obstacles"].empty());
+
+  // An older fleet summary without the echoed scenario reads the scenario file it names, and
+  // says what is missing when that file is gone.
+  json summary;
+  std::ifstream(dir / "summary.json") >> summary;
+  summary.erase("scenario_echo");
+  summary["scenario"] = (dir / "gone.json").string();
+  std::ofstream(dir / "summary.json") << summary.dump(2);
+  CHECK_THROWS_AS(replay_data(dir), ks::replay_error);
+  CHECK_THROWS_WITH(replay_data(dir), Catch::Contains("scenario_echo") &&
+                                          Catch::Contains("gone.json cannot be read"));
+}
+
+TEST_CASE("a fleet's seabed and obstacles are the scenario's", "[replay][fleet]") {
+  const std::string file = std::string(KELP_SCENARIO_DIR) + "/boat_two_rovs.json";
+  ks::Scenario sc = ks::load_scenario(file);
+  sc.duration = 2;
+  const fs::path dir = fresh_dir("test_replay_fleet_piles");
+  ks::run_fleet(sc, file, dir.string());
+  const json d = replay_data(dir);
+  REQUIRE(d["vehicles"].size() == 3);
+  CHECK(d["vehicles"][0]["model"] == "blueboat");
+  CHECK(d["vehicles"][0]["hull"]["half_extents"][0].get<double>() == 0.6);
+  CHECK(d["point_masses"].empty());
+  CHECK(d["anchors"].empty());
+  CHECK(d["tethers"].size() == 2);
+  CHECK(d["seabed"]["depth"].get<double>() == 20.0);
+  REQUIRE(d["obstacles"].size() == 2);
+  CHECK(d["obstacles"][0]["type"] == "cylinder");
+  CHECK(d["obstacles"][0]["name"] == "pile_a");
 }

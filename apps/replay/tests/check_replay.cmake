@@ -48,6 +48,35 @@ if(NOT rc EQUAL 0 OR NOT format STREQUAL "kelp-replay" OR NOT version EQUAL 1
                       "${samples} samples (expected 201 at 10 Hz over 20 s):\n${err}")
 endif()
 
+# A fleet's run: kelp-tethered-pair writes its replay.html (data version 2), kelp-replay the same
+# page again, and its data alone.
+execute_process(COMMAND "${PAIR}" --scenario "${SCENARIOS}/rov_docking.json" --duration 10 --quiet
+                        --out "${OUT}/fleet"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS "${OUT}/fleet/replay.html")
+  message(FATAL_ERROR "kelp-tethered-pair wrote no replay.html for a fleet (${rc}):\n${out}\n${err}")
+endif()
+file(SHA256 "${OUT}/fleet/replay.html" fleet_first)
+file(REMOVE "${OUT}/fleet/replay.html")
+execute_process(COMMAND "${REPLAY}" "${OUT}/fleet" RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+file(SHA256 "${OUT}/fleet/replay.html" fleet_second)
+if(NOT rc EQUAL 0 OR NOT fleet_first STREQUAL fleet_second)
+  message(FATAL_ERROR "kelp-replay on a fleet's run (${rc}): another page than the run's:\n${err}")
+endif()
+execute_process(COMMAND "${REPLAY}" "${OUT}/fleet" --json "${OUT}/fleet.json" RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+file(READ "${OUT}/fleet.json" data)
+string(JSON version GET "${data}" version)
+string(JSON vehicle GET "${data}" vehicles 0 name)
+string(JSON anchor GET "${data}" anchors 0 name)
+string(JSON rope GET "${data}" tethers 0 name)
+if(NOT rc EQUAL 0 OR NOT version EQUAL 2 OR NOT vehicle STREQUAL "rov" OR NOT anchor STREQUAL "dock"
+   OR NOT rope STREQUAL "tether")
+  message(FATAL_ERROR "kelp-replay --json on a fleet: rc ${rc}, version ${version}, vehicle "
+                      "${vehicle}, anchor ${anchor}, tether ${rope}:\n${err}")
+endif()
+
 # Not a run directory: a clear error naming the missing file, nothing written.
 file(MAKE_DIRECTORY "${OUT}/not-a-run")
 file(WRITE "${OUT}/not-a-run/notes.txt" "hello\n")

@@ -12,11 +12,13 @@
 ///   `<name>.x .y .z`, per tether `<name>.tension_start .tension_end` (the force its ends
 ///   delivered over the step [N]) and `<name>.length` (unstretched [m]);
 /// - `nodes.csv`: at `output.node_rate`, `t,tether,node,x,y,z` for every node of every tether;
-/// - `summary.json`: per vehicle, point mass and tether, the solver, the run's speed;
+/// - `summary.json`: per vehicle, point mass and tether, the solver, the run's speed (it also
+///   echoes the scenario as run and each vehicle's hull, for the replay);
 /// - `run.mcap` (the scenario's `output.mcap`, the default): the run as a ROS 2 bag with topics
 ///   per vehicle and per tether (kelp/sim/ros2/fleet.hpp), every logged sample, the markers at
 ///   the node rate.
-/// The replay page and the plots are the pair's only (yet).
+/// kelp-tethered-pair then writes the replay page of every vehicle and tether from these files
+/// (kelp/sim/replay.hpp). The plots are the pair's only (yet).
 #pragma once
 
 #include <string>

@@ -3,9 +3,11 @@
 /// summary.json) as the JSON the replay page reads, and replay.html, the page's template with
 /// that data inlined (one file that opens in a browser from file://, no network).
 ///
-/// The data's format ("kelp-replay", version 1) is documented in docs/replay.md. The sea is not
+/// The data's format ("kelp-replay": version 1 for the tethered pair, version 2 for a fleet run's
+/// vehicles, point masses, anchors and tethers) is documented in docs/replay.md. The sea is not
 /// recorded in the run's files: it is rebuilt from the scenario the summary echoes
-/// (world_setup()), and its wave components are exported with the formula kelp evaluates
+/// (world_setup(); a fleet's summary echoes it as `scenario_echo`), and its wave components are
+/// exported with the formula kelp evaluates
 /// (environment::Environment::surface_elevation):
 /// \f[ \zeta(x, y, t) = r(t) \sum_j a_j \cos\big(k_j (x\cos\beta_j + y\sin\beta_j) - \omega_j t
 ///     + \varphi_j\big) \f]
@@ -52,15 +54,19 @@ struct ReplayOptions {
 KELP_SIM_API double replay_ramp(double t, double ramp);
 
 /// \brief The replay data ("kelp-replay" version 1, docs/replay.md) of the run in `dir`, as JSON
-/// text (compact, as replay_script() inlines it):
+/// text (compact, as replay_script() inlines it). A fleet run's directory (kelp/sim/fleet_run.hpp,
+/// told by its summary) gives version 2: every vehicle's pose and hull box, every point mass,
+/// anchor and tether (its nodes, end forces and length), the sea, seabed and obstacles of the
+/// scenario its summary echoes (`scenario_echo`, else the scenario file it names). The pair's:
 /// timeseries.csv (vehicles, target, errors, thrusts, commands, end tensions at the log rate),
 /// nodes.csv (the tether's nodes and, when logged, its segment tensions at the node rate),
 /// summary.json (its `scenario` rebuilds the sea: wave components, ramp, `elevation_check`; the
 /// waypoints; obstacles and a seabed when the scenario has them). Display data is rounded
 /// (positions to 1 mm, angles to 1e-4 rad, tensions, thrusts and errors to 0.01, commands to
 /// 1e-4, times to 1e-6 s); the waves and `elevation_check` keep every digit.
-/// \throws replay_error when `dir` is not a run directory or one of its files cannot be read;
-/// scenario_error when the echoed scenario is refused.
+/// \throws replay_error when `dir` is not a run directory or one of its files cannot be read (a
+/// fleet's: also when neither the echoed scenario nor the scenario file is there, or nodes.csv
+/// names a tether the scenario lacks); scenario_error when the echoed scenario is refused.
 KELP_SIM_API std::string replay_data_json(const std::filesystem::path& dir,
                                           const ReplayOptions& o = {});
 

@@ -1,5 +1,6 @@
 // kelp replay: the 3-D view of one run, from window.KELP_REPLAY_DATA (the replay data, format
-// "kelp-replay" version 1, documented in docs/replay.md) with three.js (window.THREE).
+// "kelp-replay", documented in docs/replay.md: version 1 for the tethered pair, version 2 for any
+// fleet of vehicles, point masses, anchors and tethers) with three.js (window.THREE).
 //
 // Frames: the data is NED (north, east, down) with ZYX roll/pitch/yaw (Fossen, "Handbook of
 // Marine Craft Hydrodynamics and Motion Control", 2nd ed. 2021, eq. 2.18). three.js is y-up; the
@@ -129,7 +130,10 @@
   /// A vehicle's pose at t: NED position and roll, pitch, yaw, linear between log samples (the
   /// angles the short way round).
   function pose(series, key, loc) {
-    const s = series[key];
+    return poseOf(series[key], loc);
+  }
+  /// The same for a body's own arrays s.n, s.e, s.d, s.roll, s.pitch, s.yaw (a fleet's vehicle).
+  function poseOf(s, loc) {
     return {
       n: lerpAt(s.n, loc), e: lerpAt(s.e, loc), d: lerpAt(s.d, loc),
       roll: lerpAngle(s.roll, loc), pitch: lerpAngle(s.pitch, loc), yaw: lerpAngle(s.yaw, loc),
@@ -143,10 +147,11 @@
     if (!nodes || !nodes.t || nodes.t.length === 0) return { position: [], tension: [] };
     const loc = locate(nodes.t, t);
     const p0 = nodes.position[loc.i];
-    const t0 = nodes.tension[loc.i] || [];
+    const tension = nodes.tension || []; // a fleet's lines log no segment tension
+    const t0 = tension[loc.i] || [];
     const p1 = nodes.position[loc.i + 1];
     if (loc.u === 0 || !p1 || p1.length !== p0.length) return { position: p0.slice(), tension: t0.slice() };
-    const t1 = nodes.tension[loc.i + 1] || t0;
+    const t1 = tension[loc.i + 1] || t0;
     return {
       position: p0.map((v, k) => lerp(v, p1[k], loc.u)),
       tension: t0.map((v, k) => lerp(v, t1[k] === undefined ? v : t1[k], loc.u)),
@@ -208,7 +213,11 @@
     if (!THREE) return showMessage('three.js is missing from this page (a build problem).');
     if (!data || data.format !== 'kelp-replay')
       return showMessage('This page holds no kelp replay data (it is the template: kelp-replay DIR makes a replay of a run).');
-    if (data.version !== 1) return showMessage(`Replay data version ${data.version}; this page reads version 1.`);
+    if (data.version !== 1 && data.version !== 2)
+      return showMessage(`Replay data version ${data.version}; this page reads versions 1 (the pair) and 2 (a fleet).`);
+    // Version 2: any fleet (data.vehicles, point_masses, anchors, tethers) instead of the pair's
+    // boat, ROV and tether; the sea, seabed, obstacles, legend and controls are the same.
+    const fleet = data.version === 2;
 
     const series = data.series;
     const nodes = data.nodes || { t: [], position: [], tension: [] };
@@ -225,7 +234,8 @@
     document.getElementById('title').textContent = data.title || data.source || 'kelp run';
 
     // Query: ?t=SECONDS, ?paused=1, ?speed=X, ?camera=follow|underwater|orbit, ?sea=N (grid),
-    // ?aa=0|1 (antialiasing), ?playres=R (pixel ratio while playing; below).
+    // ?aa=0|1 (antialiasing), ?playres=R (pixel ratio while playing; below), ?focus=NAME (a
+    // fleet's vehicle or point mass the underwater camera follows).
     const query = new URLSearchParams(window.location.search);
     const qt = parseFloat(query.get('t'));
     let time = Number.isFinite(qt) ? Math.min(Math.max(qt, tmin), duration) : tmin;
@@ -373,11 +383,51 @@
       return g;
     }
 
-    const boat = makeBoat();
-    const rov = makeRov();
-    for (const o of [boat, rov]) {
+    // The pair's two vehicles (version 1), or a fleet's parts (version 2, below).
+    const boat = fleet ? null : makeBoat();
+    const rov = fleet ? null : makeRov();
+    for (const o of fleet ? [] : [boat, rov]) {
       o.matrixAutoUpdate = false;
       scene.add(o);
+    }
+
+    // A fleet's vehicle with no model of its own (not a preset): its hull box in body axes (a
+    // default 0.5 × 0.5 × 0.25 m box when the run does not know its hull), yellow, its bow dark so
+    // that its heading shows.
+    function makeHullBox(hull) {
+      const h = (hull && hull.half_extents) || [0.25, 0.25, 0.125];
+      const c = (hull && hull.center) || [0, 0, 0];
+      const g = new THREE.Group();
+      g.add(place(new THREE.Mesh(new THREE.BoxGeometry(2 * h[0], 2 * h[2], 2 * h[1]), mat(0xf2c12e)), c[0], -c[2], c[1]));
+      const bow = new THREE.Mesh(new THREE.BoxGeometry(0.2 * h[0], 2.02 * h[2], 2.02 * h[1]), mat(0x202428));
+      g.add(place(bow, c[0] + 0.9 * h[0], -c[2], c[1]));
+      return g;
+    }
+    // An anchor is a fixed point: a marker drawn a few pixels wide at least (its scale follows the
+    // camera's distance, as the tether's width does).
+    const anchorRadius = 0.25;
+    const fleetVehicles = [], fleetMasses = [], fleetAnchors = [];
+    if (fleet) {
+      for (const v of data.vehicles || []) {
+        const obj = v.model === 'bluerov2_heavy' ? makeRov() : v.model === 'blueboat' ? makeBoat() : makeHullBox(v.hull);
+        obj.matrixAutoUpdate = false;
+        scene.add(obj);
+        fleetVehicles.push({ data: v, obj, pose: poseOf(v, { i: 0, u: 0 }) });
+      }
+      const massMat = mat(0xe0702a);
+      for (const m of data.point_masses || []) {
+        const obj = new THREE.Mesh(new THREE.SphereGeometry(Math.max(m.diameter, 0.05) / 2, 16, 10), massMat);
+        scene.add(obj);
+        fleetMasses.push({ data: m, obj, at: { n: NaN, e: NaN, d: NaN } });
+      }
+      const anchorGeom = new THREE.OctahedronGeometry(anchorRadius, 0);
+      const anchorMat = mat(0xb03a2e);
+      for (const a of data.anchors || []) {
+        const obj = new THREE.Mesh(anchorGeom, anchorMat);
+        obj.position.copy(toScene(a.position[0], a.position[1], a.position[2]));
+        scene.add(obj);
+        fleetAnchors.push({ data: a, obj });
+      }
     }
 
     // -- sea surface: a grid around what the camera looks at, heights from makeWaves --
@@ -454,7 +504,13 @@
       // No seabed: deep water far below, so that the sea seen through its surface is dark
       // rather than the sky's colour.
       let deepest = 0;
-      for (const k of ['rov', 'boat']) for (const d of series[k].d) deepest = Math.max(deepest, num(d) || 0);
+      if (fleet) {
+        const tracks = fleetVehicles.map((v) => v.data.d).concat(fleetMasses.map((m) => m.data.d),
+          fleetAnchors.map((a) => [a.data.position[2]]));
+        for (const track of tracks) for (const d of track) deepest = Math.max(deepest, num(d) || 0);
+      } else {
+        for (const k of ['rov', 'boat']) for (const d of series[k].d) deepest = Math.max(deepest, num(d) || 0);
+      }
       const abyss = new THREE.Mesh(new THREE.PlaneGeometry(6000, 6000), new THREE.MeshBasicMaterial({ color: 0x0b3048 }));
       abyss.rotation.x = -Math.PI / 2;
       abyss.position.y = -(deepest + 25);
@@ -502,9 +558,10 @@
       }
     }
 
-    // -- waypoints and the ROV's target --
-    const wps = (data.waypoints || []).map((w) => toScene(w[0], w[1], w[2]));
-    if (wps.length) {
+    // -- waypoints (the ROV's; each of a fleet's vehicles its own) and the ROV's target --
+    function drawWaypoints(list) {
+      const wps = (list || []).map((w) => toScene(w[0], w[1], w[2]));
+      if (!wps.length) return;
       const wpMat = new THREE.MeshBasicMaterial({ color: 0xf27ee6 });
       const sphere = new THREE.SphereGeometry(0.08, 8, 6);
       for (const p of wps) scene.add(place(new THREE.Mesh(sphere, wpMat), p.x, p.y, p.z));
@@ -513,6 +570,8 @@
       line.computeLineDistances();
       scene.add(line);
     }
+    if (fleet) for (const v of fleetVehicles) drawWaypoints(v.data.waypoints);
+    else drawWaypoints(data.waypoints);
     const target = new THREE.Mesh(new THREE.OctahedronGeometry(0.22, 0), new THREE.MeshBasicMaterial({ color: 0x4cff7a, wireframe: true }));
     scene.add(target);
 
@@ -523,23 +582,26 @@
     // (tetherWidth scales the radius, set from the camera's distance each frame).
     const tetherRadius = 0.025;
     let tetherWidth = 1;
-    const tether = new THREE.InstancedMesh(new THREE.CylinderGeometry(tetherRadius, tetherRadius, 1, 6, 1, true),
-      new THREE.MeshBasicMaterial({ color: 0xffffff, fog: false }), maxSegments); // its colour is data: no fog
-    tether.frustumCulled = false;
-    tether.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
-    tether.setColorAt(0, new THREE.Color(0xffffff)); // creates instanceColor
-    scene.add(tether);
+    function makeLineMesh(segments) {
+      const m = new THREE.InstancedMesh(new THREE.CylinderGeometry(tetherRadius, tetherRadius, 1, 6, 1, true),
+        new THREE.MeshBasicMaterial({ color: 0xffffff, fog: false }), segments); // its colour is data: no fog
+      m.frustumCulled = false;
+      m.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+      m.setColorAt(0, new THREE.Color(0xffffff)); // creates instanceColor
+      scene.add(m);
+      return m;
+    }
+    const tether = fleet ? null : makeLineMesh(maxSegments);
     const up = new THREE.Vector3(0, 1, 0);
     const tmpA = new THREE.Vector3(), tmpB = new THREE.Vector3(), tmpD = new THREE.Vector3();
     const tmpQ = new THREE.Quaternion(), tmpS = new THREE.Vector3(), tmpM = new THREE.Matrix4(), tmpC = new THREE.Color();
     const segColours = []; // hex of each segment's colour at the current time
     let tetherNow = { position: [], tension: [] };
-    function updateTether(t) {
-      tetherNow = tetherAt(nodes, t);
-      const p = tetherNow.position;
+    // The segments of a line through nodes p (flat n, e, d), segment s in the colour of the
+    // tension tensionOf(s) [N].
+    function drawLine(mesh, p, tensionOf) {
       const count = Math.max(0, p.length / 3 - 1);
-      tether.count = count;
-      segColours.length = count;
+      mesh.count = count;
       for (let s = 0; s < count; ++s) {
         tmpA.set(p[3 * s], -p[3 * s + 2], p[3 * s + 1]);
         tmpB.set(p[3 * s + 3], -p[3 * s + 5], p[3 * s + 4]);
@@ -548,13 +610,37 @@
         if (len > 0) tmpQ.setFromUnitVectors(up, tmpD.divideScalar(len));
         tmpS.set(tetherWidth, Math.max(len, 1e-6), tetherWidth);
         tmpM.compose(tmpA.add(tmpB).multiplyScalar(0.5), tmpQ, tmpS);
-        tether.setMatrixAt(s, tmpM);
-        const rgb = tensionColour(num(tetherNow.tension[s]));
-        segColours[s] = hex(rgb);
-        tether.setColorAt(s, tmpC.setRGB(rgb[0] / 255, rgb[1] / 255, rgb[2] / 255, THREE.SRGBColorSpace));
+        mesh.setMatrixAt(s, tmpM);
+        const rgb = tensionColour(tensionOf(s));
+        if (mesh === tether) segColours[s] = hex(rgb);
+        mesh.setColorAt(s, tmpC.setRGB(rgb[0] / 255, rgb[1] / 255, rgb[2] / 255, THREE.SRGBColorSpace));
       }
-      tether.instanceMatrix.needsUpdate = true;
-      if (tether.instanceColor) tether.instanceColor.needsUpdate = true;
+      mesh.instanceMatrix.needsUpdate = true;
+      if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
+    }
+    function updateTether(t) {
+      tetherNow = tetherAt(nodes, t);
+      segColours.length = Math.max(0, tetherNow.position.length / 3 - 1);
+      drawLine(tether, tetherNow.position, (s) => num(tetherNow.tension[s]));
+    }
+    // A fleet's lines. Their segments' tensions are not logged (only the force at each end): a
+    // segment's colour is the tension interpolated linearly between the two end forces by its
+    // index along the line, which is the hanging line's own tension when its weight dominates
+    // (the tension of a hanging line changes linearly with depth) and an estimate otherwise.
+    const fleetLines = (fleet ? data.tethers || [] : []).map((l) => {
+      let most = 1;
+      for (const p of (l.nodes && l.nodes.position) || []) most = Math.max(most, p.length / 3 - 1);
+      return { data: l, mesh: makeLineMesh(most), now: { position: [], tension: [] }, ends: [NaN, NaN] };
+    });
+    function updateFleetLines(t, loc) {
+      for (const l of fleetLines) {
+        l.now = tetherAt(l.data.nodes, t);
+        const a = lerpAt(l.data.tension_start, loc), b = lerpAt(l.data.tension_end, loc);
+        const count = Math.max(0, l.now.position.length / 3 - 1);
+        l.ends = [a, b];
+        l.now.tension = Array.from({ length: count }, (_, s) => a + ((b - a) * (s + 0.5)) / count);
+        drawLine(l.mesh, l.now.position, (s) => num(l.now.tension[s]));
+      }
     }
 
     // -- legend: drawn from the same colour map --
@@ -583,7 +669,7 @@
     // -- HUD --
     const $ = (id) => document.getElementById(id);
     const thrusterBars = [];
-    {
+    if (!fleet) {
       const box = $('hud-thrusters');
       const names = ['boat P', 'boat S', 'rov 1', 'rov 2', 'rov 3', 'rov 4', 'rov 5', 'rov 6', 'rov 7', 'rov 8'];
       for (const name of names) {
@@ -602,12 +688,80 @@
     }
     const fmt = (v, digits, unit) => (Number.isFinite(v) ? `${v.toFixed(digits)} ${unit}` : '–');
     const labels = {};
-    for (const [key, text] of [['boat', 'BlueBoat'], ['rov', 'BlueROV2 Heavy']]) {
+    for (const [key, text] of fleet ? [] : [['boat', 'BlueBoat'], ['rov', 'BlueROV2 Heavy']]) {
       const el = document.createElement('div');
       el.className = 'label';
       el.textContent = text;
       $('labels').appendChild(el);
       labels[key] = el;
+    }
+    // A fleet's HUD: the pair's table and thruster bars give way to a row per vehicle and point
+    // mass (depth) and per line (unstretched length, force at each end); a label on every part.
+    const fleetCells = { bodies: [], lines: [] };
+    const fleetLabels = [];
+    if (fleet) {
+      // (style, not the hidden attribute, which the stylesheet's display: grid would override)
+      $('hud-thrusters').style.display = 'none';
+      if ($('hud-thrusters').previousElementSibling) $('hud-thrusters').previousElementSibling.style.display = 'none';
+      const table = $('hud-table');
+      table.textContent = '';
+      const row = (cells, tag) => {
+        const tr = document.createElement('tr');
+        const out = cells.map((text) => {
+          const c = document.createElement(tag);
+          c.textContent = text;
+          tr.appendChild(c);
+          return c;
+        });
+        table.appendChild(tr);
+        return out;
+      };
+      const bodies = fleetVehicles.concat(fleetMasses);
+      if (bodies.length) row(['', 'depth'], 'th');
+      for (const b of bodies) fleetCells.bodies.push(row([b.data.name, ''], 'td')[1]);
+      if (fleetLines.length) row(['line', 'length', 'start', 'end'], 'th');
+      for (const l of fleetLines) fleetCells.lines.push(row([l.data.name, '', '', ''], 'td').slice(1));
+      const label = (text, at, lift) => {
+        const el = document.createElement('div');
+        el.className = 'label';
+        el.textContent = text;
+        $('labels').appendChild(el);
+        fleetLabels.push({ el, at, lift });
+      };
+      for (const v of fleetVehicles) label(v.data.name, () => v.pose, 0.6);
+      for (const m of fleetMasses) label(m.data.name, () => m.at, m.data.diameter / 2 + 0.3);
+      for (const a of fleetAnchors) {
+        const [n, e, d] = a.data.position;
+        label(a.data.name, () => ({ n, e, d }), 0.5);
+      }
+    }
+    // The part the underwater camera follows: ?focus=NAME (a vehicle or point mass), else the
+    // first vehicle that starts under water, else the first vehicle or point mass.
+    const fleetFocus = (() => {
+      if (!fleet) return null;
+      const bodies = fleetVehicles.concat(fleetMasses);
+      return bodies.find((b) => b.data.name === query.get('focus')) ||
+        fleetVehicles.find((v) => num(v.data.d[0]) > 1) || bodies[0] || null;
+    })();
+    const focusPose = () => {
+      if (!fleetFocus) return { n: 0, e: 0, d: 0, yaw: 0 };
+      return fleetFocus.pose || Object.assign({ yaw: 0 }, fleetFocus.at);
+    };
+    // Where a fleet is: the box around its vehicles, point masses and anchors (the follow camera
+    // keeps it all in the picture).
+    function fleetBox() {
+      const lo = new THREE.Vector3(Infinity, Infinity, Infinity), hi = new THREE.Vector3(-Infinity, -Infinity, -Infinity);
+      const add = (p) => {
+        const v = toScene(p.n, p.e, p.d);
+        if (!Number.isFinite(v.x) || !Number.isFinite(v.y) || !Number.isFinite(v.z)) return;
+        lo.min(v);
+        hi.max(v);
+      };
+      for (const v of fleetVehicles) add(v.pose);
+      for (const m of fleetMasses) add(m.at);
+      for (const a of fleetAnchors) add({ n: a.data.position[0], e: a.data.position[1], d: a.data.position[2] });
+      if (!(lo.x <= hi.x)) return { centre: new THREE.Vector3(), size: 0 };
+      return { centre: lo.clone().add(hi).multiplyScalar(0.5), size: lo.distanceTo(hi) };
     }
 
     // -- camera --
@@ -616,19 +770,29 @@
     const underOffset = { azimuth: 0.35, elevation: -0.3, zoom: 1 };
     let boatPose, rovPose;
     function placeCamera() {
-      const b = toScene(boatPose.n, boatPose.e, boatPose.d);
-      const r = toScene(rovPose.n, rovPose.e, rovPose.d);
       let look, dist, az, el;
       if (cameraMode === 'follow') {
-        look = b.clone().add(r).multiplyScalar(0.5);
-        // both in the picture: the half-separation within the half-height's 27.5° view
-        dist = Math.max(6, 1.25 * b.distanceTo(r) + 4) * followOffset.zoom;
+        if (fleet) {
+          // the whole fleet in the picture, as the pair's two vehicles: the box's diagonal as
+          // their distance
+          const box = fleetBox();
+          look = box.centre;
+          dist = Math.max(6, 1.25 * box.size + 4) * followOffset.zoom;
+        } else {
+          const b = toScene(boatPose.n, boatPose.e, boatPose.d);
+          const r = toScene(rovPose.n, rovPose.e, rovPose.d);
+          look = b.clone().add(r).multiplyScalar(0.5);
+          // both in the picture: the half-separation within the half-height's 27.5° view
+          dist = Math.max(6, 1.25 * b.distanceTo(r) + 4) * followOffset.zoom;
+        }
         az = followOffset.azimuth;
         el = followOffset.elevation;
       } else if (cameraMode === 'underwater') {
+        const p = fleet ? focusPose() : rovPose; // a fleet: its focus (?focus=)
+        const r = toScene(p.n, p.e, p.d);
         look = r.clone().add(new THREE.Vector3(0, 1.2, 0)); // the ROV low in the picture, the line above
         dist = 6 * underOffset.zoom;
-        az = Math.PI + rovPose.yaw + underOffset.azimuth; // astern of the ROV
+        az = Math.PI + p.yaw + underOffset.azimuth; // astern of the ROV
         el = underOffset.elevation;
       } else {
         look = orbit.target;
@@ -656,6 +820,7 @@
     let hudTime = -Infinity;
     function update() {
       const loc = locate(series.t, time);
+      if (fleet) return updateFleet(loc);
       boatPose = pose(series, 'boat', loc);
       rovPose = pose(series, 'rov', loc);
       setPose(boat, boatPose);
@@ -667,13 +832,7 @@
       const look = placeCamera();
       tetherWidth = Math.max(1, (0.004 * camera.position.distanceTo(look)) / tetherRadius);
       updateTether(time);
-      const span = cameraMode === 'underwater' ? 80 : Math.min(Math.max(4 * camera.position.distanceTo(look), 60), 500);
-      updateSea(look.x, look.z, span, time);
-      const below = camera.position.y < waves.elevation(camera.position.x, camera.position.z, time);
-      scene.background.copy(below ? deepColour : skyColour);
-      scene.fog.color.copy(below ? deepColour : skyColour);
-      scene.fog.near = below ? 2 : 150;
-      scene.fog.far = below ? 45 : 900;
+      updateSeaAndSky(look);
       // thruster rings
       const rc = series.rov_command[loc.i] ? lerpRow(series.rov_command, loc) : [];
       rov.userData.rings.forEach((ring, k) => {
@@ -681,6 +840,59 @@
         ring.material.color.setHex(!(Math.abs(c) > 0.02) ? 0x777777 : c > 0 ? 0xf08c3c : 0x4aa3df);
       });
       updateHud(loc, rc);
+    }
+    // The sea around where the camera looks, and the sky or the deep behind everything.
+    function updateSeaAndSky(look) {
+      const span = cameraMode === 'underwater' ? 80 : Math.min(Math.max(4 * camera.position.distanceTo(look), 60), 500);
+      updateSea(look.x, look.z, span, time);
+      const below = camera.position.y < waves.elevation(camera.position.x, camera.position.z, time);
+      scene.background.copy(below ? deepColour : skyColour);
+      scene.fog.color.copy(below ? deepColour : skyColour);
+      scene.fog.near = below ? 2 : 150;
+      scene.fog.far = below ? 45 : 900;
+    }
+    // A fleet at `time` (loc: its place in the log): every vehicle at its pose, every point mass
+    // at its position, the camera, the lines, the sea, the HUD.
+    function updateFleet(loc) {
+      for (const v of fleetVehicles) {
+        v.pose = poseOf(v.data, loc);
+        setPose(v.obj, v.pose);
+      }
+      for (const m of fleetMasses) {
+        m.at = { n: lerpAt(m.data.n, loc), e: lerpAt(m.data.e, loc), d: lerpAt(m.data.d, loc) };
+        m.obj.position.copy(toScene(m.at.n, m.at.e, m.at.d));
+      }
+      target.visible = false; // a fleet's controllers' targets are not logged
+      const look = placeCamera();
+      const far = camera.position.distanceTo(look);
+      tetherWidth = Math.max(1, (0.004 * far) / tetherRadius);
+      const anchorScale = Math.max(1, (0.008 * far) / anchorRadius);
+      for (const a of fleetAnchors) a.obj.scale.setScalar(anchorScale);
+      updateFleetLines(time, loc);
+      updateSeaAndSky(look);
+      updateFleetHud(loc);
+    }
+    function updateFleetHud(loc) {
+      const now = performance.now();
+      if (playing && now - hudTime < 100) return; // as the pair's (updateHud)
+      hudTime = now;
+      $('hud-time').textContent = `t = ${time.toFixed(1)} s`;
+      $('time-label').textContent = `${time.toFixed(1)} / ${duration.toFixed(1)} s`;
+      const tl = $('timeline');
+      if (document.activeElement !== tl || playing) tl.value = String(time);
+      fleetVehicles.concat(fleetMasses).forEach((b, k) => {
+        fleetCells.bodies[k].textContent = fmt((b.pose || b.at).d, 2, 'm');
+      });
+      let nodeCount = 0;
+      fleetLines.forEach((l, k) => {
+        const [len, start, end] = fleetCells.lines[k];
+        len.textContent = fmt(lerpAt(l.data.length, loc), 1, 'm');
+        start.textContent = fmt(l.ends[0], 1, 'N');
+        end.textContent = fmt(l.ends[1], 1, 'N');
+        nodeCount += l.now.position.length / 3;
+      });
+      $('hud-tether').textContent = `${fleetLines.length} line${fleetLines.length === 1 ? '' : 's'}, ${nodeCount} nodes; ` +
+        'colours: between the end forces';
     }
     function updateHud(loc, rc) {
       // While playing, the text and the timeline change at most every 0.1 s of wall clock
@@ -719,6 +931,14 @@
       return { x: ((p.x + 1) / 2) * w, y: ((1 - p.y) / 2) * h, inFront: p.z < 1 && p.z > -1 };
     };
     function placeLabels() {
+      for (const { el, at, lift } of fleetLabels) {
+        const p = at();
+        const q = project(toScene(p.n, p.e, p.d - lift));
+        const shown = q.inFront && Number.isFinite(q.x) && Number.isFinite(q.y);
+        el.style.display = shown ? '' : 'none';
+        if (shown) el.style.transform = `translate(${q.x.toFixed(1)}px, ${q.y.toFixed(1)}px) translate(-50%, -130%)`;
+      }
+      if (fleet) return;
       for (const [key, p] of [['boat', boatPose], ['rov', rovPose]]) {
         const q = project(toScene(p.n, p.e, p.d - (key === 'boat' ? 0.7 : 0.45)));
         const el = labels[key];
@@ -873,18 +1093,41 @@
     //                          y = (1 − ndc.y) h / 2
     //   projected()            {boat, rov, midNode: {x, y (CSS px), world [n, e, d], scene,
     //                          inFront}; midNode also has index (⌊count / 2⌋ of the nodes shown)}
+    //                          A fleet (version 2): {vehicles, point_masses, anchors: {name: the
+    //                          same for its origin / centre}, tethers: {name: its midNode or null}}
     //   segmentCount(), segmentTension(i) [N], segmentColour(i) ('#rrggbb', the colour drawn)
+    //                          (the pair's tether; a fleet: segmentCount(name), ... of its line)
     //   tensionColour(T)       the colour map at tension T [N]
     //   legendTopColour(), legendBottomColour()  the legend bar's top and bottom pixels
     //   tensionScale           {min, max} [N]
     //   setLayers({boat, rov, tether, sea, target, overlay: bool}) shows or hides those (overlay:
-    //                          the HUD, legend, timeline and labels) and redraws
+    //                          the HUD, legend, timeline and labels) and redraws; a fleet's layers:
+    //                          sea, overlay, vehicles, point_masses, anchors, tethers (all of them)
+    //                          and 'vehicle:NAME', 'point_mass:NAME', 'anchor:NAME', 'tether:NAME'
+    //   fleet                  true for a fleet's data (version 2)
     //   seaVertex(i, j)        the sea mesh's vertex (i, j), 0 < i, j < seaGrid, as [n, e, ζ]
     //                          (float32; the outermost ring is the flat skirt to the horizon)
     //   measureFps(seconds)    plays for `seconds` of wall-clock time and resolves to {fps,
     //                          frames, seconds, workMs (mean JS update + render call per frame),
     //                          pixelRatio (drawing-buffer pixels per CSS pixel while playing)};
     //                          restores the play state afterwards
+    function lineNamed(name) {
+      const l = fleetLines.find((x) => x.data.name === name);
+      if (!l) throw new Error(`no line '${name}'`);
+      return l;
+    }
+    function fleetLayers() {
+      const layers = {
+        sea: [sea], target: [target],
+        vehicles: fleetVehicles.map((v) => v.obj), point_masses: fleetMasses.map((m) => m.obj),
+        anchors: fleetAnchors.map((a) => a.obj), tethers: fleetLines.map((l) => l.mesh),
+      };
+      for (const v of fleetVehicles) layers[`vehicle:${v.data.name}`] = [v.obj];
+      for (const m of fleetMasses) layers[`point_mass:${m.data.name}`] = [m.obj];
+      for (const a of fleetAnchors) layers[`anchor:${a.data.name}`] = [a.obj];
+      for (const l of fleetLines) layers[`tether:${l.data.name}`] = [l.mesh];
+      return layers;
+    }
     const members = {
       data,
       get time() { return time; },
@@ -919,6 +1162,11 @@
       },
       projected() {
         const one = (n, e, d) => Object.assign(project(toScene(n, e, d)), { world: [n, e, d], scene: [n, -d, e] });
+        const midOf = (p) => {
+          const count = p.length / 3;
+          const mid = Math.floor(count / 2);
+          return count ? Object.assign(one(p[3 * mid], p[3 * mid + 1], p[3 * mid + 2]), { index: mid }) : null;
+        };
         const p = tetherNow.position;
         const count = p.length / 3;
         const mid = Math.floor(count / 2);
@@ -927,23 +1175,34 @@
           const m = obj.matrix.elements; // column-major: the translation is 12, 13, 14
           return one(m[12], m[14], -m[13]);
         };
+        if (fleet) { // where each part is drawn (a mesh's own position for the spheres and markers)
+          const at = (obj) => one(obj.position.x, obj.position.z, -obj.position.y);
+          return {
+            vehicles: Object.fromEntries(fleetVehicles.map((v) => [v.data.name, drawn(v.obj)])),
+            point_masses: Object.fromEntries(fleetMasses.map((m) => [m.data.name, at(m.obj)])),
+            anchors: Object.fromEntries(fleetAnchors.map((a) => [a.data.name, at(a.obj)])),
+            tethers: Object.fromEntries(fleetLines.map((l) => [l.data.name, midOf(l.now.position)])),
+          };
+        }
         return {
           boat: drawn(boat),
           rov: drawn(rov),
           midNode: count ? Object.assign(one(p[3 * mid], p[3 * mid + 1], p[3 * mid + 2]), { index: mid }) : null,
         };
       },
-      segmentCount: () => tether.count,
-      segmentTension: (i) => tetherNow.tension[i],
-      segmentColour(i) {
-        tether.getColorAt(i, tmpC);
+      fleet,
+      // (the pair's tether; a fleet's line by its name as a second argument)
+      segmentCount: (name) => (fleet ? lineNamed(name).mesh.count : tether.count),
+      segmentTension: (i, name) => (fleet ? lineNamed(name).now.tension[i] : tetherNow.tension[i]),
+      segmentColour(i, name) {
+        (fleet ? lineNamed(name).mesh : tether).getColorAt(i, tmpC);
         return '#' + tmpC.getHexString(THREE.SRGBColorSpace);
       },
       tensionColour: (T) => hex(tensionColour(T)),
       legendTopColour: () => legendPixel(0),
       legendBottomColour: () => legendPixel(legendCanvas.height - 1),
       setLayers(layers) {
-        const objects = { boat: [boat], rov: [rov], tether: [tether], sea: [sea], target: [target] };
+        const objects = fleet ? fleetLayers() : { boat: [boat], rov: [rov], tether: [tether], sea: [sea], target: [target] };
         for (const [name, on] of Object.entries(layers)) {
           if (objects[name]) for (const o of objects[name]) o.visible = !!on;
           else if (name === 'overlay')
