@@ -648,14 +648,14 @@ bool actual_end(const TetherEnd<Scalar>& e, const FleetState<Scalar>& s, Vector3
 template <typename Scalar>
 void energy(const FleetModel<Scalar>& model, const FleetState<Scalar>& state,
             FleetEnergy<Scalar>& e) {
-  const auto n = std::size_t(model.vehicle_count()), p = std::size_t(model.point_mass_count()),
-             m = std::size_t(model.tether_count());
-  KELP_CHECK(e.vehicles.size() == n && e.point_masses.size() == p && e.tethers.size() == m,
+  const auto nv = std::size_t(model.vehicle_count()), np = std::size_t(model.point_mass_count()),
+             nt = std::size_t(model.tether_count());
+  KELP_CHECK(e.vehicles.size() == nv && e.point_masses.size() == np && e.tethers.size() == nt,
              "system::energy: the FleetEnergy is not sized for this fleet (one value per "
              "vehicle, point mass and tether: FleetReport's is)");
-  KELP_CHECK(state.vehicles.size() == n && state.point_masses.size() == p &&
-                 state.tethers.size() == m,
-             "system::energy: the state is not of this fleet");
+  KELP_CHECK(
+      state.vehicles.size() == nv && state.point_masses.size() == np && state.tethers.size() == nt,
+      "system::energy: the state is not of this fleet");
   const auto& env = model.environment();
   for (int i = 0; i < model.vehicle_count(); ++i) {
     const auto& x = state.vehicles[std::size_t(i)];
