@@ -71,6 +71,17 @@ inline DoubleArray points_arg(py::handle obj, py::ssize_t columns, const char* n
   return a;
 }
 
+/// Sets the 3×n matrix `x` (a tether's nodes) from an array of exactly (n, 3), n = x.cols().
+/// \throws kelp::invalid_argument naming `name` for any other shape (x is then unchanged).
+inline void set_points(Eigen::Matrix3Xd& x, py::handle obj, const char* name) {
+  bool single = false;
+  const DoubleArray a = points_arg(obj, 3, name, single);
+  if (single || a.shape(0) != x.cols())
+    kelp::detail::throw_invalid_argument(std::string(name) + ": expected shape (" +
+                                         std::to_string(x.cols()) + ", 3), got " + shape_text(a));
+  x = Eigen::Map<const Eigen::Matrix3Xd>(a.data(), 3, x.cols());
+}
+
 /// A zero-copy float64 view of `data` (shape, strides in elements) whose base is `owner`: numpy
 /// keeps `owner` alive as long as the view, so the view never dangles while the memory it shows
 /// belongs to `owner` (and is not reallocated by it).

@@ -75,15 +75,6 @@ std::vector<std::string> tether_names(const kfs::FleetModeld& m) {
   return r;
 }
 
-void set_points(Eigen::Matrix3Xd& x, py::handle v, const char* name) {
-  bool single = false;
-  const DoubleArray a = points_arg(v, 3, name, single);
-  if (single || a.shape(0) != x.cols())
-    kelp::detail::throw_invalid_argument(std::string(name) + ": expected shape (" +
-                                         std::to_string(x.cols()) + ", 3), got " + shape_text(a));
-  x = Eigen::Map<const Eigen::Matrix3Xd>(a.data(), 3, x.cols());
-}
-
 py::dict energy_dict(const kfs::FleetEnergy<double>& e) {
   py::dict d;
   d["vehicles"] = e.vehicles;

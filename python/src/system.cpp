@@ -25,15 +25,6 @@ py::array tether_view(const Eigen::Matrix3Xd& x, py::handle self) {
   return points_view(x.data(), x.cols(), self);
 }
 
-void set_tether(Eigen::Matrix3Xd& x, py::handle v, const char* name) {
-  bool single = false;
-  const DoubleArray a = points_arg(v, 3, name, single);
-  if (single || a.shape(0) != x.cols())
-    kelp::detail::throw_invalid_argument(std::string(name) + ": expected shape (" +
-                                         std::to_string(x.cols()) + ", 3), got " + shape_text(a));
-  x = Eigen::Map<const Eigen::Matrix3Xd>(a.data(), 3, x.cols());
-}
-
 // The paper's system (kelp::system::presets::paper_system) as a scenario-less world.
 kelp::sim::WorldSetup paper_world(double tether_length, const std::string& sea, std::uint64_t seed,
                                   int wave_components, double ramp, bool propulsion) {
@@ -145,7 +136,7 @@ void bind_system(py::module_& m) {
           "tether_position",
           [](py::object self) { return tether_view(self.cast<State&>().tether.position, self); },
           [](State& s, py::handle v) {
-            set_tether(s.tether.position, v, "tether_position");
+            set_points(s.tether.position, v, "tether_position");
             s.tether.clear_history();
           },
           "Tether node positions, NED [m], (nodes, 3): a view. Setting it clears the integrator "
@@ -154,7 +145,7 @@ void bind_system(py::module_& m) {
           "tether_velocity",
           [](py::object self) { return tether_view(self.cast<State&>().tether.velocity, self); },
           [](State& s, py::handle v) {
-            set_tether(s.tether.velocity, v, "tether_velocity");
+            set_points(s.tether.velocity, v, "tether_velocity");
             s.tether.clear_history();
           },
           "Tether node velocities, NED [m/s], (nodes, 3): a view. Setting it clears the integrator "

@@ -49,13 +49,7 @@ void bind_tether(py::module_& m) {
             return points_view(x.data(), x.cols(), self);
           },
           [](kt::TetherStated& s, py::handle v) {
-            bool single = false;
-            const DoubleArray a = points_arg(v, 3, "position", single);
-            if (single || a.shape(0) != s.position.cols())
-              kelp::detail::throw_invalid_argument("position: expected shape (" +
-                                                   std::to_string(s.position.cols()) +
-                                                   ", 3), got " + shape_text(a));
-            s.position = Eigen::Map<const Eigen::Matrix3Xd>(a.data(), 3, s.position.cols());
+            set_points(s.position, v, "position");
             s.clear_history();
           },
           "Node positions, NED [m], (nodes, 3): a view.")
@@ -66,13 +60,7 @@ void bind_tether(py::module_& m) {
             return points_view(x.data(), x.cols(), self);
           },
           [](kt::TetherStated& s, py::handle v) {
-            bool single = false;
-            const DoubleArray a = points_arg(v, 3, "velocity", single);
-            if (single || a.shape(0) != s.velocity.cols())
-              kelp::detail::throw_invalid_argument("velocity: expected shape (" +
-                                                   std::to_string(s.velocity.cols()) +
-                                                   ", 3), got " + shape_text(a));
-            s.velocity = Eigen::Map<const Eigen::Matrix3Xd>(a.data(), 3, s.velocity.cols());
+            set_points(s.velocity, v, "velocity");
             s.clear_history();
           },
           "Node velocities, NED [m/s], (nodes, 3): a view.")
