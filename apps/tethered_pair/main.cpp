@@ -50,6 +50,16 @@ std::string plot_script() {
   return KELP_PLOT_SCRIPT_SOURCE;
 }
 
+// The 3-D replay's page template: installed, or this build's (KELP_REPLAY_TEMPLATE_BUILD);
+// without one (empty) the run goes on and says once that replay.html is left out.
+std::string replay_template() {
+  std::string page = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
+  if (page.empty())
+    std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
+                 kelp_apps::replay_template_missing_note().c_str());
+  return page;
+}
+
 // A fleet scenario (`"fleet"`): any vehicles and tethers (kelp/sim/fleet_run.hpp).
 int run_fleet(const Options& o) {
   const kelp::sim::FleetRunSummary s = kelp::sim::run_fleet(o.scenario, o.scenario_file, o.out);
@@ -63,11 +73,8 @@ int run_fleet(const Options& o) {
       "in one step; %ld retried steps, %ld explicit fallbacks\n",
       s.newton_mean, s.newton_max, s.retried_steps, s.explicit_fallbacks);
   // The 3-D replay of every vehicle and tether, from the run directory (as the pair's).
-  const std::string page = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
-  if (page.empty())
-    std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
-                 kelp_apps::replay_template_missing_note().c_str());
-  else
+  const std::string page = replay_template();
+  if (!page.empty())
     std::printf("kelp-tethered-pair: the 3-D replay: %s\n",
                 kelp::sim::write_replay(o.out, page).c_str());
   return 0;
@@ -82,12 +89,7 @@ int run(const Options& o) {
   if (progress) ro.on_progress = kelp_apps::progress_bar(o.scenario.duration);
   ro.scenario_file = o.scenario_file;
   ro.version = KELP_VERSION_STRING;
-  // The 3-D replay's page template: installed, or this build's (KELP_REPLAY_TEMPLATE_BUILD);
-  // without one the run goes on and says once that replay.html is left out.
-  ro.replay_template = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
-  if (ro.replay_template.empty())
-    std::fprintf(stderr, "kelp-tethered-pair: no replay.html: %s\n",
-                 kelp_apps::replay_template_missing_note().c_str());
+  ro.replay_template = replay_template();
 #ifdef KELP_WITH_ROS2
   const kelp::sim::RunSummary summary =
       o.ros2 ? kelp_ros2::run_with_ros2(o.scenario, ro, o.ros2_options)

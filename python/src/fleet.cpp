@@ -59,19 +59,11 @@ std::size_t part_of(py::handle key, int n, const std::vector<std::string>& names
   return index_of(key.cast<int>(), n, what);
 }
 
-std::vector<std::string> vehicle_names(const kfs::FleetModeld& m) {
+// The names of a fleet's vehicles, point masses or tethers (FleetParameters' lists), in order.
+template <class Parts>
+std::vector<std::string> names_of(const Parts& parts) {
   std::vector<std::string> r;
-  for (const auto& v : m.parameters().vehicles) r.push_back(v.name);
-  return r;
-}
-std::vector<std::string> point_mass_names(const kfs::FleetModeld& m) {
-  std::vector<std::string> r;
-  for (const auto& p : m.parameters().point_masses) r.push_back(p.name);
-  return r;
-}
-std::vector<std::string> tether_names(const kfs::FleetModeld& m) {
-  std::vector<std::string> r;
-  for (const auto& t : m.parameters().tethers) r.push_back(t.name);
+  for (const auto& x : parts) r.push_back(x.name);
   return r;
 }
 
@@ -314,31 +306,34 @@ void bind_fleet(py::module_& m) {
           py::arg("state"),
           "The mechanical energy of `state` [J]: vehicles, point_masses, tethers (lists), total.")
       .def_property_readonly(
-          "vehicle_names", [](const Fleet& f) { return vehicle_names(f.model); },
+          "vehicle_names", [](const Fleet& f) { return names_of(f.model.parameters().vehicles); },
           "The vehicles' names, in index order.")
       .def_property_readonly(
-          "point_mass_names", [](const Fleet& f) { return point_mass_names(f.model); },
+          "point_mass_names",
+          [](const Fleet& f) { return names_of(f.model.parameters().point_masses); },
           "The point masses' names, in index order.")
       .def_property_readonly(
-          "tether_names", [](const Fleet& f) { return tether_names(f.model); },
+          "tether_names", [](const Fleet& f) { return names_of(f.model.parameters().tethers); },
           "The tethers' names, in index order.")
       .def(
           "vehicle_index",
           [](const Fleet& f, py::handle key) {
-            return int(part_of(key, f.model.vehicle_count(), vehicle_names(f.model), "vehicle"));
+            return int(part_of(key, f.model.vehicle_count(),
+                               names_of(f.model.parameters().vehicles), "vehicle"));
           },
           py::arg("name"), "A vehicle's index by name (or index, checked).")
       .def(
           "point_mass_index",
           [](const Fleet& f, py::handle key) {
-            return int(
-                part_of(key, f.model.point_mass_count(), point_mass_names(f.model), "point mass"));
+            return int(part_of(key, f.model.point_mass_count(),
+                               names_of(f.model.parameters().point_masses), "point mass"));
           },
           py::arg("name"), "A point mass's index by name (or index, checked).")
       .def(
           "tether_index",
           [](const Fleet& f, py::handle key) {
-            return int(part_of(key, f.model.tether_count(), tether_names(f.model), "tether"));
+            return int(part_of(key, f.model.tether_count(), names_of(f.model.parameters().tethers),
+                               "tether"));
           },
           py::arg("name"), "A tether's index by name (or index, checked).")
       .def(
