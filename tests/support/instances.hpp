@@ -1,11 +1,15 @@
 // What every test executable shares instead of compiling it again: the double-precision wave
-// kernels, instantiated once (tests/support/instances.cpp, compiled with the tests' own flags into
-// kelp_test_instances) and declared extern here. tests/CMakeLists.txt includes this header first
-// in every test unit that does not link kelp::sim (which declares and provides the same instances
-// itself: kelp/sim/instantiation.hpp); tests/system/ includes system_instances.hpp instead. The
-// float and Jet instances, and everything else, are still compiled by each test.
+// kernels and the vehicle's costliest code (a model's construction, the thruster allocation's
+// pseudo-inverse, the RK4 steps: kelp/vehicle/instances.hpp), instantiated once
+// (tests/support/instances.cpp, compiled with the tests' own flags into kelp_test_instances) and
+// declared extern here. tests/CMakeLists.txt includes this header first in every test unit that
+// does not link kelp::sim (which declares and provides the same instances itself:
+// kelp/sim/instantiation.hpp); tests/system/ includes system_instances.hpp instead. The float and
+// Jet instances, and everything else, are still compiled by each test.
 #pragma once
 
 #include "kelp/environment/wave_kernels.hpp"
+#include "kelp/vehicle/instances.hpp"
 
 KELP_WAVE_KERNEL_INSTANCES(extern template)
+KELP_VEHICLE_INSTANCES(extern template)

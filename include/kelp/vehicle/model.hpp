@@ -189,35 +189,7 @@ class VehicleModel {
   /// \throws kelp::invalid_argument naming the offending field, or when a derived quantity
   /// (M_RB, M, M⁻¹, the surface vessel's stiffnesses ρ g A_wp and ρ g ∇ GM) is not finite, e.g.
   /// for a mass or inertia near the largest double.
-  explicit VehicleModel(const VehicleParameters<Scalar>& parameters)
-      : parameters_((validate(parameters), parameters)) {
-    const Scalar h(0.5);
-    rigid_body_mass_ =
-        rigid_body_mass_matrix(parameters_.mass, parameters_.inertia, parameters_.r_g);
-    added_mass_ = h * (parameters_.added_mass + parameters_.added_mass.transpose());
-    mass_ = rigid_body_mass_ + added_mass_;
-    ldlt_.compute(mass_);
-    // M_RB is positive definite and M_A positive semi-definite, so M is positive definite.
-    KELP_CHECK(ldlt_.info() == Eigen::Success && ldlt_.isPositive(),
-               "mass matrix M = M_RB + M_A must be positive definite");
-    // M⁻¹ formed once here from the factorisation (never per step): for a 6×6 system one
-    // matrix-vector product per evaluation is several times faster than two triangular solves.
-    // Column by column: a vector right-hand side keeps Eigen's blocked matrix kernels (GEBP/TRSM),
-    // heavy to compile, out of every translation unit that builds a model.
-    for (int j = 0; j < 6; ++j) mass_inverse_.col(j) = ldlt_.solve(Vector6<Scalar>::Unit(j));
-    check_all_finite(mass_, "mass matrix M = M_RB + M_A (mass, inertia, r_g, added_mass)");
-    check_all_finite(mass_inverse_, "inverse mass matrix (mass, inertia, r_g, added_mass)");
-    weight_ = parameters_.weight();
-    buoyancy_ = parameters_.buoyancy();
-    if (parameters_.hydrostatics == Hydrostatics::surface) {
-      const Scalar rho_g = parameters_.density * parameters_.gravity;
-      check_finite(rho_g * parameters_.waterplane_area, "heave stiffness rho g waterplane_area");
-      check_finite(rho_g * parameters_.displaced_volume * parameters_.gm_transverse,
-                   "roll stiffness rho g displaced_volume gm_transverse");
-      check_finite(rho_g * parameters_.displaced_volume * parameters_.gm_longitudinal,
-                   "pitch stiffness rho g displaced_volume gm_longitudinal");
-    }
-  }
+  explicit VehicleModel(const VehicleParameters<Scalar>& parameters);
 
   /// \brief The validated parameters.
   const VehicleParameters<Scalar>& parameters() const { return parameters_; }
@@ -316,6 +288,39 @@ class VehicleModel {
   Scalar weight_;
   Scalar buoyancy_;
 };
+
+// Defined out of the class, so not inline: a program that links an explicit instantiation
+// (KELP_VEHICLE_INSTANCES, kelp/vehicle/instances.hpp) and declares it extern does not compile
+// the validation and the factorisation again.
+template <typename Scalar>
+VehicleModel<Scalar>::VehicleModel(const VehicleParameters<Scalar>& parameters)
+    : parameters_((validate(parameters), parameters)) {
+  const Scalar h(0.5);
+  rigid_body_mass_ = rigid_body_mass_matrix(parameters_.mass, parameters_.inertia, parameters_.r_g);
+  added_mass_ = h * (parameters_.added_mass + parameters_.added_mass.transpose());
+  mass_ = rigid_body_mass_ + added_mass_;
+  ldlt_.compute(mass_);
+  // M_RB is positive definite and M_A positive semi-definite, so M is positive definite.
+  KELP_CHECK(ldlt_.info() == Eigen::Success && ldlt_.isPositive(),
+             "mass matrix M = M_RB + M_A must be positive definite");
+  // M⁻¹ formed once here from the factorisation (never per step): for a 6×6 system one
+  // matrix-vector product per evaluation is several times faster than two triangular solves.
+  // Column by column: a vector right-hand side keeps Eigen's blocked matrix kernels (GEBP/TRSM),
+  // heavy to compile, out of every translation unit that builds a model.
+  for (int j = 0; j < 6; ++j) mass_inverse_.col(j) = ldlt_.solve(Vector6<Scalar>::Unit(j));
+  check_all_finite(mass_, "mass matrix M = M_RB + M_A (mass, inertia, r_g, added_mass)");
+  check_all_finite(mass_inverse_, "inverse mass matrix (mass, inertia, r_g, added_mass)");
+  weight_ = parameters_.weight();
+  buoyancy_ = parameters_.buoyancy();
+  if (parameters_.hydrostatics == Hydrostatics::surface) {
+    const Scalar rho_g = parameters_.density * parameters_.gravity;
+    check_finite(rho_g * parameters_.waterplane_area, "heave stiffness rho g waterplane_area");
+    check_finite(rho_g * parameters_.displaced_volume * parameters_.gm_transverse,
+                 "roll stiffness rho g displaced_volume gm_transverse");
+    check_finite(rho_g * parameters_.displaced_volume * parameters_.gm_longitudinal,
+                 "pitch stiffness rho g displaced_volume gm_longitudinal");
+  }
+}
 
 /// \brief Mutable per-simulation buffers of the forward dynamics. After each call they hold the
 /// terms of the last evaluation (useful to log loads or to couple a tether in `system/`).

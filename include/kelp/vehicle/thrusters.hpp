@@ -48,6 +48,21 @@ Eigen::Matrix<typename DP::Scalar, 6, Eigen::Dynamic> allocation_matrix(
   return B;
 }
 
+namespace detail {
+/// B⁺ (n×6) of a 6×n allocation matrix by a complete orthogonal decomposition (valid for any
+/// rank); returns the rank of B. A function of its own, not inline, so that a program that links
+/// an explicit instantiation (KELP_VEHICLE_INSTANCES, kelp/vehicle/instances.hpp) and declares
+/// it extern does not compile the decomposition again: it is the heaviest code a vehicle's
+/// construction instantiates.
+template <typename Scalar>
+Eigen::Index pseudo_inverse(const Eigen::Matrix<Scalar, 6, Eigen::Dynamic>& b,
+                            Eigen::Matrix<Scalar, Eigen::Dynamic, 6>& b_plus) {
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<Scalar, 6, Eigen::Dynamic>> cod(b);
+  b_plus = cod.pseudoInverse();
+  return cod.rank();
+}
+}  // namespace detail
+
 /// \brief A fixed set of thrusters: allocation matrix B and its Moore–Penrose pseudo-inverse B⁺,
 /// both computed once at construction. wrench() and distribute() are allocation-free.
 /// \tparam Scalar double, float or ceres::Jet.
@@ -65,9 +80,7 @@ class ThrusterAllocation {
     // positions_ is assigned only after allocation_matrix() has checked the shapes.
     positions_ = positions;
     directions_ = matrix_.template topRows<3>();
-    Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<Scalar, 6, Eigen::Dynamic>> cod(matrix_);
-    pseudo_inverse_ = cod.pseudoInverse();
-    rank_ = cod.rank();
+    rank_ = detail::pseudo_inverse(matrix_, pseudo_inverse_);
     check_all_finite(pseudo_inverse_, "thruster_positions: the pseudo-inverse of the allocation");
   }
 
