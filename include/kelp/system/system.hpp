@@ -475,7 +475,11 @@ tether::StepReport<Scalar> advance_tether(const tether::TetherModel<Scalar>& lin
   try {
     return tether::advance(line, ws, env, state, ends, dt, options);
   } catch (const kelp::numerical_error&) {
-    if (!fallback || !tether::is_implicit(options.integrator)) throw;
+    // A line without a free node has no stable explicit step to redo it in (estimate_stable_dt
+    // refuses it), nor anything an explicit scheme would do differently.
+    if (!fallback || !tether::is_implicit(options.integrator) ||
+        line.first_free_node() > line.last_free_node())
+      throw;
     // The failed step left the tether as it was: redo it explicitly.
     using std::sqrt;
     const Scalar h =
