@@ -438,8 +438,9 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
                Vector6<Scalar> tau_ext = in.tau_ext;
                for (int k = 0; k < n; ++k) tau_ext += wrench_of_force(s, loads[k].r, loads[k].f);
                if (hull) tau_ext += hull_contact(*hull, env, s).wrench;
-               d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.tau, tau_ext,
-                                                    lerp(s0, s1, Scalar(c)));
+               // Unchecked: a NaN tether force or stage state ends the step as numerical_error.
+               d.nu_dot = vehicle::detail::forward_dynamics_unchecked(model, ws, s, in.tau, tau_ext,
+                                                                      lerp(s0, s1, Scalar(c)));
                return d;
              },
              "system::step (vehicle)")
