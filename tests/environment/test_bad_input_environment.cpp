@@ -563,13 +563,40 @@ TEST_CASE("bad input: a current profile's factor at a NaN depth", "[environment]
                                                                   : 0.25;
     CHECK(profile_factor(p, kInf) == bottom);
   }
-  // Inside a step a NaN position stays the samplers' NaN (reported by the step as its
-  // numerical_error, state unchanged), not an exception from the middle of the step.
+}
+
+// The issue's probe: CurrentModel::velocity, the public query that applies the profile at a point,
+// gave NaN for a NaN point where profile_factor refused it. It refuses a NaN point the same way
+// (±∞ depths give the surface and seabed values, as profile_factor's); the per-node sampler of
+// the tether step (Environment::sample_water) keeps its documented NaN for a NaN node, which the
+// step reports as numerical_error with the state unchanged.
+TEST_CASE("bad input: a current's velocity at a NaN point", "[environment][bad_input]") {
   CurrentParameters cp;
   cp.speed = 1.0;
   cp.profile.kind = CurrentProfileKind::power_law;
   cp.profile.depth = 40.0;
   const CurrentModel<double> c(cp);
-  CHECK(std::isnan(c.velocity(Vector3<double>(0.0, 0.0, kNan), 0.0)(0)));
+  for (int i = 0; i < 3; ++i) {
+    Vector3<double> p(0.0, 0.0, 5.0);
+    p(i) = kNan;
+    INFO("coordinate " << i);
+    REQUIRE_THROWS_AS(c.velocity(p, 0.0), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(c.velocity(p, 0.0), Catch::Contains("must not be NaN"));
+  }
   CHECK(c.velocity(Vector3<double>(0.0, 0.0, 20.0), 0.0)(0) == Approx(std::pow(0.5, 1.0 / 7.0)));
+  CHECK(c.velocity(Vector3<double>(0.0, 0.0, -kInf), 0.0)(0) == 1.0);
+  CHECK(c.velocity(Vector3<double>(0.0, 0.0, kInf), 0.0)(0) == 0.0);
+  const CurrentModel<float> cf(cp);
+  REQUIRE_THROWS_AS(
+      cf.velocity(Vector3<float>(0.0F, 0.0F, std::numeric_limits<float>::quiet_NaN()), 0.0),
+      kelp::invalid_argument);
+
+  Environment<double> env;
+  env.set_current(c);
+  Matrix3X<double> pts(3, 3), vel(3, 3), acc(3, 3);
+  pts << 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 5.0, kNan, 20.0;
+  env.sample_water(pts, 0.0, vel, acc);  // the step's sampler: no exception, NaN at that node
+  CHECK(std::isnan(vel(0, 1)));
+  CHECK(vel.col(0).allFinite());
+  CHECK(vel(0, 2) == Approx(std::pow(0.5, 1.0 / 7.0)));
 }

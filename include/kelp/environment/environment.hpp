@@ -241,7 +241,9 @@ class Environment {
   EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t,
                                    bool with_wind = true) const {
     EnvironmentSample<Scalar> s;
-    if (!current_.is_zero()) s.current = current_.velocity(p_ned, t);
+    if (!current_.is_zero())  // as CurrentModel::velocity, without its check of the point
+      s.current = current_.surface_velocity(t) *
+                  detail::profile_factor_unchecked(current_.parameters().profile, p_ned(2));
     if (!waves_.empty()) {
       const WaveKinematics<Scalar> k = waves_.kinematics(p_ned, t);
       s.wave_velocity = k.velocity;
