@@ -73,9 +73,9 @@ inline void validate(const CurrentProfile& p) {
 namespace detail {
 
 /// profile_factor() without the check of z, for the samplers that run per point inside a step
-/// (Environment::sample_water, Environment::sample): there a NaN position gives a NaN factor,
-/// which the step reports as its numerical_error with the state unchanged (their documented
-/// contract), instead of an invalid_argument from the middle of a step.
+/// (Environment::sample_water, Environment::sample_unchecked): there a NaN position gives a NaN
+/// factor, which the step reports as its numerical_error with the state unchanged (their
+/// documented contract), instead of an invalid_argument from the middle of a step.
 template <typename Scalar>
 Scalar profile_factor_unchecked(const CurrentProfile& p, const Scalar& z) {
   using std::pow;
@@ -241,7 +241,7 @@ class CurrentModel {
   /// give the surface and seabed values, as profile_factor's.
   /// \throws kelp::invalid_argument when p has not 3 entries or one of them is NaN (a point
   /// without a depth has no current; as profile_factor), or when the current varies and t is not
-  /// finite. The samplers of the steps (Environment::sample_water, Environment::sample) apply the
+  /// finite. The samplers of the steps (Environment::sample_water, sample_unchecked) apply the
   /// profile without this check: there a NaN node gives NaN, which the step reports as
   /// numerical_error with the state unchanged.
   template <typename Derived>
