@@ -563,13 +563,78 @@ TEST_CASE("bad input: a current profile's factor at a NaN depth", "[environment]
                                                                   : 0.25;
     CHECK(profile_factor(p, kInf) == bottom);
   }
-  // Inside a step a NaN position stays the samplers' NaN (reported by the step as its
-  // numerical_error, state unchanged), not an exception from the middle of the step.
+}
+
+// The issue's probe: CurrentModel::velocity, the public query that applies the profile at a point,
+// gave NaN for a NaN point where profile_factor refused it. It refuses a NaN point the same way
+// (±∞ depths give the surface and seabed values, as profile_factor's); the per-node sampler of
+// the tether step (Environment::sample_water) keeps its documented NaN for a NaN node, which the
+// step reports as numerical_error with the state unchanged.
+TEST_CASE("bad input: a current's velocity at a NaN point", "[environment][bad_input]") {
   CurrentParameters cp;
   cp.speed = 1.0;
   cp.profile.kind = CurrentProfileKind::power_law;
   cp.profile.depth = 40.0;
   const CurrentModel<double> c(cp);
-  CHECK(std::isnan(c.velocity(Vector3<double>(0.0, 0.0, kNan), 0.0)(0)));
+  for (int i = 0; i < 3; ++i) {
+    Vector3<double> p(0.0, 0.0, 5.0);
+    p(i) = kNan;
+    INFO("coordinate " << i);
+    REQUIRE_THROWS_AS(c.velocity(p, 0.0), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(c.velocity(p, 0.0), Catch::Contains("must not be NaN"));
+  }
   CHECK(c.velocity(Vector3<double>(0.0, 0.0, 20.0), 0.0)(0) == Approx(std::pow(0.5, 1.0 / 7.0)));
+  CHECK(c.velocity(Vector3<double>(0.0, 0.0, -kInf), 0.0)(0) == 1.0);
+  CHECK(c.velocity(Vector3<double>(0.0, 0.0, kInf), 0.0)(0) == 0.0);
+  const CurrentModel<float> cf(cp);
+  REQUIRE_THROWS_AS(
+      cf.velocity(Vector3<float>(0.0F, 0.0F, std::numeric_limits<float>::quiet_NaN()), 0.0),
+      kelp::invalid_argument);
+
+  Environment<double> env;
+  env.set_current(c);
+  Matrix3X<double> pts(3, 3), vel(3, 3), acc(3, 3);
+  pts << 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 5.0, kNan, 20.0;
+  env.sample_water(pts, 0.0, vel, acc);  // the step's sampler: no exception, NaN at that node
+  CHECK(std::isnan(vel(0, 1)));
+  CHECK(vel.col(0).allFinite());
+  CHECK(vel(0, 2) == Approx(std::pow(0.5, 1.0 / 7.0)));
+}
+
+// The issue's probe: Environment::sample answered a NaN point with NaN values (in calm water with
+// zeros). It is the public single-point query and refuses a point that is not finite (no depth,
+// no wave phase); the vehicle steps sample their stages through sample_unchecked, so a stage
+// that blows up still ends the step as numerical_error (tests/vehicle/test_bad_input_vehicle.cpp).
+TEST_CASE("bad input: Environment::sample at a NaN or infinite point", "[environment][bad_input]") {
+  const Environment<double> sea_env = make_environment<double>(presets::moderate());
+  const Environment<double> calm;
+  const Environment<float> sea_f = make_environment<float>(presets::moderate());
+  for (const double bad : {kNan, kInf, -kInf})
+    for (int i = 0; i < 3; ++i) {
+      Vector3<double> p(10.0, -4.0, 3.0);
+      p(i) = bad;
+      INFO("coordinate " << i << " = " << bad);
+      REQUIRE_THROWS_AS(sea_env.sample(p, 30.0), kelp::invalid_argument);
+      REQUIRE_THROWS_WITH(sea_env.sample(p, 30.0, false), Catch::Contains("p_ned must be finite"));
+      REQUIRE_THROWS_AS(calm.sample(p, 30.0), kelp::invalid_argument);
+      REQUIRE_THROWS_AS(sea_f.sample(p.cast<float>(), 30.0), kelp::invalid_argument);
+    }
+  // The finite neighbours answer with finite values, and the unchecked sampler the steps use gives
+  // the same numbers bit for bit.
+  const Vector3<double> p(10.0, -4.0, 3.0);
+  const EnvironmentSample<double> s = sea_env.sample(p, 30.0);
+  CHECK(s.current.allFinite());
+  CHECK(s.wave_velocity.allFinite());
+  CHECK(s.wave_velocity.norm() > 0.0);
+  CHECK(s.wind.allFinite());
+  const EnvironmentSample<double> u = sea_env.sample_unchecked(p, 30.0, true);
+  CHECK(u.current == s.current);
+  CHECK(u.wave_velocity == s.wave_velocity);
+  CHECK(u.wave_acceleration == s.wave_acceleration);
+  CHECK(u.wave_velocity_gradient == s.wave_velocity_gradient);
+  CHECK(u.surface_elevation == s.surface_elevation);
+  CHECK(u.surface_slope == s.surface_slope);
+  CHECK(u.wind == s.wind);
+  CHECK(std::isnan(
+      sea_env.sample_unchecked(Vector3<double>(kNan, 0.0, 3.0), 30.0, false).wave_velocity(0)));
 }

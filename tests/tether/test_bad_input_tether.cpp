@@ -393,6 +393,54 @@ TEST_CASE("Stable time step estimate refuses non-physical water and safety facto
   CHECK(std::isinf(kt::estimate_stable_dt(model, kt::Integrator::bdf2, 1025.0)));
 }
 
+// The issue's probe: a one-segment line between two kinematic ends got +infinity from RK2 and RK4
+// (and "no stable step found" from symplectic Euler). Such a line has no free node: nothing is
+// integrated, so no step is limited by stability, and the estimate refuses the question instead
+// of answering with a number a step would then refuse.
+TEST_CASE("Stable time step of a one-segment line: refused without a free node, finite with one",
+          "[tether][bad_input]") {
+  const kt::Integrator all[] = {kt::Integrator::symplectic_euler, kt::Integrator::rk2,
+                                kt::Integrator::rk4, kt::Integrator::implicit_euler,
+                                kt::Integrator::bdf2};
+  kt::TetherParametersd p = kelp_test::benchmark_line<double>(1);
+  p.internal_damping = 10.0;  // RK2 needs internal damping (checked separately above)
+  const kt::TetherModeld fixed(p);
+  REQUIRE(fixed.first_free_node() > fixed.last_free_node());
+  for (const kt::Integrator integ : all) {
+    INFO(kt::integrator_name(integ));
+    REQUIRE_THROWS_AS(kt::estimate_stable_dt(fixed, integ), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(kt::estimate_stable_dt(fixed, integ), Catch::Contains("no free node"));
+  }
+  // One or both ends free: the free nodes (μ l/2 each) on the segment's spring k = EA/l oscillate
+  // at ω = √(k/m) (one free end) or √(2k/m) (both: the two nodes against each other). The RK4
+  // step is finite, inside RK4's limit h ω ≤ 2√2 for that mode, and steps the line for 10 s
+  // without blowing up.
+  const double m = p.mass_per_length * p.length / 2, k = p.axial_stiffness / p.length;
+  for (const int free_ends : {1, 2}) {
+    INFO("free ends " << free_ends);
+    kt::TetherParametersd q = p;
+    q.end_mode = kt::EndMode::free;
+    if (free_ends == 2) q.start_mode = kt::EndMode::free;
+    const kt::TetherModeld model(q);
+    const double omega = std::sqrt(free_ends * k / m);
+    const double dt = kt::estimate_stable_dt(model, kt::Integrator::rk4);
+    REQUIRE(std::isfinite(dt));
+    REQUIRE(dt > 0.0);
+    CHECK(dt * omega <= 2.0 * std::sqrt(2.0));
+    for (const kt::Integrator integ : all)
+      CHECK(kt::estimate_stable_dt(model, integ) > 0.0);  // an answer for every scheme
+    kt::TetherWorkspaced ws(model);
+    kelp_test::TestWater<double> water;
+    const Vector3<double> a(0, 0, 0), b(p.length, 0, 0);
+    kt::TetherStated s = kt::straight_line_state(model, a, b);
+    s.velocity.col(1) = Vector3<double>(0.5, 0.0, 0.2);  // a stretch and a swing
+    const kt::TetherBoundaryd bnd = kt::TetherBoundaryd::fixed(a, b);
+    REQUIRE_NOTHROW(kt::advance(model, ws, water, s, bnd, 10.0, {dt, kt::Integrator::rk4}));
+    CHECK(kelp::all_finite(s.position));
+    CHECK(s.velocity.norm() < 10.0);
+  }
+}
+
 TEST_CASE("Catenary solvers answer bad input with invalid_input and valid input with finite values",
           "[tether][catenary][bad_input]") {
   const double values[] = {0, -1, 1e-300, 1e300, nan_, inf_, -inf_,

@@ -297,10 +297,13 @@ TEST_CASE("a step keeps the attitude a unit quaternion however fast the vehicle 
   }
 }
 
-// The README's bad-input table: forward_dynamics is the per-stage evaluation of the steps, so it
-// checks sizes (free for fixed-size vectors) but not values; a NaN in gives a NaN ν̇ (which a
-// step turns into numerical_error, state unchanged), never an exception from the middle of a step.
-TEST_CASE("bad input: forward_dynamics checks sizes only", "[vehicle][bad_input]") {
+// The issue's probe: forward_dynamics took a NaN τ and answered a NaN ν̇. As a public entry point it
+// now refuses every non-finite value it reads (τ, τ_ext, the state, the surroundings) before
+// touching the workspace; the steps evaluate their stages without these checks, so a NaN that
+// appears inside a step (a NaN wrench, a stage state that blows up) still ends the step as
+// numerical_error with the state unchanged, never as an invalid_argument from a stage.
+TEST_CASE("bad input: forward_dynamics refuses non-finite input; the steps keep numerical_error",
+          "[vehicle][bad_input]") {
   const kv::VehicleModel<double> model(kv::bluerov2_heavy<double>().parameters);
   kv::VehicleWorkspace<double> ws;
   kv::VehicleState<double> x;
@@ -308,10 +311,64 @@ TEST_CASE("bad input: forward_dynamics checks sizes only", "[vehicle][bad_input]
   const Vector6<double> zero = Vector6<double>::Zero();
   REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, x, Eigen::VectorXd::Zero(7), zero),
                     kelp::invalid_argument);
-  CHECK(kv::forward_dynamics(model, ws, x, zero, zero).allFinite());
-  x.nu(0) = kNan;
-  const Vector6<double> nu_dot = kv::forward_dynamics(model, ws, x, zero, zero);  // no throw
-  CHECK_FALSE(nu_dot.allFinite());
-  // The step that takes the same state refuses it up front.
-  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, {zero, zero}, 0.01), kelp::invalid_argument);
+  const Vector6<double> good = kv::forward_dynamics(model, ws, x, zero, zero);
+  CHECK(good.allFinite());
+  for (const double bad_value : {kNan, kInf, -kInf}) {
+    INFO("value " << bad_value);
+    for (int i = 0; i < 6; ++i) {
+      Vector6<double> bad = zero;
+      bad(i) = bad_value;
+      REQUIRE_THROWS_WITH(kv::forward_dynamics(model, ws, x, bad, zero),
+                          Catch::StartsWith("forward_dynamics: tau must be finite"));
+      REQUIRE_THROWS_WITH(kv::forward_dynamics(model, ws, x, zero, bad),
+                          Catch::Contains("tau_ext must be finite"));
+    }
+    REQUIRE_THROWS_AS(
+        kv::forward_dynamics(model, ws, x, zero, zero, Vector3<double>(0.0, bad_value, 0.0)),
+        kelp::invalid_argument);
+    kv::Surroundings<double> s;
+    s.surface_elevation = bad_value;
+    REQUIRE_THROWS_WITH(kv::forward_dynamics(model, ws, x, zero, zero, s),
+                        Catch::Contains("surroundings"));
+    kv::VehicleState<double> y = x;
+    y.nu(4) = bad_value;
+    REQUIRE_THROWS_WITH(kv::forward_dynamics(model, ws, y, zero, zero),
+                        Catch::Contains("state.nu"));
+    y = x;
+    y.position(0) = bad_value;
+    REQUIRE_THROWS_AS(kv::forward_dynamics(model, ws, y, zero, zero), kelp::invalid_argument);
+  }
+  // Refused before the workspace is touched: it still holds the last good evaluation.
+  CHECK(ws.nu_dot == good);
+
+  // Every step still reports a NaN wrench as numerical_error, state unchanged: held over the
+  // step (τ or τ_ext), in still water, in a current and in an environment, and from a wrench
+  // callable that turns NaN only at a later RK4 stage.
+  Vector6<double> nan_wrench = zero;
+  nan_wrench(1) = kNan;
+  const ke::Environment<double> env = ke::make_environment<double>(ke::presets::moderate());
+  const Vector3<double> current(0.3, 0.0, 0.0);
+  x.time = 20.0;
+  const kv::VehicleState<double> before = x;
+  for (const kv::VehicleInputs<double>& in :
+       {kv::VehicleInputs<double>{nan_wrench, zero}, kv::VehicleInputs<double>{zero, nan_wrench}}) {
+    REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, in, 0.01), kelp::numerical_error);
+    REQUIRE_THROWS_AS(kv::step_rk4(model, ws, x, in, 0.01, current), kelp::numerical_error);
+    REQUIRE_THROWS_AS(kv::step_rk4(model, ws, env, x, in, 0.01), kelp::numerical_error);
+    REQUIRE_THROWS_AS(kv::step_symplectic_euler(model, ws, x, in, 0.01), kelp::numerical_error);
+    REQUIRE_THROWS_AS(kv::step_symplectic_euler(model, ws, x, in, 0.01, current),
+                      kelp::numerical_error);
+    REQUIRE_THROWS_AS(kv::step_symplectic_euler(model, ws, env, x, in, 0.01),
+                      kelp::numerical_error);
+    CHECK(same(x, before));
+  }
+  const auto late_nan = [&](const kv::VehicleState<double>&, double offset) {
+    return offset > 0.0 ? nan_wrench : zero;
+  };
+  REQUIRE_THROWS_AS(kv::step_rk4_with(model, ws, x, late_nan, 0.01), kelp::numerical_error);
+  CHECK(same(x, before));
+  // The step that takes a NaN state refuses it up front, as before.
+  kv::VehicleState<double> nan_state = x;
+  nan_state.nu(0) = kNan;
+  REQUIRE_THROWS_AS(kv::step_rk4(model, ws, nan_state, {zero, zero}, 0.01), kelp::invalid_argument);
 }

@@ -73,9 +73,9 @@ inline void validate(const CurrentProfile& p) {
 namespace detail {
 
 /// profile_factor() without the check of z, for the samplers that run per point inside a step
-/// (CurrentModel::velocity, Environment::sample_water): there a NaN position gives a NaN factor,
-/// which the step reports as its numerical_error with the state unchanged (their documented
-/// contract), instead of an invalid_argument from the middle of a step.
+/// (Environment::sample_water, Environment::sample_unchecked): there a NaN position gives a NaN
+/// factor, which the step reports as its numerical_error with the state unchanged (their
+/// documented contract), instead of an invalid_argument from the middle of a step.
 template <typename Scalar>
 Scalar profile_factor_unchecked(const CurrentProfile& p, const Scalar& z) {
   using std::pow;
@@ -236,11 +236,19 @@ class CurrentModel {
     return current_velocity_ned(Scalar(speed_at(t)), Scalar(params_.vertical_angle),
                                 Scalar(direction_at(t)));
   }
-  /// \brief Current velocity at NED point p [m] and time t [s], NED [m/s]. Above the surface
-  /// (z < 0) the surface value is returned.
-  /// \throws kelp::invalid_argument when the current varies and t is not finite.
+  /// \brief Current velocity at NED point p [m] and time t [s], NED [m/s]: the surface velocity
+  /// times profile_factor(z). Above the surface (z < 0) the surface value is returned; z = ±∞
+  /// give the surface and seabed values, as profile_factor's.
+  /// \throws kelp::invalid_argument when p has not 3 entries or one of them is NaN (a point
+  /// without a depth has no current; as profile_factor), or when the current varies and t is not
+  /// finite. The samplers of the steps (Environment::sample_water, sample_unchecked) apply the
+  /// profile without this check: there a NaN node gives NaN, which the step reports as
+  /// numerical_error with the state unchanged.
   template <typename Derived>
   Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, double t) const {
+    KELP_CHECK(p.size() == 3, "CurrentModel::velocity: p must have 3 entries");
+    if (std::isnan(value_of(p(0))) || std::isnan(value_of(p(1))) || std::isnan(value_of(p(2))))
+      ::kelp::detail::throw_invalid_argument("CurrentModel::velocity: p must not be NaN");
     return surface_velocity(t) * detail::profile_factor_unchecked(params_.profile, Scalar(p(2)));
   }
 

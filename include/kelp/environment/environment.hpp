@@ -236,12 +236,28 @@ class Environment {
   /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
   /// and acceleration (zero above the free surface), surface elevation and slope at (x, y), wind at
   /// 10 m (left at zero when `with_wind` is false: the gust sum costs as much as the waves at a
-  /// point). \throws kelp::invalid_argument when t is not finite and a wave field, a varying
-  /// current or gusts read it (a NaN position gives NaN values, no exception).
+  /// point). \throws kelp::invalid_argument when a coordinate of p_ned is NaN or ±∞ (a point
+  /// without a depth or a wave phase: no sample), or when t is not finite and a wave field, a
+  /// varying current or gusts read it.
   EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t,
                                    bool with_wind = true) const {
+    check_all_finite(p_ned, "Environment::sample: p_ned");
+    return sample_unchecked(p_ned, t, with_wind);
+  }
+
+  /// \brief sample() without the check of the point, for the samplers inside a step (the vehicle
+  /// steps sample their stages through it, vehicle::surroundings): there a stage that has blown
+  /// up to NaN gives NaN values, which the step reports as numerical_error with the state
+  /// unchanged, instead of an invalid_argument from the middle of the step (the step checks the
+  /// state it is given once, up front). Same values as sample() for a finite point.
+  /// \throws kelp::invalid_argument when t is not finite and a wave field, a varying current or
+  /// gusts read it.
+  EnvironmentSample<Scalar> sample_unchecked(const Vector3<Scalar>& p_ned, double t,
+                                             bool with_wind) const {
     EnvironmentSample<Scalar> s;
-    if (!current_.is_zero()) s.current = current_.velocity(p_ned, t);
+    if (!current_.is_zero())  // as CurrentModel::velocity, without its check of the point
+      s.current = current_.surface_velocity(t) *
+                  detail::profile_factor_unchecked(current_.parameters().profile, p_ned(2));
     if (!waves_.empty()) {
       const WaveKinematics<Scalar> k = waves_.kinematics(p_ned, t);
       s.wave_velocity = k.velocity;

@@ -438,8 +438,9 @@ Vector6<Scalar> step_vehicle(const vehicle::VehicleModel<Scalar>& model,
                Vector6<Scalar> tau_ext = in.tau_ext;
                for (int k = 0; k < n; ++k) tau_ext += wrench_of_force(s, loads[k].r, loads[k].f);
                if (hull) tau_ext += hull_contact(*hull, env, s).wrench;
-               d.nu_dot = vehicle::forward_dynamics(model, ws, s, in.tau, tau_ext,
-                                                    lerp(s0, s1, Scalar(c)));
+               // Unchecked: a NaN tether force or stage state ends the step as numerical_error.
+               d.nu_dot = vehicle::detail::forward_dynamics_unchecked(model, ws, s, in.tau, tau_ext,
+                                                                      lerp(s0, s1, Scalar(c)));
                return d;
              },
              "system::step (vehicle)")
@@ -475,7 +476,11 @@ tether::StepReport<Scalar> advance_tether(const tether::TetherModel<Scalar>& lin
   try {
     return tether::advance(line, ws, env, state, ends, dt, options);
   } catch (const kelp::numerical_error&) {
-    if (!fallback || !tether::is_implicit(options.integrator)) throw;
+    // A line without a free node has no stable explicit step to redo it in (estimate_stable_dt
+    // refuses it), nor anything an explicit scheme would do differently.
+    if (!fallback || !tether::is_implicit(options.integrator) ||
+        line.first_free_node() > line.last_free_node())
+      throw;
     // The failed step left the tether as it was: redo it explicitly.
     using std::sqrt;
     const Scalar h =

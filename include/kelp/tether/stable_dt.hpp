@@ -160,7 +160,8 @@ inline bool line_stable(Integrator integ, double h, const LinearisedLine& line) 
 /// ω_a = 2√(EA/(l μ l)), the top of the lumped chain's spectrum 2√(k/m) sin(jπ/(2N))). Bending
 /// (EI > 0): the discrete bending stiffness is (EI/l³)·DᵀD with D the second difference
 /// (‖DᵀD‖ ≤ 16), so ω²_b ≤ 16 EI/(l³ m_i). Returns √(ω²_a + ω²_b). The masses are structural:
-/// added mass only lowers the frequencies, and a node at or above the surface has none.
+/// added mass only lowers the frequencies, and a node at or above the surface has none. 0 for a
+/// line without a free node (one segment between two kinematic ends: no mode is integrated).
 /// \param[in] water_density ρ [kg/m³], checked only (kept for the callers of earlier versions,
 /// where it lowered the frequency by the tangential added mass).
 /// \throws kelp::invalid_argument for a water density ρ outside [0, 1e5] kg/m³ or NaN.
@@ -216,14 +217,20 @@ Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_de
 /// ramp (seabed_damping_depth), the surface band's buoyancy spring ρVg/d (tiny), added-mass rate
 /// terms. Transverse (pendulum and bending) modes get no internal damping: RK2 relies on the
 /// water's quadratic drag to hold their slow growth (rate ω y³/8 per second at y = hω ≪ 1).
+///
+/// A line of one segment with a free end has one free node (two with both ends free) and a
+/// finite step like any other; a line of one segment between two kinematic ends has none and is
+/// refused (see below).
 /// \param[in] options water density (drag), safety factor, speed bound, seabed contact.
 /// \return the step [s]; +infinity for the implicit schemes (unconditionally stable for the
 /// linearised line; choose dt for accuracy, e.g. 10 ms).
 /// \throws kelp::invalid_argument for ρ outside [0, 1e5] kg/m³ or NaN, a safety factor outside
 /// (0, 1], a negative or non-finite speed bound, an Integrator value outside the enumeration,
-/// or RK2 on a line without internal damping (BA = 0: its axial modes grow at every step; give
-/// the line internal damping, e.g. ζ = 0.2 at the highest mode, BA = 2ζ·EA/ω_max = 0.4·EA/ω_max
-/// with ω_max from highest_axial_frequency, or use symplectic Euler or RK4).
+/// a line without a free node (one segment with both ends kinematic: nothing is integrated, so
+/// no step is limited by stability, whatever the scheme), or RK2 on a line without internal
+/// damping (BA = 0: its axial modes grow at every step; give the line internal damping, e.g.
+/// ζ = 0.2 at the highest mode, BA = 2ζ·EA/ω_max = 0.4·EA/ω_max with ω_max from
+/// highest_axial_frequency, or use symplectic Euler or RK4).
 template <typename Scalar>
 Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrator,
                           const StableDtOptions<Scalar>& options) {
@@ -233,6 +240,12 @@ Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrato
   check_non_negative(options.max_relative_speed, "max_relative_speed");
   check_at_most(options.max_relative_speed, 1e6, "max_relative_speed");
   KELP_CHECK(is_valid(integrator), "integrator is not a kelp::tether::Integrator value");
+  // One segment between two kinematic ends: no node is integrated (the step only moves the ends),
+  // so there is no oscillator to bound. +∞ here would be a number a step then refuses as dt.
+  KELP_CHECK(model.first_free_node() <= model.last_free_node(),
+             "estimate_stable_dt: the line has no free node (one segment with both ends "
+             "kinematic): nothing is integrated, so no time step is limited by stability; "
+             "choose dt for the motion of the ends");
   if (is_implicit(integrator)) return std::numeric_limits<Scalar>::infinity();
   const detail::LinearisedLine line =
       detail::linearise_line(model, value_of(options.water_density),

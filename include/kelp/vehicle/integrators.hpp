@@ -49,19 +49,37 @@ struct StateDerivative {
   Vector6<Scalar> nu_dot = Vector6<Scalar>::Zero();
 };
 
+namespace detail {
+
+/// state_derivative() with the unchecked forward dynamics: the stage derivative of the steps.
+template <typename Scalar, typename DT>
+StateDerivative<Scalar> state_derivative_unchecked(const VehicleModel<Scalar>& model,
+                                                   VehicleWorkspace<Scalar>& ws,
+                                                   const VehicleState<Scalar>& state,
+                                                   const Eigen::MatrixBase<DT>& tau_total,
+                                                   const Surroundings<Scalar>& s) {
+  StateDerivative<Scalar> d;
+  d.pose = pose_rate(state.attitude, state.nu);
+  d.nu_dot = forward_dynamics_unchecked(model, ws, state, tau_total, Vector6<Scalar>::Zero(), s);
+  return d;
+}
+
+}  // namespace detail
+
 /// \brief Full state derivative: kinematics (pose_rate()) and kinetics (forward_dynamics()).
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in] state current state.
 /// \param[in] tau_total τ + τ_ext [N, N m], body axes. \param[in] current_ned v_c^n [m/s], NED.
+/// \throws as forward_dynamics(): kelp::invalid_argument for a wrench or current of the wrong
+/// size or a non-finite value in them or in the state.
 template <typename Scalar, typename DT, typename DC>
 StateDerivative<Scalar> state_derivative(const VehicleModel<Scalar>& model,
                                          VehicleWorkspace<Scalar>& ws,
                                          const VehicleState<Scalar>& state,
                                          const Eigen::MatrixBase<DT>& tau_total,
                                          const Eigen::MatrixBase<DC>& current_ned) {
-  StateDerivative<Scalar> d;
-  d.pose = pose_rate(state.attitude, state.nu);
-  d.nu_dot = forward_dynamics(model, ws, state, tau_total, Vector6<Scalar>::Zero(), current_ned);
-  return d;
+  const Surroundings<Scalar> s = detail::current_surroundings<Scalar>(current_ned);
+  detail::check_dynamics_input(state, tau_total, Vector6<Scalar>::Zero(), s);
+  return detail::state_derivative_unchecked(model, ws, state, tau_total, s);
 }
 
 namespace detail {
@@ -195,11 +213,12 @@ void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
                    const Eigen::MatrixBase<DC>& current_ned) {
   detail::check_step_input(state, dt);
   detail::check_current(current_ned);
-  const Vector3<Scalar> vc(current_ned);
+  const Surroundings<Scalar> s = detail::current_surroundings<Scalar>(current_ned);
+  // Stages unchecked: a NaN wrench or stage state ends the step as numerical_error (rk4).
   detail::rk4(
       state, dt,
       [&](const VehicleState<Scalar>& x, double c) {
-        return state_derivative(model, ws, x, wrench(x, Scalar(c) * dt), vc);
+        return detail::state_derivative_unchecked(model, ws, x, wrench(x, Scalar(c) * dt), s);
       },
       "step_rk4");
 }
@@ -309,8 +328,8 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws, c
       [&](const VehicleState<Scalar>& x, double c) {
         StateDerivative<Scalar> d;
         d.pose = pose_rate(x.attitude, x.nu);
-        d.nu_dot =
-            forward_dynamics(model, ws, x, total, zero, surroundings(model, env, x, t + c * dt_d));
+        d.nu_dot = detail::forward_dynamics_unchecked(model, ws, x, total, zero,
+                                                      surroundings(model, env, x, t + c * dt_d));
         return d;
       },
       "step_rk4");
@@ -336,7 +355,8 @@ void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<S
   detail::check_step_input(state, dt);
   detail::check_current(current_ned);
   const Vector6<Scalar> nu_dot =
-      forward_dynamics(model, ws, state, inputs.tau, inputs.tau_ext, current_ned);
+      detail::forward_dynamics_unchecked(model, ws, state, inputs.tau, inputs.tau_ext,
+                                         detail::current_surroundings<Scalar>(current_ned));
   detail::symplectic_euler(state, nu_dot, Scalar(dt), "step_symplectic_euler");
 }
 
@@ -356,8 +376,8 @@ void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<S
                            const Env& env, VehicleState<Scalar>& state,
                            const VehicleInputs<Scalar>& inputs, identity_t<Scalar> dt) {
   detail::check_step_input(state, dt);
-  const Vector6<Scalar> nu_dot = forward_dynamics(model, ws, state, inputs.tau, inputs.tau_ext,
-                                                  surroundings(model, env, state, state.time));
+  const Vector6<Scalar> nu_dot = detail::forward_dynamics_unchecked(
+      model, ws, state, inputs.tau, inputs.tau_ext, surroundings(model, env, state, state.time));
   detail::symplectic_euler(state, nu_dot, Scalar(dt), "step_symplectic_euler");
 }
 

@@ -369,53 +369,21 @@ struct VehicleWorkspace {
   Vector6<Scalar> nu_dot = Vector6<Scalar>::Zero();
 };
 
-/// \brief Forward dynamics of a vehicle in its surroundings (water velocity and acceleration, free
-/// surface, wind), allocation-free:
-/// \f[ \dot\nu = M^{-1}\big(\tau + \tau_{ext} - C_{RB}(\nu)\nu - C_A(\nu_r)\nu_r - D(\nu_r)\nu_r
-///     - g(\eta, \zeta, \nabla\zeta) + M_A\dot\nu_w + \tau_{FK} + \tau_{wind}\big). \f]
-///
-/// Water motion (Fossen 2021, §10.3, extended to a non-uniform, unsteady flow as in Faltinsen
-/// 1990, ch. 3, for a body small against the wavelength): ν_w = (Rᵀ v_w, 0) with v_w the water
-/// velocity at the CO (current + wave orbital velocity), ν_r = ν − ν_w, and the body-frame rate
-/// of the water velocity seen by the vehicle ν̇_w = (ν_{w,1} × ν₂ + Rᵀ a_w, 0), where a_w is the
-/// water's material acceleration Dv/Dt = ∂v/∂t + (v·∇)v at the CO (Surroundings::
-/// water_acceleration: the convective part from the wave velocity gradient; without it a
-/// neutrally buoyant body sinks under waves, pushed by the mean (m + A₃₃) k a²ω² e^{−2kz}). The
-/// difference (∇v_w)(ṗ − v_w) between the rate along the body's path and along the water's
-/// (second order in the wave steepness times the relative velocity) and the slow time variation
-/// of the current are neglected.
-/// M_A ν̇_w is the added-mass (diffraction) force of the accelerating flow; τ_FK = (ρ ∇ φ Rᵀ a_w,
-/// 0) is the Froude–Krylov force (the pressure gradient of the undisturbed flow on the displaced
-/// volume, φ the submerged fraction), so the translational forcing is (ρ∇ I + M_A) Rᵀ a_w, the
-/// inertia term of Morison's equation with C_M = 1 + C_A. For a surface vessel only the
-/// horizontal part of a_w enters τ_FK: the vertical pressure of the wave is already in the
-/// restoring that follows the local surface. The moments of τ_FK are neglected (small body).
-/// Wind (surface vessels): environment::wind_load() with the model's `wind_areas` and
-/// `wind_coefficients` and the surroundings' air density (the environment's: one air, as there
-/// is one water), on the heading ψ and the body velocity over ground (Fossen 2021,
-/// §10.1.1). With still water, no wind and a flat surface this is the irrotational-current
-/// model of the file comment.
-/// Free surface (`submerged_free_surface`, docs/equations.md "Free surface"): every fluid term
-/// scales with the submerged fraction φ of the box hull about the CB: buoyancy, τ_FK, the added
-/// mass (M = M_RB + φ M_A in the mass matrix, φ C_A, φ M_A ν̇_w) and the damping φ D; the
-/// position-dependent added mass adds ws.added_mass_change = −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ
-/// (Lagrange's equations for T = ½ νᵀ M(φ) ν), so that T + U is conserved without damping.
-///
-/// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
-/// \param[in] state pose (NED, unit quaternion) and ν (body).
-/// \param[in] tau control wrench (thrusters) [N, N m], body axes about the CO.
-/// \param[in] tau_ext other external wrench [N, N m], body axes about the CO (e.g. the tether's).
-/// \param[in] s the surroundings at the vehicle's position (see surroundings()).
-/// \return ν̇ [m/s², rad/s²], body axes.
-/// \throws kelp::invalid_argument when tau or tau_ext has not 6 entries (a size, so free for
-/// fixed-size vectors). Values are not checked here: the integrators check what they take from
-/// the caller, and a non-finite stage state must end as their numerical_error.
+namespace detail {
+
+/// forward_dynamics() without the checks of the values, for the evaluations inside a step (every
+/// stage of the vehicle steps and of the system's step): there a NaN wrench, state or water
+/// velocity gives a NaN ν̇, which the step reports as numerical_error with the state unchanged
+/// (its documented contract), instead of an invalid_argument from the middle of the step. The
+/// step checks what it takes from its caller once, up front. Sizes are still checked (free for
+/// fixed-size vectors).
 template <typename Scalar, typename D1, typename D2>
-Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
-                                 const VehicleState<Scalar>& state,
-                                 const Eigen::MatrixBase<D1>& tau,
-                                 const Eigen::MatrixBase<D2>& tau_ext,
-                                 const Surroundings<Scalar>& s) {
+Vector6<Scalar> forward_dynamics_unchecked(const VehicleModel<Scalar>& model,
+                                           VehicleWorkspace<Scalar>& ws,
+                                           const VehicleState<Scalar>& state,
+                                           const Eigen::MatrixBase<D1>& tau,
+                                           const Eigen::MatrixBase<D2>& tau_ext,
+                                           const Surroundings<Scalar>& s) {
   KELP_CHECK(tau.size() == 6 && tau_ext.size() == 6,
              "forward_dynamics: tau and tau_ext must have 6 entries");
   const VehicleParameters<Scalar>& p = model.parameters();
@@ -490,6 +458,90 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
   return ws.nu_dot;
 }
 
+/// The surroundings of a uniform current under a flat calm surface, no wind.
+template <typename Scalar, typename DC>
+Surroundings<Scalar> current_surroundings(const Eigen::MatrixBase<DC>& current_ned) {
+  KELP_CHECK(current_ned.size() == 3, "forward_dynamics: current_ned must have 3 entries");
+  Surroundings<Scalar> s;
+  s.water_velocity = current_ned;
+  return s;
+}
+
+/// Throws kelp::invalid_argument naming the first value forward_dynamics() reads that is not
+/// finite (about 40 comparisons: nothing beside the 6×6 solve).
+template <typename Scalar, typename D1, typename D2>
+void check_dynamics_input(const VehicleState<Scalar>& state, const Eigen::MatrixBase<D1>& tau,
+                          const Eigen::MatrixBase<D2>& tau_ext, const Surroundings<Scalar>& s) {
+  KELP_CHECK(tau.size() == 6 && tau_ext.size() == 6,
+             "forward_dynamics: tau and tau_ext must have 6 entries");
+  check_all_finite(tau, "forward_dynamics: tau");
+  check_all_finite(tau_ext, "forward_dynamics: tau_ext");
+  check_all_finite(state.position, "forward_dynamics: state.position");
+  check_all_finite(state.attitude.coeffs(), "forward_dynamics: state.attitude");
+  check_all_finite(state.nu, "forward_dynamics: state.nu");
+  check_all_finite(s.water_velocity, "forward_dynamics: surroundings water_velocity");
+  check_all_finite(s.water_acceleration, "forward_dynamics: surroundings water_acceleration");
+  check_finite(s.surface_elevation, "forward_dynamics: surroundings surface_elevation");
+  check_all_finite(s.surface_slope, "forward_dynamics: surroundings surface_slope");
+  check_all_finite(s.wind_velocity, "forward_dynamics: surroundings wind_velocity");
+  check_finite(s.air_density, "forward_dynamics: surroundings air_density");
+}
+
+}  // namespace detail
+
+/// \brief Forward dynamics of a vehicle in its surroundings (water velocity and acceleration, free
+/// surface, wind), allocation-free:
+/// \f[ \dot\nu = M^{-1}\big(\tau + \tau_{ext} - C_{RB}(\nu)\nu - C_A(\nu_r)\nu_r - D(\nu_r)\nu_r
+///     - g(\eta, \zeta, \nabla\zeta) + M_A\dot\nu_w + \tau_{FK} + \tau_{wind}\big). \f]
+///
+/// Water motion (Fossen 2021, §10.3, extended to a non-uniform, unsteady flow as in Faltinsen
+/// 1990, ch. 3, for a body small against the wavelength): ν_w = (Rᵀ v_w, 0) with v_w the water
+/// velocity at the CO (current + wave orbital velocity), ν_r = ν − ν_w, and the body-frame rate
+/// of the water velocity seen by the vehicle ν̇_w = (ν_{w,1} × ν₂ + Rᵀ a_w, 0), where a_w is the
+/// water's material acceleration Dv/Dt = ∂v/∂t + (v·∇)v at the CO (Surroundings::
+/// water_acceleration: the convective part from the wave velocity gradient; without it a
+/// neutrally buoyant body sinks under waves, pushed by the mean (m + A₃₃) k a²ω² e^{−2kz}). The
+/// difference (∇v_w)(ṗ − v_w) between the rate along the body's path and along the water's
+/// (second order in the wave steepness times the relative velocity) and the slow time variation
+/// of the current are neglected.
+/// M_A ν̇_w is the added-mass (diffraction) force of the accelerating flow; τ_FK = (ρ ∇ φ Rᵀ a_w,
+/// 0) is the Froude–Krylov force (the pressure gradient of the undisturbed flow on the displaced
+/// volume, φ the submerged fraction), so the translational forcing is (ρ∇ I + M_A) Rᵀ a_w, the
+/// inertia term of Morison's equation with C_M = 1 + C_A. For a surface vessel only the
+/// horizontal part of a_w enters τ_FK: the vertical pressure of the wave is already in the
+/// restoring that follows the local surface. The moments of τ_FK are neglected (small body).
+/// Wind (surface vessels): environment::wind_load() with the model's `wind_areas` and
+/// `wind_coefficients` and the surroundings' air density (the environment's: one air, as there
+/// is one water), on the heading ψ and the body velocity over ground (Fossen 2021,
+/// §10.1.1). With still water, no wind and a flat surface this is the irrotational-current
+/// model of the file comment.
+/// Free surface (`submerged_free_surface`, docs/equations.md "Free surface"): every fluid term
+/// scales with the submerged fraction φ of the box hull about the CB: buoyancy, τ_FK, the added
+/// mass (M = M_RB + φ M_A in the mass matrix, φ C_A, φ M_A ν̇_w) and the damping φ D; the
+/// position-dependent added mass adds ws.added_mass_change = −φ̇ M_A ν_r + ½ (ν_rᵀ M_A ν_r) ∇φ
+/// (Lagrange's equations for T = ½ νᵀ M(φ) ν), so that T + U is conserved without damping.
+///
+/// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
+/// \param[in] state pose (NED, unit quaternion) and ν (body).
+/// \param[in] tau control wrench (thrusters) [N, N m], body axes about the CO.
+/// \param[in] tau_ext other external wrench [N, N m], body axes about the CO (e.g. the tether's).
+/// \param[in] s the surroundings at the vehicle's position (see surroundings()).
+/// \return ν̇ [m/s², rad/s²], body axes.
+/// \throws kelp::invalid_argument when tau or tau_ext has not 6 entries, or naming the first
+/// value that is not finite (NaN or ±Inf) in tau, tau_ext, the state's position, attitude or ν,
+/// or the surroundings; `ws` is then left as it was. The steps evaluate their stages without
+/// these checks (detail::forward_dynamics_unchecked): they check their own input once, and a
+/// non-finite value that appears inside a step ends it as numerical_error, state unchanged.
+template <typename Scalar, typename D1, typename D2>
+Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
+                                 const VehicleState<Scalar>& state,
+                                 const Eigen::MatrixBase<D1>& tau,
+                                 const Eigen::MatrixBase<D2>& tau_ext,
+                                 const Surroundings<Scalar>& s) {
+  detail::check_dynamics_input(state, tau, tau_ext, s);
+  return detail::forward_dynamics_unchecked(model, ws, state, tau, tau_ext, s);
+}
+
 /// \brief Forward dynamics ν̇ = M⁻¹(τ + τ_ext − C_RB(ν)ν − C_A(ν_r)ν_r − D(ν_r)ν_r − g + M_A ν̇_c)
 /// in a uniform current, flat calm surface at z = 0, no wind (see the file comment; Fossen 2021,
 /// §10.3). Same as the Surroundings overload with water_velocity = current_ned. Allocation-free.
@@ -501,20 +553,21 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
 ///   waves... added by the caller each step).
 /// \param[in] current_ned ocean current velocity v_c^n [m/s] in NED (irrotational, uniform).
 /// \return ν̇ [m/s², rad/s²], body axes.
-/// \throws kelp::invalid_argument when tau or tau_ext has not 6 entries or current_ned not 3.
+/// \throws kelp::invalid_argument when tau or tau_ext has not 6 entries or current_ned not 3, or
+/// naming the first value that is not finite in tau, tau_ext, the state or current_ned (as the
+/// Surroundings overload; `ws` is then left as it was).
 template <typename Scalar, typename DT, typename DE, typename DC>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                                  const VehicleState<Scalar>& state,
                                  const Eigen::MatrixBase<DT>& tau,
                                  const Eigen::MatrixBase<DE>& tau_ext,
                                  const Eigen::MatrixBase<DC>& current_ned) {
-  KELP_CHECK(current_ned.size() == 3, "forward_dynamics: current_ned must have 3 entries");
-  Surroundings<Scalar> s;
-  s.water_velocity = current_ned;
-  return forward_dynamics(model, ws, state, tau, tau_ext, s);
+  return forward_dynamics(model, ws, state, tau, tau_ext,
+                          detail::current_surroundings<Scalar>(current_ned));
 }
 
 /// \brief Forward dynamics without current: ν̇ = M⁻¹(τ + τ_ext − C_RB ν − C_A ν − D ν − g).
+/// \throws as the overload with a current.
 template <typename Scalar, typename DT, typename DE>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                                  const VehicleState<Scalar>& state,

@@ -77,10 +77,22 @@ template <typename Sample>
 struct has_surface_slope<Sample, std::void_t<decltype(std::declval<const Sample&>().surface_slope)>>
     : std::true_type {};
 
-/// env.sample(p, t), told to skip the wind when it can be (`sample(p, t, false)`).
+template <typename Env, typename P, typename = void>
+struct has_unchecked_sample : std::false_type {};
+template <typename Env, typename P>
+struct has_unchecked_sample<Env, P,
+                            std::void_t<decltype(std::declval<const Env&>().sample_unchecked(
+                                std::declval<const P&>(), 0.0, false))>> : std::true_type {};
+
+/// env.sample(p, t), told to skip the wind when it can be (`sample(p, t, false)`), without the
+/// check of the point when the environment has one to skip (`sample_unchecked(p, t, wind)`, as
+/// Environment has): a stage state that has blown up to NaN must end the step as its
+/// numerical_error, not as an invalid_argument from the environment.
 template <typename Env, typename P>
 auto sample(const Env& env, const P& p, double t, bool wind) {
-  if constexpr (has_windless_sample<Env, P>::value)
+  if constexpr (has_unchecked_sample<Env, P>::value)
+    return env.sample_unchecked(p, t, wind);
+  else if constexpr (has_windless_sample<Env, P>::value)
     return env.sample(p, t, wind);
   else
     return env.sample(p, t);
@@ -115,8 +127,11 @@ Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scal
 /// density when `env.air_density()` exists (else kelp::air_density). `Env` is
 /// `kelp::environment::Environment` or any type with those two queries. The water acceleration is
 /// the material one, ∂v/∂t + (v·∇)v, when the sample carries the wave velocity gradient (as
-/// Environment's does). \param[in] env environment \param[in] x vehicle state (its CO position is
-/// used) \param[in] t time [s]
+/// Environment's does). The steps call it at every stage, so the position is not checked here
+/// (Environment::sample_unchecked when the environment has it): a NaN position gives NaN
+/// surroundings, which forward_dynamics() refuses and a step reports as numerical_error.
+/// \param[in] env environment \param[in] x vehicle state (its CO position is used)
+/// \param[in] t time [s]
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x, double t) {
   return detail::sample_surroundings(env, x, t, true, true);
