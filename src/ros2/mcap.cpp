@@ -275,6 +275,9 @@ void McapWriter::flush_chunk() {
   chunk_indexes_.push_back(std::move(ci));
   chunk_.clear();
   chunk_messages_ = 0;
+  // The chunk and its message indexes go to the system now, not when the stdio buffer fills: a
+  // process killed later leaves a file that a streaming reader reads up to this chunk's end.
+  if (std::fflush(file_) != 0) throw kelp::error("McapWriter: cannot write " + path_);
 }
 
 void McapWriter::finish() {

@@ -75,6 +75,12 @@ struct McapOptions {
 ///
 /// After the first chunk the buffers are reused: writing a message allocates nothing (the chunk
 /// index grows by one entry a chunk).
+///
+/// Each completed chunk is handed to the system with its message indexes (fflush) before the
+/// next message is gathered: a process killed mid-run (SIGKILL) leaves a file without summary and
+/// footer that a streaming reader (@mcap/core's McapStreamReader) reads up to the end of its last
+/// completed chunk, every message of every completed chunk with its index; only the open chunk
+/// (at most `chunk_size` bytes) is lost. An indexed reader needs the footer, which close() writes.
 class KELP_SIM_API McapWriter {
  public:
   /// Options of a writer (McapOptions).
@@ -131,7 +137,8 @@ class KELP_SIM_API McapWriter {
   void emit(const void* p, std::size_t n);
   void emit_record(McapOp op, const std::vector<std::uint8_t>& content);
 
-  // Writes the open chunk (if it has messages), its message indexes, and its chunk index entry.
+  // Writes the open chunk (if it has messages), its message indexes, and its chunk index entry,
+  // and hands them to the system (fflush).
   void flush_chunk();
 
   void finish();
