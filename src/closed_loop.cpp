@@ -16,6 +16,7 @@
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
+#include "kelp/sim/stop.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/vehicle/presets.hpp"
 
@@ -438,7 +439,9 @@ EntanglementSummary ClosedLoop::entanglement_summary() const {
 RunSummary ClosedLoop::summary() const {
   const RunMetrics& m = metrics_;
   RunSummary s;
-  s.simulated_s = scenario_.duration;
+  // A run stopped early (kelp/sim/stop.hpp), or a summary taken before the end: the time reached.
+  s.completed = done();
+  s.simulated_s = s.completed ? scenario_.duration : state_.time;
   s.auv.rms_path_error_m = m.auv_rms_error();
   s.auv.max_path_error_m = m.auv_max_error;
   s.auv.waypoints_reached = auv_.next_waypoint();
@@ -507,6 +510,8 @@ RunSummary simulate(const Scenario& sc, const SimulateOptions& o) {
   const long steps = loop.total_steps();
   const auto wall0 = std::chrono::steady_clock::now();
   while (!loop.done()) {
+    // A stop (kelp/sim/stop.hpp): the run ends here, between two steps.
+    if (stop_requested() || (o.should_stop && o.should_stop())) break;
     const long k = loop.steps_taken();
     const double t = loop.time();
     loop.step();
@@ -517,7 +522,7 @@ RunSummary simulate(const Scenario& sc, const SimulateOptions& o) {
   if (log) log->close();
   RunSummary summary = loop.summary();
   summary.wall_s = wall;
-  summary.realtime_factor = sc.duration / wall;
+  summary.realtime_factor = summary.simulated_s / wall;
   return summary;
 }
 

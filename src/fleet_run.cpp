@@ -20,6 +20,8 @@
 #include "kelp/core/constants.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/sim/ros2/fleet.hpp"
+#include "kelp/sim/run_log.hpp"
+#include "kelp/sim/stop.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/tether/failure.hpp"
 #include "kelp/tether/initial_state.hpp"
@@ -217,7 +219,8 @@ ks::FleetStated fleet_start_state(const ks::FleetModeld& model, ks::FleetWorkspa
   return state;
 }
 
-FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std::string& out) {
+FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std::string& out,
+                          const std::function<bool()>& should_stop) {
   FleetWorld w = fleet_world(sc, file);
   const FleetScenario& f = *sc.fleet;
   const ks::FleetModeld model(w.parameters, w.environment);
@@ -270,53 +273,68 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
     }
   }
   // The outputs.
+  // The CSV files in whole lines (LineFile, kelp/sim/run_log.hpp), written out at least once a
+  // simulated second: a run killed mid-way leaves files that end on a whole line.
   fs::create_directories(out);
-  std::ofstream series(fs::path(out) / "timeseries.csv"), nodes(fs::path(out) / "nodes.csv");
-  if (!series || !nodes) throw kelp::invalid_argument("run_fleet: cannot write into " + out);
-  series << "t";
+  LineFile series, nodes;
+  try {
+    series.open(fs::path(out) / "timeseries.csv");
+    nodes.open(fs::path(out) / "nodes.csv");
+  } catch (const kelp::error&) {
+    throw kelp::invalid_argument("run_fleet: cannot write into " + out);
+  }
+  std::string& st = series.text();
+  std::string& nt = nodes.text();
+  st += "t";
   for (const auto& v : f.vehicles)
     for (const char* c : {".x", ".y", ".z", ".roll", ".pitch", ".yaw", ".u", ".v", ".w"})
-      series << ',' << v.name << c;
+      st += ',' + v.name + c;
   for (const auto& p : f.point_masses)
-    for (const char* c : {".x", ".y", ".z"}) series << ',' << p.name << c;
+    for (const char* c : {".x", ".y", ".z"}) st += ',' + p.name + c;
   for (const auto& t : f.tethers)
-    for (const char* c : {".tension_start", ".tension_end", ".length"})
-      series << ',' << t.name << c;
-  series << '\n';
-  nodes << "t,tether,node,x,y,z\n";
+    for (const char* c : {".tension_start", ".tension_end", ".length"}) st += ',' + t.name + c;
+  series.end_line();
+  nt += "t,tether,node,x,y,z";
+  nodes.end_line();
+  series.write_out();
+  nodes.write_out();
   char buf[64];
-  const auto num = [&](std::ostream& o, double x) {
+  const auto num = [&](std::string& o, double x) {
     std::snprintf(buf, sizeof buf, "%.6g", x);
-    o << ',' << buf;
+    o += ',';
+    o += buf;
   };
   const auto log_row = [&](const ks::FleetReportd* r) {
     std::snprintf(buf, sizeof buf, "%.3f", state.time);
-    series << buf;
+    st += buf;
     for (const auto& v : state.vehicles) {
       const Vector3<double> e = kelp::euler_from_quaternion(v.attitude);
-      for (int j = 0; j < 3; ++j) num(series, v.position(j));
-      for (int j = 0; j < 3; ++j) num(series, e(j));
-      for (int j = 0; j < 3; ++j) num(series, v.nu(j));
+      for (int j = 0; j < 3; ++j) num(st, v.position(j));
+      for (int j = 0; j < 3; ++j) num(st, e(j));
+      for (int j = 0; j < 3; ++j) num(st, v.nu(j));
     }
     for (const auto& p : state.point_masses)
-      for (int j = 0; j < 3; ++j) num(series, p.position(j));
+      for (int j = 0; j < 3; ++j) num(st, p.position(j));
     for (int k = 0; k < m; ++k) {
-      num(series, r ? r->force_at_start[std::size_t(k)].norm() : 0.0);
-      num(series, r ? r->force_at_end[std::size_t(k)].norm() : 0.0);
-      num(series,
-          kelp::tether::unstretched_length(model.tether_of(k, state.tethers[std::size_t(k)]),
-                                           state.tethers[std::size_t(k)]));
+      num(st, r ? r->force_at_start[std::size_t(k)].norm() : 0.0);
+      num(st, r ? r->force_at_end[std::size_t(k)].norm() : 0.0);
+      num(st, kelp::tether::unstretched_length(model.tether_of(k, state.tethers[std::size_t(k)]),
+                                               state.tethers[std::size_t(k)]));
     }
-    series << '\n';
+    series.end_line();
   };
   const auto log_nodes = [&] {
     for (int k = 0; k < m; ++k) {
       const auto& x = state.tethers[std::size_t(k)].position;
       for (Eigen::Index i = 0; i < x.cols(); ++i) {
         std::snprintf(buf, sizeof buf, "%.3f", state.time);
-        nodes << buf << ',' << f.tethers[std::size_t(k)].name << ',' << i;
-        for (int j = 0; j < 3; ++j) num(nodes, x(j, i));
-        nodes << '\n';
+        nt += buf;
+        nt += ',';
+        nt += f.tethers[std::size_t(k)].name;
+        std::snprintf(buf, sizeof buf, ",%ld", static_cast<long>(i));
+        nt += buf;
+        for (int j = 0; j < 3; ++j) num(nt, x(j, i));
+        nodes.end_line();
       }
     }
   };
@@ -408,7 +426,10 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
   log_nodes();
   record(nullptr, in);
   const auto wall0 = std::chrono::steady_clock::now();
+  double next_flush = state.time + 1.0;
   for (long step = 1; step <= steps; ++step) {
+    // A stop (kelp/sim/stop.hpp): the run ends here, between two steps.
+    if (stop_requested() || (should_stop && should_stop())) break;
     const double t = state.time;
     for (int i = 0; i < n; ++i) {
       Controller& c = control[std::size_t(i)];
@@ -453,8 +474,14 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
       record(&r, in);
     }
     if (step % node_every == 0) log_nodes();
+    if (state.time + 1e-9 >= next_flush) {
+      next_flush = state.time + 1.0;
+      series.write_out();
+      nodes.write_out();
+    }
     s.steps = step;
   }
+  s.completed = s.steps == steps;
   s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   s.simulated_s = state.time;
   s.newton_mean = s.steps > 0 ? double(newton) / double(s.steps) : 0.0;
@@ -469,7 +496,7 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
   nlohmann::json j;
   j["source"] = "kelp-tethered-pair (fleet)";
   j["scenario"] = file;
-  j["completed"] = true;
+  j["completed"] = s.completed;
   j["simulated_s"] = s.simulated_s;
   j["wall_s"] = s.wall_s;
   j["realtime_factor"] = s.wall_s > 0 ? s.simulated_s / s.wall_s : 0.0;
@@ -510,7 +537,8 @@ FleetRunSummary run_fleet(const Scenario& sc, const std::string& file, const std
   // The scenario as run, every field (as the pair's summary echoes it in `scenario`): what the
   // replay rebuilds the sea and the fleet from when the scenario file is gone or changed.
   j["scenario_echo"] = nlohmann::json::parse(scenario_json(sc));
-  std::ofstream(fs::path(out) / "summary.json") << j.dump(2) << '\n';
+  // Atomically: a run directory with summary.json has all of it.
+  write_file_atomically(fs::path(out) / "summary.json", j.dump(2) + '\n');
   return s;
 }
 

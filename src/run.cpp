@@ -3,7 +3,6 @@
 #include "kelp/sim/run.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <utility>
 
 #include "kelp/core/error.hpp"
@@ -57,10 +56,8 @@ std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
 void finish_run_with(const std::string& summary_text, const RunOptions& o,
                      const std::string& source) {
   if (o.out.empty()) return;
-  std::ofstream f(std::filesystem::path(o.out) / "summary.json");
-  f << summary_text << '\n';
-  if (!f) throw kelp::error("cannot write summary.json in " + o.out);
-  f.close();
+  // Atomically: a run directory with summary.json has all of it (a kill leaves none or the whole).
+  write_file_atomically(std::filesystem::path(o.out) / "summary.json", summary_text + '\n');
   if (!o.replay_template.empty()) {
     ReplayOptions ro;
     ro.source = source;
@@ -80,6 +77,7 @@ RunSummary run_scenario(const Scenario& sc, const RunOptions& o) {
   so.on_progress = o.on_progress;
   so.scenario_file = o.scenario_file;
   so.on_sample = o.on_sample;
+  so.should_stop = o.should_stop;
   std::unique_ptr<RunBag> bag = open_run_bag(sc, o, so.on_sample);
   RunSummary summary = simulate(sc, so);
   if (bag) bag->close();

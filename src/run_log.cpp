@@ -1,6 +1,12 @@
 // The run's CSV log (kelp/sim/run_log.hpp): timeseries.csv's columns and RunLog's members.
 #include "kelp/sim/run_log.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 namespace kelp {
 namespace sim {
 
@@ -50,44 +56,163 @@ const std::vector<std::string>& timeseries_columns() {
   return columns;
 }
 
+namespace {
+// A block is written once this much has gathered; the capacity reserved leaves room for one more
+// line of any length a run writes (a timeseries row is about 1 KB), so appending never allocates.
+constexpr std::size_t block_size = 64 * 1024, reserved = 2 * block_size;
+
+// Writes `n` bytes: one write(), repeated only for what the system did not take (a signal, a
+// full disk). \returns 0, or the error number.
+int write_all(int fd, const char* p, std::size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w < 0) return errno;
+    if (w == 0) return ENOSPC;
+    p += w;
+    n -= std::size_t(w);
+  }
+  return 0;
+}
+}  // namespace
+
+LineFile::~LineFile() {
+  try {
+    close();
+  } catch (...) {
+  }
+}
+
+void LineFile::open(const std::filesystem::path& path) {
+  KELP_CHECK(fd_ < 0, "LineFile::open: already open");
+  path_ = path.string();
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ < 0) throw kelp::error("cannot write " + path_ + ": " + std::strerror(errno));
+  text_.clear();
+  text_.reserve(reserved);
+  ended_ = 0;
+}
+
+void LineFile::end_line() {
+  text_ += '\n';
+  ended_ = text_.size();
+  if (ended_ >= block_size) write_out();
+}
+
+void LineFile::write_out() {
+  if (fd_ < 0 || ended_ == 0) return;
+  const int e = write_all(fd_, text_.data(), ended_);
+  text_.erase(0, ended_);  // the line not ended yet, if any, moves to the front
+  ended_ = 0;
+  if (e != 0) throw kelp::error("cannot write " + path_ + ": " + std::strerror(e));
+}
+
+void LineFile::close() {
+  if (fd_ < 0) return;
+  std::string error;
+  try {
+    write_out();
+  } catch (const kelp::error& e) {
+    error = e.what();
+  }
+  if (::close(fd_) != 0 && error.empty())
+    error = "cannot write " + path_ + ": " + std::strerror(errno);
+  fd_ = -1;
+  if (!error.empty()) throw kelp::error(error);
+}
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+  // The temporary's name is the process's own, so that two processes writing the same file do
+  // not write into one temporary.
+  std::filesystem::path tmp = path;
+  tmp += ".tmp" + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw kelp::error("cannot write " + path.string() + ": " + std::strerror(errno));
+  int e = write_all(fd, text.data(), text.size());
+  if (::close(fd) != 0 && e == 0) e = errno;
+  std::error_code ec;
+  if (e == 0) std::filesystem::rename(tmp, path, ec);
+  if (e != 0 || ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw kelp::error("cannot write " + path.string() + ": " +
+                      (e != 0 ? std::string(std::strerror(e)) : ec.message()));
+  }
+}
+
 RunLog::RunLog(const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
-  ts_.open(dir / "timeseries.csv");
-  nodes_.open(dir / "nodes.csv");
-  events_.open(dir / "events.csv");
-  if (!ts_ || !nodes_ || !events_)
-    throw kelp::error("cannot write the run's CSV files in " + dir.string());
+  try {
+    ts_.open(dir / "timeseries.csv");
+    nodes_.open(dir / "nodes.csv");
+    events_.open(dir / "events.csv");
+  } catch (const kelp::error& e) {
+    throw kelp::error("cannot write the run's CSV files in " + dir.string() + " (" + e.what() +
+                      ")");
+  }
   const std::vector<std::string>& columns = timeseries_columns();
-  for (std::size_t i = 0; i < columns.size(); ++i) ts_ << (i ? "," : "") << columns[i];
-  ts_ << '\n';
-  nodes_ << "t,node,x,y,z,tension\n";
-  events_ << "t,event,segment,x,y,z,tension,obstacle,winding\n";
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (i) ts_.text() += ',';
+    ts_.text() += columns[i];
+  }
+  ts_.end_line();
+  nodes_.text() += "t,node,x,y,z,tension";
+  nodes_.end_line();
+  events_.text() += "t,event,segment,x,y,z,tension,obstacle,winding";
+  events_.end_line();
+  flush();  // the header lines at once
+}
+
+void RunLog::flush_due(double t) {
+  if (t + 1e-9 < next_flush_) return;
+  next_flush_ = t + 1.0;
+  flush();
 }
 
 void RunLog::row(const LogRow& r) {
   bool first = true;
   for_each_value(r, [&](double v) {
-    if (!first) ts_ << ',';
+    if (!first) ts_.text() += ',';
     first = false;
-    ts_ << num(v);
+    ts_.text() += num(v);
   });
-  ts_ << '\n';
+  ts_.end_line();
+  flush_due(r.t);
 }
 
 void RunLog::line_parted(const kelp::tether::LineFailured& f) {
-  events_ << num(f.time) << ",line_parted," << f.segment;
-  for (double v : {f.position.x(), f.position.y(), f.position.z(), f.tension})
-    events_ << ',' << num(v);
-  events_ << ",," << num(std::numeric_limits<double>::quiet_NaN()) << '\n';
-  events_.flush();
+  std::string& s = events_.text();
+  s += num(f.time);
+  s += ",line_parted,";
+  s += std::to_string(f.segment);
+  for (double v : {f.position.x(), f.position.y(), f.position.z(), f.tension}) {
+    s += ',';
+    s += num(v);
+  }
+  s += ",,";
+  s += num(std::numeric_limits<double>::quiet_NaN());
+  events_.end_line();
+  events_.write_out();
 }
 
 void RunLog::entanglement(double t, const char* event, const kelp::Vector3<double>& position,
                           double tension, const std::string& obstacle, double winding) {
-  events_ << num(t) << ',' << event << ',' << num(std::numeric_limits<double>::quiet_NaN());
-  for (double v : {position.x(), position.y(), position.z(), tension}) events_ << ',' << num(v);
-  events_ << ',' << obstacle << ',' << num(winding) << '\n';
-  events_.flush();
+  std::string& s = events_.text();
+  s += num(t);
+  s += ',';
+  s += event;
+  s += ',';
+  s += num(std::numeric_limits<double>::quiet_NaN());
+  for (double v : {position.x(), position.y(), position.z(), tension}) {
+    s += ',';
+    s += num(v);
+  }
+  s += ',';
+  s += obstacle;
+  s += ',';
+  s += num(winding);
+  events_.end_line();
+  events_.write_out();
 }
 
 void RunLog::nodes(double t, const kelp::tether::TetherModeld& line,
@@ -96,24 +221,42 @@ void RunLog::nodes(double t, const kelp::tether::TetherModeld& line,
   KELP_CHECK(line.nodes() == n && tether.velocity.cols() == n,
              "RunLog::nodes: the line model has " + std::to_string(line.nodes()) +
                  " nodes, the state " + std::to_string(n));
+  std::string& s = nodes_.text();
+  char index[24];
   for (Eigen::Index i = 0; i < n; ++i) {
     const double tension =
         i + 1 < n ? kelp::tether::segment_axial_force(line, tether, static_cast<int>(i)) : 0.0;
-    nodes_ << num(t) << ',' << i << ',' << num(tether.position(0, i)) << ','
-           << num(tether.position(1, i)) << ',' << num(tether.position(2, i)) << ',' << num(tension)
-           << '\n';
+    s += num(t);
+    s += ',';
+    std::snprintf(index, sizeof index, "%ld", static_cast<long>(i));
+    s += index;
+    for (double v :
+         {tether.position(0, i), tether.position(1, i), tether.position(2, i), tension}) {
+      s += ',';
+      s += num(v);
+    }
+    nodes_.end_line();
   }
+  flush_due(t);
 }
 
 void RunLog::flush() {
-  ts_.flush();
-  nodes_.flush();
+  ts_.write_out();
+  nodes_.write_out();
+  events_.write_out();
 }
 
 void RunLog::close() {
-  ts_.close();
-  nodes_.close();
-  events_.close();
+  // Every file is closed, whatever fails; the first failure is reported.
+  std::string error;
+  for (LineFile* f : {&ts_, &nodes_, &events_}) {
+    try {
+      f->close();
+    } catch (const kelp::error& e) {
+      if (error.empty()) error = e.what();
+    }
+  }
+  if (!error.empty()) throw kelp::error(error);
 }
 
 const char* RunLog::num(double v) {

@@ -114,6 +114,7 @@ nlohmann::json solver_summary_to_json(const SolverSummary& s) {
 
 nlohmann::json summary_to_json(const RunSummary& s) {
   nlohmann::json j;
+  j["completed"] = s.completed;
   j["simulated_s"] = s.simulated_s;
   j["auv"] = {{"rms_path_error_m", s.auv.rms_path_error_m},
               {"max_path_error_m", s.auv.max_path_error_m},

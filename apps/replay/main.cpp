@@ -3,6 +3,7 @@
 // (<sweep>/runs/<hash>/). Reads timeseries.csv, nodes.csv and summary.json; writes replay.html
 // into the directory (or --out), or with --json the replay data alone.
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,8 @@
 
 #include "common/replay_template.hpp"
 #include "kelp/sim/replay.hpp"
+#include "kelp/sim/run_log.hpp"
+#include "kelp/sim/stop.hpp"
 
 namespace fs = std::filesystem;
 
@@ -26,15 +29,27 @@ int main(int argc, char** argv) {
   app.add_option("--title", title, "the page's title (default: program, scenario, duration)");
   app.add_option("--source", source, "the program that made the run (default: told from DIR)")
       ->check(CLI::IsMember({"kelp-tethered-pair", "kelp-sitl", "kelp-sweep"}));
+  app.footer(
+      "Exit status: 0 written, 1 not a run directory or a file error, 2 no page template, 130 / "
+      "143 stopped by SIGINT / SIGTERM before the page was written (nothing written). The page "
+      "(or the data) is written to a temporary file beside it and renamed: never half a page.");
   CLI11_PARSE(app, argc, argv);
   kelp::sim::ReplayOptions o;
   o.title = title;
   o.source = source;
+  // SIGINT or SIGTERM: the page is not written (kelp/sim/stop.hpp); a second signal stops at once.
+  kelp::sim::install_stop_handlers();
+  const auto stopped = [] {
+    if (!kelp::sim::stop_requested()) return false;
+    std::fprintf(stderr, "kelp-replay: stopped by %s; nothing written\n",
+                 kelp::sim::stop_signal() == SIGTERM ? "SIGTERM" : "SIGINT");
+    return true;
+  };
   try {
     if (!json_out.empty()) {
-      std::ofstream f(json_out);
-      f << kelp::sim::replay_data_json(dir, o) << '\n';
-      if (!f) throw kelp::error("cannot write " + json_out);
+      const std::string data = kelp::sim::replay_data_json(dir, o) + '\n';
+      if (stopped()) return kelp::sim::interrupted_exit_status();
+      kelp::sim::write_file_atomically(json_out, data);
       std::printf("kelp-replay: replay data of %s in %s\n", dir.c_str(), json_out.c_str());
       return 0;
     }
@@ -43,20 +58,14 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "kelp-replay: %s\n", kelp_apps::replay_template_missing_note().c_str());
       return 2;
     }
-    fs::path written;
-    if (out.empty()) {
-      written = kelp::sim::write_replay(dir, page, o);
-    } else {  // elsewhere (perhaps another file system): written in place
-      std::ifstream in(page, std::ios::binary);
-      if (!in) throw kelp::error("cannot read the replay template " + page);
-      const std::string text((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
-      const std::string html = kelp::sim::replay_html(text, kelp::sim::replay_data_json(dir, o));
-      std::ofstream f(out, std::ios::binary);
-      f << html;
-      if (!f) throw kelp::error("cannot write " + out);
-      written = out;
-    }
+    // DIR/replay.html or --out, through a temporary file beside it (the same file system).
+    const fs::path written = out.empty() ? fs::path(dir) / "replay.html" : fs::path(out);
+    std::ifstream in(page, std::ios::binary);
+    if (!in) throw kelp::error("cannot read the replay template " + page);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string html = kelp::sim::replay_html(text, kelp::sim::replay_data_json(dir, o));
+    if (stopped()) return kelp::sim::interrupted_exit_status();
+    kelp::sim::write_file_atomically(written, html);
     std::error_code ec;
     const auto size = fs::file_size(written, ec);
     std::printf("kelp-replay: %s (%.1f MB); open it in a browser: file://%s\n",

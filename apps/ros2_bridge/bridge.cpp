@@ -38,6 +38,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/run_log.hpp"
+#include "kelp/sim/stop.hpp"
 #include "nav_msgs.h"
 #include "publisher.hpp"
 #include "rosgraph_msgs.h"
@@ -201,6 +202,7 @@ class Subscriptions {
         }
       });
       if (raised) return true;
+      if (kelp::sim::stop_requested()) return false;  // a signal: the run stops (kelp/sim/stop.hpp)
       const double left = std::chrono::duration<double>(until - Clock::now()).count();
       if (left <= 0) return false;
       const dds_return_t rc =
@@ -249,7 +251,12 @@ kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& sc, const kelp::s
   double publish_s = 0, target = 0;
   long published_steps = 0;
   bool stopped = false;
+  const auto stop = [&] {
+    return kelp::sim::stop_requested() || (run.should_stop && run.should_stop());
+  };
   while (!loop.done()) {
+    // A stop (kelp/sim/stop.hpp): the run ends between two steps, its files whole.
+    if (stop()) break;
     if (o.lockstep) {
       while (target < loop.time() + 0.5 * dt) {
         if (!subs.wait_clock(target, o.clock_timeout)) {
@@ -269,9 +276,12 @@ kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& sc, const kelp::s
     publish_s += std::chrono::duration<double>(Clock::now() - p0).count();
     ++published_steps;
     if (!o.lockstep) {
-      std::this_thread::sleep_until(wall0 +
-                                    std::chrono::duration_cast<Clock::duration>(
-                                        std::chrono::duration<double>(loop.time() / o.speed)));
+      // Paced: in slices of at most 0.1 s, so that a slow --ros2-speed still stops at once.
+      const auto until = wall0 + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(loop.time() / o.speed));
+      while (Clock::now() < until && !stop())
+        std::this_thread::sleep_until(
+            std::min(until, Clock::now() + std::chrono::milliseconds(100)));
     }
   }
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
@@ -287,7 +297,8 @@ kelp::sim::RunSummary run_with_ros2(const kelp::sim::Scenario& sc, const kelp::s
   if (!o.lockstep) r["speed"] = o.speed;
   r["domain_id"] = participant.domain();
   r["simulated_s"] = loop.time();
-  r["stopped_early"] = stopped;  // lockstep: no /clock for clock_timeout before the end
+  // lockstep: no /clock for clock_timeout before the end (a signal's stop is `completed`: false)
+  r["stopped_early"] = stopped && !kelp::sim::stop_requested();
   r["published"] = publisher.counts();
   r["publish_us_per_step_mean"] =
       published_steps > 0 ? 1e6 * publish_s / double(published_steps) : 0.0;

@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -31,6 +30,7 @@
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/stop.hpp"
 #include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"
@@ -39,9 +39,6 @@ namespace fs = std::filesystem;
 namespace ks = kelp::system;
 
 namespace {
-
-std::atomic<bool> stop_requested{false};
-void on_signal(int) { stop_requested = true; }
 
 struct Options {
   kelp::sim::Scenario scenario = kelp_sitl::default_scenario();
@@ -220,8 +217,6 @@ int run(const Options& o) {
   };
   log_state();
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
   std::array<UdpSocket*, 2> sockets{&sub, &rover};
   std::array<std::uint8_t, 2048> buf{};
   kelp_sitl::Outbox out;
@@ -235,7 +230,8 @@ int run(const Options& o) {
   pollfd fds[2] = {{sub.fd(), POLLIN, 0}, {rover.fd(), POLLIN, 0}};
   std::uint64_t logged_steps = 0;
   bool done = false;
-  while (!stop_requested && !done) {
+  // SIGINT or SIGTERM (kelp/sim/stop.hpp, installed in main) ends the loop between two frames.
+  while (!kelp::sim::stop_requested() && !done) {
     const int ready = ::poll(fds, 2, 100);
     if (ready < 0 && errno != EINTR)
       throw std::runtime_error(std::string("poll: ") + std::strerror(errno));
@@ -276,8 +272,13 @@ int run(const Options& o) {
   log.close();
   if (bag) bag->close();
   const double wall = wall_now() - wall0;
+  // Completed: stopped at --duration, or by a signal when no duration was asked (kelp-sitl's
+  // usual end); a signal before --duration leaves an interrupted run (kelp/sim/stop.hpp).
+  const bool completed = done || o.duration <= 0;
   nlohmann::json summary;
   summary["kelp_version"] = KELP_VERSION_STRING;
+  summary["completed"] = completed;
+  summary["simulated_s"] = bridge.state().time;
   summary["physics_s"] = bridge.state().time;
   summary["wall_s"] = wall;
   summary["steps"] = bridge.steps();
@@ -315,7 +316,7 @@ int run(const Options& o) {
          {"tension_n", f.tension}});
   summary["scenario_file"] = o.scenario_file;
   summary["scenario"] = nlohmann::json::parse(kelp::sim::scenario_json(o.scenario));
-  std::ofstream(fs::path(o.log) / "summary.json") << summary.dump(2) << '\n';
+  kelp::sim::write_file_atomically(fs::path(o.log) / "summary.json", summary.dump(2) + '\n');
   // The 3-D replay (docs/replay.md): without the page's template (kelp built without three.js)
   // the run is still complete; a replay that cannot be made is reported, not fatal.
   const std::string replay_template = kelp_apps::find_replay_template(KELP_REPLAY_TEMPLATE_BUILD);
@@ -337,6 +338,11 @@ int run(const Options& o) {
                bridge.state().time, static_cast<unsigned long long>(bridge.steps()), wall,
                static_cast<unsigned long long>(bridge.counters(0).malformed),
                static_cast<unsigned long long>(bridge.counters(1).malformed), o.log.c_str());
+  if (!completed) {
+    std::fprintf(stderr, "kelp-sitl: stopped by %s before --duration %g s (\"completed\": false)\n",
+                 kelp::sim::stop_signal() == SIGTERM ? "SIGTERM" : "SIGINT", o.duration);
+    return kelp::sim::interrupted_exit_status();
+  }
   return 0;
 }
 
@@ -401,6 +407,9 @@ int main(int argc, char** argv) {
       o.scenario = kelp::sim::load_scenario(file);
       o.scenario_file = file;
     }
+    // SIGINT and SIGTERM stop the lockstep after the frame they land in, the files whole; a
+    // second one at once.
+    kelp::sim::install_stop_handlers();
     return run(o);
   } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-sitl: invalid scenario: %s\n", e.what());

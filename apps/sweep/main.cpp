@@ -5,19 +5,23 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/ros2.hpp"
+#include "kelp/sim/stop.hpp"
 #include "sweep.hpp"
 
 namespace fs = std::filesystem;
@@ -170,19 +174,28 @@ int run(const RunOptions& o) {
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex mutex;
   std::vector<std::string> failures;
+  // What became of each run of this shard, for status.json: done (a stored result), interrupted
+  // (stopped by a signal: rerun on resume), failed; the rest did not start.
+  std::vector<std::size_t> done_runs, failed_runs;
+  json interrupted_runs = json::array();
+  for (const auto& [hash, result] : results)
+    done_runs.push_back(result.value("index", std::size_t(0)));
   double simulated = 0;
   const auto wall0 = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   };
   const auto worker = [&] {
-    for (std::size_t k; (k = next++) < todo.size();) {
+    // A signal (kelp/sim/stop.hpp) stops the runs under way after their step and starts no more.
+    for (std::size_t k; !kelp::sim::stop_requested() && (k = next++) < todo.size();) {
       const paper_sweep::Run& r = *todo[k];
       json result = {{"hash", r.hash},
                      {"index", r.index},
                      {"point", paper_sweep::point_values(s, r.point)},
                      {"seed", r.seed}};
       std::string error;
+      bool completed = true;
+      double reached = 0;
       try {
         kelp::sim::SimulateOptions so;
         // --keep-series: the run's time series in runs/<hash>/ as kelp-tethered-pair writes them
@@ -196,21 +209,31 @@ int run(const RunOptions& o) {
                                                          r.scenario.node_rate);
           so.on_sample = [&bag](const kelp::sim::LogRow& row) { bag->record(row); };
         }
-        result["summary"] =
-            nlohmann::json::parse(kelp::sim::summary_json(kelp::sim::simulate(r.scenario, so)));
+        const kelp::sim::RunSummary summary = kelp::sim::simulate(r.scenario, so);
+        completed = summary.completed;
+        reached = summary.simulated_s;
+        result["summary"] = nlohmann::json::parse(kelp::sim::summary_json(summary));
         if (bag) bag->close();
+        // A stopped run's series and bag are whole, its summary.json says "completed": false;
+        // it stores no result, so that a resumed sweep runs it again.
         if (o.keep_series)
           write_atomically(series / "summary.json", result["summary"].dump(2) + "\n");
-        write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
+        if (completed) write_atomically(out / "runs" / (r.hash + ".json"), result.dump(1) + "\n");
       } catch (const std::exception& e) {
         error = e.what();
       }
       std::lock_guard<std::mutex> lock(mutex);
-      if (error.empty()) {
+      if (!error.empty()) {
+        failures.push_back("run " + std::to_string(r.index) + " (" + r.hash + "): " + error);
+        failed_runs.push_back(r.index);
+      } else if (!completed) {
+        simulated += reached;
+        interrupted_runs.push_back(
+            {{"index", r.index}, {"hash", r.hash}, {"simulated_s", reached}});
+      } else {
         simulated += r.scenario.duration;
         results[r.hash] = std::move(result);
-      } else {
-        failures.push_back("run " + std::to_string(r.index) + " (" + r.hash + "): " + error);
+        done_runs.push_back(r.index);
       }
       const std::size_t d = ++done;
       if (bar) {
@@ -227,12 +250,42 @@ int run(const RunOptions& o) {
   for (std::thread& t : pool) t.join();
   if (bar && !todo.empty()) std::fprintf(stderr, "\n");
   const double wall = elapsed();
+  const bool stopped = kelp::sim::stop_requested();
   std::printf(
       "kelp-sweep: %zu runs%s: %zu ran, %zu reused, %zu failed; %.0f s simulated in %.1f s wall "
       "on %u threads (%.0fx real time)\n",
-      mine, shards > 1 ? (" in shard " + o.shard).c_str() : "", todo.size() - failures.size(),
-      reused, failures.size(), simulated, wall, jobs, wall > 0 ? simulated / wall : 0.0);
+      mine, shards > 1 ? (" in shard " + o.shard).c_str() : "", done_runs.size() - reused, reused,
+      failures.size(), simulated, wall, jobs, wall > 0 ? simulated / wall : 0.0);
   for (const std::string& f : failures) std::fprintf(stderr, "kelp-sweep: failed: %s\n", f.c_str());
+  // status.json: which of this shard's runs are done, which a signal interrupted, which did not
+  // start (a resumed sweep runs all but the done ones).
+  {
+    std::sort(done_runs.begin(), done_runs.end());
+    std::sort(failed_runs.begin(), failed_runs.end());
+    std::vector<std::size_t> not_started;
+    std::set<std::size_t> seen(done_runs.begin(), done_runs.end());
+    seen.insert(failed_runs.begin(), failed_runs.end());
+    for (const json& i : interrupted_runs) seen.insert(i.at("index").get<std::size_t>());
+    for (const paper_sweep::Run& r : s.runs)
+      if (r.index % shards == shard && !seen.count(r.index)) not_started.push_back(r.index);
+    json status = {{"completed", !stopped && failures.empty()},
+                   {"runs", mine},
+                   {"done", done_runs},
+                   {"interrupted", interrupted_runs},
+                   {"failed", failed_runs},
+                   {"not_started", not_started}};
+    if (shards > 1) status["shard"] = o.shard;
+    if (stopped) status["stopped_by"] = kelp::sim::stop_signal() == SIGTERM ? "SIGTERM" : "SIGINT";
+    write_atomically(out / "status.json", status.dump(1) + "\n");
+    if (stopped) {
+      std::fprintf(stderr,
+                   "kelp-sweep: stopped by %s: %zu of %zu runs done, %zu interrupted, %zu not "
+                   "started (status.json); run it again to resume\n",
+                   kelp::sim::stop_signal() == SIGTERM ? "SIGTERM" : "SIGINT", done_runs.size(),
+                   mine, interrupted_runs.size(), not_started.size());
+      return kelp::sim::interrupted_exit_status();
+    }
+  }
   if (!failures.empty()) return 1;
   if (shards > 1) return 0;  // the table comes from `kelp-sweep merge`
   return finish(s, results, out, !o.no_plot);
@@ -297,6 +350,10 @@ int main(int argc, char** argv) {
   app.add_flag("--dry-run", o.dry_run,
                "check and expand the sweep, print its runs (one JSON object a line: index, "
                "hash, grid point, seed, scenario as used) and exit; runs and writes nothing");
+  app.footer(
+      "Exit status: 0 done, 1 a run failed, 2 the plotting script failed, 3 an invalid sweep file "
+      "or option, 130 / 143 stopped by SIGINT / SIGTERM (the runs under way stopped with their "
+      "files whole and no result stored; status.json lists the runs done; run again to resume).");
   CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
   std::vector<std::string> dirs;
   std::string merged = "kelp-sweep-merged";
@@ -309,6 +366,9 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*m) return merge(dirs, merged, !merge_no_plot);
+    // SIGINT and SIGTERM stop the runs under way cleanly (their files whole, no result stored)
+    // and start no more; a second signal stops at once.
+    kelp::sim::install_stop_handlers();
     return run(o);
   } catch (const paper_sweep::sweep_error& e) {
     std::fprintf(stderr, "kelp-sweep: invalid sweep: %s\n", e.what());

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -21,6 +22,7 @@
 #include "kelp/sim/replay.hpp"
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/stop.hpp"
 
 namespace fs = std::filesystem;
 
@@ -60,9 +62,28 @@ std::string replay_template() {
   return page;
 }
 
+// A run stopped by SIGINT or SIGTERM (kelp/sim/stop.hpp): what it left, and the interrupted
+// exit status (128 + the signal: 130, 143).
+int stopped(const Options& o, double simulated, bool completed, bool plots) {
+  const int signal = kelp::sim::stop_signal();
+  std::fprintf(stderr,
+               "kelp-tethered-pair: stopped by %s at %.2f s of %.0f s simulated; the outputs in %s "
+               "are whole (summary.json: \"completed\": %s)%s\n",
+               signal == SIGTERM ? "SIGTERM" : "SIGINT", simulated, o.scenario.duration,
+               o.out.c_str(), completed ? "true" : "false",
+               plots ? "; no plots (plot_run.py DIR draws them)" : "");
+  return kelp::sim::interrupted_exit_status();
+}
+
 // A fleet scenario (`"fleet"`): any vehicles and tethers (kelp/sim/fleet_run.hpp).
 int run_fleet(const Options& o) {
   const kelp::sim::FleetRunSummary s = kelp::sim::run_fleet(o.scenario, o.scenario_file, o.out);
+  if (kelp::sim::stop_requested()) {
+    // The replay of what ran (written atomically: a second signal leaves no half page).
+    const std::string page = replay_template();
+    if (!page.empty()) kelp::sim::write_replay(o.out, page);
+    return stopped(o, s.simulated_s, s.completed, false);
+  }
   std::printf(
       "kelp-tethered-pair: fleet of %zu vehicles and %zu tethers: %.0f s simulated in %.2f s "
       "(%.0fx real time); outputs in %s (timeseries.csv, nodes.csv, summary.json%s)\n",
@@ -98,6 +119,10 @@ int run(const Options& o) {
   const kelp::sim::RunSummary summary = kelp::sim::run_scenario(o.scenario, ro);
 #endif
   if (progress) kelp_apps::progress_done();
+  // Stopped by a signal: the files are whole (summary.json and replay.html written, atomically);
+  // the plots are left out.
+  if (kelp::sim::stop_requested())
+    return stopped(o, summary.simulated_s, summary.completed, !o.no_plots);
   const double duration = summary.simulated_s, wall = summary.wall_s.value_or(0.0);
   const double auv_rms = summary.auv.rms_path_error_m, asv_rms = summary.asv.rms_distance_to_auv_m,
                t_max = summary.tether.max_tension_n;
@@ -106,7 +131,11 @@ int run(const Options& o) {
   if (!o.no_plots) {
     const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
     const std::string cmd = python + " '" + plot_script() + "' '" + o.out + "'";
-    if (std::system(cmd.c_str()) != 0) {
+    const int rc = std::system(cmd.c_str());
+    // A signal while plotting (Ctrl-C reaches the script too): the run itself is whole.
+    if (kelp::sim::stop_requested())
+      return stopped(o, summary.simulated_s, summary.completed, true);
+    if (rc != 0) {
       std::fprintf(stderr, "kelp-tethered-pair: the plotting script failed (%s)\n", cmd.c_str());
       return 2;
     }
@@ -136,6 +165,10 @@ int main(int argc, char** argv) {
       "kelp-tethered-pair: a BlueBoat and a BlueROV2 Heavy joined by a tether in waves, "
       "wind and current (the embedded default: the paper's moderate sea, a square "
       "survey)"};
+  app.footer(
+      "Exit status: 0 done, 1 a simulation or file error, 2 the plotting script failed, 3 an "
+      "invalid scenario or option (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the "
+      "run's files whole, summary.json \"completed\": false; a second signal stops at once).");
   std::string file;
   double duration = -1;
   std::int64_t seed = -1;
@@ -211,6 +244,8 @@ int main(int argc, char** argv) {
     overrides.deterministic = deterministic;
     if (mcap || no_mcap) overrides.mcap = mcap && !no_mcap ? 1 : 0;
     o.scenario = kelp::sim::apply_overrides(o.scenario, overrides);
+    // SIGINT and SIGTERM stop the run cleanly after the step they land in; a second one at once.
+    kelp::sim::install_stop_handlers();
     return run(o);
   } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-tethered-pair: invalid scenario: %s\n", e.what());

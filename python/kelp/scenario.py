@@ -56,6 +56,11 @@ def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseri
         A bad override (duration <= 0, seed < 0, an unknown kernel).
     kelp.NumericalError
         A step that could not be completed.
+    KeyboardInterrupt
+        Ctrl-C (or any exception a Python signal handler raises) during the run: the run stops
+        within a simulated second, after the step it is in, and leaves its files in ``out``
+        whole (summary.json with ``"completed": false`` and the time reached ``simulated_s``)
+        before the exception is raised.
     """
     file = text = None
     if isinstance(path_or_dict, dict):

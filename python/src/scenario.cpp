@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <optional>
 #include <sstream>
@@ -31,6 +32,32 @@ void append_row(const kelp::sim::LogRow& r, std::vector<double>& out) {
   kelp::sim::for_each_value(r, [&](double v) { out.push_back(v); });
 }
 
+// Ctrl-C in Python during a run: Python's own SIGINT handler only sets a flag, which the run
+// polls through should_stop (PyErr_CheckSignals, with the GIL, once every 100 steps: a simulated
+// second, a few milliseconds). The run then stops cleanly after its step (its files whole,
+// summary.json "completed": false) and the pending exception (KeyboardInterrupt) is raised when
+// it returns (rethrow()). kelp::sim installs no handler of its own.
+class PythonSignals {
+ public:
+  std::function<bool()> check() {
+    return [this] {
+      if (raised_) return true;
+      if (++calls_ % 100 != 0) return false;
+      py::gil_scoped_acquire gil;
+      raised_ = PyErr_CheckSignals() != 0;  // the exception stays set until rethrow()
+      return raised_;
+    };
+  }
+  // Raises the exception a signal's handler set during the run, if any (with the GIL held).
+  void rethrow() const {
+    if (raised_) throw py::error_already_set();
+  }
+
+ private:
+  long calls_ = 0;
+  bool raised_ = false;
+};
+
 // A fleet scenario (kelp::sim::run_fleet) into `out`, or into a temporary directory removed
 // afterwards: (summary.json's text, timeseries.csv's columns or None).
 py::tuple run_fleet(const kelp::sim::Scenario& sc, const std::string& file,
@@ -51,10 +78,12 @@ py::tuple run_fleet(const kelp::sim::Scenario& sc, const std::string& file,
       if (!dir.empty()) fs::remove_all(dir, ec);
     }
   } cleanup{out ? std::string() : dir};
+  PythonSignals signals;
   {
     py::gil_scoped_release release;
-    kelp::sim::run_fleet(sc, file, dir);
+    kelp::sim::run_fleet(sc, file, dir, signals.check());
   }
+  signals.rethrow();
   std::ifstream in(fs::path(dir) / "summary.json");
   const std::string summary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!timeseries) return py::make_tuple(summary, py::none());
@@ -117,10 +146,13 @@ void bind_scenario(py::module_& m) {
           ro.on_sample = [&rows](const kelp::sim::LogRow& r) { append_row(r, rows); };
         }
         std::string summary;
+        PythonSignals signals;
+        ro.should_stop = signals.check();
         {
           py::gil_scoped_release release;
           summary = kelp::sim::summary_json(kelp::sim::run_scenario(sc, ro));
         }
+        signals.rethrow();
         if (!timeseries) return py::make_tuple(summary, py::none());
         // One (columns, samples) array; each column a contiguous view into it.
         const std::size_t nc = names.size(), nr = rows.size() / nc;

@@ -131,3 +131,45 @@ def test_a_fleet_scenario_runs_and_returns_its_parts(scenarios_dir, tmp_path):
     assert again["vehicles"]["rov"]["final_position_m"] == summary["vehicles"]["rov"]["final_position_m"]
     assert {p.name for p in tmp_path.iterdir()} == {"summary.json", "timeseries.csv", "nodes.csv",
                                                      "run.mcap"}
+
+
+def test_ctrl_c_stops_a_run_cleanly_and_raises_keyboard_interrupt(tmp_path):
+    # Ctrl-C (SIGINT) during a long run: the run stops within a simulated second (kelp::sim polls
+    # Python's signal flag), its files are whole, summary.json says "completed": false, and
+    # KeyboardInterrupt is raised. Before, Ctrl-C waited for the run's end (7200 s: half a minute).
+    import os
+    import signal
+    import sys
+    import time
+    out = tmp_path / "run"
+    child = subprocess.Popen(
+        [sys.executable, "-c",
+         "import signal, sys, kelp\n"
+         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+         "try:\n"
+         "    kelp.run_scenario(duration=7200, out=sys.argv[1])\n"
+         "except KeyboardInterrupt:\n"
+         "    sys.exit(5)\n",
+         str(out)], env=dict(os.environ))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and child.poll() is None:
+        if (out / "timeseries.csv").exists() and (out / "timeseries.csv").stat().st_size > 100000:
+            break
+        time.sleep(0.01)
+    start = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    try:
+        code = child.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.wait()
+        pytest.fail("Ctrl-C did not stop kelp.run_scenario within 10 s")
+    assert code == 5, "no KeyboardInterrupt (exit status %s)" % code
+    assert time.monotonic() - start < 10
+    with open(out / "summary.json") as f:
+        summary = json.load(f)
+    assert summary["completed"] is False
+    assert 0 < summary["simulated_s"] < 7200
+    for name in ("timeseries.csv", "nodes.csv", "events.csv"):
+        with open(out / name, "rb") as f:
+            assert f.read().endswith(b"\n"), name

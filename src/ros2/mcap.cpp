@@ -2,6 +2,12 @@
 // BagWriter's members, the QoS metadata.
 #include "kelp/sim/ros2/mcap.hpp"
 
+#include <sys/uio.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <initializer_list>
+
 namespace kelp {
 namespace ros2 {
 
@@ -239,27 +245,33 @@ void McapWriter::flush_chunk() {
   head[0] = static_cast<std::uint8_t>(McapOp::chunk);
   const std::uint64_t length = rec_.size() + chunk_.size();
   for (int i = 0; i < 8; ++i) head[1 + i] = static_cast<std::uint8_t>(length >> (8 * i));
-  emit(head, sizeof head);
-  emit(rec_.data(), rec_.size());
-  emit(chunk_.data(), chunk_.size());
-  const std::uint64_t chunk_length = pos_ - chunk_start;
+  const std::uint64_t chunk_length = sizeof head + length;
   // Message Index records, one per channel with messages in the chunk, in channel order.
-  const std::uint64_t index_start = pos_;
+  const std::uint64_t index_start = chunk_start + chunk_length;
   offsets_.clear();
+  indexes_.clear();
   for (std::size_t c = 0; c < index_.size(); ++c) {
     if (index_[c].empty()) continue;
     put_u16(offsets_, static_cast<std::uint16_t>(c + 1));
-    put_u64(offsets_, pos_);
-    rec_.clear();
-    put_u16(rec_, static_cast<std::uint16_t>(c + 1));
-    put_u32(rec_, static_cast<std::uint32_t>(16 * index_[c].size()));
+    put_u64(offsets_, index_start + indexes_.size());
+    const std::uint32_t entries = static_cast<std::uint32_t>(16 * index_[c].size());
+    put_u8(indexes_, static_cast<std::uint8_t>(McapOp::message_index));
+    put_u64(indexes_, 2 + 4 + std::uint64_t(entries));
+    put_u16(indexes_, static_cast<std::uint16_t>(c + 1));
+    put_u32(indexes_, entries);
     for (const auto& [t, off] : index_[c]) {
-      put_u64(rec_, t);
-      put_u64(rec_, off);
+      put_u64(indexes_, t);
+      put_u64(indexes_, off);
     }
-    emit_record(McapOp::message_index, rec_);
     index_[c].clear();
   }
+  // The chunk and its indexes in one system call: a process stopped or killed at any point of its
+  // own leaves a file that ends after a whole chunk and its indexes, which a streaming reader
+  // reads to the end (only a kill while the kernel copies them can cut them).
+  emit_at_once({{head, sizeof head},
+                {rec_.data(), rec_.size()},
+                {chunk_.data(), chunk_.size()},
+                {indexes_.data(), indexes_.size()}});
   // The Chunk Index record for the summary.
   std::vector<std::uint8_t> ci;
   put_u64(ci, chunk_start_);
@@ -268,13 +280,41 @@ void McapWriter::flush_chunk() {
   put_u64(ci, chunk_length);
   put_u32(ci, static_cast<std::uint32_t>(offsets_.size()));
   ci.insert(ci.end(), offsets_.begin(), offsets_.end());
-  put_u64(ci, pos_ - index_start);
+  put_u64(ci, indexes_.size());
   put_string(ci, "");
   put_u64(ci, chunk_.size());  // compressed size: the records as stored
   put_u64(ci, chunk_.size());
   chunk_indexes_.push_back(std::move(ci));
   chunk_.clear();
   chunk_messages_ = 0;
+}
+
+void McapWriter::emit_at_once(std::initializer_list<std::pair<const void*, std::size_t>> parts) {
+  // What the stdio buffer holds (the header, schemas and channels before the first chunk) first.
+  if (std::fflush(file_) != 0) throw kelp::error("McapWriter: cannot write " + path_);
+  std::array<iovec, 4> iov{};
+  int n = 0;
+  for (const auto& [p, size] : parts) {
+    KELP_CHECK(n < int(iov.size()), "McapWriter::emit_at_once: too many parts");
+    data_crc_ = crc32(p, size, data_crc_);
+    pos_ += size;
+    iov[std::size_t(n++)] = {const_cast<void*>(p), size};
+  }
+  const int fd = ::fileno(file_);
+  int first = 0;
+  while (first < n) {  // one writev(), repeated only for what the system did not take
+    const ssize_t w = ::writev(fd, iov.data() + first, n - first);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) throw kelp::error("McapWriter: cannot write " + path_);
+    auto left = std::size_t(w);
+    while (first < n && left >= iov[std::size_t(first)].iov_len)
+      left -= iov[std::size_t(first++)].iov_len;
+    if (first < n) {
+      iovec& v = iov[std::size_t(first)];
+      v.iov_base = static_cast<char*>(v.iov_base) + left;
+      v.iov_len -= left;
+    }
+  }
 }
 
 void McapWriter::finish() {

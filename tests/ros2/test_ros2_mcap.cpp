@@ -224,3 +224,29 @@ TEST_CASE("McapWriter: an unwritable path is a kelp::error", "[ros2][mcap]") {
   r2::McapWriter w;
   CHECK_THROWS_AS(w.write(1, 0, 0, nullptr, 0), kelp::invalid_argument);
 }
+
+TEST_CASE("McapWriter: each completed chunk and its indexes reach the file at once",
+          "[ros2][mcap][stop]") {
+  // What a run killed mid-way leaves (kelp/sim/stop.hpp): every completed chunk with its message
+  // indexes on the file, not in the stdio buffer (@mcap/core's stream reader reads it: the
+  // check of apps/tethered_pair/check_stop.py).
+  const std::filesystem::path path = "test_ros2_mcap_chunk_flush.mcap";
+  r2::McapOptions opt;
+  opt.chunk_size = 4096;
+  r2::McapWriter w(path, opt);
+  const std::uint16_t schema = w.add_schema("std_msgs/msg/Empty", "ros2msg", "");
+  const std::uint16_t channel = w.add_channel(schema, "/a", "cdr");
+  const std::uint8_t payload[100] = {};
+  int chunks = 0;
+  for (std::uint32_t i = 0; i < 400; ++i) {
+    const std::uint64_t before = w.bytes_written();
+    w.write(channel, i, 1000u * i, payload, sizeof payload);
+    if (w.bytes_written() != before) {  // a chunk was completed: all of it is on the file
+      ++chunks;
+      CHECK(std::filesystem::file_size(path) == w.bytes_written());
+    }
+  }
+  CHECK(chunks >= 5);
+  w.close();
+  std::filesystem::remove(path);
+}

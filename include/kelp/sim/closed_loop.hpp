@@ -218,7 +218,8 @@ class KELP_SIM_API ClosedLoop {
   /// the C library's math (`math_library`), the scenario file and the scenario with every field
   /// as used. `tether` also holds the AUV's turns about the tether (`net_turns`,
   /// `max_abs_turns`: TurnCounter) and the line's partings (`line_failures`: time, segment,
-  /// position, tension; empty while it holds).
+  /// position, tension; empty while it holds). Before the end (done()), `completed` is false and
+  /// `simulated_s` the time reached.
   RunSummary summary() const;
 
  private:
@@ -289,11 +290,18 @@ struct SimulateOptions {
   std::function<void(const StepView&)> on_step;
   /// Called with every sample at the log rate (ClosedLoopOptions::on_sample); empty: none.
   std::function<void(const LogRow&)> on_sample;
+  /// Polled before every step, with stop_requested() (kelp/sim/stop.hpp): true stops the run
+  /// there (e.g. Python's check for Ctrl-C); empty: stop_requested() alone.
+  std::function<bool()> should_stop;
 };
 
 /// \brief Runs a scenario to its end in a ClosedLoop and returns its summary (what
 /// kelp-tethered-pair writes as summary.json, without the program's version): ClosedLoop::summary()
 /// with the wall time [s] and the real-time factor.
+///
+/// Before every step it polls for a stop (stop_requested(), kelp/sim/stop.hpp, and
+/// `o.should_stop`): a stopped run ends after the step it was in, closes its log whole and
+/// returns the summary with `completed` false and the simulated time reached.
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when the
 /// log cannot be written.
 KELP_SIM_API RunSummary simulate(const Scenario& sc, const SimulateOptions& o = {});

@@ -21,6 +21,7 @@
 /// (kelp/sim/replay.hpp). The plots are the pair's only (yet).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,7 +65,8 @@ KELP_SIM_API kelp::system::FleetStated fleet_start_state(const kelp::system::Fle
 
 /// \brief What a fleet run did (also in summary.json).
 struct FleetRunSummary {
-  double simulated_s = 0;       ///< simulated time [s]
+  bool completed = true;        ///< the whole duration ran (false: stopped, kelp/sim/stop.hpp)
+  double simulated_s = 0;       ///< simulated time [s] (reached, when stopped)
   double wall_s = 0;            ///< wall time of the loop [s]
   long steps = 0;               ///< system steps of 10 ms
   double newton_mean = 0;       ///< tether Newton iterations per step, all tethers
@@ -82,11 +84,16 @@ struct FleetRunSummary {
 
 /// \brief Runs the fleet scenario `sc` closed loop into the directory `out` (created), writing
 /// timeseries.csv, nodes.csv, summary.json and (unless `sc.mcap` is false) run.mcap. `file`
-/// names the scenario.
+/// names the scenario. Before every step it polls for a stop (stop_requested(),
+/// kelp/sim/stop.hpp, and `should_stop` when given): a stopped run ends after the step it was
+/// in, closes its files whole and writes summary.json with `"completed": false` and the
+/// simulated time reached. The CSV files are written in whole lines at least once a simulated
+/// second (LineFile), so a run killed mid-way leaves them ending on a whole line.
 /// \throws scenario_error as fleet_world(); kelp::error when a step fails (the outputs so far
 /// are closed whole).
 KELP_SIM_API FleetRunSummary run_fleet(const Scenario& sc, const std::string& file,
-                                       const std::string& out);
+                                       const std::string& out,
+                                       const std::function<bool()>& should_stop = {});
 
 }  // namespace sim
 }  // namespace kelp

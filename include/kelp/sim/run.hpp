@@ -57,6 +57,9 @@ struct RunOptions {
   /// The replay page's template (find_replay_template()): with `out`, replay.html is written
   /// there at the end of the run (write_replay()); empty: no replay.html.
   std::string replay_template;
+  /// Polled before every step with stop_requested() (SimulateOptions::should_stop,
+  /// kelp/sim/stop.hpp): true stops the run there; empty: stop_requested() alone.
+  std::function<bool()> should_stop;
 };
 
 /// \brief A run's ROS 2 bag (BagRecorder), opened at the run's first sample (t = 0, taken when
@@ -89,10 +92,11 @@ KELP_SIM_API std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunO
                                                   std::function<void(const LogRow&)>& on_sample);
 
 /// \brief What a run leaves after its last step: the summary's `kelp_version`, summary.json
-/// (indented by 2) in `o.out` and, with a `replay_template`, replay.html there (write_replay(),
-/// `source` named in it). run_scenario() calls it, and so does a program that runs its own loop
-/// (kelp-tethered-pair --ros2), so that every run directory has the same files.
-/// \throws kelp::error when a file cannot be written (replay_error for replay.html).
+/// (indented by 2; written atomically, write_file_atomically()) in `o.out` and, with a
+/// `replay_template`, replay.html there (write_replay(), `source` named in it). run_scenario()
+/// calls it, and so does a program that runs its own loop (kelp-tethered-pair --ros2), so that
+/// every run directory has the same files. \throws kelp::error when a file cannot be written
+/// (replay_error for replay.html).
 KELP_SIM_API void finish_run(RunSummary& summary, const RunOptions& o,
                              const std::string& source = "kelp-tethered-pair");
 
@@ -108,6 +112,10 @@ KELP_SIM_API void finish_run_with(const std::string& summary_text, const RunOpti
 /// `replay_template`, replay.html (the 3-D replay, docs/replay.md); with the scenario's
 /// `output.mcap` (the default) also run.mcap, the run as a ROS 2 bag (open_run_bag(): every
 /// sample, the markers at the node rate).
+///
+/// A run stopped early (stop_requested() or `o.should_stop`, kelp/sim/stop.hpp) ends after the
+/// step it was in and leaves the same files, whole: the CSV files end on a full line, run.mcap
+/// has its summary and footer, summary.json says `"completed": false` and the time reached.
 /// \returns the summary (summary.json's content: summary_json()).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
 /// file cannot be written (replay_error for replay.html).

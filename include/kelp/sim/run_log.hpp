@@ -9,12 +9,21 @@
 /// apps/tethered_pair/README.md. It knows vehicle and tether states only, not the scenario or
 /// the controllers: a program fills a LogRow from whatever flies the vehicles. Numbers are written
 /// with printf's `%.6g`. Part of the optional `kelp::sim` component (it needs no JSON itself).
+///
+/// What a crash leaves: lines gather in memory and reach the files in blocks of whole lines, each
+/// block one write() (repeated only for the rest of a block the system wrote in part), at least
+/// once a simulated second (when a row or snapshot is at least 1 s after the last block; an
+/// event at once). So a process killed at any point (SIGKILL) leaves every file ending on a
+/// whole line, with everything logged up to about a simulated second before it died. Only a kill
+/// that lands while the kernel copies a block (Linux checks for one between pages) or a power
+/// loss (nothing is synced to disk) can leave a last line cut short or missing: a reader should
+/// drop a last line without its newline.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <fstream>  // not used here any more; kept for the files that relied on it
 #include <limits>
 #include <string>
 #include <vector>
@@ -144,6 +153,52 @@ void for_each_value(const LogRow& r, F&& f) {
   f(r.winding_obstacle);
 }
 
+/// \brief A text file written in whole lines (RunLog's CSV files, a fleet run's): lines gather in
+/// memory and reach the file in blocks of whole lines, each block one write() (repeated only for
+/// the part of a block the system did not take), when a block is full (64 KiB), on write_out()
+/// and on close(). A process killed at any other point leaves the file ending on a whole line.
+///
+/// A line is appended to text() and ended by end_line(); up to the capacity reserved when opened
+/// (128 KiB) appending allocates nothing.
+class KELP_SIM_API LineFile {
+ public:
+  LineFile() = default;
+  /// \brief Opens `path` (see open()).
+  explicit LineFile(const std::filesystem::path& path) { open(path); }
+  /// \brief Writes out and closes (close()), errors swallowed: call close() to see them.
+  ~LineFile();
+  LineFile(const LineFile&) = delete;
+  LineFile& operator=(const LineFile&) = delete;
+
+  /// \brief Creates (or truncates) `path` for writing.
+  /// \throws kelp::error naming the file when it cannot be created.
+  void open(const std::filesystem::path& path);
+  /// \brief Is a file open?
+  bool is_open() const { return fd_ >= 0; }
+  /// \brief The text gathered: append the current line's text to it.
+  std::string& text() { return text_; }
+  /// \brief Ends the current line (a newline); writes the gathered lines out once they fill a
+  /// block. \throws kelp::error when the file cannot be written.
+  void end_line();
+  /// \brief Writes every ended line gathered to the file (a line not ended yet stays).
+  /// \throws kelp::error when the file cannot be written.
+  void write_out();
+  /// \brief Writes the ended lines out and closes the file. Does nothing when not open.
+  /// \throws kelp::error when the file cannot be written (it is closed anyway).
+  void close();
+
+ private:
+  int fd_ = -1;
+  std::string path_, text_;
+  std::size_t ended_ = 0;  // text_'s ended lines: its first ended_ bytes
+};
+
+/// \brief Writes `text` as the file `path` atomically: into a temporary file beside it (same
+/// directory, so the same file system), then renamed over it. A reader, or a process killed at any
+/// point, sees the old file (or none) or the new one whole, never a part (summary.json,
+/// replay.html). \throws kelp::error naming the file when it cannot be written.
+KELP_SIM_API void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+
 /// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
 /// documented in apps/tethered_pair/README.md). Writes the header lines when constructed.
 class KELP_SIM_API RunLog {
@@ -153,40 +208,53 @@ class KELP_SIM_API RunLog {
   /// when the directory cannot be created.
   explicit RunLog(const std::filesystem::path& dir);
 
-  /// \brief Appends one row to timeseries.csv.
+  /// \brief Appends one row to timeseries.csv (and writes every file's lines out when the row is
+  /// a simulated second or more after the last time they were).
+  /// \throws kelp::error when a file cannot be written.
   void row(const LogRow& r);
 
   /// \brief Appends the tether's parting to events.csv
   /// (`t,event,segment,x,y,z,tension,obstacle,winding`, event `line_parted`): its time [s],
-  /// segment, position NED [m] and axial force [N] (no obstacle, winding `nan`).
+  /// segment, position NED [m] and axial force [N] (no obstacle, winding `nan`). Written at once.
   void line_parted(const kelp::tether::LineFailured& f);
 
   /// \brief Appends an entanglement event to events.csv (kelp/sim/entanglement.hpp): `entangled`
   /// (the winding about obstacle `obstacle` passed the threshold; `tension` nan) or `pinned`
   /// (`tension`: the axial force on the ROV's side of the contact less the boat's [N]); its
   /// time [s], no segment (`nan`), the contact's position NED [m], the obstacle's name and the
-  /// winding about it then [rad].
+  /// winding about it then [rad]. Written at once.
   void entanglement(double t, const char* event, const kelp::Vector3<double>& position,
                     double tension, const std::string& obstacle, double winding);
 
   /// \brief Appends the tether's node positions at time `t` [s] to nodes.csv, one line a node
   /// (`t,node,x,y,z,tension`): the node's NED position [m] and the axial tension [N] of the
   /// segment that starts at it (tether::segment_axial_force, as the step's force pass evaluates
-  /// it; 0 for the last node, which starts no segment, and for a parted segment).
+  /// it; 0 for the last node, which starts no segment, and for a parted segment). Written out as
+  /// row() says.
   /// \param[in] t time [s] \param[in] line the line model of `tether` (with a winch, the model
   /// of its current node count: system::SystemModel::tether_of) \param[in] tether its state
-  /// \throws kelp::invalid_argument when `line` has not the state's node count.
+  /// \throws kelp::invalid_argument when `line` has not the state's node count; kelp::error when
+  /// a file cannot be written.
   void nodes(double t, const kelp::tether::TetherModeld& line,
              const kelp::tether::TetherStated& tether);
 
   /// \brief Writes what is buffered to the files (e.g. before a status line of a long run).
+  /// \throws kelp::error when a file cannot be written.
   void flush();
-  /// \brief Closes both files (also done by the destructor).
+  /// \brief Writes what is buffered and closes the files (the destructor does too, quietly).
+  /// \throws kelp::error when a file cannot be written.
   void close();
 
+  ~RunLog() = default;
+  RunLog(const RunLog&) = delete;
+  RunLog& operator=(const RunLog&) = delete;
+
  private:
+  // A row or snapshot at `t` [s]: every file written out once t is 1 s past the last time.
+  void flush_due(double t);
   const char* num(double v);
-  std::ofstream ts_, nodes_, events_;
+  LineFile ts_, nodes_, events_;
+  double next_flush_ = 0;
   char buf_[64] = {};
 };
 

@@ -159,7 +159,11 @@ struct EntanglementSummary {
 
 /// \brief A run's summary (summary.json).
 struct RunSummary {
-  double simulated_s = 0;                   ///< simulated time [s]
+  /// The run simulated its whole duration (`completed`); false: it was stopped (a signal,
+  /// kelp/sim/stop.hpp) or the summary was taken before its end.
+  bool completed = true;
+  /// Simulated time [s]: the scenario's duration when completed, else the time reached.
+  double simulated_s = 0;
   AuvSummary auv;                           ///< the AUV
   AsvSummary asv;                           ///< the ASV
   TetherSummary tether;                     ///< the tether

@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <string>
 #include <utility>
@@ -75,6 +76,14 @@ struct McapOptions {
 ///
 /// After the first chunk the buffers are reused: writing a message allocates nothing (the chunk
 /// index grows by one entry a chunk).
+///
+/// Each completed chunk is written with its message indexes in one system call (writev) before
+/// the next message is gathered: a process killed mid-run (SIGKILL) leaves a file without summary
+/// and footer that ends after a whole chunk and its indexes, which a streaming reader (@mcap/core's
+/// McapStreamReader) reads to the end, every message of every completed chunk; only the open
+/// chunk (at most `chunk_size` bytes) is lost. Only a kill while the kernel copies a chunk (Linux
+/// checks for one between pages) can cut it. An indexed reader needs the footer, which close()
+/// writes.
 class KELP_SIM_API McapWriter {
  public:
   /// Options of a writer (McapOptions).
@@ -131,8 +140,12 @@ class KELP_SIM_API McapWriter {
   void emit(const void* p, std::size_t n);
   void emit_record(McapOp op, const std::vector<std::uint8_t>& content);
 
-  // Writes the open chunk (if it has messages), its message indexes, and its chunk index entry.
+  // Writes the open chunk (if it has messages) and its message indexes, at once (emit_at_once),
+  // and keeps its chunk index entry.
   void flush_chunk();
+  // Writes what the stdio buffer holds, then `parts` (at most 4) in one writev(), repeated only
+  // for what the system did not take; counts them and keeps the data section's CRC.
+  void emit_at_once(std::initializer_list<std::pair<const void*, std::size_t>> parts);
 
   void finish();
   void finish_quietly();
@@ -142,7 +155,7 @@ class KELP_SIM_API McapWriter {
   std::FILE* file_ = nullptr;
   std::uint64_t pos_ = 0;
   std::uint32_t data_crc_ = 0;
-  std::vector<std::uint8_t> rec_, chunk_, offsets_;
+  std::vector<std::uint8_t> rec_, chunk_, offsets_, indexes_;
   std::vector<std::vector<std::uint8_t>> schemas_, channels_, chunk_indexes_;
   std::vector<std::uint64_t> channel_counts_;
   std::vector<std::vector<std::pair<std::uint64_t, std::uint64_t>>> index_;

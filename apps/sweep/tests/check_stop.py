@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""kelp-sweep stopped mid-way, then resumed (CTest: example_paper_sweep_stop).
+
+  check_stop.py KELP_SWEEP WORK
+
+A sweep of 4 runs of 60 s (one job, --keep-series) gets SIGTERM once its first result is stored:
+exit status 143; status.json says "completed": false, lists the runs done (those with a stored
+result), the one under way as interrupted (its series whole: CSV files ending on a full line,
+summary.json "completed": false; no stored result) and the rest as not started. Run again, it
+resumes: status 0, only the runs not done run, status.json "completed": true with every run done.
+About 1 s of one core. Before the clean stop, the first SIGTERM killed kelp-sweep (status -15,
+no status.json).
+"""
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+failures = []
+
+
+def check(cond, what):
+    if not cond:
+        failures.append(what)
+        print("FAIL: " + what, file=sys.stderr)
+    return cond
+
+
+def csv_whole(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    lines = data.decode().split("\n")
+    columns = lines[0].count(",") + 1
+    return data.endswith(b"\n") and all(line.count(",") + 1 == columns for line in lines[1:-1])
+
+
+def main(program, work):
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    sweep = os.path.join(work, "stop.json")
+    with open(sweep, "w") as f:
+        json.dump({"base": {"duration": 60}, "axes": [{"path": "/sea", "values": ["moderate"]}],
+                   "seeds": 4}, f)
+    out = os.path.join(work, "out")
+    args = [program, "--sweep", sweep, "--out", out, "--jobs", "1", "--keep-series", "--quiet",
+            "--no-plot"]
+    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    runs = os.path.join(out, "runs")
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and p.poll() is None:
+        if os.path.isdir(runs) and any(n.endswith(".json") for n in os.listdir(runs)):
+            break
+        time.sleep(0.005)
+    time.sleep(0.05)  # the second run under way (about 15 s of its 60 s)
+    p.send_signal(signal.SIGTERM)
+    stdout, stderr = p.communicate(timeout=60)
+    print(stdout.strip())
+    print(stderr.strip())
+    check(p.returncode == 143, "SIGTERM: exit status %s, expected 143" % p.returncode)
+    try:
+        with open(os.path.join(out, "status.json")) as f:
+            status = json.load(f)
+    except (OSError, ValueError) as e:
+        check(False, "SIGTERM: no status.json (%s)" % e)
+        status = {}
+    print("status.json:", json.dumps(status))
+    done = status.get("done", [])
+    interrupted = status.get("interrupted", [])
+    not_started = status.get("not_started", [])
+    check(status.get("completed") is False, "status.json: completed is not false")
+    check(status.get("stopped_by") == "SIGTERM", "status.json: stopped_by is not SIGTERM")
+    check(len(done) >= 1 and len(done) + len(interrupted) + len(not_started) == 4 and
+          len(interrupted) <= 1, "status.json: not 4 runs done, interrupted and not started")
+    stored = sorted(n[:-5] for n in os.listdir(runs) if n.endswith(".json"))
+    check(len(stored) == len(done), "%d results stored, %d runs done" % (len(stored), len(done)))
+    for run in interrupted:
+        d = os.path.join(runs, run["hash"])
+        check(run["hash"] not in stored, "the interrupted run %s stored a result" % run["hash"])
+        for name in ("timeseries.csv", "nodes.csv", "events.csv"):
+            check(csv_whole(os.path.join(d, name)), "the interrupted run's %s is cut" % name)
+        with open(os.path.join(d, "summary.json")) as f:
+            s = json.load(f)
+        check(s["completed"] is False and 0 <= s["simulated_s"] < 60 and
+              abs(s["simulated_s"] - run["simulated_s"]) < 1e-9,
+              "the interrupted run's summary.json: completed %r, simulated_s %r"
+              % (s["completed"], s["simulated_s"]))
+
+    # Resumed: only what was not done runs.
+    r = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    print(r.stdout.strip())
+    check(r.returncode == 0, "resumed: exit status %s\n%s" % (r.returncode, r.stderr))
+    check("%d ran, %d reused" % (4 - len(done), len(done)) in r.stdout,
+          "resumed: not %d ran, %d reused" % (4 - len(done), len(done)))
+    try:
+        with open(os.path.join(out, "status.json")) as f:
+            status = json.load(f)
+    except (OSError, ValueError) as e:
+        status = {"error": str(e)}
+    check(status.get("completed") is True and status.get("done") == [0, 1, 2, 3] and
+          not status.get("interrupted") and not status.get("not_started"),
+          "resumed: status.json %s" % json.dumps(status))
+    if failures:
+        print("check_stop: %d failures" % len(failures), file=sys.stderr)
+        return 1
+    print("check_stop: all passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(*sys.argv[1:]))
