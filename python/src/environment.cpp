@@ -205,7 +205,8 @@ void bind_environment(py::module_& m) {
           "[s]: a dict of numpy arrays 'current', 'wave_velocity', 'wave_acceleration', 'wind' "
           "(n, 3) [m/s, m/s^2], 'surface_elevation' (n,) [m, positive up] and 'surface_slope' "
           "(n, 2) at the points' (x, y). Wave kinematics are zero above the free surface; wind "
-          "is at 10 m (zero with with_wind=False, which saves the gust sum).")
+          "is at 10 m (zero with with_wind=False, which saves the gust sum). A point with a NaN or "
+          "infinite coordinate raises kelp.InvalidArgument.")
       .def(
           "surface_elevation",
           [](const Env& e, py::handle points, double t) -> py::object {

@@ -123,6 +123,11 @@ def test_environment_presets_and_errors():
     assert calm.surface_elevation([1.0, 2.0, 0.0], 3.0) == 0.0
     with pytest.raises(kelp.InvalidArgument, match="points: expected shape \\(n, 3\\)"):
         calm.sample(np.zeros((4, 2)), 0.0)
+    # A point with a NaN or infinite coordinate is refused, in calm water too (no silent zeros).
+    with pytest.raises(kelp.InvalidArgument):
+        calm.sample([0.0, math.nan, 1.0], 0.0)
+    with pytest.raises(kelp.InvalidArgument):
+        calm.sample([[0.0, 0.0, 1.0], [math.inf, 0.0, 1.0]], 0.0)
     with pytest.raises(kelp.InvalidArgument, match='sea: expected "calm"'):
         kelp.Environment.preset("stormy")
     waves = kelp.Environment.sea_state(significant_height=1.0, peak_period=6.0)
