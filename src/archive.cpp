@@ -1,11 +1,14 @@
 // kelp's binary archive (archive.hpp): the writer, the reader and its checks.
 #include "archive.hpp"
 
+#include <algorithm>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "kelp/sim/ros2/mcap.hpp"  // kelp::ros2::crc32 (zlib's CRC-32)
-#include "kelp/sim/state_io.hpp"   // state_error
+#include "kelp/sim/state_error.hpp"
 
 namespace kelp {
 namespace sim {

@@ -11,7 +11,7 @@
 #include "bindings.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/sim/scenario.hpp"
-#include "kelp/sim/state_io.hpp"
+#include "kelp/sim/state_error.hpp"
 
 namespace kelp_python {
 

@@ -19,27 +19,19 @@
 /// allocated past what the input holds. Part of the compiled `kelp::sim` component.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 
 #include "kelp/core/error.hpp"
 #include "kelp/sim/export.hpp"
 #include "kelp/sim/instantiation.hpp"
+#include "kelp/sim/state_error.hpp"
 #include "kelp/system/fleet.hpp"
 #include "kelp/system/system.hpp"
 
 namespace kelp {
 namespace sim {
-
-/// \brief A state that cannot be saved or loaded: the message names the input (a path or
-/// `state`) and what is wrong (e.g. `run.state: section 'TETH' #0: nodes: 12 where 11 are
-/// expected`).
-///
-/// It is bad input, so it derives from kelp::invalid_argument (and so from kelp::error).
-class KELP_SIM_API state_error : public invalid_argument {
- public:
-  using invalid_argument::invalid_argument;
-};
 
 /// \brief The pair's state as a state file's bytes.
 /// \throws state_error when the state could not be loaded back (sizes that do not fit together,
