@@ -259,6 +259,34 @@ TEST_CASE("the integrator history and the kept Newton matrix change the next ste
   }
 }
 
+TEST_CASE("one workspace steps states of other node counts in turn (fit_workspace), bit for bit",
+          "[sim][state_io]") {
+  // A copy kept at one node count is stepped after the original re-meshed past it: the
+  // workspace lends the copy's count back, and its spare buffers are whole again, so that the
+  // copy's own re-mesh into the count the original left goes through (and allocates nothing).
+  Pair p;
+  ks::SystemStated a = stepped_pair(p);
+  const ks::SystemStated copy = a;
+  const auto in = p.inputs(0.5);
+  const auto nodes = a.tether.position.cols();
+  std::vector<std::string> trail;
+  for (int i = 0; i < 400 && a.tether.position.cols() == nodes; ++i) {
+    (void)ks::step(p.model, p.ws, a, in, 0.01);
+    trail.push_back(sim::save_state(a));
+  }
+  REQUIRE(a.tether.position.cols() == nodes + 1);
+  ks::SystemStated b = copy;
+  CHECK_THROWS_WITH(ks::step(p.model, p.ws, b, in, 0.01), Catch::Contains("fit_workspace"));
+  ks::fit_workspace(p.model, p.ws, b);
+  for (const std::string& expected : trail) {
+    const long before = kelp_test::heap_allocations();
+    (void)ks::step(p.model, p.ws, b, in, 0.01);
+    REQUIRE(kelp_test::heap_allocations() == before);
+    REQUIRE(same_bytes(sim::save_state(b), expected));
+  }
+  CHECK(b.tether.position.cols() == nodes + 1);
+}
+
 TEST_CASE("a fleet's state saved and loaded steps on bit for bit (point mass, winch, thrusters)",
           "[sim][state_io]") {
   Fleet a;
