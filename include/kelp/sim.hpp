@@ -22,6 +22,7 @@
 #include "kelp/sim/run_log.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/scenario_reader.hpp"
+#include "kelp/sim/state_io.hpp"
 #include "kelp/sim/stop.hpp"
 #include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"

@@ -19,8 +19,8 @@ namespace kelp_python {
 namespace py = pybind11;
 
 /// kelp.Error, kelp.InvalidArgument (a ValueError), kelp.NumericalError (a RuntimeError),
-/// kelp.ScenarioError (an InvalidArgument) and the translation of kelp's C++ exceptions to them
-/// (errors.cpp). Called first.
+/// kelp.ScenarioError and kelp.StateError (InvalidArguments) and the translation of kelp's C++
+/// exceptions to them (errors.cpp). Called first.
 void bind_errors(py::module_& m);
 
 /// kelp.VehicleState, kelp.Vehicle, kelp.t200_thrust/t200_current (vehicle.cpp).

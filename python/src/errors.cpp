@@ -4,12 +4,14 @@
 //   kelp::invalid_argument -> kelp.InvalidArgument  (kelp.Error and ValueError)
 //   kelp::numerical_error  -> kelp.NumericalError   (kelp.Error, so a RuntimeError)
 //   kelp::sim::scenario_error -> kelp.ScenarioError (kelp.InvalidArgument)
+//   kelp::sim::state_error    -> kelp.StateError    (kelp.InvalidArgument)
 // each carrying the C++ message (what()).
 #include <Python.h>
 
 #include "bindings.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "kelp/sim/state_error.hpp"
 
 namespace kelp_python {
 
@@ -20,6 +22,7 @@ PyObject* error_type = nullptr;
 PyObject* invalid_argument_type = nullptr;
 PyObject* numerical_error_type = nullptr;
 PyObject* scenario_error_type = nullptr;
+PyObject* state_error_type = nullptr;
 
 PyObject* new_exception(py::module_& m, const char* name, const char* doc, py::tuple bases) {
   const std::string qualified = std::string("kelp.") + name;
@@ -53,6 +56,13 @@ void bind_errors(py::module_& m) {
       "A scenario kelp::sim refuses: the message names the file (or '(dict)') and the JSON path "
       "of the offending field (C++ kelp::sim::scenario_error). A kelp.InvalidArgument.",
       py::make_tuple(py::handle(invalid_argument_type)));
+  state_error_type = new_exception(
+      m, "StateError",
+      "A state that cannot be saved or loaded (kelp.save_state, kelp.load_state, pickle): a "
+      "truncated or corrupted file, one of another kind or system, NaN where a step refuses it. "
+      "The message names the input and what is wrong (C++ kelp::sim::state_error). A "
+      "kelp.InvalidArgument.",
+      py::make_tuple(py::handle(invalid_argument_type)));
 
   // Tried before pybind11's own translations (the latest registered is tried first), so the
   // most derived C++ type is caught first here.
@@ -61,6 +71,8 @@ void bind_errors(py::module_& m) {
       if (p) std::rethrow_exception(p);
     } catch (const kelp::sim::scenario_error& e) {
       PyErr_SetString(scenario_error_type, e.what());
+    } catch (const kelp::sim::state_error& e) {
+      PyErr_SetString(state_error_type, e.what());
     } catch (const kelp::invalid_argument& e) {
       PyErr_SetString(invalid_argument_type, e.what());
     } catch (const kelp::numerical_error& e) {
@@ -77,12 +89,13 @@ void bind_errors(py::module_& m) {
         if (kind == "invalid_argument") throw kelp::invalid_argument(message);
         if (kind == "numerical_error") throw kelp::numerical_error(message);
         if (kind == "scenario_error") throw kelp::sim::scenario_error(message);
+        if (kind == "state_error") throw kelp::sim::state_error(message);
         if (kind == "error") throw kelp::error(message);
         throw std::logic_error("unknown kind " + kind);
       },
       py::arg("kind"), py::arg("message"),
       "Raises the C++ exception `kind` ('invalid_argument', 'numerical_error', "
-      "'scenario_error', 'error') with `message` (tests only).");
+      "'scenario_error', 'state_error', 'error') with `message` (tests only).");
 }
 
 }  // namespace kelp_python

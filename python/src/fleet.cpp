@@ -1,5 +1,6 @@
 // kelp.Fleet (any vehicles, point masses and tethers of a fleet scenario: kelp::system's fleet
-// step), kelp.FleetState, kelp.FleetInputs and kelp.FleetReport.
+// step), kelp.FleetState (which pickles through kelp::sim's state files), kelp.FleetInputs,
+// kelp.FleetReport, and the fleet's overloads of kelp.save_state / kelp.load_state.
 #include <pybind11/stl.h>
 
 #include <memory>
@@ -10,6 +11,7 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "kelp/sim/fleet_run.hpp"
+#include "kelp/sim/state_io.hpp"
 #include "types.hpp"
 
 namespace kelp_python {
@@ -202,7 +204,23 @@ void bind_fleet(py::module_& m) {
           "copy", [](const FState& s) { return s; }, "An independent copy (for saving).")
       .def("__copy__", [](const FState& s) { return s; })
       .def(
-          "__deepcopy__", [](const FState& s, py::dict) { return s; }, py::arg("memo"));
+          "__deepcopy__", [](const FState& s, py::dict) { return s; }, py::arg("memo"))
+      // Pickling: the state file's bytes, checked on their own when unpickled (as
+      // kelp.SystemState's; the fleet it is stepped with checks the counts).
+      .def(py::pickle([](const FState& s) { return py::bytes(kelp::sim::save_state(s)); },
+                      [](const py::bytes& b) {
+                        const std::string data = b;
+                        return kelp::sim::load_fleet_state(data, "pickled kelp.FleetState");
+                      }));
+
+  m.def(
+      "save_state", [](const FState& s) { return py::bytes(kelp::sim::save_state(s)); },
+      py::arg("state"), "A kelp.FleetState as a state file's bytes (see the pair's overload).");
+  m.def(
+      "save_state_file",
+      [](const std::string& path, const FState& s) { kelp::sim::save_state_file(path, s); },
+      py::arg("path"), py::arg("state"),
+      "Writes a kelp.FleetState to `path` atomically (see the pair's overload).");
 
   py::class_<FReport>(m, "FleetReport", "What one Fleet.step did (a copy).")
       .def_property_readonly(
@@ -285,6 +303,9 @@ void bind_fleet(py::module_& m) {
             const FInputs none(f.model);
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(f.mutex);
+            // A state whose winch lines have other node counts than the last one stepped (a
+            // copy restored, a state loaded or unpickled) gets those counts' buffers.
+            kfs::fit_workspace(f.model, f.workspace, state);
             return FReport(kfs::step(f.model, f.workspace, state, inputs ? *inputs : none, dt, o));
           },
           py::arg("state"), py::arg("inputs") = py::none(), py::arg("dt") = 0.01,
@@ -292,7 +313,8 @@ void bind_fleet(py::module_& m) {
           "Advances `state` in place by `dt` [s] under `inputs` (a kelp.FleetInputs; None: zero) "
           "and returns a kelp.FleetReport. The GIL is released during the step. Raises "
           "kelp.InvalidArgument (bad dt, inputs of another fleet, non-finite values) or "
-          "kelp.NumericalError; the state is then unchanged.")
+          "kelp.NumericalError; the state is then unchanged. Any state of this fleet may be "
+          "stepped: a copy, one restored from kelp.load_state or a pickle.")
       .def(
           "energy",
           [](const Fleet& f, const FState& state) {
@@ -348,6 +370,24 @@ void bind_fleet(py::module_& m) {
       .def_property_readonly(
           "notes", [](const Fleet& f) { return f.world.notes; },
           "What building the fleet changed in what it loaded (e.g. a Gazebo model's water).");
+
+  m.def(
+      "load_state",
+      [](const py::bytes& b, const Fleet& f) {
+        const std::string data = b;
+        return kelp::sim::load_state(data, f.model);
+      },
+      py::arg("data"), py::arg("fleet"),
+      "The kelp.FleetState saved in `data`, checked against `fleet` (its vehicle, point mass and "
+      "tether counts, each tether's node count, each vehicle's thrusters). Raises "
+      "kelp.StateError naming what is wrong.");
+  m.def(
+      "load_state_file",
+      [](const std::string& path, const Fleet& f) {
+        return kelp::sim::load_state_file(path, f.model);
+      },
+      py::arg("path"), py::arg("fleet"),
+      "kelp.load_state of a fleet's file `path` (errors name it).");
 }
 
 }  // namespace kelp_python

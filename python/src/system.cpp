@@ -1,5 +1,6 @@
-// kelp.System (the coupled ASV + tether + AUV), kelp.SystemState, kelp.SystemInputs and
-// kelp.SystemReport.
+// kelp.System (the coupled ASV + tether + AUV), kelp.SystemState (which pickles through
+// kelp::sim's state files), kelp.SystemInputs, kelp.SystemReport, and kelp.save_state /
+// kelp.load_state for the pair (fleet.cpp adds the fleet's overloads).
 #include <pybind11/stl.h>
 
 #include <string>
@@ -7,6 +8,7 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "kelp/environment/sea_state.hpp"
+#include "kelp/sim/state_io.hpp"
 #include "kelp/sim/world.hpp"
 #include "kelp/system/presets.hpp"
 #include "types.hpp"
@@ -66,8 +68,9 @@ void bind_system(py::module_& m) {
   py::class_<Inputs>(
       m, "SystemInputs",
       "The inputs of one System.step: each vehicle's control wrench tau and other external "
-      "wrench tau_ext (body axes [N, N m], shape (6,)) and, for a vehicle with propulsion, its "
-      "thrusters' normalised commands in [-1, 1] (held over the step). Get one sized for a "
+      "wrench tau_ext (body axes [N, N m], shape (6,)), for a vehicle with propulsion its "
+      "thrusters' normalised commands in [-1, 1] (held over the step), and with a winch its "
+      "commanded payout rate. Get one sized for a "
       "system from System.inputs(); every array is a writable zero-copy view, so filling it in "
       "place (inputs.auv_commands[:] = u) costs no allocation.")
       .def(py::init<>(), "Zero wrenches, no commands (all thrusters at 0).")
@@ -114,7 +117,10 @@ void bind_system(py::module_& m) {
           [](Inputs& i, py::handle v) {
             set_commands(i.auv_commands, i.auv_commands.size(), v, "auv_commands");
           },
-          "The AUV's thruster commands in ArduSub's motor order, (n,): a view (empty: all 0).");
+          "The AUV's thruster commands in ArduSub's motor order, (n,): a view (empty: all 0).")
+      .def_readwrite("winch_payout_rate", &Inputs::winch_payout_rate,
+                     "The winch's commanded payout rate [m/s] (positive: paying out), followed "
+                     "within its limits; must be 0 for a system without a winch.");
 
   py::class_<State>(
       m, "SystemState",
@@ -176,7 +182,31 @@ void bind_system(py::module_& m) {
           "An independent copy (for saving and restoring).")
       .def("__copy__", [](const State& s) { return s; })
       .def(
-          "__deepcopy__", [](const State& s, py::dict) { return s; }, py::arg("memo"));
+          "__deepcopy__", [](const State& s, py::dict) { return s; }, py::arg("memo"))
+      // Pickling: the state file's bytes (kelp.save_state). A kelp.SystemState is a plain C++
+      // state with no reference to its system, so unpickling checks the state on its own (sizes
+      // that fit together, finite values, equal clocks); System.step then refuses a node or
+      // thruster count that is not its system's, and kelp.load_state(data, system) checks all
+      // of it (a winch length without a winch too) at once.
+      .def(py::pickle([](const State& s) { return py::bytes(kelp::sim::save_state(s)); },
+                      [](const py::bytes& b) {
+                        const std::string data = b;
+                        return kelp::sim::load_system_state(data, "pickled kelp.SystemState");
+                      }));
+
+  m.def(
+      "save_state", [](const State& s) { return py::bytes(kelp::sim::save_state(s)); },
+      py::arg("state"),
+      "The state as a state file's bytes (kelp::sim::save_state; docs/state-files.md): "
+      "everything that influences its next steps, bit for bit. Raises kelp.StateError for a "
+      "state that could not be loaded back (NaN where a step refuses it, sizes that do not fit "
+      "together).");
+  m.def(
+      "save_state_file",
+      [](const std::string& path, const State& s) { kelp::sim::save_state_file(path, s); },
+      py::arg("path"), py::arg("state"),
+      "Writes kelp.save_state(state) to `path` atomically (a new file beside it, flushed, then "
+      "renamed over it). Raises kelp.StateError, or kelp.Error when the file cannot be written.");
 
   py::class_<Report>(m, "SystemReport", "What one System.step did.")
       .def_property_readonly(
@@ -275,6 +305,9 @@ void bind_system(py::module_& m) {
             o.with_energy = with_energy;
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(s.mutex);
+            // A state of another tether node count than the last one stepped (a copy restored,
+            // a state loaded or unpickled, with a winch) gets that count's buffers.
+            ks::fit_workspace(s.model, s.workspace, state);
             return ks::step(s.model, s.workspace, state, inputs ? *inputs : none, dt, o);
           },
           py::arg("state"), py::arg("inputs") = py::none(), py::arg("dt") = 0.01,
@@ -282,7 +315,8 @@ void bind_system(py::module_& m) {
           "Advances `state` in place by `dt` [s] under `inputs` (a kelp.SystemInputs; None: "
           "zero) and returns a kelp.SystemReport. The GIL is released during the step. Raises "
           "kelp.InvalidArgument (bad dt, non-finite inputs or state, wrong command count) or "
-          "kelp.NumericalError; the state is then unchanged.")
+          "kelp.NumericalError; the state is then unchanged. Any state of this system may be "
+          "stepped: a copy, one restored from kelp.load_state or a pickle.")
       .def(
           "energy",
           [](const System& s, const State& state) {
@@ -326,6 +360,26 @@ void bind_system(py::module_& m) {
           "auv_attachment",
           [](const System& s) { return copy_vector(s.model.parameters().auv_attachment); },
           "The tether's point on the AUV, body axes [m].");
+
+  m.def(
+      "load_state",
+      [](const py::bytes& b, const System& sys) {
+        const std::string data = b;
+        return kelp::sim::load_state(data, sys.model);
+      },
+      py::arg("data"), py::arg("system"),
+      "The kelp.SystemState saved in `data` (bytes from kelp.save_state), checked against "
+      "`system` (its tether's node count, within its winch's range; its thruster counts). Raises "
+      "kelp.StateError naming what is wrong (truncated or corrupted bytes, a fleet's state, "
+      "another system's, NaN).");
+  m.def(
+      "load_state_file",
+      [](const std::string& path, const System& sys) {
+        return kelp::sim::load_state_file(path, sys.model);
+      },
+      py::arg("path"), py::arg("system"),
+      "kelp.load_state of the file `path` (errors name it). Raises kelp.StateError, or "
+      "kelp.Error when it cannot be read.");
 }
 
 }  // namespace kelp_python

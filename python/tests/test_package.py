@@ -18,6 +18,7 @@ def test_imports_with_version_and_docs():
         ("invalid_argument", kelp.InvalidArgument, ValueError),
         ("numerical_error", kelp.NumericalError, RuntimeError),
         ("scenario_error", kelp.ScenarioError, ValueError),
+        ("state_error", kelp.StateError, ValueError),
         ("error", kelp.Error, RuntimeError),
     ],
 )
@@ -33,6 +34,7 @@ def test_exception_hierarchy_mirrors_cpp():
     assert issubclass(kelp.InvalidArgument, ValueError)
     assert issubclass(kelp.NumericalError, RuntimeError)
     assert issubclass(kelp.ScenarioError, kelp.InvalidArgument)
+    assert issubclass(kelp.StateError, kelp.InvalidArgument)
     assert not issubclass(kelp.NumericalError, ValueError)
     # Other C++ exceptions keep pybind11's translation.
     with pytest.raises(RuntimeError) as info:

@@ -502,6 +502,26 @@ struct FleetWorkspace {
   }
 };
 
+/// \brief Readies `ws` for stepping `state` when the workspace last stepped another state: each
+/// tether with a winch whose node count in `state` is not the one the workspace holds gets that
+/// count's buffers (as the pair's fit_workspace, system.hpp). Call it between steps: it may
+/// allocate (once).
+/// \throws kelp::invalid_argument when the workspace or the state is not sized for the fleet
+/// or a tether's node count is outside its winch's range.
+template <typename Scalar>
+void fit_workspace(const FleetModel<Scalar>& model, FleetWorkspace<Scalar>& ws,
+                   const FleetState<Scalar>& state) {
+  KELP_CHECK(ws.fits(model), "workspace was built for a different fleet");
+  KELP_CHECK(state.tethers.size() == std::size_t(model.tether_count()),
+             "state must be sized for the fleet (initial_state(model, ...))");
+  for (std::size_t k = 0; k < state.tethers.size(); ++k) {
+    const tether::WinchModel<Scalar>* w = model.winch(int(k));
+    const int nodes = int(state.tethers[k].position.cols());
+    if (w == nullptr || ws.tethers[k].tether.fits(nodes)) continue;
+    ws.tethers[k].winch->lend(*w, ws.tethers[k].tether, nodes - 1);
+  }
+}
+
 namespace detail {
 
 /// Sphere of volume V: radius, and its submerged volume and volume integral at centre depth d
@@ -726,7 +746,11 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
     KELP_CHECK(state.tethers[k].time == state.time,
                "state.tethers[k].time must equal state.time (use FleetState::set_time)");
     KELP_CHECK(ws.tethers[k].tether.fits(model.tether_of(int(k), state.tethers[k]).nodes()),
-               "workspace was built for a different fleet");
+               ws.tethers[k].winch
+                   ? "workspace holds tether k's buffers of another node count than the "
+                     "state's: call system::fit_workspace(model, ws, state) first (a state "
+                     "loaded or restored at another count)"
+                   : "workspace was built for a different fleet");
   }
   FleetReport<Scalar>& report = ws.report;
   report.tether = {};

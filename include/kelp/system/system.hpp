@@ -363,6 +363,25 @@ struct SystemWorkspace {
   }
 };
 
+/// \brief Readies `ws` for stepping `state` when the workspace last stepped another state: with
+/// a winch, a state of another node count (one loaded from a file, kelp/sim/state_io.hpp, or a
+/// copy restored after the winch re-meshed) gets that count's buffers
+/// (tether::WinchWorkspace::lend). Does nothing without a winch or at the count the workspace
+/// holds. Call it between steps: it may allocate (once); step() refuses a state whose node count
+/// the workspace does not hold. The steps that follow are those of the state's own run, bit for
+/// bit (the workspace holds scratch only).
+/// \throws kelp::invalid_argument when the state's node count is outside the winch's range or
+/// the workspace was built for another system.
+template <typename Scalar>
+void fit_workspace(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
+                   const SystemState<Scalar>& state) {
+  if (model.winch() == nullptr) return;
+  KELP_CHECK(ws.winch, "workspace was built for a different system (it has no winch buffers)");
+  const int nodes = int(state.tether.position.cols());
+  if (ws.tether.fits(nodes)) return;
+  ws.winch->lend(*model.winch(), ws.tether, nodes - 1);
+}
+
 namespace detail {
 
 /// NED acceleration of the body point r of a vehicle in state x with body acceleration ν̇:
@@ -591,7 +610,11 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
              "inputs.winch_payout_rate must be 0: the system has no winch");
   check_finite(inputs.winch_payout_rate, "inputs.winch_payout_rate");
   const tether::TetherModel<Scalar>& line = model.tether_of(state);
-  KELP_CHECK(ws.tether.fits(line.nodes()), "workspace was built for a different system");
+  KELP_CHECK(ws.tether.fits(line.nodes()),
+             ws.winch ? "workspace holds the tether buffers of another node count than the "
+                        "state's: call system::fit_workspace(model, ws, state) first (a state "
+                        "loaded or restored at another count)"
+                      : "workspace was built for a different system");
   vehicle::detail::check_state(state.asv);
   vehicle::detail::check_state(state.auv);
   check_all_finite(state.asv_nu_dot, "state.asv_nu_dot");

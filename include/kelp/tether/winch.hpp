@@ -327,6 +327,35 @@ struct WinchWorkspace {
   }
   /// \brief Slot index of `segments`.
   std::size_t slot(int segments) const { return std::size_t(segments - min_n); }
+
+  /// \brief Makes `ws` (the line buffers lent out, sized for the count last stepped) the
+  /// buffers of `segments` segments, and every spare state but that count's sized for its own
+  /// count: for stepping a state of another count than the one these buffers followed (a state
+  /// loaded from a file, or a copy restored after the winch re-meshed). The line buffers are
+  /// swapped; a spare state is rebuilt (an allocation) only when it holds another count's
+  /// buffers (at most one: the count lent before). Call it between steps.
+  /// \throws kelp::invalid_argument when `segments` is outside the model's range or `ws` holds
+  /// no count of it (nothing changed then).
+  void lend(const WinchModel<Scalar>& model, TetherWorkspace<Scalar>& ws, int segments) {
+    KELP_CHECK(segments >= model.min_segments() && segments <= model.max_segments() &&
+                   model.min_segments() == min_n &&
+                   std::size_t(model.max_segments() - min_n + 1) == line.size(),
+               "WinchWorkspace::lend: segment count outside the winch's range, or a workspace "
+               "built for another winch");
+    const int from = int(ws.force.cols()) - 1;
+    KELP_CHECK(from >= model.min_segments() && from <= model.max_segments() && ws.fits(from + 1),
+               "WinchWorkspace::lend: the lent buffers are not one of the winch's counts");
+    if (from != segments) {
+      using std::swap;
+      swap(ws, line[slot(segments)]);
+      swap(line[slot(segments)], line[slot(from)]);
+    }
+    for (int n = model.min_segments(); n <= model.max_segments(); ++n) {
+      TetherState<Scalar>& s = spare[slot(n)];
+      if (n != segments && (s.position.cols() != n + 1 || s.velocity.cols() != n + 1))
+        s = TetherState<Scalar>(model.line(n));
+    }
+  }
 };
 
 /// \brief The payout rate [m/s] the winch reaches in a step of dt [s] from `rate` towards
