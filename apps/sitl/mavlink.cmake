@@ -29,10 +29,7 @@ if(KELP_BUILD_TESTS)
                      ${CMAKE_CURRENT_SOURCE_DIR}/tests/mavlink/node/crosscheck.js
                      $<TARGET_FILE:kelp-mavlink-vectors>)
   else()
-    add_test(NAME sitl_mavlink_node_crosscheck
-             COMMAND ${CMAKE_COMMAND} -E echo
-                     "sitl_mavlink_node_crosscheck: FAILED: node not found; run scripts/install-deps")
-    set_tests_properties(sitl_mavlink_node_crosscheck PROPERTIES WILL_FAIL ON)
+    kelp_add_node_missing_test(sitl_mavlink_node_crosscheck)
   endif()
   set_tests_properties(sitl_mavlink_node_crosscheck PROPERTIES TIMEOUT 120)
 

@@ -36,14 +36,9 @@ import subprocess
 import sys
 import time
 
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL: " + what, file=sys.stderr)
-    return cond
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from stop_checks import check, check_csv, failures  # noqa: E402
 
 
 def wait_for_size(path, size, proc, timeout=60.0):
@@ -79,20 +74,6 @@ def start(args, watch, size, rng):
                          % (args[0], size, watch, p.returncode, out, err))
     time.sleep(rng.uniform(0.0, 0.3))
     return p
-
-
-def check_csv(path):
-    """Ends with a newline, every row has the header's column count. Returns (rows, last row)."""
-    with open(path, "rb") as f:
-        data = f.read()
-    name = os.path.relpath(path)
-    if not check(data.endswith(b"\n"), "%s does not end with a newline (a row cut short)" % name):
-        return 0, None
-    lines = data.decode().split("\n")[:-1]
-    columns = lines[0].count(",") + 1
-    bad = [i + 1 for i, line in enumerate(lines) if line.count(",") + 1 != columns]
-    check(not bad, "%s: rows %s do not have the header's %d columns" % (name, bad[:5], columns))
-    return len(lines) - 1, lines[-1].split(",") if len(lines) > 1 else None
 
 
 def check_bag(node, bag_check, mode, path):

@@ -20,22 +20,9 @@ import subprocess
 import sys
 import time
 
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL: " + what, file=sys.stderr)
-    return cond
-
-
-def csv_whole(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    lines = data.decode().split("\n")
-    columns = lines[0].count(",") + 1
-    return data.endswith(b"\n") and all(line.count(",") + 1 == columns for line in lines[1:-1])
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "common"))
+from stop_checks import check, check_csv, failures  # noqa: E402
 
 
 def main(program, work):
@@ -81,7 +68,7 @@ def main(program, work):
         d = os.path.join(runs, run["hash"])
         check(run["hash"] not in stored, "the interrupted run %s stored a result" % run["hash"])
         for name in ("timeseries.csv", "nodes.csv", "events.csv"):
-            check(csv_whole(os.path.join(d, name)), "the interrupted run's %s is cut" % name)
+            check_csv(os.path.join(d, name))  # the interrupted run's series: whole lines
         with open(os.path.join(d, "summary.json")) as f:
             s = json.load(f)
         check(s["completed"] is False and 0 <= s["simulated_s"] < 60 and
