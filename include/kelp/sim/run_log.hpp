@@ -23,7 +23,6 @@
 #include <Eigen/Core>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>  // not used here any more; kept for the files that relied on it
 #include <limits>
 #include <string>
 #include <vector>
