@@ -36,6 +36,8 @@ std::string kind_name(std::uint16_t kind) {
       return "pair state";
     case std::uint16_t(ArchiveKind::fleet_state):
       return "fleet state";
+    case std::uint16_t(ArchiveKind::run_checkpoint):
+      return "run checkpoint";
     default:
       return "kind " + std::to_string(kind);
   }
@@ -94,6 +96,12 @@ void Writer::f64s(const double* v, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) f64(v[i]);
 }
 
+void Writer::text(std::string_view s) {
+  if (s.size() > 0xFFFFFFFFu) throw std::length_error("archive::Writer::text: longer than 4 GiB");
+  u32(std::uint32_t(s.size()));
+  payload_.append(s.data(), s.size());
+}
+
 std::string Writer::bytes() const {
   if (open_ != 0) throw std::logic_error("archive::Writer::bytes: a section is open");
   std::string out(reinterpret_cast<const char*>(magic.data()), magic.size());
@@ -137,6 +145,14 @@ double Section::f64() {
 void Section::f64s(double* v, std::size_t n) {
   if (n > left() / 8) take(n * 8);  // fails with the sizes, before any partial read
   for (std::size_t i = 0; i < n; ++i) v[i] = f64();
+}
+
+std::string_view Section::text(std::size_t max, const char* what) {
+  const std::uint32_t n = u32();
+  if (n > max)
+    fail(std::string(what) + ": " + std::to_string(n) + " bytes, more than the " +
+         std::to_string(max) + " allowed");
+  return std::string_view(take(n), n);
 }
 
 void Section::expect_count(std::uint32_t expected, const char* what) {

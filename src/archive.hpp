@@ -1,5 +1,6 @@
 // kelp's binary archive (private to kelp::sim): the container of state files
-// (kelp/sim/state_io.hpp, docs/state-files.md) and, next, of a closed-loop run's checkpoint.
+// (kelp/sim/state_io.hpp, docs/state-files.md) and of a closed-loop run's checkpoint
+// (kelp/sim/checkpoint.hpp, docs/checkpoints.md).
 //
 // An archive is a header, a payload of tagged sections and a CRC-32, little-endian throughout
 // (written byte by byte, never as structs):
@@ -47,9 +48,9 @@ inline constexpr std::size_t max_writer_bytes = 64;
 
 /// What an archive holds (the header's kind).
 enum class ArchiveKind : std::uint16_t {
-  pair_state = 1,   ///< kelp::system::SystemState<double> (the tethered pair)
-  fleet_state = 2,  ///< kelp::system::FleetState<double>
-  // 3: reserved for a closed-loop run's checkpoint.
+  pair_state = 1,      ///< kelp::system::SystemState<double> (the tethered pair)
+  fleet_state = 2,     ///< kelp::system::FleetState<double>
+  run_checkpoint = 3,  ///< a closed-loop run's checkpoint (checkpoint.cpp)
 };
 /// "pair state", "fleet state" or "kind <n>".
 std::string kind_name(std::uint16_t kind);
@@ -79,6 +80,8 @@ class Writer {
   void f64(double v);
   /// `n` doubles.
   void f64s(const double* v, std::size_t n);
+  /// Bytes: a u32 length, then the bytes.
+  void text(std::string_view s);
 
   /// The whole archive: header, payload, CRC. Every section must have ended.
   std::string bytes() const;
@@ -102,6 +105,8 @@ class Section {
   std::int32_t i32();
   double f64();
   void f64s(double* v, std::size_t n);
+  /// Bytes written by Writer::text, at most `max`; `what` names them in the error.
+  std::string_view text(std::size_t max, const char* what);
   /// A u32 count that must equal `expected`; `what` names it in the error.
   void expect_count(std::uint32_t expected, const char* what);
   /// A u32 count of elements of `element_bytes` each, at most `max` and no more than the bytes

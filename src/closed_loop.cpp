@@ -3,7 +3,6 @@
 #include "kelp/sim/closed_loop.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -16,7 +15,6 @@
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
 #include "kelp/core/kernel_path.hpp"
-#include "kelp/sim/stop.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/vehicle/presets.hpp"
 
@@ -495,35 +493,6 @@ RunSummary ClosedLoop::summary() const {
   s.scenario_file = options_.scenario_file;
   s.scenario = scenario_;
   return s;
-}
-
-RunSummary simulate(const Scenario& sc, const SimulateOptions& o) {
-  const WorldSetup setup = world_setup(sc, o.scenario_file);
-  std::unique_ptr<RunLog> log;
-  if (!o.log_dir.empty()) log = std::make_unique<RunLog>(o.log_dir);
-  ClosedLoopOptions lo;
-  lo.scenario_file = o.scenario_file;
-  lo.log = log.get();
-  lo.on_step = o.on_step;
-  lo.on_sample = o.on_sample;
-  ClosedLoop loop(sc, setup, lo);
-  const long steps = loop.total_steps();
-  const auto wall0 = std::chrono::steady_clock::now();
-  while (!loop.done()) {
-    // A stop (kelp/sim/stop.hpp): the run ends here, between two steps.
-    if (stop_requested() || (o.should_stop && o.should_stop())) break;
-    const long k = loop.steps_taken();
-    const double t = loop.time();
-    loop.step();
-    if (o.on_progress) o.on_progress(k, steps, t);
-  }
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  if (log) log->close();
-  RunSummary summary = loop.summary();
-  summary.wall_s = wall;
-  summary.realtime_factor = summary.simulated_s / wall;
-  return summary;
 }
 
 }  // namespace sim

@@ -1,8 +1,14 @@
-// A run's samples as ROS 2 messages and its bag (kelp/sim/ros2.hpp): Ros2Sampler's and
-// BagRecorder's members.
+// A run's samples as ROS 2 messages and its bag (kelp/sim/ros2.hpp): Ros2Sampler's,
+// BagRecorder's and RunBag's (kelp/sim/run.hpp) members.
 #include "kelp/sim/ros2.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <utility>
+
+#include "kelp/sim/run.hpp"
 
 namespace kelp {
 namespace sim {
@@ -50,6 +56,34 @@ void BagRecorder::record(const LogRow& r) {
   const bool markers = r.t + 1e-9 >= next_marker_;
   if (markers) next_marker_ = r.t + marker_period_;
   bag_.write(m, markers);
+}
+
+RunBag::RunBag(std::filesystem::path file, double marker_rate)
+    : file_(std::move(file)), marker_rate_(marker_rate) {}
+
+RunBag::~RunBag() = default;
+
+void RunBag::record(const LogRow& r) {
+  if (!bag_) {
+    if (file_.has_parent_path()) std::filesystem::create_directories(file_.parent_path());
+    bag_ = std::make_unique<BagRecorder>(file_, marker_rate_);
+  }
+  bag_->record(r);
+}
+
+void RunBag::close() {
+  if (bag_) bag_->close();
+}
+
+std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
+                                     std::function<void(const LogRow&)>& on_sample) {
+  if (!sc.mcap || o.out.empty()) return nullptr;
+  auto bag = std::make_unique<RunBag>(std::filesystem::path(o.out) / "run.mcap", sc.node_rate);
+  on_sample = [b = bag.get(), user = on_sample](const LogRow& r) {
+    b->record(r);
+    if (user) user(r);
+  };
+  return bag;
 }
 
 }  // namespace sim

@@ -91,6 +91,7 @@ void LineFile::open(const std::filesystem::path& path) {
   text_.clear();
   text_.reserve(reserved);
   ended_ = 0;
+  written_ = 0;
 }
 
 void LineFile::end_line() {
@@ -102,6 +103,7 @@ void LineFile::end_line() {
 void LineFile::write_out() {
   if (fd_ < 0 || ended_ == 0) return;
   const int e = write_all(fd_, text_.data(), ended_);
+  if (e == 0) written_ += ended_;
   text_.erase(0, ended_);  // the line not ended yet, if any, moves to the front
   ended_ = 0;
   if (e != 0) throw kelp::error("cannot write " + path_ + ": " + std::strerror(e));

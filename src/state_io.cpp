@@ -16,6 +16,7 @@
 
 #include "archive.hpp"
 #include "kelp/sim/version.hpp"
+#include "state_sections.hpp"
 
 namespace kelp {
 namespace sim {
@@ -396,8 +397,8 @@ void read_tether(Reader& r, kt::TetherStated& t) {
   s.end();
 }
 
-ks::SystemStated read_pair(std::string_view bytes, const std::string& input) {
-  Reader r(bytes, ArchiveKind::pair_state, input);
+// The pair's sections, from the reader's next section on.
+ks::SystemStated read_pair_sections(Reader& r, const std::string& input) {
   const Head h = read_head(r);
   if (h.vehicles != 2 || h.point_masses != 0 || h.tethers != 1)
     r.fail("a pair's state has 2 vehicles, no point mass and 1 tether, the header says " +
@@ -410,8 +411,14 @@ ks::SystemStated read_pair(std::string_view bytes, const std::string& input) {
   read_vehicle(r, s.auv, s.auv_nu_dot);
   read_propulsion(r, s.auv_propulsion);
   read_tether(r, s.tether);
-  r.end();
   check_pair(input, s);
+  return s;
+}
+
+ks::SystemStated read_pair(std::string_view bytes, const std::string& input) {
+  Reader r(bytes, ArchiveKind::pair_state, input);
+  ks::SystemStated s = read_pair_sections(r, input);
+  r.end();
   return s;
 }
 
@@ -526,15 +533,35 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
-std::string save_state(const ks::SystemStated& state) {
-  check_pair("state", state);
-  Writer a(ArchiveKind::pair_state, version());
+namespace state_sections {
+
+void write_pair(Writer& a, const ks::SystemStated& state, const std::string& input) {
+  check_pair(input, state);
   write_head(a, state.time, 2, 0, 1);
   write_vehicle(a, state.asv, state.asv_nu_dot);
   write_propulsion(a, state.asv_propulsion);
   write_vehicle(a, state.auv, state.auv_nu_dot);
   write_propulsion(a, state.auv_propulsion);
   write_tether(a, state.tether);
+}
+
+ks::SystemStated read_pair(Reader& r, const ks::SystemModeld& model, const std::string& input) {
+  ks::SystemStated s = read_pair_sections(r, input);
+  check_pair_fits(input, model, s);
+  return s;
+}
+
+void write_file_durably(const std::string& path, const std::string& bytes) {
+  write_file_atomically(path, bytes);
+}
+
+std::string read_whole_file(const std::string& path) { return read_file(path); }
+
+}  // namespace state_sections
+
+std::string save_state(const ks::SystemStated& state) {
+  Writer a(ArchiveKind::pair_state, version());
+  state_sections::write_pair(a, state, "state");
   return a.bytes();
 }
 

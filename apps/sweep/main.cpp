@@ -19,8 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include "kelp/sim/checkpoint.hpp"
 #include "kelp/sim/closed_loop.hpp"
-#include "kelp/sim/ros2.hpp"
 #include "kelp/sim/stop.hpp"
 #include "sweep.hpp"
 
@@ -115,9 +115,10 @@ struct RunOptions {
   std::string shard;
   unsigned jobs = 0;
   bool quiet = false, no_plot = false;
-  bool keep_series = false;  // runs/<hash>/: timeseries.csv, nodes.csv, summary.json
-  bool mcap = false;         // each run's ROS 2 bag, runs/<hash>.mcap
-  bool dry_run = false;      // list the runs (JSON lines on stdout); run and write nothing
+  bool keep_series = false;     // runs/<hash>/: timeseries.csv, nodes.csv, summary.json
+  bool mcap = false;            // each run's ROS 2 bag, runs/<hash>.mcap
+  bool dry_run = false;         // list the runs (JSON lines on stdout); run and write nothing
+  double checkpoint_every = 0;  // runs/<hash>.checkpoint.bin every this many simulated s
 };
 
 int run(const RunOptions& o) {
@@ -193,7 +194,7 @@ int run(const RunOptions& o) {
                      {"index", r.index},
                      {"point", paper_sweep::point_values(s, r.point)},
                      {"seed", r.seed}};
-      std::string error;
+      std::string error, note;
       bool completed = true;
       double reached = 0;
       try {
@@ -203,17 +204,40 @@ int run(const RunOptions& o) {
         const fs::path series = out / "runs" / r.hash;
         if (o.keep_series) so.log_dir = series.string();
         // With --mcap, each run's ROS 2 bag beside its result (runs/<hash>.mcap).
-        std::unique_ptr<kelp::sim::BagRecorder> bag;
-        if (o.mcap) {
-          bag = std::make_unique<kelp::sim::BagRecorder>(out / "runs" / (r.hash + ".mcap"),
-                                                         r.scenario.node_rate);
-          so.on_sample = [&bag](const kelp::sim::LogRow& row) { bag->record(row); };
+        so.mcap = o.mcap;
+        so.mcap_file = (out / "runs" / (r.hash + ".mcap")).string();
+        // A run stopped or killed before resumes from its checkpoint (kelp/sim/checkpoint.hpp),
+        // at the interval it was written at unless --checkpoint-every says otherwise.
+        so.checkpoint_file = (out / "runs" / (r.hash + ".checkpoint.bin")).string();
+        so.checkpoint_every = o.checkpoint_every;
+        so.resume = fs::exists(so.checkpoint_file);
+        if (so.resume) {
+          try {
+            const kelp::sim::CheckpointInfo info =
+                kelp::sim::read_checkpoint_info(so.checkpoint_file);
+            if (so.checkpoint_every == 0) so.checkpoint_every = info.checkpoint_every;
+            char at[64];
+            std::snprintf(at, sizeof at, "%.2f", info.time);
+            note = std::string("resumed from its checkpoint at ") + at + " s";
+          } catch (const kelp::error&) {  // refused below, by the resume itself
+          }
         }
-        const kelp::sim::RunSummary summary = kelp::sim::simulate(r.scenario, so);
+        kelp::sim::RunSummary summary;
+        try {
+          summary = kelp::sim::simulate(r.scenario, so);
+        } catch (const kelp::sim::state_error& e) {
+          if (!so.resume) throw;
+          // A checkpoint that cannot be resumed (another kelp version, a damaged file): the run
+          // starts again from its beginning.
+          note = std::string("its checkpoint is refused (") + e.what() + "); it started again";
+          fs::remove(so.checkpoint_file);
+          so.resume = false;
+          summary = kelp::sim::simulate(r.scenario, so);
+        }
         completed = summary.completed;
         reached = summary.simulated_s;
         result["summary"] = nlohmann::json::parse(kelp::sim::summary_json(summary));
-        if (bag) bag->close();
+        if (completed) fs::remove(so.checkpoint_file);
         // A stopped run's series and bag are whole, its summary.json says "completed": false;
         // it stores no result, so that a resumed sweep runs it again.
         if (o.keep_series)
@@ -223,13 +247,18 @@ int run(const RunOptions& o) {
         error = e.what();
       }
       std::lock_guard<std::mutex> lock(mutex);
+      if (!note.empty())
+        std::fprintf(stderr, "kelp-sweep: run %zu (%s): %s\n", r.index, r.hash.c_str(),
+                     note.c_str());
       if (!error.empty()) {
         failures.push_back("run " + std::to_string(r.index) + " (" + r.hash + "): " + error);
         failed_runs.push_back(r.index);
       } else if (!completed) {
         simulated += reached;
-        interrupted_runs.push_back(
-            {{"index", r.index}, {"hash", r.hash}, {"simulated_s", reached}});
+        interrupted_runs.push_back({{"index", r.index},
+                                    {"hash", r.hash},
+                                    {"simulated_s", reached},
+                                    {"checkpoint", o.checkpoint_every > 0}});
       } else {
         simulated += r.scenario.duration;
         results[r.hash] = std::move(result);
@@ -347,13 +376,19 @@ int main(int argc, char** argv) {
   app.add_flag("--mcap", o.mcap,
                "also write each run as a ROS 2 bag, runs/<hash>.mcap (off by default: a bag is "
                "a few MB a simulated minute, a sweep has many runs)");
+  app.add_option("--checkpoint-every", o.checkpoint_every,
+                 "write each run's checkpoint (runs/<hash>.checkpoint.bin) every this many "
+                 "simulated seconds and when stopped: a stopped or killed sweep run again resumes "
+                 "its interrupted runs from there instead of from their start [s]")
+      ->check(CLI::Range(1e-2, 1e7));
   app.add_flag("--dry-run", o.dry_run,
                "check and expand the sweep, print its runs (one JSON object a line: index, "
                "hash, grid point, seed, scenario as used) and exit; runs and writes nothing");
   app.footer(
       "Exit status: 0 done, 1 a run failed, 2 the plotting script failed, 3 an invalid sweep file "
       "or option, 130 / 143 stopped by SIGINT / SIGTERM (the runs under way stopped with their "
-      "files whole and no result stored; status.json lists the runs done; run again to resume).");
+      "files whole and no result stored; status.json lists the runs done; run again to resume: "
+      "with --checkpoint-every, the interrupted runs go on from their checkpoints).");
   CLI::App* m = app.add_subcommand("merge", "combine shard directories into one table");
   std::vector<std::string> dirs;
   std::string merged = "kelp-sweep-merged";

@@ -18,6 +18,7 @@
 #endif
 #include "common/progress.hpp"
 #include "common/replay_template.hpp"
+#include "kelp/sim/checkpoint.hpp"
 #include "kelp/sim/fleet_run.hpp"
 #include "kelp/sim/replay.hpp"
 #include "kelp/sim/run.hpp"
@@ -34,7 +35,9 @@ struct Options {
   std::string out = "kelp-run";
   bool quiet = false;
   bool no_plots = false;
-  bool ros2 = false;  // --ros2: live ROS 2 topics over DDS (apps/ros2_bridge/)
+  bool ros2 = false;            // --ros2: live ROS 2 topics over DDS (apps/ros2_bridge/)
+  double checkpoint_every = 0;  // --checkpoint-every [s]
+  bool resume = false;          // --resume DIR: `out` is DIR
 #ifdef KELP_WITH_ROS2
   kelp_ros2::Ros2Options ros2_options;
 #endif
@@ -68,10 +71,12 @@ int stopped(const Options& o, double simulated, bool completed, bool plots) {
   const int signal = kelp::sim::stop_signal();
   std::fprintf(stderr,
                "kelp-tethered-pair: stopped by %s at %.2f s of %.0f s simulated; the outputs in %s "
-               "are whole (summary.json: \"completed\": %s)%s\n",
+               "are whole (summary.json: \"completed\": %s)%s%s%s\n",
                signal == SIGTERM ? "SIGTERM" : "SIGINT", simulated, o.scenario.duration,
                o.out.c_str(), completed ? "true" : "false",
-               plots ? "; no plots (plot_run.py DIR draws them)" : "");
+               plots ? "; no plots (plot_run.py DIR draws them)" : "",
+               o.checkpoint_every > 0 ? "; continue it with --resume " : "",
+               o.checkpoint_every > 0 ? o.out.c_str() : "");
   return kelp::sim::interrupted_exit_status();
 }
 
@@ -110,6 +115,8 @@ int run(const Options& o) {
   if (progress) ro.on_progress = kelp_apps::progress_bar(o.scenario.duration);
   ro.scenario_file = o.scenario_file;
   ro.version = KELP_VERSION_STRING;
+  ro.checkpoint_every = o.checkpoint_every;
+  ro.resume = o.resume;
   ro.replay_template = replay_template();
 #ifdef KELP_WITH_ROS2
   const kelp::sim::RunSummary summary =
@@ -167,8 +174,9 @@ int main(int argc, char** argv) {
       "survey)"};
   app.footer(
       "Exit status: 0 done, 1 a simulation or file error, 2 the plotting script failed, 3 an "
-      "invalid scenario or option (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the "
-      "run's files whole, summary.json \"completed\": false; a second signal stops at once).");
+      "invalid scenario, option or checkpoint (nothing written), 130 / 143 stopped by SIGINT / "
+      "SIGTERM (the run's files whole, summary.json \"completed\": false; with "
+      "--checkpoint-every, checkpoint.bin to --resume from; a second signal stops at once).");
   std::string file;
   double duration = -1;
   std::int64_t seed = -1;
@@ -179,6 +187,15 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--out", o.out, "output directory");
   app.add_flag("--quiet", o.quiet, "no progress bar");
+  std::string resume_dir;
+  auto* every = app.add_option("--checkpoint-every", o.checkpoint_every,
+                               "write OUT/checkpoint.bin every this many simulated seconds and "
+                               "when stopped, to continue the run from with --resume [s]")
+                    ->check(CLI::Range(1e-2, 1e7));
+  app.add_option("--resume", resume_dir,
+                 "continue the stopped or killed run in DIR from its checkpoint.bin (its "
+                 "scenario and options are the checkpoint's; its files end as an uninterrupted "
+                 "run's)");
   app.add_flag("--no-plots", o.no_plots, "do not run the plotting script");
   std::string kernel;
   bool deterministic = false;
@@ -233,6 +250,22 @@ int main(int argc, char** argv) {
     return 3;
   }
   try {
+    if (!resume_dir.empty()) {
+      // The run's scenario is in its checkpoint (read whole and checked here: a corrupted or
+      // foreign one stops the program before anything is written); with --scenario, the
+      // checkpoint must be of that scenario (simulate() compares them).
+      if (app.count("--out") > 0 && fs::path(o.out) != fs::path(resume_dir))
+        throw CLI::ValidationError("--out", "--resume continues the run in its own directory");
+      o.out = resume_dir;
+      o.resume = true;
+      const kelp::sim::CheckpointInfo info = kelp::sim::read_checkpoint_info(
+          (fs::path(resume_dir) / kelp::sim::checkpoint_file_name).string());
+      if (file.empty()) {
+        o.scenario = kelp::sim::parse_scenario(info.scenario_json, info.scenario_file);
+        o.scenario_file = info.scenario_file;
+      }
+      if (every->count() == 0) o.checkpoint_every = info.checkpoint_every;
+    }
     if (!file.empty()) {
       o.scenario = kelp::sim::load_scenario(file);
       o.scenario_file = file;
@@ -244,11 +277,21 @@ int main(int argc, char** argv) {
     overrides.deterministic = deterministic;
     if (mcap || no_mcap) overrides.mcap = mcap && !no_mcap ? 1 : 0;
     o.scenario = kelp::sim::apply_overrides(o.scenario, overrides);
+    if ((o.checkpoint_every > 0 || o.resume) && (o.scenario.fleet || o.ros2))
+      throw CLI::ValidationError(o.resume ? "--resume" : "--checkpoint-every",
+                                 "checkpoints are for a pair's run without --ros2 (a fleet's run "
+                                 "and a live ROS 2 run cannot be checkpointed yet)");
     // SIGINT and SIGTERM stop the run cleanly after the step they land in; a second one at once.
     kelp::sim::install_stop_handlers();
     return run(o);
   } catch (const kelp::sim::scenario_error& e) {
     std::fprintf(stderr, "kelp-tethered-pair: invalid scenario: %s\n", e.what());
+    return 3;
+  } catch (const kelp::sim::state_error& e) {
+    std::fprintf(stderr, "kelp-tethered-pair: cannot resume: %s\n", e.what());
+    return 3;
+  } catch (const CLI::ValidationError& e) {
+    std::fprintf(stderr, "kelp-tethered-pair: %s\n", e.what());
     return 3;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "kelp-tethered-pair: %s\n", e.what());

@@ -10,7 +10,7 @@ __all__ = ["run_scenario"]
 
 
 def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseries=False,
-                 kernel=None, deterministic=False):
+                 kernel=None, deterministic=False, checkpoint_every=0.0, resume=False):
     """Runs a scenario of the tethered pair, or of any fleet, to its end and returns its summary.
 
     This is what ``kelp-tethered-pair`` runs: the same scenario, duration and seed give the same
@@ -41,6 +41,14 @@ def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseri
         The wave kernel's instruction path: "auto", "portable", "avx2" or "avx512".
     deterministic : bool
         The same numbers on every CPU: the kernel "portable".
+    checkpoint_every : float
+        With ``out``: write ``out/checkpoint.bin`` every this many simulated seconds and when the
+        run is stopped (Ctrl-C), for ``resume`` (docs/checkpoints.md). 0: none. A run that
+        completes removes it.
+    resume : bool
+        Continue the run in ``out`` from its checkpoint instead of starting it: the scenario and
+        overrides must be those it started with (else ``kelp.StateError``). Its files end as an
+        uninterrupted run's; ``timeseries=True`` returns the samples from the checkpoint on.
 
     Returns
     -------
@@ -56,6 +64,9 @@ def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseri
         A bad override (duration <= 0, seed < 0, an unknown kernel).
     kelp.NumericalError
         A step that could not be completed.
+    kelp.StateError
+        ``resume`` with a checkpoint that is missing, corrupted, of another scenario or kelp
+        version, or that does not match the files in ``out`` (nothing in ``out`` changed).
     KeyboardInterrupt
         Ctrl-C (or any exception a Python signal handler raises) during the run: the run stops
         within a simulated second, after the step it is in, and leaves its files in ``out``
@@ -72,6 +83,7 @@ def run_scenario(path_or_dict=None, duration=None, seed=None, out=None, timeseri
     summary, columns = _kelp._run_scenario(
         file, text, None if duration is None else float(duration),
         None if seed is None else int(seed), kernel, bool(deterministic),
-        None if out is None else os.fspath(out), bool(timeseries))
+        None if out is None else os.fspath(out), bool(timeseries), float(checkpoint_every),
+        bool(resume))
     summary = json.loads(summary)
     return (summary, columns) if timeseries else summary

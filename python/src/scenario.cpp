@@ -113,7 +113,8 @@ void bind_scenario(py::module_& m) {
       [](const std::optional<std::string>& file, const std::optional<std::string>& text,
          std::optional<double> duration, std::optional<std::int64_t> seed,
          const std::optional<std::string>& kernel, bool deterministic,
-         const std::optional<std::string>& out, bool timeseries) {
+         const std::optional<std::string>& out, bool timeseries, double checkpoint_every,
+         bool resume) {
         kelp::sim::Scenario sc;
         kelp::sim::RunOptions ro;
         if (file) {
@@ -136,8 +137,16 @@ void bind_scenario(py::module_& m) {
         if (kernel) ov.kernel = *kernel;
         ov.deterministic = deterministic;
         sc = kelp::sim::apply_overrides(sc, ov);
+        KELP_CHECK(!(sc.fleet && (checkpoint_every != 0 || resume)),
+                   "run_scenario: a fleet's run cannot be checkpointed yet");
         if (sc.fleet) return run_fleet(sc, ro.scenario_file, out, timeseries);
         if (out) ro.out = *out;
+        KELP_CHECK(std::isfinite(checkpoint_every) && checkpoint_every >= 0,
+                   "run_scenario: checkpoint_every must be a finite number >= 0 [s]");
+        KELP_CHECK(out || (checkpoint_every == 0 && !resume),
+                   "run_scenario: checkpoint_every and resume need out (the run's directory)");
+        ro.checkpoint_every = checkpoint_every;
+        ro.resume = resume;
         ro.version = KELP_VERSION_STRING;
         const std::vector<std::string> names = column_names();
         std::vector<double> rows;
@@ -166,7 +175,8 @@ void bind_scenario(py::module_& m) {
         return py::make_tuple(summary, columns);
       },
       py::arg("file"), py::arg("text"), py::arg("duration"), py::arg("seed"), py::arg("kernel"),
-      py::arg("deterministic"), py::arg("out"), py::arg("timeseries"),
+      py::arg("deterministic"), py::arg("out"), py::arg("timeseries"), py::arg("checkpoint_every"),
+      py::arg("resume"),
       "kelp::sim::run_scenario on a scenario file (`file`), a scenario's JSON text (`text`) or "
       "the embedded default (both None), with kelp-tethered-pair's overrides; a fleet scenario "
       "(\"fleet\") with kelp::sim::run_fleet. Returns (the summary as JSON text, the samples "

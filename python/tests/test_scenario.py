@@ -173,3 +173,56 @@ def test_ctrl_c_stops_a_run_cleanly_and_raises_keyboard_interrupt(tmp_path):
     for name in ("timeseries.csv", "nodes.csv", "events.csv"):
         with open(out / name, "rb") as f:
             assert f.read().endswith(b"\n"), name
+
+
+def test_a_run_stopped_by_ctrl_c_resumes_from_its_checkpoint_to_an_uninterrupted_runs_files(
+        tmp_path):
+    # Ctrl-C with checkpoint_every: the run stops and leaves out/checkpoint.bin; run_scenario with
+    # resume=True goes on from there, and its files equal those of a run never stopped (summary
+    # less its wall time). A completed run removes its checkpoint.
+    import os
+    import signal
+    import sys
+    import time
+    ref, out = tmp_path / "ref", tmp_path / "run"
+    whole = kelp.run_scenario(duration=120, out=ref)
+    assert not (ref / "checkpoint.bin").exists()
+    child = subprocess.Popen(
+        [sys.executable, "-c",
+         "import signal, sys, kelp\n"
+         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+         "try:\n"
+         "    kelp.run_scenario(duration=120, out=sys.argv[1], checkpoint_every=1.0)\n"
+         "except KeyboardInterrupt:\n"
+         "    sys.exit(5)\n",
+         str(out)], env=dict(os.environ))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and child.poll() is None:
+        if (out / "checkpoint.bin").exists():
+            break
+        time.sleep(0.005)
+    child.send_signal(signal.SIGINT)
+    code = child.wait(timeout=30)
+    if code == 0:
+        pytest.skip("the run finished before Ctrl-C reached it")
+    assert code == 5
+    assert (out / "checkpoint.bin").exists()
+    with open(out / "summary.json") as f:
+        assert json.load(f)["completed"] is False
+    resumed = kelp.run_scenario(duration=120, out=out, resume=True)
+    assert resumed["completed"] is True
+    assert not (out / "checkpoint.bin").exists()
+    for s in (whole, resumed):
+        s.pop("wall_s")
+        s.pop("realtime_factor")
+    assert resumed == whole
+    for name in ("timeseries.csv", "nodes.csv", "events.csv", "run.mcap"):
+        assert (out / name).read_bytes() == (ref / name).read_bytes(), name
+
+
+def test_resume_refuses_what_it_cannot_resume(tmp_path):
+    # No checkpoint, another scenario's: kelp.StateError, the directory unchanged.
+    with pytest.raises(kelp.StateError, match="no checkpoint"):
+        kelp.run_scenario(duration=5, out=tmp_path / "none", resume=True)
+    with pytest.raises(kelp.InvalidArgument, match="need out"):
+        kelp.run_scenario(duration=5, checkpoint_every=1.0)

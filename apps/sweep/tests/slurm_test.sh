@@ -9,7 +9,10 @@
 # all traffic on 127.0.0.1. It submits the sweep with submit.sh as 3 shards plus the merge, waits
 # for both jobs (at most $KELP_SLURM_TEST_TIMEOUT s, default 300), runs PROGRAM unsharded, and
 # passes only when the merged table.csv and table.md equal the unsharded ones byte for byte and
-# the shards split the runs exactly. It always stops the daemons it started, prints their logs
+# the shards split the runs exactly. Then it pre-empts a task (SIGTERM to its batch script, as
+# Slurm sends before a time limit) while its runs write checkpoints: the task must requeue itself
+# and resume the interrupted run from its checkpoint to the table of a sweep never stopped. It
+# always stops the daemons it started, prints their logs
 # on failure, and fails (never skips) when Slurm cannot be started: not root, a package missing
 # (scripts/install-deps installs slurm-wlm and munge), or a daemon that does not come up.
 set -euo pipefail
@@ -48,7 +51,8 @@ for c in munged munge unmunge slurmctld slurmd sbatch squeue sinfo scontrol scan
 done
 
 # --- layout -------------------------------------------------------------------------------------
-rm -rf "$work/slurm" "$work/sharded" "$work/unsharded" "$work/unsharded.log"
+rm -rf "$work/slurm" "$work/sharded" "$work/unsharded" "$work/unsharded.log" "$work/requeue" \
+  "$work/requeue_ref" "$work"/kelp-sweep-*.out
 rt=$work/slurm
 tmp_rt=
 # Unix socket paths are limited to 107 bytes (munged's socket, slurmd's step sockets in its spool).
@@ -254,4 +258,47 @@ for t in table.csv table.md; do
   fi
 done
 [ "$ok" = 1 ] || fail "the merged table differs from the unsharded one"
-say "PASS: merged table of $shards shards equals the unsharded one ($(grep -c . <<<"$all") runs, $((SECONDS - t0)) s)"
+say "merged table of $shards shards equals the unsharded one ($(grep -c . <<<"$all") runs, $((SECONDS - t0)) s)"
+
+# --- pre-empted: SIGTERM to the task, which stops kelp-sweep, requeues itself and resumes -------
+# (sweep.sbatch: --requeue, the runs checkpointed every KELP_SWEEP_CHECKPOINT_EVERY s.) Two runs
+# of 120 s; once one has written a checkpoint, the batch script gets SIGTERM as Slurm sends it
+# before a time limit (scancel --signal=TERM --batch). The task must requeue itself, run again
+# (restart 1), resume the interrupted run from its checkpoint, and leave the table of the same
+# sweep run without a stop.
+echo '{"base": {"duration": 120}, "axes": [{"path": "/sea", "values": ["moderate"]}], "seeds": 2}' \
+  >"$work/requeue.json"
+job=$(KELP_SWEEP_CHECKPOINT_EVERY=1 sbatch --parsable --array=0 --time 10 \
+  "$here/../slurm/sweep.sbatch" --program "$program" --shards 1 "$work/requeue.json" \
+  "$work/requeue") || fail "sbatch of the requeue sweep failed"
+job=${job%%;*}
+runs=$work/requeue/shard-0/runs
+deadline=$((SECONDS + timeout))
+until compgen -G "$runs/*.checkpoint.bin" >/dev/null; do
+  ((SECONDS < deadline)) || fail "the requeue sweep wrote no checkpoint in $timeout s"
+  sleep 0.05
+done
+scancel --signal=TERM --batch "${job}_0" || fail "scancel --signal=TERM --batch ${job}_0 failed"
+say "sent SIGTERM to task ${job}_0 with a checkpoint under way"
+task_field() { { scontrol -o show job "${job}_0" 2>/dev/null || true; } | grep -o "$1=[A-Z_0-9]*" | sed "s/$1=//"; }
+while :; do
+  state=$(task_field JobState)
+  [ "$state" = COMPLETED ] && break
+  case "$state" in FAILED | CANCELLED | TIMEOUT | NODE_FAIL) fail "task ${job}_0: $state" ;; esac
+  ((SECONDS < deadline)) || fail "task ${job}_0 not done after $timeout s (state $state)"
+  sleep 0.5
+done
+restarts=$(task_field Restarts)
+log=$work/kelp-sweep-${job}_0.out
+[ "$restarts" = 1 ] || fail "task ${job}_0 restarted ${restarts:-?} times, expected once (requeued)"
+grep -q "requeueing job" "$log" || fail "$log: the task did not requeue itself: $(cat "$log")"
+grep -q "resumed from its checkpoint at" "$log" ||
+  fail "$log: the interrupted run did not resume from its checkpoint: $(cat "$log")"
+"$program" --sweep "$work/requeue.json" --out "$work/requeue_ref" --no-plot \
+  >"$work/requeue_ref.log" 2>&1 || fail "the uninterrupted requeue sweep failed"
+"$program" merge "$work/requeue/shard-0" --out "$work/requeue/merged" --no-plot \
+  >"$work/requeue_merge.log" 2>&1 || fail "merging the requeued shard failed"
+cmp "$work/requeue/merged/table.csv" "$work/requeue_ref/table.csv" ||
+  fail "the requeued sweep's table differs from the uninterrupted one's"
+say "requeue: task ${job}_0 stopped, requeued and resumed from its checkpoint; its table equals the uninterrupted one's ($((SECONDS - t0)) s)"
+say "PASS"

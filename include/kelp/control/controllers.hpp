@@ -27,12 +27,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "kelp/control/pid.hpp"
 #include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/memory.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/nav/estimate.hpp"
@@ -67,6 +69,8 @@ class SampleClockT {
     started_ = true;
     return true;
   }
+  /// \brief visit_memory(v): the last and next update times (kelp/core/memory.hpp).
+  KELP_MEMORY(last_, next_, started_)
 
  private:
   Time last_ = Time(0), next_ = Time(0);
@@ -110,6 +114,8 @@ class DisturbanceObserverT {
   }
   /// \brief The current estimate d̂.
   const Vector6<Scalar>& estimate() const { return estimate_; }
+  /// \brief visit_memory(v): the last navigation and the estimate (kelp/core/memory.hpp).
+  KELP_MEMORY(last_.position, last_.attitude, last_.nu, has_last_, estimate_)
 
  private:
   const vehicle::VehicleModel<Scalar>* model_ = nullptr;
@@ -419,7 +425,33 @@ class AuvControllerT {
   /// \brief The disturbance estimate (zero unless compensating).
   const Vector6<Scalar>& disturbance_estimate() const { return observer_.estimate(); }
 
+  /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
+  /// PIDs, the observer, the waypoints and the progress along them, the last command, the clock
+  /// and the thrusters' supply voltage. For a run's checkpoint.
+  template <class V>
+  void visit_memory(V& v) {
+    memory(*this, v);
+  }
+  /// \brief visit_memory of a const controller (saving it).
+  template <class V>
+  void visit_memory(V& v) const {
+    memory(*this, v);
+  }
+
  private:
+  template <class Self, class V>
+  static void memory(Self& s, V& v) {
+    v(s.surge_, s.sway_, s.heave_, s.roll_, s.pitch_, s.yaw_, s.observer_);
+    v.list(s.waypoints_, std::size_t(1) << 20, [&](auto& w) { v(w); });
+    v.bounded(s.next_, s.waypoints_.size());
+    v(s.target_, s.leg_start_, s.has_leg_start_, s.leg_, s.progress_, s.heading_);
+    v(s.command_.wrench, s.command_.thrust, s.command_.command, s.command_.position_error,
+      s.command_.heading_error, s.command_.saturated, s.force_, s.vertical_, s.clock_);
+    double volts = s.thrusters_.voltage();
+    v(volts);
+    if constexpr (!std::is_const_v<Self>) s.thrusters_.set_voltage(volts);
+  }
+
   AuvControllerSettings settings_;
   vehicle::ThrusterChain<Scalar> thrusters_;
   Pid surge_, sway_, heave_, roll_, pitch_, yaw_;
@@ -619,7 +651,31 @@ class AsvControllerT {
   /// have seen it), NED [m/s].
   const Vector3<Scalar>& target_velocity() const { return target_velocity_; }
 
+  /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
+  /// PIDs, the observer, the target and its velocity, the course, the last command, the clock and
+  /// the thrusters' supply voltage. For a run's checkpoint.
+  template <class V>
+  void visit_memory(V& v) {
+    memory(*this, v);
+  }
+  /// \brief visit_memory of a const controller (saving it).
+  template <class V>
+  void visit_memory(V& v) const {
+    memory(*this, v);
+  }
+
  private:
+  template <class Self, class V>
+  static void memory(Self& s, V& v) {
+    v(s.linear_, s.angular_, s.yaw_, s.speed_, s.heading_pid_, s.last_target_, s.target_velocity_,
+      s.course_, s.has_last_target_, s.has_course_, s.observer_, s.target_, s.heading_, s.follow_);
+    v(s.command_.left, s.command_.right, s.command_.command, s.command_.wrench,
+      s.command_.position_error, s.command_.heading_error, s.clock_);
+    double volts = s.thrusters_.voltage();
+    v(volts);
+    if constexpr (!std::is_const_v<Self>) s.thrusters_.set_voltage(volts);
+  }
+
   // AsvLaw::track: velocity command from the target's velocity and the position error, heading
   // to it, surge speed along the bow.
   void track(const NavigationT<Scalar>& nav, const Vector3<Scalar>& e, double psi, double dt,

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "kelp/core/error.hpp"
+#include "kelp/core/memory.hpp"
 #include "kelp/core/scalar.hpp"
 
 namespace kelp::control {
@@ -87,6 +88,9 @@ class Pid {
   }
   /// \brief The gains.
   const PidGains& gains() const { return gains_; }
+  /// \brief visit_memory(v): the integral, the last output and error and their flags, for a
+  /// run's checkpoint (kelp/core/memory.hpp).
+  KELP_MEMORY(integral_, output_, last_error_, has_last_, saturated_)
 
  private:
   PidGains gains_;

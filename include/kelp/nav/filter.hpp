@@ -42,6 +42,7 @@
 #include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/memory.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/nav/estimate.hpp"
@@ -277,7 +278,28 @@ class NavigationFilterT {
     return history_[(head_ + cap - kept) % cap].p + shift_;  // older than the history: its oldest
   }
 
+  /// \brief Visits what the filter knows (kelp/core/memory.hpp): attitude, biases, Kalman state
+  /// and covariance, clock, the kept positions and the estimate. For a run's checkpoint.
+  template <class V>
+  void visit_memory(V& v) {
+    memory(*this, v);
+  }
+  /// \brief visit_memory of a const filter (saving it).
+  template <class V>
+  void visit_memory(V& v) const {
+    memory(*this, v);
+  }
+
  private:
+  template <class Self, class V>
+  static void memory(Self& s, V& v) {
+    v(s.q_, s.gyro_bias_, s.omega_, s.x_, s.P_, s.t_);
+    for (auto& e : s.history_) v(e.t, e.p);
+    v(s.shift_);
+    v.bounded(s.head_, s.history_.size() - 1);
+    v(s.count_, s.initialized_, s.nav_.position, s.nav_.attitude, s.nav_.nu);
+  }
+
   struct Entry {
     double t = 0.0;
     Vector3<Scalar> p = Vector3<Scalar>::Zero();

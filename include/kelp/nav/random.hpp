@@ -19,6 +19,8 @@
 #include <cstdint>
 #include <random>
 
+#include "kelp/core/memory.hpp"
+
 namespace kelp::nav {
 
 /// \brief One SplitMix64 step: advances `x` and returns the next 64-bit output.
@@ -70,6 +72,8 @@ class RandomStream {
 
   /// \brief True with probability `p` (one uniform deviate).
   bool bernoulli(double p) { return uniform() < p; }
+  /// \brief visit_memory(v): the engine's state and the spare deviate (kelp/core/memory.hpp).
+  KELP_MEMORY(engine_, spare_, has_spare_)
 
  private:
   std::mt19937_64 engine_;

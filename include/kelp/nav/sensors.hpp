@@ -71,6 +71,7 @@
 #include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/memory.hpp"
 #include "kelp/core/rotation.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
@@ -115,6 +116,8 @@ class SensorSchedule {
     period_ = p;
     next_ = t + p;
   }
+  /// \brief visit_memory(v): the period and the next due time (kelp/core/memory.hpp).
+  KELP_MEMORY(period_, next_, started_)
 
  private:
   double period_ = 1.0, next_ = 0.0;
@@ -202,6 +205,9 @@ class ImuSensor {
   const Vector3<double>& accel_bias() const { return accel_bias_; }
   /// \brief The parameters.
   const ImuParameters& parameters() const { return p_; }
+  /// \brief visit_memory(v): the noise stream, the schedule and the biases
+  /// (kelp/core/memory.hpp).
+  KELP_MEMORY(rng_, schedule_, gyro_bias_, accel_bias_)
 
  private:
   ImuParameters p_;
@@ -240,6 +246,8 @@ class DepthSensor {
   /// \brief One reading of depth z [m], regardless of the schedule.
   double measure(double z) { return z + p_.bias + p_.noise * rng_.normal(); }
   const DepthParameters& parameters() const { return p_; }
+  /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
+  KELP_MEMORY(rng_, schedule_)
 
  private:
   DepthParameters p_;
@@ -339,6 +347,8 @@ class Dvl {
     return s;
   }
   const DvlParameters& parameters() const { return p_; }
+  /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
+  KELP_MEMORY(rng_, schedule_)
 
  private:
   DvlParameters p_;
@@ -379,6 +389,8 @@ class Compass {
     return std::atan2(std::sin(a), std::cos(a));
   }
   const CompassParameters& parameters() const { return p_; }
+  /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
+  KELP_MEMORY(rng_, schedule_)
 
  private:
   CompassParameters p_;
@@ -437,6 +449,9 @@ class Gps {
   /// \brief σ of one fix per axis (white and slow parts together) [m].
   Vector3<double> sigma() const { return std::hypot(p_.noise, p_.bias_sigma) * scale_; }
   const GpsParameters& parameters() const { return p_; }
+  /// \brief visit_memory(v): the noise stream, the schedule and the slow error
+  /// (kelp/core/memory.hpp).
+  KELP_MEMORY(rng_, schedule_, bias_)
 
  private:
   GpsParameters p_;
@@ -534,7 +549,28 @@ class Usbl {
   long dropouts() const { return dropouts_; }
   const UsblParameters& parameters() const { return p_; }
 
+  /// \brief Visits the noise stream, the schedule, the fixes in flight and the counts
+  /// (kelp/core/memory.hpp).
+  template <class V>
+  void visit_memory(V& v) {
+    memory(*this, v);
+  }
+  /// \brief visit_memory of a const Usbl (saving it).
+  template <class V>
+  void visit_memory(V& v) const {
+    memory(*this, v);
+  }
+
  private:
+  template <class Self, class V>
+  static void memory(Self& s, V& v) {
+    v(s.rng_, s.schedule_);
+    for (auto& f : s.queue_) v(f.measured_at, f.delivered_at, f.position, f.range, f.sigma);
+    v.bounded(s.head_, usbl_queue_capacity - 1);
+    v.bounded(s.size_, usbl_queue_capacity);
+    v(s.pings_, s.dropouts_);
+  }
+
   UsblParameters p_;
   RandomStream rng_;
   SensorSchedule schedule_;

@@ -223,6 +223,7 @@ class KELP_SIM_API ClosedLoop {
   RunSummary summary() const;
 
  private:
+  friend struct CheckpointAccess;  // a run's checkpoint (kelp/sim/checkpoint.hpp)
   // The environment's cylinders as the entanglement monitor's axes.
   static std::vector<EntanglementAxis> entanglement_axes(const kelp::system::SystemModeld& model);
   static kelp::vehicle::ThrusterAllocationd auv_allocation();
@@ -293,6 +294,22 @@ struct SimulateOptions {
   /// Polled before every step, with stop_requested() (kelp/sim/stop.hpp): true stops the run
   /// there (e.g. Python's check for Ctrl-C); empty: stop_requested() alone.
   std::function<bool()> should_stop;
+  /// With `log_dir` or `mcap_file`: also the run as a ROS 2 bag (RunBag, kelp/sim/run.hpp:
+  /// every sample, the markers at the scenario's node rate), which checkpoints include.
+  bool mcap = false;
+  /// Where the bag goes; empty: `log_dir`/run.mcap.
+  std::string mcap_file;
+  /// Writes the run's checkpoint (kelp/sim/checkpoint.hpp) every this many simulated seconds
+  /// (rounded to whole steps) and when the run is stopped; 0: none. Writing one allocates and
+  /// flushes the files to disk (between two steps; the steps themselves still allocate nothing).
+  /// [s]
+  double checkpoint_every = 0;
+  /// Where the checkpoint is written and read; empty: `log_dir`/checkpoint.bin.
+  std::string checkpoint_file;
+  /// Continues the run from its checkpoint instead of starting it: the scenario must be the
+  /// one the run started with; its files in `log_dir` are truncated to the lengths the
+  /// checkpoint records, and the run goes on from there, as if it had never stopped.
+  bool resume = false;
 };
 
 /// \brief Runs a scenario to its end in a ClosedLoop and returns its summary (what
@@ -301,9 +318,12 @@ struct SimulateOptions {
 ///
 /// Before every step it polls for a stop (stop_requested(), kelp/sim/stop.hpp, and
 /// `o.should_stop`): a stopped run ends after the step it was in, closes its log whole and
-/// returns the summary with `completed` false and the simulated time reached.
+/// returns the summary with `completed` false and the simulated time reached. With
+/// `o.checkpoint_every`, it writes a checkpoint at that interval and at a stop; with `o.resume`
+/// it continues from the checkpoint (kelp/sim/checkpoint.hpp).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when the
-/// log cannot be written.
+/// log cannot be written; state_error for a checkpoint that cannot be resumed (nothing in
+/// `log_dir` is then changed).
 KELP_SIM_API RunSummary simulate(const Scenario& sc, const SimulateOptions& o = {});
 
 }  // namespace sim

@@ -19,6 +19,7 @@
 
 #include "kelp/core/constants.hpp"
 #include "kelp/core/error.hpp"
+#include "kelp/core/memory.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/tether/winding.hpp"
 
@@ -224,7 +225,33 @@ class EntanglementMonitor {
   /// \brief The settings.
   const EntanglementSettings& settings() const { return settings_; }
 
+  /// \brief Visits what the monitor knows (kelp/core/memory.hpp): every obstacle's winding and
+  /// contact, the events and the dropped count. For a run's checkpoint.
+  template <class V>
+  void visit_memory(V& v) {
+    memory(*this, v);
+  }
+  /// \brief visit_memory of a const monitor (saving it).
+  template <class V>
+  void visit_memory(V& v) const {
+    memory(*this, v);
+  }
+
  private:
+  template <class Self, class V>
+  static void memory(Self& s, V& v) {
+    for (auto& w : s.state_)
+      v(w.winding, w.max_abs_winding, w.contact_nodes, w.tension_difference, w.slip_speed,
+        w.entangled, w.pinned, w.pin_since, w.first_entangled, w.first_pinned);
+    v.list(s.events_, max_events, [&](auto& e) {
+      v.choice(e.kind, 2);
+      v(e.time);
+      v.bounded(e.obstacle, int(s.axes_.size()) - 1);
+      v(e.value, e.position);
+    });
+    v(s.dropped_);
+  }
+
   static double distance_to_axis(const kelp::Vector3<double>& p, const EntanglementAxis& a) {
     const kelp::Vector3<double> ab = a.to - a.from;
     const double s = std::clamp((p - a.from).dot(ab) / ab.squaredNorm(), 0.0, 1.0);

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "kelp/core/memory.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/nav/filter.hpp"
 #include "kelp/nav/sensors.hpp"
@@ -103,7 +104,28 @@ class KELP_SIM_API PairNavigation {
   /// \brief The parameters.
   const PairSensors& parameters() const { return p_; }
 
+  /// \brief Visits every sensor's and filter's memory and the counts and error statistics
+  /// (kelp/core/memory.hpp). For a run's checkpoint.
+  template <class V>
+  void visit_memory(V& v) {
+    memory(*this, v);
+  }
+  /// \brief visit_memory of a const navigation (saving it).
+  template <class V>
+  void visit_memory(V& v) const {
+    memory(*this, v);
+  }
+
  private:
+  template <class Self, class V>
+  static void memory(Self& s, V& v) {
+    v(s.auv_imu_, s.asv_imu_, s.depth_, s.dvl_, s.auv_compass_, s.asv_compass_, s.gps_, s.usbl_,
+      s.auv_, s.asv_, s.last_, s.usbl_fixes_, s.dvl_counts_[0], s.dvl_counts_[1], s.dvl_counts_[2]);
+    for (auto* e : {&s.auv_errors_, &s.asv_errors_})
+      v(e->samples, e->position_squared_sum, e->heading_squared_sum, e->velocity_squared_sum,
+        e->horizontal_squared_sum, e->max_position);
+  }
+
   static void accumulate(const nav::Navigation& est, const vehicle::VehicleStated& x,
                          EstimateErrors& e);
 

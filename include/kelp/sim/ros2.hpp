@@ -61,6 +61,8 @@ class KELP_SIM_API BagRecorder {
   const ros2::BagWriter& bag() const { return bag_; }
 
  private:
+  friend struct CheckpointAccess;  // a run's checkpoint
+  explicit BagRecorder(double marker_rate) : marker_period_(1.0 / marker_rate) {}  // to continue
   Ros2Sampler sampler_;
   ros2::BagWriter bag_;
   double marker_period_, next_marker_ = 0;

@@ -60,6 +60,12 @@ struct RunOptions {
   /// Polled before every step with stop_requested() (SimulateOptions::should_stop,
   /// kelp/sim/stop.hpp): true stops the run there; empty: stop_requested() alone.
   std::function<bool()> should_stop;
+  /// Writes `out`/checkpoint.bin every this many simulated seconds and when the run is stopped
+  /// (SimulateOptions::checkpoint_every, kelp/sim/checkpoint.hpp); 0: none. A run that completes
+  /// removes its checkpoint once summary.json is written. [s]
+  double checkpoint_every = 0;
+  /// Continues the run in `out` from its checkpoint (SimulateOptions::resume).
+  bool resume = false;
 };
 
 /// \brief A run's ROS 2 bag (BagRecorder), opened at the run's first sample (t = 0, taken when
@@ -79,6 +85,7 @@ class KELP_SIM_API RunBag {
   void close();
 
  private:
+  friend struct CheckpointAccess;  // a run's checkpoint
   std::filesystem::path file_;
   double marker_rate_;
   std::unique_ptr<BagRecorder> bag_;
@@ -116,6 +123,8 @@ KELP_SIM_API void finish_run_with(const std::string& summary_text, const RunOpti
 /// A run stopped early (stop_requested() or `o.should_stop`, kelp/sim/stop.hpp) ends after the
 /// step it was in and leaves the same files, whole: the CSV files end on a full line, run.mcap
 /// has its summary and footer, summary.json says `"completed": false` and the time reached.
+/// With `o.checkpoint_every` it also leaves checkpoint.bin, from which `o.resume` continues it
+/// (kelp/sim/checkpoint.hpp): the files of a resumed run are those of a run never stopped.
 /// \returns the summary (summary.json's content: summary_json()).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
 /// file cannot be written (replay_error for replay.html).

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -187,9 +188,11 @@ class KELP_SIM_API LineFile {
   void close();
 
  private:
+  friend struct CheckpointAccess;  // a run's checkpoint: the file's length, reopened there
   int fd_ = -1;
   std::string path_, text_;
-  std::size_t ended_ = 0;  // text_'s ended lines: its first ended_ bytes
+  std::size_t ended_ = 0;      // text_'s ended lines: its first ended_ bytes
+  std::uint64_t written_ = 0;  // bytes in the file
 };
 
 /// \brief Writes `text` as the file `path` atomically: into a temporary file beside it (same
@@ -249,6 +252,8 @@ class KELP_SIM_API RunLog {
   RunLog& operator=(const RunLog&) = delete;
 
  private:
+  friend struct CheckpointAccess;  // a run's checkpoint: the files' lengths, reopened there
+  RunLog() = default;
   // A row or snapshot at `t` [s]: every file written out once t is 1 s past the last time.
   void flush_due(double t);
   const char* num(double v);

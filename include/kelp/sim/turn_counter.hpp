@@ -12,6 +12,7 @@
 
 #include "kelp/core/angles.hpp"
 #include "kelp/core/constants.hpp"
+#include "kelp/core/memory.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/tether/state.hpp"
 #include "kelp/vehicle/state.hpp"
@@ -84,6 +85,8 @@ class TurnCounter {
   double turns() const { return turns_; }
   /// \brief Largest |turns()| so far.
   double max_abs_turns() const { return max_abs_; }
+  /// \brief visit_memory(v): the azimuth, the angle and the counts (kelp/core/memory.hpp).
+  KELP_MEMORY(azimuth_, phi_, turns_, max_abs_, started_)
 
  private:
   double reference_ = 2.0, azimuth_ = 0.0, phi_ = 0.0, turns_ = 0.0, max_abs_ = 0.0;

@@ -37,6 +37,10 @@
 #include "kelp/sim/ros2/messages.hpp"
 
 namespace kelp {
+namespace sim {
+struct CheckpointAccess;  // a run's checkpoint (kelp/sim/checkpoint.hpp)
+class BagRecorder;
+}  // namespace sim
 namespace ros2 {
 
 /// \brief CRC32 (ISO-HDLC, zlib's crc32) of `n` bytes, continuing from `crc` (0 to start).
@@ -136,6 +140,7 @@ class KELP_SIM_API McapWriter {
   void close();
 
  private:
+  friend struct kelp::sim::CheckpointAccess;  // a run's checkpoint: this writer's bookkeeping
   // Writes bytes to the file, counting them and keeping the data section's CRC.
   void emit(const void* p, std::size_t n);
   void emit_record(McapOp op, const std::vector<std::uint8_t>& content);
@@ -199,6 +204,9 @@ class KELP_SIM_API BagWriter {
   const McapWriter& mcap() const { return mcap_; }
 
  private:
+  friend struct kelp::sim::CheckpointAccess;  // a run's checkpoint: the sequence numbers
+  friend class kelp::sim::BagRecorder;        // its checkpoint's recorder, made here
+  BagWriter() = default;                      // a run's checkpoint: a bag to continue
   McapWriter mcap_;
   std::array<std::uint16_t, static_cast<std::size_t>(TopicId::count)> channel_{};
   std::array<std::uint32_t, static_cast<std::size_t>(TopicId::count)> sequence_{};
