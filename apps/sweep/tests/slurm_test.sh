@@ -266,7 +266,7 @@ say "merged table of $shards shards equals the unsharded one ($(grep -c . <<<"$a
 # before a time limit (scancel --signal=TERM --batch). The task must requeue itself, run again
 # (restart 1), resume the interrupted run from its checkpoint, and leave the table of the same
 # sweep run without a stop.
-echo '{"base": {"duration": 120}, "axes": [{"path": "/sea", "values": ["moderate"]}], "seeds": 2}' \
+echo '{"base": {"duration": 120}, "axes": [{"path": "/tether/length", "values": [10]}], "seeds": 2}' \
   >"$work/requeue.json"
 job=$(KELP_SWEEP_CHECKPOINT_EVERY=1 sbatch --parsable --array=0 --time 10 \
   "$here/../slurm/sweep.sbatch" --program "$program" --shards 1 "$work/requeue.json" \
@@ -281,9 +281,15 @@ done
 scancel --signal=TERM --batch "${job}_0" || fail "scancel --signal=TERM --batch ${job}_0 failed"
 say "sent SIGTERM to task ${job}_0 with a checkpoint under way"
 task_field() { { scontrol -o show job "${job}_0" 2>/dev/null || true; } | grep -o "$1=[A-Z_0-9]*" | sed "s/$1=//"; }
+released=0
 while :; do
   state=$(task_field JobState)
   [ "$state" = COMPLETED ] && break
+  # Slurm makes a requeued job wait (its begin time a few minutes on): start it now.
+  if [ "$state" = PENDING ] && [ "$released" = 0 ] && [ "$(task_field Restarts)" = 1 ]; then
+    scontrol update JobId="${job}_0" StartTime=now || fail "cannot start the requeued task now"
+    released=1
+  fi
   case "$state" in FAILED | CANCELLED | TIMEOUT | NODE_FAIL) fail "task ${job}_0: $state" ;; esac
   ((SECONDS < deadline)) || fail "task ${job}_0 not done after $timeout s (state $state)"
   sleep 0.5
