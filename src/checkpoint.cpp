@@ -311,12 +311,14 @@ struct CheckpointAccess {
   };
 
   static Files load(archive::Reader& r, const std::string& input, ClosedLoop& l) {
+    std::uint64_t k = 0;
     {
       archive::Section s = r.next(run_tag);
       const std::string_view scenario = s.text(max_text, "the scenario");
       const std::string_view file = s.text(max_text, "the scenario file");
       (void)file;
-      const std::uint64_t k = s.u64(), steps = s.u64();
+      k = s.u64();
+      const std::uint64_t steps = s.u64();
       (void)s.f64();  // the time (read_checkpoint_info's)
       (void)s.f64();  // the interval
       s.end();
@@ -336,13 +338,16 @@ struct CheckpointAccess {
       LoadVisitor v{s};
       try {
         f(v);
+      } catch (const state_error&) {
+        throw;
       } catch (const kelp::invalid_argument& e) {  // a value the object refuses (a voltage)
         s.fail(e.what());
       }
       s.end();
     };
     visit(loop_tag, [&](LoadVisitor& v) { loop_memory(l, v); });
-    if (l.k_ > l.steps_) r.fail("the checkpoint's step count is past its run's end");
+    if (l.k_ < 0 || std::uint64_t(l.k_) != k)
+      r.fail("the loop's step count differs from the header's (" + std::to_string(k) + ")");
     l.sample_.tether_model = &l.model_.tether_of(l.state_);
     visit(auv_tag, [&](LoadVisitor& v) { v(l.auv_); });
     visit(asv_tag, [&](LoadVisitor& v) { v(l.asv_); });

@@ -9,6 +9,7 @@
 
 #include "kelp/sim/closed_loop.hpp"
 #include "kelp/sim/run.hpp"
+#include "kelp/sim/state_error.hpp"
 
 namespace kelp {
 namespace sim {
