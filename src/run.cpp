@@ -80,6 +80,7 @@ RunSummary simulate(const Scenario& sc, const SimulateOptions& o) {
   }
   if (!checkpoint.empty() && (o.resume || o.checkpoint_every > 0))
     remove_checkpoint_temporaries(checkpoint);
+  const double resumed_at = loop.time();  // 0 unless resumed
   const long steps = loop.total_steps();
   const long every =
       o.checkpoint_every > 0 ? std::max(1L, std::lround(o.checkpoint_every / ClosedLoop::dt)) : 0;
@@ -108,7 +109,8 @@ RunSummary simulate(const Scenario& sc, const SimulateOptions& o) {
   if (bag) bag->close();
   RunSummary summary = loop.summary();
   summary.wall_s = wall;
-  summary.realtime_factor = summary.simulated_s / wall;
+  // What this process simulated (a resumed run: from its checkpoint on) over its wall time.
+  summary.realtime_factor = (summary.simulated_s - resumed_at) / wall;
   return summary;
 }
 
