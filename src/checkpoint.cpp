@@ -463,6 +463,16 @@ void write_checkpoint(const std::string& path, const ClosedLoop& loop, RunLog* l
 
 namespace {
 
+// The checkpoint file's bytes; a state_error when there is none.
+std::string read_checkpoint_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw state_error(path +
+                      ": no checkpoint: the run has none to resume from (a run writes one "
+                      "with checkpoint_every, kelp-tethered-pair --checkpoint-every)");
+  return state_sections::read_whole_file(path);
+}
+
 // The reader of a checkpoint's bytes, its kelp version checked.
 archive::Reader checkpoint_reader(std::string_view bytes, const std::string& input) {
   archive::Reader r(bytes, ArchiveKind::run_checkpoint, input);
@@ -504,12 +514,7 @@ void remove_checkpoint_temporaries(const std::string& path) {
 ResumedFiles resume_checkpoint(const std::string& path, ClosedLoop& loop,
                                const std::string& log_dir, const std::string& mcap,
                                double marker_rate, std::function<void(const LogRow&)> on_sample) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw state_error(path +
-                      ": no checkpoint: the run has none to resume from (a run writes one "
-                      "with checkpoint_every, kelp-tethered-pair --checkpoint-every)");
-  const std::string bytes = state_sections::read_whole_file(path);
+  const std::string bytes = read_checkpoint_file(path);
   archive::Reader r = checkpoint_reader(bytes, path);
   CheckpointAccess::Files f = CheckpointAccess::load(r, path, loop);
   // Every check before any file is touched.
@@ -540,7 +545,7 @@ ResumedFiles resume_checkpoint(const std::string& path, ClosedLoop& loop,
 }
 
 CheckpointInfo read_checkpoint_info(const std::string& path) {
-  const std::string bytes = state_sections::read_whole_file(path);
+  const std::string bytes = read_checkpoint_file(path);
   archive::Reader r = checkpoint_reader(bytes, path);
   archive::Section s = r.next(run_tag);
   CheckpointInfo info;

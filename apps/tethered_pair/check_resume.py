@@ -14,8 +14,8 @@ sensors and the pile wrap (120 s, 4 kills each). The delays come from a seed, pr
 KELP_RESUME_TEST_SEED replays.
 
 Then the refusals, each leaving the directory as it was: a checkpoint truncated, one with a
-flipped bit, and one of another scenario (--seed given again) end the program with status 3 and
-a message that names the problem.
+flipped bit, one of another scenario (--seed given again), and none at all end the program with
+status 3 and a message that names the problem.
 """
 
 import hashlib
@@ -150,6 +150,10 @@ def main():
         check(r.returncode == 3 and message in r.stderr,
               "%s: status %s (expected 3), %r" % (what, r.returncode, r.stderr))
         check(digest(d) == before, "%s: the refused resume changed the directory" % what)
+    os.remove(cp)
+    r = run([program, "--resume", d, "--quiet", "--no-plots"])
+    check(r.returncode == 3 and "no checkpoint" in r.stderr,
+          "no checkpoint: status %s (expected 3), %r" % (r.returncode, r.stderr))
     if failures:
         print("check_resume: %d failure(s)" % len(failures), file=sys.stderr)
         return 1

@@ -47,8 +47,8 @@ struct CheckpointInfo {
 
 /// \brief Reads the checkpoint at `path` (every byte checked: magic, version, kind, CRC-32) and
 /// returns what it says about its run, e.g. the scenario to resume it with.
-/// \throws state_error for a file that is not a whole checkpoint of this kelp version;
-/// kelp::error when it cannot be read.
+/// \throws state_error for a missing file or one that is not a whole checkpoint of this kelp
+/// version; kelp::error when it cannot be read.
 KELP_SIM_API CheckpointInfo read_checkpoint_info(const std::string& path);
 
 }  // namespace sim
