@@ -3,6 +3,7 @@
 #pragma once
 
 #include "kelp/sim/export.hpp"
+#include "kelp/version.hpp"
 
 namespace kelp {
 namespace sim {
