@@ -11,9 +11,9 @@
 /// Ceres.
 ///
 /// The namespace is `kelp::ceres_solver` (header path and CMake target stay `kelp/ceres/...` and
-/// `kelp::ceres`): a namespace named `kelp::ceres` would hide Ceres' own `::ceres` from any code
-/// inside `namespace kelp` (user code included), so that `ceres::Jet<double, N>` written there
-/// would not find Ceres' type.
+/// `kelp::ceres`): a namespace named `kelp::ceres` would hide the global namespace of Ceres from
+/// any code inside `namespace kelp` (user code included), so that `ceres::Jet<double, N>` written
+/// there would not find Ceres' type.
 #pragma once
 
 #include <cmath>
