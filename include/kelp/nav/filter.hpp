@@ -278,6 +278,7 @@ class NavigationFilterT {
   }
 
  private:
+  /// \cond PRIVATE
   struct Entry {
     double t = 0.0;
     Vector3<Scalar> p = Vector3<Scalar>::Zero();
@@ -335,6 +336,7 @@ class NavigationFilterT {
   std::size_t head_ = 0, count_ = 0;
   bool initialized_ = false;
   NavigationT<Scalar> nav_;
+  /// \endcond
 };
 
 /// \brief The navigation filter in double precision.
