@@ -42,8 +42,27 @@ def locate(name, member, include_dir, cache={}):
                         for ident in set(re.findall(r"\b([A-Za-z_~]\w*)\s*\(", fh.read())):
                             index.setdefault(ident, []).append(rel)
         cache["index"] = {k: sorted(v) for k, v in index.items()}
-    found = cache["index"].get(short, [])
     parts = member.split("::")[1:-1]
+    if "classes" not in cache:
+        # Every class and struct defined in every header: name -> headers.
+        classes = {}
+        for d, _, files in os.walk(include_dir):
+            for fn in sorted(files):
+                if fn.endswith(".hpp"):
+                    p = os.path.join(d, fn)
+                    with open(p, encoding="utf-8", errors="replace") as fh:
+                        for c in set(re.findall(r"\b(?:class|struct)\s+(?:KELP_SIM_API\s+)?(\w+)\s*(?:final\s*)?[:{]",
+                                                fh.read())):
+                            classes.setdefault(c, []).append(os.path.relpath(p, include_dir))
+        cache["classes"] = classes
+    # A member of a class: the header that defines the class.
+    if parts and parts[-1] in cache["classes"]:
+        owners = sorted(cache["classes"][parts[-1]])
+        for rel in owners:
+            if any("/%s/" % p in "/" + rel for p in parts[:-1]):
+                return rel
+        return owners[0]
+    found = cache["index"].get(short, [])
     for rel in found:
         if any("/%s/" % p in "/" + rel for p in parts):
             return rel
