@@ -1,4 +1,4 @@
-# kelp's programs, Python package and SITL bridge in one image (README, "With Docker").
+# kelp's programs, Python package and SITL bridge in one image (docs/docker.md).
 #
 #   docker build -t kelp .                                     # from Docker Hub's debian:bookworm
 #   docker build --build-arg BASE=kelp-base:bookworm -t kelp . # any Debian 12 image (no registry:

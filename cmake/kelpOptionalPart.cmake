@@ -47,7 +47,7 @@ dependencies are found), ON (dependencies required) or OFF")
       find_package(${args} QUIET)
       if(NOT ${name}_FOUND)
         message(FATAL_ERROR "kelp: ${var}=${${var}} but ${spec} was not found. Install it (see the "
-                            "Dependencies table in README.md) or configure with -D${var}=OFF.")
+                            "Dependencies table in docs/install.md) or configure with -D${var}=OFF.")
       endif()
     endforeach()
     set(${var} ON PARENT_SCOPE)

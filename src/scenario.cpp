@@ -16,6 +16,7 @@
 #include "kelp/sim/heightfield_file.hpp"
 #include "kelp/sim/ros2/names.hpp"
 #include "kelp/sim/scenario.hpp"
+#include "scenario_reference.hpp"
 #include "scenario_schema.hpp"
 
 namespace kelp {
@@ -149,9 +150,9 @@ using namespace schema;
 /// The contact keys an obstacle may set.
 template <class V>
 void contact_fields(V& v, kelp::environment::ContactProperties& c) {
-  v.number("friction", c.friction, 0, 100);
-  v.number("stiffness", c.stiffness, 1e-6, 1e13);
-  v.number("damping", c.damping, 0, 1e13);
+  v.unit("1").number("friction", c.friction, 0, 100);
+  v.unit("N/m³").number("stiffness", c.stiffness, 1e-6, 1e13);
+  v.unit("Pa s/m").number("damping", c.damping, 0, 1e13);
 }
 
 /// An obstacle `{"type": "cylinder", ...}` (`type` and `name` are read by the list).
@@ -159,9 +160,9 @@ template <class V>
 void cylinder_fields(V& v, kelp::environment::Cylinder& c) {
   v.key("type");
   v.key("name");
-  v.vec3("from", c.from, required);
-  v.vec3("to", c.to, required);
-  v.number("radius", c.radius, 1e-6, 1e4, required);
+  v.unit("m").vec3("from", c.from, required);
+  v.unit("m").vec3("to", c.to, required);
+  v.unit("m").number("radius", c.radius, 1e-6, 1e4, required);
   contact_fields(v, c.contact);
 }
 
@@ -170,11 +171,11 @@ template <class V>
 void box_fields(V& v, kelp::environment::Box& b) {
   v.key("type");
   v.key("name");
-  v.vec3("center", b.center, required);
-  v.vec3("half_extents", b.half_extents, required);
-  v.number("yaw", b.yaw, -100, 100);
-  v.number("roll", b.roll, -100, 100, unless(0.0));
-  v.number("pitch", b.pitch, -100, 100, unless(0.0));
+  v.unit("m").vec3("center", b.center, required);
+  v.unit("m").vec3("half_extents", b.half_extents, required);
+  v.unit("rad").number("yaw", b.yaw, -100, 100);
+  v.unit("rad").number("roll", b.roll, -100, 100, unless(0.0));
+  v.unit("rad").number("pitch", b.pitch, -100, 100, unless(0.0));
   contact_fields(v, b.contact);
 }
 
@@ -185,8 +186,8 @@ void seabed_fields(V& v, Scenario& s) {
     if (b.contains("depth") && b.contains("heightfield"))
       r.fail(p, "expected \"depth\" (flat) or \"heightfield\", not both");
   });
-  v.number("depth", s.seabed_depth, 0.1, 1e5, finite);
-  v.number("friction", s.seabed_friction, 0, 100, if_set);
+  v.unit("m").number("depth", s.seabed_depth, 0.1, 1e5, finite);
+  v.unit("1").number("friction", s.seabed_friction, 0, 100, if_set);
   v.custom(
       "heightfield",
       [&](const nlohmann::json& h, const Reader& r, const std::string& p) {
@@ -200,20 +201,20 @@ template <class V>
 void winch_fields(V& v, Scenario& s) {
   WinchScenario& x = s.winch;
   v.on_read([&] { x.enabled = true; });
-  v.number("max_speed", x.max_speed, 0.01, 10);
-  v.number("max_acceleration", x.max_acceleration, 0.01, 100);
-  v.number("max_pull", x.max_pull, 1, 1e6);
-  v.number("min_length", x.min_length, 0.5, 1000);
-  v.number("max_length", x.max_length, 0.5, 1000);
+  v.unit("m/s").number("max_speed", x.max_speed, 0.01, 10);
+  v.unit("m/s²").number("max_acceleration", x.max_acceleration, 0.01, 100);
+  v.unit("N").number("max_pull", x.max_pull, 1, 1e6);
+  v.unit("m").number("min_length", x.min_length, 0.5, 1000);
+  v.unit("m").number("max_length", x.max_length, 0.5, 1000);
   v.choice("strategy", s.winch_strategy, winch_strategy_names);
-  v.number("tension_low", x.tension_low, 0, 1e5);
-  v.number("tension_high", x.tension_high, 0, 1e5);
-  v.number("tension_gain", x.tension_gain, 0, 10);
-  v.number("slack", x.slack, 0, 10);
-  v.number("extra_length", x.extra_length, 0, 1000);
-  v.number("length_per_depth", x.length_per_depth, 0, 10);
-  v.number("length_per_offset", x.length_per_offset, 0, 10);
-  v.number("length_gain", x.length_gain, 0, 100);
+  v.unit("N").number("tension_low", x.tension_low, 0, 1e5);
+  v.unit("N").number("tension_high", x.tension_high, 0, 1e5);
+  v.unit("m/s/N").number("tension_gain", x.tension_gain, 0, 10);
+  v.unit("1").number("slack", x.slack, 0, 10);
+  v.unit("m").number("extra_length", x.extra_length, 0, 1000);
+  v.unit("1").number("length_per_depth", x.length_per_depth, 0, 10);
+  v.unit("1").number("length_per_offset", x.length_per_offset, 0, 10);
+  v.unit("1/s").number("length_gain", x.length_gain, 0, 100);
   v.check([&](const Reader& r, const std::string& p) {
     if (x.max_length < x.min_length) r.fail(p + "/max_length", "expected at least min_length");
     if (x.tension_high <= x.tension_low)
@@ -231,59 +232,59 @@ void navigation_fields(V& v, NavigationSettings& n) {
   v.integer("seed", n.seed, 0, 1e18);
   PairSensors& s = n.sensors;
   v.object("imu", true, [&](auto& o) {
-    o.number("rate", s.imu.rate, 1, 100);
-    o.number("gyro_noise_density", s.imu.gyro_noise_density, 0, 0.1);
-    o.number("gyro_bias_walk", s.imu.gyro_bias_walk, 0, 0.1);
-    o.number("gyro_bias_initial", s.imu.gyro_bias_initial, 0, 0.5);
-    o.number("accel_noise_density", s.imu.accel_noise_density, 0, 1);
-    o.number("accel_bias_walk", s.imu.accel_bias_walk, 0, 1);
-    o.number("accel_bias_initial", s.imu.accel_bias_initial, 0, 2);
+    o.unit("Hz").number("rate", s.imu.rate, 1, 100);
+    o.unit("rad/s/√Hz").number("gyro_noise_density", s.imu.gyro_noise_density, 0, 0.1);
+    o.unit("rad/s²/√Hz").number("gyro_bias_walk", s.imu.gyro_bias_walk, 0, 0.1);
+    o.unit("rad/s").number("gyro_bias_initial", s.imu.gyro_bias_initial, 0, 0.5);
+    o.unit("m/s²/√Hz").number("accel_noise_density", s.imu.accel_noise_density, 0, 1);
+    o.unit("m/s³/√Hz").number("accel_bias_walk", s.imu.accel_bias_walk, 0, 1);
+    o.unit("m/s²").number("accel_bias_initial", s.imu.accel_bias_initial, 0, 2);
   });
   v.object("depth", true, [&](auto& o) {
-    o.number("rate", s.depth.rate, 0.01, 100);
-    o.number("noise", s.depth.noise, 0, 10);
-    o.number("bias", s.depth.bias, -100, 100);
+    o.unit("Hz").number("rate", s.depth.rate, 0.01, 100);
+    o.unit("m").number("noise", s.depth.noise, 0, 10);
+    o.unit("m").number("bias", s.depth.bias, -100, 100);
   });
   v.object("dvl", true, [&](auto& o) {
-    o.number("bottom_rate", s.dvl.bottom_rate, 0.01, 100);
-    o.number("water_rate", s.dvl.water_rate, 0.01, 100);
-    o.number("min_altitude", s.dvl.min_altitude, 0, 1000);
-    o.number("max_altitude", s.dvl.max_altitude, 0, 1e4);
+    o.unit("Hz").number("bottom_rate", s.dvl.bottom_rate, 0.01, 100);
+    o.unit("Hz").number("water_rate", s.dvl.water_rate, 0.01, 100);
+    o.unit("m").number("min_altitude", s.dvl.min_altitude, 0, 1000);
+    o.unit("m").number("max_altitude", s.dvl.max_altitude, 0, 1e4);
     o.check([&](const Reader& r, const std::string& p) {
       if (s.dvl.max_altitude <= s.dvl.min_altitude)
         r.fail(p + "/max_altitude", "expected more than /navigation/dvl/min_altitude (" +
                                         std::to_string(s.dvl.min_altitude) + ")");
     });
-    o.number("noise_floor", s.dvl.noise_floor, 0, 10);
-    o.number("noise_fraction", s.dvl.noise_fraction, 0, 1);
+    o.unit("m/s").number("noise_floor", s.dvl.noise_floor, 0, 10);
+    o.unit("1").number("noise_fraction", s.dvl.noise_fraction, 0, 1);
     o.boolean("water_track", s.dvl.water_track);
-    o.number("water_noise", s.dvl.water_noise, 0, 10);
-    o.number("water_track_distance", s.dvl.water_track_distance, 0, 100);
+    o.unit("m/s").number("water_noise", s.dvl.water_noise, 0, 10);
+    o.unit("m").number("water_track_distance", s.dvl.water_track_distance, 0, 100);
   });
   v.object("compass", true, [&](auto& o) {
-    o.number("rate", s.compass.rate, 0.01, 100);
-    o.number("noise", s.compass.noise, 0, 1);
-    o.number("bias", s.compass.bias, -3.15, 3.15);
+    o.unit("Hz").number("rate", s.compass.rate, 0.01, 100);
+    o.unit("rad").number("noise", s.compass.noise, 0, 1);
+    o.unit("rad").number("bias", s.compass.bias, -3.15, 3.15);
   });
   v.object("gps", true, [&](auto& o) {
-    o.number("rate", s.gps.rate, 0.01, 100);
-    o.number("noise", s.gps.noise, 0, 100);
-    o.number("bias_sigma", s.gps.bias_sigma, 0, 100);
-    o.number("bias_time", s.gps.bias_time, 0.01, 1e6);
-    o.number("vertical_factor", s.gps.vertical_factor, 0, 10);
+    o.unit("Hz").number("rate", s.gps.rate, 0.01, 100);
+    o.unit("m").number("noise", s.gps.noise, 0, 100);
+    o.unit("m").number("bias_sigma", s.gps.bias_sigma, 0, 100);
+    o.unit("s").number("bias_time", s.gps.bias_time, 0.01, 1e6);
+    o.unit("1").number("vertical_factor", s.gps.vertical_factor, 0, 10);
   });
   v.object("usbl", true, [&](auto& o) {
-    o.number("rate", s.usbl.rate, 0.01, 100);
-    o.number("noise_floor", s.usbl.noise_floor, 0, 100);
-    o.number("noise_fraction", s.usbl.noise_fraction, 0, 1);
-    o.number("latency", s.usbl.latency, 0, 10);
+    o.unit("Hz").number("rate", s.usbl.rate, 0.01, 100);
+    o.unit("m").number("noise_floor", s.usbl.noise_floor, 0, 100);
+    o.unit("1").number("noise_fraction", s.usbl.noise_fraction, 0, 1);
+    o.unit("s").number("latency", s.usbl.latency, 0, 10);
     o.check([&](const Reader& r, const std::string& p) {
       if (s.usbl.latency * s.usbl.rate >= kelp::nav::usbl_queue_capacity - 2)
         r.fail(p, "latency × rate must be < " + std::to_string(kelp::nav::usbl_queue_capacity - 2) +
                       " (fixes in flight)");
     });
-    o.number("dropout", s.usbl.dropout, 0, 0.99);
-    o.number("max_range", s.usbl.max_range, 0.1, 1e4);
+    o.unit("1").number("dropout", s.usbl.dropout, 0, 0.99);
+    o.unit("m").number("max_range", s.usbl.max_range, 0.1, 1e4);
   });
 }
 
@@ -296,21 +297,21 @@ void regular_wave_fields(V& v, RegularWaveScenario& x) {
     if (b.contains("period") == b.contains("wavelength"))
       r.fail(p, "expected \"period\" or \"wavelength\" (exactly one)");
   });
-  v.number("height", x.height, 0, 30, required);
-  v.number("period", x.period, 0.5, 60, if_set);
-  v.number("wavelength", x.wavelength, 0.5, 5000, if_set);
-  v.number("direction", x.direction, -10, 10);
-  v.number("phase", x.phase, -10, 10);
+  v.unit("m").number("height", x.height, 0, 30, required);
+  v.unit("s").number("period", x.period, 0.5, 60, if_set);
+  v.unit("m").number("wavelength", x.wavelength, 0.5, 5000, if_set);
+  v.unit("rad").number("direction", x.direction, -10, 10);
+  v.unit("rad").number("phase", x.phase, -10, 10);
 }
 
 /// A vehicle's battery (`"battery": {"asv": {...}, "auv": {...}}`).
 template <class V>
 void battery_fields(V& v, BatteryScenario& b) {
-  v.number("capacity_ah", b.capacity_ah, 0.01, 1e5);
+  v.unit("A h").number("capacity_ah", b.capacity_ah, 0.01, 1e5);
   v.integer("cells_in_series", b.cells_in_series, 1, 1000);
-  v.number("internal_resistance", b.internal_resistance, 0.0, 100.0);
-  v.number("initial_soc", b.initial_soc, 0.0, 1.0);
-  v.number("hotel_current", b.hotel_current, 0.0, 1000.0);
+  v.unit("Ω").number("internal_resistance", b.internal_resistance, 0.0, 100.0);
+  v.unit("1").number("initial_soc", b.initial_soc, 0.0, 1.0);
+  v.unit("A").number("hotel_current", b.hotel_current, 0.0, 1000.0);
 }
 
 void parse_fleet(const nlohmann::json& fleet, const Reader& r, Scenario& s);
@@ -321,17 +322,17 @@ template <class V>
 void fleet_vehicle_fields(V& v, FleetVehicleScenario& x) {
   v.key("name");
   v.key("vehicle");
-  v.vec3("start", x.start);
-  v.number("heading", x.heading, -10, 10);
+  v.unit("m").vec3("start", x.start);
+  v.unit("rad").number("heading", x.heading, -10, 10);
   v.object("controller", true, [&](auto& o) {
     FleetControllerScenario& c = x.controller;
     o.choice("type", c.type, fleet_control_names, required);
-    o.vec3("position", c.position);
-    o.number("heading", c.heading, -10, 10);
-    o.vec3_list("waypoints", c.waypoints, if_set);
-    o.number("leg_speed", c.leg_speed, 0.01, 10);
+    o.unit("m").vec3("position", c.position);
+    o.unit("rad").number("heading", c.heading, -10, 10);
+    o.unit("m").vec3_list("waypoints", c.waypoints, if_set);
+    o.unit("m/s").number("leg_speed", c.leg_speed, 0.01, 10);
     o.key("target");
-    o.vec3("offset", c.offset);
+    o.unit("m").vec3("offset", c.offset);
   });
 }
 
@@ -339,18 +340,18 @@ void fleet_vehicle_fields(V& v, FleetVehicleScenario& x) {
 template <class V>
 void fleet_point_mass_fields(V& v, FleetPointMassScenario& x) {
   v.key("name");
-  v.number("mass", x.mass, 1e-3, 1e7, required);
-  v.number("volume", x.volume, 0, 1e4);
-  v.number("added_mass_coefficient", x.added_mass_coefficient, 0, 10);
-  v.number("drag_area", x.drag_area, 0, 1e4);
-  v.vec3("start", x.start, required);
+  v.unit("kg").number("mass", x.mass, 1e-3, 1e7, required);
+  v.unit("m³").number("volume", x.volume, 0, 1e4);
+  v.unit("1").number("added_mass_coefficient", x.added_mass_coefficient, 0, 10);
+  v.unit("m²").number("drag_area", x.drag_area, 0, 1e4);
+  v.unit("m").vec3("start", x.start, required);
 }
 
 /// A fleet anchor (`name` read by the list).
 template <class V>
 void fleet_anchor_fields(V& v, FleetAnchorScenario& x) {
   v.key("name");
-  v.vec3("position", x.position, required);
+  v.unit("m").vec3("position", x.position, required);
 }
 
 /// A fleet tether (`name`, `from` and `to` read by the list).
@@ -359,26 +360,26 @@ void fleet_tether_fields(V& v, FleetTetherScenario& x) {
   v.key("name");
   v.key("from");
   v.key("to");
-  v.vec3("from_point", x.from_point, if_set);
-  v.vec3("to_point", x.to_point, if_set);
-  v.number("length", x.length, 0.5, 10000, required);
-  v.number("segment_length", x.segment_length, 0.05, 100);
-  v.number("diameter", x.diameter, 1e-4, 0.5, if_set);
-  v.number("mass_per_length", x.mass_per_length, 1e-4, 1000, if_set);
-  v.number("axial_stiffness", x.axial_stiffness, 1, 1e11, if_set);
-  v.number("internal_damping_ratio", x.internal_damping_ratio, 0, 1000, if_set);
-  v.number("normal_drag", x.normal_drag, 0, 10, if_set);
-  v.number("tangential_drag", x.tangential_drag, 0, 10, if_set);
-  v.number("breaking_strength", x.breaking_strength, 0, 1e9, if_set);
+  v.unit("m").vec3("from_point", x.from_point, if_set);
+  v.unit("m").vec3("to_point", x.to_point, if_set);
+  v.unit("m").number("length", x.length, 0.5, 10000, required);
+  v.unit("m").number("segment_length", x.segment_length, 0.05, 100);
+  v.unit("m").number("diameter", x.diameter, 1e-4, 0.5, if_set);
+  v.unit("kg/m").number("mass_per_length", x.mass_per_length, 1e-4, 1000, if_set);
+  v.unit("N").number("axial_stiffness", x.axial_stiffness, 1, 1e11, if_set);
+  v.unit("1").number("internal_damping_ratio", x.internal_damping_ratio, 0, 1000, if_set);
+  v.unit("1").number("normal_drag", x.normal_drag, 0, 10, if_set);
+  v.unit("1").number("tangential_drag", x.tangential_drag, 0, 10, if_set);
+  v.unit("N").number("breaking_strength", x.breaking_strength, 0, 1e9, if_set);
   v.object("winch", x.winch.enabled, [&](auto& o) {
     FleetWinchScenario& w = x.winch;
     o.on_read([&] { w.enabled = true; });
-    o.number("max_speed", w.max_speed, 0.01, 10);
-    o.number("max_acceleration", w.max_acceleration, 0.01, 100);
-    o.number("max_pull", w.max_pull, 1, 1e7);
-    o.number("min_length", w.min_length, 0.5, 10000);
-    o.number("max_length", w.max_length, 0.5, 10000);
-    o.number("payout_rate", w.payout_rate, -10, 10);
+    o.unit("m/s").number("max_speed", w.max_speed, 0.01, 10);
+    o.unit("m/s²").number("max_acceleration", w.max_acceleration, 0.01, 100);
+    o.unit("N").number("max_pull", w.max_pull, 1, 1e7);
+    o.unit("m").number("min_length", w.min_length, 0.5, 10000);
+    o.unit("m").number("max_length", w.max_length, 0.5, 10000);
+    o.unit("m/s").number("payout_rate", w.payout_rate, -10, 10);
     o.check([&](const Reader& r, const std::string& p) {
       if (w.max_length < w.min_length) r.fail(p + "/max_length", "expected at least min_length");
       if (x.length < w.min_length || x.length > w.max_length)
@@ -393,7 +394,7 @@ nlohmann::json obstacles_json(Scenario& s);
 /// The scenario file: every key of the schema (the nested objects' tables above or inline).
 template <class V>
 void scenario_fields(V& v, Scenario& s) {
-  v.number("duration", s.duration, 1e-3, 1e7);
+  v.unit("s").number("duration", s.duration, 1e-3, 1e7);
   v.integer("seed", s.seed, 0, 1e18);
   // The sea: a preset's name, or an object of values (then "custom", its peak period 8 s unless
   // set).
@@ -402,13 +403,13 @@ void scenario_fields(V& v, Scenario& s) {
       s.sea = Sea::custom;
       s.peak_period = 8.0;
     });
-    o.number("significant_height", s.significant_height, 0, 20);
-    o.number("peak_period", s.peak_period, 1, 30);
-    o.number("wave_direction", s.wave_direction, -10, 10);
-    o.number("wind_speed", s.wind_speed, 0, 60);
-    o.number("wind_direction", s.wind_direction, -10, 10);
-    o.number("current_speed", s.current_speed, 0, 5);
-    o.number("current_direction", s.current_direction, -10, 10);
+    o.unit("m").number("significant_height", s.significant_height, 0, 20);
+    o.unit("s").number("peak_period", s.peak_period, 1, 30);
+    o.unit("rad").number("wave_direction", s.wave_direction, -10, 10);
+    o.unit("m/s").number("wind_speed", s.wind_speed, 0, 60);
+    o.unit("rad").number("wind_direction", s.wind_direction, -10, 10);
+    o.unit("m/s").number("current_speed", s.current_speed, 0, 5);
+    o.unit("rad").number("current_direction", s.current_direction, -10, 10);
     o.whole("wave_components", s.wave_components, 1, 4096);
     o.object("regular", s.regular_wave.enabled,
              [&](auto& r) { regular_wave_fields(r, s.regular_wave); });
@@ -417,28 +418,28 @@ void scenario_fields(V& v, Scenario& s) {
   });
   // The cable properties are written when set (unset: keep the kind's).
   v.object("tether", true, [&](auto& o) {
-    o.number("breaking_strength", s.breaking_strength, 0, 1e7, if_set);
-    o.number("diameter", s.diameter, 1e-4, 0.5, if_set);
-    o.number("mass_per_length", s.mass_per_length, 1e-4, 100, if_set);
-    o.number("axial_stiffness", s.axial_stiffness, 1, 1e10, if_set);
-    o.number("internal_damping", s.internal_damping, 0, 1e6, if_set);
-    o.number("internal_damping_ratio", s.internal_damping_ratio, 0, 1000, if_set);
-    o.number("normal_drag", s.normal_drag, 0, 10, if_set);
-    o.number("tangential_drag", s.tangential_drag, 0, 10, if_set);
-    o.number("length", s.tether_length, 0.5, 1000);
+    o.unit("N").number("breaking_strength", s.breaking_strength, 0, 1e7, if_set);
+    o.unit("m").number("diameter", s.diameter, 1e-4, 0.5, if_set);
+    o.unit("kg/m").number("mass_per_length", s.mass_per_length, 1e-4, 100, if_set);
+    o.unit("N").number("axial_stiffness", s.axial_stiffness, 1, 1e10, if_set);
+    o.unit("N s").number("internal_damping", s.internal_damping, 0, 1e6, if_set);
+    o.unit("1").number("internal_damping_ratio", s.internal_damping_ratio, 0, 1000, if_set);
+    o.unit("1").number("normal_drag", s.normal_drag, 0, 10, if_set);
+    o.unit("1").number("tangential_drag", s.tangential_drag, 0, 10, if_set);
+    o.unit("m").number("length", s.tether_length, 0.5, 1000);
     o.choice("kind", s.tether_kind, tether_kind_names);
-    o.number("segment_length", s.segment_length, 0.05, 10);
+    o.unit("m").number("segment_length", s.segment_length, 0.05, 10);
     o.boolean("explicit_fallback", s.explicit_fallback);
     o.choice("line_model", s.line_model, line_model_names, unless(kelp::tether::LineModel::kelp));
     o.object("winch", s.winch.enabled, [&](auto& w) { winch_fields(w, s); });
   });
   v.object("vehicles", true, [&](auto& o) {
-    o.vec3("asv_attachment", s.asv_attachment);
-    o.vec3("auv_attachment", s.auv_attachment);
-    o.vec3("auv_start", s.auv_start, if_set);
+    o.unit("m").vec3("asv_attachment", s.asv_attachment);
+    o.unit("m").vec3("auv_attachment", s.auv_attachment);
+    o.unit("m").vec3("auv_start", s.auv_start, if_set);
   });
   v.object("start", true, [&](auto& o) {
-    o.number("ramp", s.start_ramp, 0, 1e5);
+    o.unit("s").number("ramp", s.start_ramp, 0, 1e5);
     o.boolean("with_water", s.start_with_water);
   });
   v.object("control", true, [&](auto& o) {
@@ -453,27 +454,27 @@ void scenario_fields(V& v, Scenario& s) {
       a.gains("linear", s.asv_linear);
       a.gains("angular", s.asv_angular);
       a.gains("yaw", s.asv_yaw);
-      a.number("thrust_clip", s.asv_thrust_clip, 0.1, 30.6);
-      a.number("rate", s.asv_rate, 0.1, 1000);
+      a.unit("N").number("thrust_clip", s.asv_thrust_clip, 0.1, 30.6);
+      a.unit("Hz").number("rate", s.asv_rate, 0.1, 1000);
     });
     o.object("auv", true, [&](auto& a) {
       a.gains("surge", s.auv_surge);
       a.gains("sway", s.auv_sway);
       a.gains("heave", s.auv_heave);
       a.gains("yaw", s.auv_yaw);
-      a.number("rate", s.auv_rate, 0.1, 1000);
+      a.unit("Hz").number("rate", s.auv_rate, 0.1, 1000);
     });
   });
   v.object("mission", true, [&](auto& o) {
-    o.number("depth", s.depth, 0.5, 1000);
-    o.number("square_side", s.square_side, 0.5, 1000);
-    o.vec3_list("waypoints", s.waypoints, if_set);
+    o.unit("m").number("depth", s.depth, 0.5, 1000);
+    o.unit("m").number("square_side", s.square_side, 0.5, 1000);
+    o.unit("m").vec3_list("waypoints", s.waypoints, if_set);
   });
   // mcap only when off: writing a bag does not change the run, so the default leaves the JSON
   // (and the run hashes of kelp-sweep, which key stored results) as they were.
   v.object("output", true, [&](auto& o) {
-    o.number("log_rate", s.log_rate, 0.01, 100);
-    o.number("node_rate", s.node_rate, 0.001, 100);
+    o.unit("Hz").number("log_rate", s.log_rate, 0.01, 100);
+    o.unit("Hz").number("node_rate", s.node_rate, 0.001, 100);
     o.boolean("mcap", s.mcap, unless(true));
   });
   // Navigation: likewise only when it differs from the default (perfect navigation).
@@ -482,7 +483,7 @@ void scenario_fields(V& v, Scenario& s) {
   v.object("thrusters", true, [&](auto& o) {
     o.boolean("propulsion", s.propulsion);
     o.boolean("lag", s.thruster_lag);
-    o.number("time_constant", s.thruster_time_constant, 0.0, 10.0);
+    o.unit("s").number("time_constant", s.thruster_time_constant, 0.0, 10.0);
   });
   v.object("battery", true, [&](auto& o) {
     o.object("asv", true, [&](auto& b) { battery_fields(b, s.asv_battery); });
@@ -507,12 +508,12 @@ void scenario_fields(V& v, Scenario& s) {
   // without them, and kelp-sweep's run hashes, stay as they were).
   v.object("entanglement", unless_default, [&](auto& o) {
     EntanglementSettings& x = s.entanglement;
-    o.number("wrap_threshold", x.wrap_threshold, 1e-3, 1e3);
-    o.number("wrap_hysteresis", x.wrap_hysteresis, 0, 1e3);
-    o.number("contact_margin", x.contact_margin, 0, 10);
-    o.number("pin_slip_speed", x.pin_slip_speed, 1e-6, 10);
-    o.number("pin_tension_difference", x.pin_tension_difference, 1e-3, 1e6);
-    o.number("pin_hold_time", x.pin_hold_time, 0, 1e4);
+    o.unit("rad").number("wrap_threshold", x.wrap_threshold, 1e-3, 1e3);
+    o.unit("rad").number("wrap_hysteresis", x.wrap_hysteresis, 0, 1e3);
+    o.unit("m").number("contact_margin", x.contact_margin, 0, 10);
+    o.unit("m/s").number("pin_slip_speed", x.pin_slip_speed, 1e-6, 10);
+    o.unit("N").number("pin_tension_difference", x.pin_tension_difference, 1e-3, 1e6);
+    o.unit("s").number("pin_hold_time", x.pin_hold_time, 0, 1e4);
     o.check([&](const Reader& r, const std::string& p) {
       if (x.wrap_hysteresis > x.wrap_threshold)
         r.fail(p + "/wrap_hysteresis", "expected at most wrap_threshold");
@@ -755,6 +756,133 @@ nlohmann::json obstacles_json(Scenario& s) {
   return list;
 }
 
+namespace {
+
+/// The rows of `table` walked over `x` at `path`, as a Markdown table.
+template <class X, class Table>
+std::string reference_table(const std::string& path, X& x, Table&& table) {
+  std::vector<schema::Reference::Row> rows;
+  schema::Reference ref(rows, path);
+  table(ref, x);
+  // One table per object, in the order the objects are first met.
+  std::vector<std::pair<std::string, std::string>> tables;
+  for (const auto& r : rows) {
+    const std::string p = r.path.substr(0, r.path.rfind('/'));
+    auto t =
+        std::find_if(tables.begin(), tables.end(), [&](const auto& e) { return e.first == p; });
+    if (t == tables.end()) {
+      tables.push_back({p,
+                        "| key | type | unit | default | allowed | notes |\n"
+                        "|---|---|---|---|---|---|\n"});
+      t = tables.end() - 1;
+    }
+    const std::string key = r.path.substr(r.path.rfind('/') + 1);
+    t->second += "| `" + key + "` | " + r.type + " | " + r.unit + " | " +
+                 (r.value.empty() ? "" : "`" + r.value + "`") + " | " + r.allowed + " | " + r.note +
+                 " |\n";
+  }
+  std::string out;
+  for (const auto& [p, rows_md] : tables)
+    out += "\n### `" + (p.empty() ? std::string("/") : p) + "`\n\n" + rows_md;
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> scenario_reference_examples() {
+  return {
+      R"({
+  "duration": 120,
+  "seed": 1,
+  "sea": "rough",
+  "tether": {"length": 15, "segment_length": 0.5},
+  "control": {"preset": "paper", "compensation": true},
+  "mission": {"depth": 5, "square_side": 10}
+})",
+      R"({
+  "sea": {"significant_height": 1.5, "peak_period": 7, "wind_speed": 5, "current_speed": 0.3,
+          "regular": {"height": 0.5, "period": 6, "direction": 0.5}, "stretching": "wheeler"},
+  "start": {"ramp": 20}
+})",
+      R"({
+  "tether": {"length": 20, "winch": {"strategy": "constant_tension", "tension_low": 5,
+                                     "tension_high": 25, "max_length": 40}},
+  "mission": {"waypoints": [[0, 0, 5], [10, 0, 10], [10, 10, 10]]}
+})",
+      R"({
+  "navigation": {"mode": "sensors", "seed": 3, "usbl": {"rate": 0.5, "latency": 1}},
+  "output": {"log_rate": 20, "node_rate": 2, "mcap": false},
+  "deterministic": true
+})",
+      R"({
+  "obstacles": [{"type": "cylinder", "name": "pile", "from": [5, 5, -2], "to": [5, 5, 30],
+                 "radius": 0.5}],
+  "seabed": {"depth": 30, "friction": 0.5}
+})",
+      R"({
+  "fleet": {
+    "vehicles": [{"name": "boat", "vehicle": "blueboat", "controller": {"type": "hold"}},
+                 {"name": "rov", "vehicle": "bluerov2_heavy", "start": [2, 0, 5],
+                  "controller": {"type": "follow", "target": "boat", "offset": [0, 0, 5]}}],
+    "tethers": [{"name": "umbilical", "from": "boat", "to": "rov", "length": 12}]
+  }
+})",
+  };
+}
+
+std::string scenario_reference_markdown() {
+  std::string out =
+      "# Scenario file reference\n\n"
+      "<!-- Generated by kelp_scenario_reference from the parser's table (scenario_fields in\n"
+      "     src/scenario.cpp); do not edit: `cmake --build <build> --target "
+      "scenario_reference_update`. -->\n\n"
+      "Every key a scenario file may hold (JSON), as kelp-tethered-pair, kelp-sweep, kelp-sitl,\n"
+      "`kelp.run_scenario` and `kelp::sim::parse_scenario` read it. Every key is optional unless\n"
+      "marked required; a missing key keeps its default, which is the embedded default run\n"
+      "(`{}`). A key outside these tables, a value of the wrong type or outside its range is\n"
+      "refused with the file's name and the JSON path. Frames: positions and waypoints are NED\n"
+      "(north, east, down) [m]; attachment points are in the vehicle's body frame (x forward,\n"
+      "y starboard, z down) [m]; directions are azimuths from north, clockwise [rad]. A unit\n"
+      "of 1 is a ratio. The keys are listed in the order they are read (the first error found\n"
+      "is the one reported). How the keys work together: [scenarios.md](scenarios.md) and\n"
+      "[apps/tethered_pair/README.md](../apps/tethered_pair/README.md#scenario-files).\n";
+  Scenario s;
+  out += reference_table("", s, [](auto& v, Scenario& x) { scenario_fields(v, x); });
+  out +=
+      "\n## Lists\n\n`/obstacles` is an array of obstacles, each an object with `\"type\"`: "
+      "`\"cylinder\"`, `\"box\"` or `\"heightfield\"` and an optional `\"name\"`; "
+      "`/seabed/heightfield` is a file in MoorDyn's seafloor format (relative to the scenario "
+      "file) or an object `{\"origin\": [x, y], \"spacing\": [dx, dy], \"size\": [rows, cols], "
+      "\"depth\": [...]}` [m] (as the height-field obstacle).\n";
+  kelp::environment::Cylinder c;
+  out += reference_table("/obstacles/N (cylinder)", c,
+                         [](auto& v, kelp::environment::Cylinder& x) { cylinder_fields(v, x); });
+  kelp::environment::Box b;
+  out += reference_table("/obstacles/N (box)", b,
+                         [](auto& v, kelp::environment::Box& x) { box_fields(v, x); });
+  out +=
+      "\n`/fleet` runs any fleet instead of the pair: `vehicles`, `point_masses`, `anchors` "
+      "and `tethers`, arrays of objects, each with a `\"name\"` (a ROS name: a letter, then "
+      "letters, digits and single underscores); a vehicle's `\"vehicle\"` names a preset "
+      "(\"bluerov2_heavy\", \"blueboat\") or a vehicle file; a tether's `\"from\"` and "
+      "`\"to\"` name a vehicle, a point mass, an anchor or `\"free\"`; a follow controller's "
+      "`\"target\"` names another vehicle.\n";
+  FleetVehicleScenario fv;
+  out += reference_table("/fleet/vehicles/N", fv,
+                         [](auto& v, FleetVehicleScenario& x) { fleet_vehicle_fields(v, x); });
+  FleetPointMassScenario fp;
+  out += reference_table("/fleet/point_masses/N", fp,
+                         [](auto& v, FleetPointMassScenario& x) { fleet_point_mass_fields(v, x); });
+  FleetAnchorScenario fa;
+  out += reference_table("/fleet/anchors/N", fa,
+                         [](auto& v, FleetAnchorScenario& x) { fleet_anchor_fields(v, x); });
+  FleetTetherScenario ft;
+  out += reference_table("/fleet/tethers/N", ft,
+                         [](auto& v, FleetTetherScenario& x) { fleet_tether_fields(v, x); });
+  out += "\n## Examples\n\nEach of these parses (the test `docs_scenario_reference` reads them).\n";
+  for (const std::string& e : scenario_reference_examples()) out += "\n```json\n" + e + "\n```\n";
+  return out;
+}
 }  // namespace detail
 
 /// \brief Reads and validates a scenario from JSON text.

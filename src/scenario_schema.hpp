@@ -6,6 +6,10 @@
 /// each key back, under its when-to-write rule). The shape follows kelp/sim/ros2/messages.hpp's
 /// `fields()`. Private to the kelp::sim library.
 ///
+/// A fourth visitor, Reference, lists every key with its type, unit, default and allowed values:
+/// docs/scenario-reference.md is generated from it (scenario_reference_markdown()), so the
+/// reference cannot drift from the parser.
+///
 /// A table is a function of a visitor `v` (a generic lambda or a template) that calls, per key:
 ///
 ///     v.number(key, member, lo, hi[, rule])     a finite number in [lo, hi]
@@ -28,6 +32,9 @@
 ///                                               and `body` reads it)
 ///     v.custom(key, parse, write)               a key read and written by hand (lists)
 ///     v.key(key)                                a key read by the caller (allowed, not visited)
+///     v.unit(u).number(...)                     the unit of the key that follows (`unit` returns
+///                                               the visitor): the reference prints it, reading
+///                                               and writing ignore it
 ///     v.on_read(f)                              parse only: f() at this point of the reading
 ///     v.check(f)                                parse only: f(reader, path) or f(reader, path,
 ///                                               object) at this point, for checks between keys
@@ -43,6 +50,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <set>
 #include <string>
@@ -200,6 +209,8 @@ class Keys {
     allowed.insert(k);
   }
   void key(const char* k) { allowed.insert(k); }
+  /// \brief The unit of the next key (for the reference; ignored here).
+  Keys& unit(const char*) { return *this; }
   template <class F>
   void on_read(F&&) {}
   template <class F>
@@ -308,6 +319,8 @@ class Parser {
     if (j_.contains(k)) parse(j_.at(k), r_, path_ + "/" + k);
   }
   void key(const char*) {}
+  /// \brief The unit of the next key (for the reference; ignored here).
+  Parser& unit(const char*) { return *this; }
   template <class F>
   void on_read(F&& f) {
     f();
@@ -412,6 +425,8 @@ class Writer {
     if (!v.is_null()) out_[k] = std::move(v);
   }
   void key(const char*) {}
+  /// \brief The unit of the next key (for the reference; ignored here).
+  Writer& unit(const char*) { return *this; }
   template <class F>
   void on_read(F&&) {}
   template <class F>
@@ -442,6 +457,146 @@ class Writer {
   nlohmann::json& out_;
   const nlohmann::json* defaults_;
   const nlohmann::json null_;
+};
+
+/// \brief The visitor that lists an object's keys for the scenario reference: each key's path,
+/// type, unit, default (the value in the scenario the table is walked over: the default one)
+/// and allowed values. Nested objects are walked with their path.
+class Reference {
+ public:
+  /// \brief One key of the reference.
+  struct Row {
+    std::string path;     ///< JSON pointer, e.g. /tether/length
+    std::string type;     ///< number, integer, boolean, string, [x, y, z], object, ...
+    std::string unit;     ///< SI unit, "1" for a ratio, empty when none applies
+    std::string value;    ///< the default
+    std::string allowed;  ///< range or choices
+    std::string note;     ///< required, written when ..., read by the list
+  };
+
+  /// \brief Appends the rows of the object at `path` to `rows`.
+  Reference(std::vector<Row>& rows, std::string path) : rows_(rows), path_(std::move(path)) {}
+
+  /// \brief The unit of the next key.
+  Reference& unit(const char* u) {
+    unit_ = u;
+    return *this;
+  }
+  template <class R = Always>
+  void number(const char* k, double& x, double lo, double hi, R rule = {}) {
+    add(k, "number", num(x), range(lo, hi), note(rule));
+  }
+  template <class R = Always>
+  void number(const char* k, std::optional<double>& x, double lo, double hi, R rule = {}) {
+    add(k, "number", x ? num(*x) : "unset", range(lo, hi), note(rule));
+  }
+  template <class X, class R = Always>
+  void integer(const char* k, X& x, double lo, double hi, R rule = {}) {
+    add(k, "integer", std::to_string(x), range(lo, hi), note(rule));
+  }
+  template <class R = Always>
+  void whole(const char* k, int& x, double lo, double hi, R rule = {}) {
+    add(k, "integer", std::to_string(x), range(lo, hi), note(rule));
+  }
+  template <class R = Always>
+  void boolean(const char* k, bool& x, R rule = {}) {
+    add(k, "boolean", x ? "true" : "false", "true, false", note(rule));
+  }
+  template <class E, std::size_t N, class R = Always>
+  void choice(const char* k, E& x, const ChoiceName<E> (&names)[N], R rule = {}) {
+    const char* n = choice_name(x, names);
+    add(k, "string", n ? quoted(n) : "unset", choices(option_names(names)), note(rule));
+  }
+  template <class R = Always>
+  void vec3(const char* k, kelp::Vector3<double>& x, R rule = {}) {
+    add(k, "[x, y, z]", v3(x), "each within ±1e4", note(rule));
+  }
+  template <class R = Always>
+  void vec3(const char* k, std::optional<kelp::Vector3<double>>& x, R rule = {}) {
+    add(k, "[x, y, z]", x ? v3(*x) : "unset", "each within ±1e4", note(rule));
+  }
+  template <class R = Always>
+  void vec3_list(const char* k, std::vector<kelp::Vector3<double>>& x, R rule = {}) {
+    std::string v = x.empty() ? "[]" : std::to_string(x.size()) + " points";
+    add(k, "array of [x, y, z]", v, "at least one; each within ±1e4", note(rule));
+  }
+  template <class R = Always>
+  void gains(const char* k, Gains& x, R rule = {}) {
+    add(k, "[kp, ki, kd]", "[" + num(x.kp) + ", " + num(x.ki) + ", " + num(x.kd) + "]", "each ≥ 0",
+        note(rule));
+  }
+  template <class R, class Body>
+  void object(const char* k, R, Body&& body) {
+    add(k, "object", "", "", "");
+    Reference sub(rows_, path_ + "/" + k);
+    body(sub);
+  }
+  template <class E, std::size_t N, class Body>
+  void preset_or_object(const char* k, E& x, const ChoiceName<E> (&names)[N], E custom,
+                        Body&& body) {
+    const char* n = choice_name(x, names);
+    add(k, "string or object", n ? quoted(n) : "", choices(option_names(names, &custom)),
+        "a preset's name, or an object of the keys below");
+    Reference sub(rows_, path_ + "/" + k);
+    body(sub);
+  }
+  template <class P, class W>
+  void custom(const char* k, P&&, W&&) {
+    add(k, "see below", "none", "", "");
+  }
+  /// \brief A key read by the list that holds the object (a name, a type, a reference).
+  void key(const char* k) { add(k, "string", "", "", "read by the list"); }
+  /// \brief Runs f() as the parser does: the defaults listed after it are those of an object
+  /// given in the file (a custom sea's peak period, an enabled winch).
+  template <class F>
+  void on_read(F&& f) {
+    f();
+  }
+  template <class F>
+  void check(F&&) {}
+
+  /// \brief A number as the shortest text that reads back to it.
+  static std::string num(double x) {
+    if (std::isinf(x)) return x > 0 ? "∞" : "−∞";
+    char b[40];
+    if (x == std::floor(x) && std::abs(x) < 1e15) {
+      std::snprintf(b, sizeof b, "%.0f", x);
+      return b;
+    }
+    for (int p = 1; p <= 17; ++p) {
+      std::snprintf(b, sizeof b, "%.*g", p, x);
+      if (std::strtod(b, nullptr) == x) break;
+    }
+    return b;
+  }
+
+ private:
+  static std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+  static std::string range(double lo, double hi) { return "[" + num(lo) + ", " + num(hi) + "]"; }
+  static std::string v3(const kelp::Vector3<double>& v) {
+    return "[" + num(v(0)) + ", " + num(v(1)) + ", " + num(v(2)) + "]";
+  }
+  static std::string choices(const Options& o) {
+    std::string s;
+    for (const auto& n : o) s += (s.empty() ? "" : ", ") + quoted(n);
+    return s;
+  }
+  template <class R>
+  static std::string note(const R&) {
+    if (std::is_same<R, Required>::value) return "required";
+    if (std::is_same<R, Never>::value) return "read only (not echoed)";
+    if (std::is_same<R, IfSet>::value) return "written back when set";
+    return "";
+  }
+  void add(const char* k, std::string type, std::string value, std::string allowed,
+           std::string note) {
+    rows_.push_back({path_ + "/" + k, std::move(type), unit_, std::move(value), std::move(allowed),
+                     std::move(note)});
+    unit_.clear();
+  }
+  std::vector<Row>& rows_;
+  std::string path_;
+  std::string unit_;
 };
 
 /// \brief The object written by the table `body` (every `unless_default` object written).

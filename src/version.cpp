@@ -1,5 +1,7 @@
 #include "kelp/sim/version.hpp"
 
+#include "kelp/version.hpp"
+
 namespace kelp {
 namespace sim {
 

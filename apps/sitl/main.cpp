@@ -34,6 +34,7 @@
 #include "kelp/sim/summary.hpp"
 #include "kelp/sim/turn_counter.hpp"
 #include "kelp/sim/world.hpp"
+#include "kelp/version.hpp"
 
 namespace fs = std::filesystem;
 namespace ks = kelp::system;

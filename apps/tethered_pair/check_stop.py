@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""kelp-tethered-pair stopped mid-run (CTest: example_tethered_pair_stop; README, "Stopping and
-resuming a run").
+"""kelp-tethered-pair stopped mid-run (CTest: example_tethered_pair_stop; docs/stopping-and-
+resuming.md).
 
   check_stop.py PROGRAM NODE BAG_CHECK WORK [--fleet SCENARIO] [--replay KELP_REPLAY]
 

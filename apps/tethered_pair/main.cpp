@@ -24,6 +24,7 @@
 #include "kelp/sim/run.hpp"
 #include "kelp/sim/scenario.hpp"
 #include "kelp/sim/stop.hpp"
+#include "kelp/version.hpp"
 
 namespace fs = std::filesystem;
 

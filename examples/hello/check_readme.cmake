@@ -1,4 +1,5 @@
-# Keeps a README section and its hello program in step (run by CTest, see CMakeLists.txt).
+# Keeps a section of a Markdown document (README.md, docs/getting-started.md) and its hello
+# program in step (run by CTest, see CMakeLists.txt).
 #
 #   cmake -DREADME=<README.md> "-DSECTION=Hello vehicle" -DSOURCE=<hello.cpp> -DPROGRAM=<exe>
 #         -P check_readme.cmake
@@ -10,7 +11,7 @@
 #   2. the first "prints `...`" after that block is the quoted output: PROGRAM is run (it must
 #      exit 0) and its output must read the same, each number within half a unit in the last
 #      digit the README prints (plus 1 %), so a change of the physics fails here until the README
-#      quotes the new numbers. README.md is the single source of those numbers.
+#      quotes the new numbers. The document is the single source of those numbers.
 cmake_minimum_required(VERSION 3.16)
 
 foreach(var README SECTION SOURCE PROGRAM)
@@ -23,7 +24,7 @@ endforeach()
 file(READ "${README}" readme)
 string(FIND "${readme}" "\n## ${SECTION}\n" start)
 if(start EQUAL -1)
-  message(FATAL_ERROR "check_readme: README.md has no section \"## ${SECTION}\"")
+  message(FATAL_ERROR "check_readme: ${README} has no section \"## ${SECTION}\"")
 endif()
 math(EXPR start "${start} + 1")
 string(SUBSTRING "${readme}" ${start} -1 section)
@@ -85,7 +86,7 @@ if(NOT block STREQUAL source)
     endif()
     math(EXPR i "${i} + 1")
   endwhile()
-  message(FATAL_ERROR "check_readme: the ```cpp block of \"## ${SECTION}\" in README.md differs "
+  message(FATAL_ERROR "check_readme: the ```cpp block of \"## ${SECTION}\" in ${README} differs "
                       "from ${SOURCE}; ${where}\nCopy the source into the README (or back).")
 endif()
 
@@ -172,8 +173,8 @@ foreach(i RANGE ${last})
   endif()
 endforeach()
 if(failures)
-  message(FATAL_ERROR "check_readme: the program prints other numbers than README.md quotes "
+  message(FATAL_ERROR "check_readme: the program prints other numbers than ${README} quotes "
                       "(tolerance: half a unit in the README's last digit):${failures}\n"
                       "If the change is intended, update the \"prints\" line of \"## ${SECTION}\".")
 endif()
-message(STATUS "check_readme: \"${SECTION}\" matches README.md (${count} numbers)")
+message(STATUS "check_readme: \"${SECTION}\" matches ${README} (${count} numbers)")

@@ -1,5 +1,5 @@
 // Hello sim: 30 s of kelp-tethered-pair's closed loop (a scenario file, or the embedded default)
-// through kelp::sim, with its CSV log (checked against the README by CTest).
+// through kelp::sim, with its CSV log (checked against docs/getting-started.md by CTest).
 #include <cstdio>
 
 #include "kelp/sim.hpp"

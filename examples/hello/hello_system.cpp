@@ -1,5 +1,5 @@
 // Hello system: the paper's BlueBoat, BlueROV2 Heavy and 10 m tether in its moderate sea, the ROV
-// driving away from the boat for 20 s (checked against the README by CTest).
+// driving away from the boat for 20 s (checked against docs/getting-started.md by CTest).
 #include <algorithm>
 #include <cstdio>
 

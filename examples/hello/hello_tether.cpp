@@ -1,5 +1,5 @@
-// The README's "hello tether": a 20 m lumped-mass tether between a fixed ASV and an AUV that
-// drives away at 0.5 m/s, stepped with the implicit BDF2 integrator at 10 ms.
+// docs/getting-started.md's "hello tether": a 20 m lumped-mass tether between a fixed ASV and
+// an AUV that drives away at 0.5 m/s, stepped with the implicit BDF2 integrator at 10 ms.
 #include <cstdio>
 
 #include "kelp/environment/environment.hpp"

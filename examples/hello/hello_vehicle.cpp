@@ -1,4 +1,5 @@
-// The README's "hello vehicle": a BlueROV2 Heavy driven forward by its thrusters in a current.
+// The "hello vehicle" of README.md and docs/getting-started.md: a BlueROV2 Heavy driven forward
+// by its thrusters in a current.
 #include <cstdio>
 
 #include "kelp/vehicle/integrators.hpp"

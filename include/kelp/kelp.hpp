@@ -37,3 +37,4 @@
 #include "kelp/vehicle/surroundings.hpp"
 #include "kelp/vehicle/thrusters.hpp"
 #include "kelp/vehicle/water.hpp"
+#include "kelp/version.hpp"

@@ -1,5 +1,6 @@
 // kelp._kelp: the extension module under the `kelp` package (python/kelp/__init__.py imports it).
 #include "bindings.hpp"
+#include "kelp/version.hpp"
 
 namespace kelp_python {
 /// kelp.Tether and kelp.TetherState (tether.cpp).

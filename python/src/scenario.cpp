@@ -19,6 +19,7 @@
 #include "kelp/core/rotation.hpp"
 #include "kelp/sim/fleet_run.hpp"
 #include "kelp/sim/run.hpp"
+#include "kelp/version.hpp"
 
 namespace kelp_python {
 

@@ -1,12 +1,19 @@
 """The package itself: it imports from the build tree, has a version and docstrings, and turns
 kelp's C++ exceptions into its Python ones with the C++ message."""
 
+import pathlib
+import re
+
 import pytest
 
 import kelp
 
 
 def test_imports_with_version_and_docs():
+    # kelp.__version__ is the string of include/kelp/version.hpp, the one place it is written.
+    header = pathlib.Path(__file__).resolve().parents[2] / "include" / "kelp" / "version.hpp"
+    written = re.search(r'#define KELP_VERSION_STRING "([^"]+)"', header.read_text()).group(1)
+    assert kelp.__version__ == written
     assert kelp.__version__.count(".") == 2
     assert "tethered" in kelp.__doc__
     assert kelp._kelp.__file__.endswith(".so")

@@ -11,9 +11,9 @@
 /// Ceres.
 ///
 /// The namespace is `kelp::ceres_solver` (header path and CMake target stay `kelp/ceres/...` and
-/// `kelp::ceres`): a namespace named `kelp::ceres` would hide Ceres' own `::ceres` from any code
-/// inside `namespace kelp` (user code included), so that `ceres::Jet<double, N>` written there
-/// would not find Ceres' type.
+/// `kelp::ceres`): a namespace named `kelp::ceres` would hide the global namespace of Ceres from
+/// any code inside `namespace kelp` (user code included), so that `ceres::Jet<double, N>` written
+/// there would not find Ceres' type.
 #pragma once
 
 #include <cmath>
@@ -49,6 +49,8 @@ struct CatenaryResidual {
   enum { NUM_RESIDUALS = 2, NUM_PARAMETERS = 2 };
 
   /// \brief r = (R1, R2) [m] at x = (a, c) [m].
+  /// \tparam T double or a ceres::Jet. \param x (a, c) [m]. \param r the residuals [m], written.
+  /// \return true (Ceres' convention: the residuals were computed).
   template <typename T>
   bool operator()(const T* x, T* r) const {
     using std::cosh;
@@ -72,8 +74,11 @@ struct CatenaryResidual {
 /// Not thread-safe (one instance per thread). No heap allocation per solve.
 class CatenarySolver {
  public:
+  /// \brief The residual with its automatic derivatives, as TinySolver wants it.
   using Function = ::ceres::TinySolverAutoDiffFunction<CatenaryResidual, 2, 2>;
+  /// \brief Ceres' small dense Levenberg–Marquardt solver over Function.
   using Solver = ::ceres::TinySolver<Function>;
+  /// \brief The unknowns (a, c) [m].
   using Parameters = Eigen::Vector2d;
 
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
@@ -90,6 +95,8 @@ class CatenarySolver {
   /// \param[in] L tether length [m], > 0.
   /// \param[in] options the Ceres path uses max_iterations, residual_tolerance, target_residual
   ///   and vertical_tolerance (and tolerance for the fast-path start).
+  /// \return the status (converged, taut, vertical, invalid_input or max_iterations: never throws)
+  /// with a and c [m], the iterations, the relative residual and, taut, the tension [N].
   template <typename Scalar>
   CatenaryResult<Scalar> solve(Scalar D, Scalar dz, Scalar L,
                                const CatenaryOptions<Scalar>& options = {}) {
@@ -108,6 +115,12 @@ class CatenarySolver {
   /// the (a, c) problem is badly conditioned — and options.restart_from_fast_path is set (default),
   /// the solve is repeated from the fast path's solution; restarted() tells, and `iterations`
   /// counts both runs.
+  /// \tparam Scalar as solve(D, dz, L, options).
+  /// \param[in] D horizontal distance [m], ≥ 0. \param[in] dz z_end − z_start, z up [m].
+  /// \param[in] L tether length [m], > 0. \param[in] a0 guess of a [m]. \param[in] c0 guess of c
+  /// [m]. \param[in] options as solve(D, dz, L, options).
+  /// \return the status (converged, taut, vertical, invalid_input or max_iterations: never throws)
+  /// with a and c [m], the iterations, the relative residual and, taut, the tension [N].
   template <typename Scalar>
   CatenaryResult<Scalar> solve(Scalar D, Scalar dz, Scalar L, double a0, double c0,
                                const CatenaryOptions<Scalar>& options = {}) {
@@ -126,10 +139,16 @@ class CatenarySolver {
   }
 
   /// \brief True when the last solve from a caller's guess had to restart from the fast path.
+  /// \return whether it restarted.
   bool restarted() const { return restarted_; }
 
   /// \brief Solves warm-started from this solver's previous converged solution (the fast path on
   /// the first call or after a failure).
+  /// \tparam Scalar as solve(D, dz, L, options).
+  /// \param[in] D horizontal distance [m], ≥ 0. \param[in] dz z_end − z_start, z up [m].
+  /// \param[in] L tether length [m], > 0. \param[in] options as solve(D, dz, L, options).
+  /// \return the status (converged, taut, vertical, invalid_input or max_iterations: never throws)
+  /// with a and c [m], the iterations, the relative residual and, taut, the tension [N].
   template <typename Scalar>
   CatenaryResult<Scalar> solve_from_previous(Scalar D, Scalar dz, Scalar L,
                                              const CatenaryOptions<Scalar>& options = {}) {
@@ -138,6 +157,7 @@ class CatenarySolver {
   }
 
   /// \brief Ceres' summary of the last solve (iterations, costs, termination reason).
+  /// \return a reference valid until the next solve.
   const Solver::Summary& summary() const { return solver_.summary; }
 
  private:
@@ -244,6 +264,8 @@ class CatenarySolver {
 /// \param[in] L tether length [m], > 0.
 /// \param[in] options tolerances and limits; the Ceres path uses max_iterations, residual_tolerance
 /// and target_residual.
+/// \return the status (converged, taut, vertical, invalid_input or max_iterations: never throws)
+/// with a and c [m], the iterations, the relative residual and, taut, the tension [N].
 template <typename Scalar>
 CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
                                       const CatenaryOptions<Scalar>& options = {}) {
@@ -252,6 +274,12 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
 }
 
 /// \brief As above, from a caller's guess (a0, c0) [m] (e.g. the previous control step).
+/// \tparam Scalar double, float or `ceres::Jet<double, N>`.
+/// \param[in] D horizontal distance [m], ≥ 0. \param[in] dz z_end − z_start, z up [m].
+/// \param[in] L tether length [m], > 0. \param[in] a0 guess of a [m]. \param[in] c0 guess of c [m].
+/// \param[in] options as solve_catenary(D, dz, L, options).
+/// \return the status (converged, taut, vertical, invalid_input or max_iterations: never throws)
+/// with a and c [m], the iterations, the relative residual and, taut, the tension [N].
 template <typename Scalar>
 CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L, double a0, double c0,
                                       const CatenaryOptions<Scalar>& options = {}) {

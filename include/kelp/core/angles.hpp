@@ -21,6 +21,8 @@ namespace kelp {
 /// \brief Angle `a` [rad] wrapped to (−π, π] exactly: a − 2πk by std::remainder, then −π moved
 /// to π (see the file comment for how it differs from wrap_angle). NaN and ±∞ give NaN.
 /// \tparam Scalar float or double.
+/// \param a any angle [rad].
+/// \return the angle in (−π, π] [rad]; never throws.
 template <typename Scalar>
 Scalar wrap_angle_exact(Scalar a) {
   using std::remainder;
@@ -33,6 +35,8 @@ Scalar wrap_angle_exact(Scalar a) {
 /// convention; see the file comment for how it differs from wrap_angle_exact). NaN and ±∞ give
 /// NaN.
 /// \tparam Scalar float or double.
+/// \param a any angle [rad].
+/// \return the angle in (−π, π] [rad]; never throws.
 template <typename Scalar>
 Scalar wrap_angle(Scalar a) {
   using std::fmod;
@@ -44,6 +48,9 @@ Scalar wrap_angle(Scalar a) {
 
 /// \brief Heading ψ [rad] of an attitude (body → NED): the yaw of its ZYX Euler angles
 /// (euler_from_quaternion(q).z()), in [−π, π].
+/// \tparam Scalar float, double or ceres::Jet.
+/// \param q a unit quaternion rotating body vectors into NED.
+/// \return ψ [rad], positive clockwise seen from above (north 0, east π/2).
 template <typename Scalar>
 Scalar heading_of(const Quaternion<Scalar>& q) {
   return euler_from_quaternion(q).z();

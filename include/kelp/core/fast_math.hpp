@@ -7,7 +7,7 @@
 /// with |x| ≤ 10 rad, ≲ 1e-11 with |x| ≤ 1e5 rad (Cody–Waite reduction by multiples of π with a
 /// two-part split and near-minimax polynomials on [−π/2, π/2]; Cody–Waite reduction by ln 2 and
 /// a near-minimax polynomial on [−ln2/2, ln2/2] for exp).
-/// The tests compare them against std::sin/std::cos/std::exp.
+/// The tests compare them against `std::sin`, `std::cos` and `std::exp`.
 #pragma once
 
 #include <cmath>

@@ -58,6 +58,8 @@
 /// attribute, so there the portable path's widest build is AVX2).
 #define KELP_PORTABLE_AVX512 1
 #else
+/// \brief 1 when the portable kernel path has an AVX-512 build without FMA (GCC on x86-64), 0
+/// otherwise (this build: no such build; the portable path's widest is AVX2 or the baseline).
 #define KELP_PORTABLE_AVX512 0
 #endif
 
@@ -78,6 +80,7 @@ inline constexpr const char* kernel_environment_variable = "KELP_KERNEL";
 
 /// \brief The name of a path as the environment variable, scenario files and summaries spell it:
 /// "auto", "portable", "avx2", "avx512".
+/// \param p the path. \return its name, a string literal ("?" for a value outside the enum).
 inline const char* kernel_name(KernelPath p) {
   switch (p) {
     case KernelPath::automatic:
@@ -93,6 +96,7 @@ inline const char* kernel_name(KernelPath p) {
 }
 
 /// \brief The path named `name` ("auto", "portable", "avx2", "avx512").
+/// \param name the name, as kernel_name spells it. \return the path.
 /// \throws kelp::invalid_argument naming the value and the allowed ones.
 inline KernelPath parse_kernel_path(const std::string& name) {
   for (KernelPath p :
@@ -105,6 +109,7 @@ inline KernelPath parse_kernel_path(const std::string& name) {
 /// \brief True when this program on this CPU can take path `p` (`automatic` and `portable`
 /// always; `avx2` and `avx512` only in a dispatching build, KELP_X86_DISPATCH, on a CPU and OS
 /// that support them).
+/// \param p the path. \return whether a kernel may take it here; never throws.
 inline bool kernel_supported(KernelPath p) {
   if (p == KernelPath::automatic || p == KernelPath::portable) return true;
 #ifdef KELP_X86_DISPATCH
@@ -201,6 +206,7 @@ inline const char* portable_build_name(int build) {
 /// agree. Overrides the environment variable.
 /// \throws kelp::invalid_argument when the CPU (or the build) lacks `p`: a forced path is never
 /// taken on a CPU that would fault on it.
+/// \param p the path every kernel takes from now on (`automatic`: the widest this CPU runs).
 inline void set_kernel_policy(KernelPath p) {
   detail::check_kernel_supported(p, "set_kernel_policy");
   detail::kernel_policy_slot().store(static_cast<int>(p), std::memory_order_relaxed);
@@ -212,6 +218,7 @@ inline void set_kernel_policy(KernelPath p) {
 /// \throws kelp::invalid_argument when KELP_KERNEL holds an unknown name or a path this CPU
 /// lacks (the message names the variable and its value; every call throws until it is fixed or
 /// `set_kernel_policy` is called).
+/// \return the requested path, possibly `automatic`.
 inline KernelPath kernel_policy() {
   int v = detail::kernel_policy_slot().load(std::memory_order_relaxed);
   if (v >= 0) return static_cast<KernelPath>(v);
@@ -236,6 +243,8 @@ inline KernelPath kernel_policy() {
 /// is `automatic`, then the process' policy, and if that is `automatic` too the widest path.
 /// \throws kelp::invalid_argument when `requested` is a path the CPU lacks, or from
 /// `kernel_policy()` (a bad KELP_KERNEL).
+/// \param requested a path, or `automatic` for the process' policy.
+/// \return a concrete path (never `automatic`) that this CPU runs.
 inline KernelPath resolve_kernel(KernelPath requested = KernelPath::automatic) {
   if (requested != KernelPath::automatic) {
     detail::check_kernel_supported(requested, "resolve_kernel");

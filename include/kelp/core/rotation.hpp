@@ -16,6 +16,9 @@
 namespace kelp {
 
 /// \brief Skew-symmetric matrix S(a) with S(a) b = a × b (Fossen 2021, eq. 2.9).
+/// \tparam Derived an Eigen 3-vector expression.
+/// \param a the vector (any frame; S(a) acts in the same frame).
+/// \return S(a) = −S(a)ᵀ.
 template <typename Derived>
 Matrix3<typename Derived::Scalar> skew(const Eigen::MatrixBase<Derived>& a) {
   using S = typename Derived::Scalar;
@@ -28,6 +31,7 @@ Matrix3<typename Derived::Scalar> skew(const Eigen::MatrixBase<Derived>& a) {
 
 /// \brief Rotation matrix R_zyx(φ, θ, ψ) from body to NED (Fossen 2021, eq. 2.18).
 /// \param[in] phi roll [rad] \param[in] theta pitch [rad] \param[in] psi yaw [rad]
+/// \return R with v_NED = R v_body (orthonormal, det 1).
 template <typename Scalar>
 Matrix3<Scalar> rotation_zyx(const Scalar& phi, const Scalar& theta, const Scalar& psi) {
   using std::cos;
@@ -43,6 +47,9 @@ Matrix3<Scalar> rotation_zyx(const Scalar& phi, const Scalar& theta, const Scala
 
 /// \brief Euler-angle rate transformation T_zyx(φ, θ): Θ̇ = T ω (Fossen 2021, eq. 2.41).
 /// Singular at θ = ±90°; use the quaternion form there.
+/// \param phi roll φ [rad] \param theta pitch θ [rad]
+/// \return T_zyx, mapping body rates ω = (p, q, r) [rad/s] to Euler rates (φ̇, θ̇, ψ̇) [rad/s];
+/// its entries are infinite or NaN at θ = ±90° (no check, no throw).
 template <typename Scalar>
 Matrix3<Scalar> euler_rate_matrix(const Scalar& phi, const Scalar& theta) {
   using std::cos;
@@ -57,6 +64,8 @@ Matrix3<Scalar> euler_rate_matrix(const Scalar& phi, const Scalar& theta) {
 }
 
 /// \brief Unit quaternion for zyx Euler angles (φ, θ, ψ): q = q_z(ψ) q_y(θ) q_x(φ).
+/// \param phi roll [rad] \param theta pitch [rad] \param psi yaw [rad]
+/// \return the unit quaternion rotating body vectors into NED (the rotation of rotation_zyx).
 template <typename Scalar>
 Quaternion<Scalar> quaternion_from_euler(const Scalar& phi, const Scalar& theta,
                                          const Scalar& psi) {
@@ -70,6 +79,8 @@ Quaternion<Scalar> quaternion_from_euler(const Scalar& phi, const Scalar& theta,
 }
 
 /// \brief zyx Euler angles (φ, θ, ψ) [rad] of a unit quaternion; θ ∈ [−π/2, π/2].
+/// \param q a unit quaternion rotating body vectors into NED (not checked).
+/// \return (φ, θ, ψ) [rad]: φ and ψ in [−π, π], θ in [−π/2, π/2].
 template <typename Scalar>
 Vector3<Scalar> euler_from_quaternion(const Quaternion<Scalar>& q) {
   using std::asin;
@@ -87,6 +98,10 @@ Vector3<Scalar> euler_from_quaternion(const Quaternion<Scalar>& q) {
 /// (Fossen 2021, eq. 2.75), returned in Eigen's `coeffs()` order (ẋ, ẏ, ż, ẇ), the order of
 /// `Quaternion::coeffs()` and of `vehicle::PoseRate::attitude_dot` (kelp's one quaternion order
 /// for rates: `q.coeffs() += h * quaternion_rate(q, omega)` is an Euler step).
+/// \tparam Derived an Eigen 3-vector expression.
+/// \param q the attitude, a unit quaternion (body → NED).
+/// \param omega body angular velocity (p, q, r) [rad/s], body frame.
+/// \return q̇ [1/s] as (ẋ, ẏ, ż, ẇ).
 template <typename Scalar, typename Derived>
 Eigen::Matrix<Scalar, 4, 1> quaternion_rate(const Quaternion<Scalar>& q,
                                             const Eigen::MatrixBase<Derived>& omega) {
@@ -99,6 +114,8 @@ Eigen::Matrix<Scalar, 4, 1> quaternion_rate(const Quaternion<Scalar>& q,
 
 /// \brief 6×6 kinematic transformation J_Θ(η) for zyx Euler angles: η̇ = J ν with
 /// η = (x, y, z, φ, θ, ψ) NED and ν = (u, v, w, p, q, r) body (Fossen 2021, eq. 2.53).
+/// \param phi roll [rad] \param theta pitch [rad] \param psi yaw [rad]
+/// \return J = diag(R_zyx, T_zyx); singular at θ = ±90°, like euler_rate_matrix.
 template <typename Scalar>
 Matrix6<Scalar> kinematics_euler(const Scalar& phi, const Scalar& theta, const Scalar& psi) {
   Matrix6<Scalar> J = Matrix6<Scalar>::Zero();

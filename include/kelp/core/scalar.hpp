@@ -31,6 +31,8 @@ using identity_t = typename identity<T>::type;
 
 /// \brief The value part of a scalar as a double: the number itself for arithmetic types, the
 /// real part `x.a` (recursively) for automatic-differentiation types such as `ceres::Jet`.
+/// \tparam Scalar an arithmetic type or a type with a value member `a`.
+/// \param x the scalar. \return its value part.
 template <typename Scalar>
 constexpr double value_of(const Scalar& x) {
   if constexpr (std::is_arithmetic_v<Scalar>) {
@@ -41,6 +43,7 @@ constexpr double value_of(const Scalar& x) {
 }
 
 /// \brief True when the value part of `x` is finite (neither NaN nor ±Inf).
+/// \tparam Scalar as value_of. \param x the scalar. \return whether value_of(x) is finite.
 template <typename Scalar>
 bool is_finite(const Scalar& x) {
   return std::isfinite(value_of(x));

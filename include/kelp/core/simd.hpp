@@ -107,13 +107,16 @@ struct Pack {
       return Pack(Eigen::internal::psqrt(a.r));
     }
   }
-  /// Lane-wise maximum (the second operand where either is NaN, as SSE's maxpd).
+  // Lane-wise maximum (the second operand where either is NaN, as SSE's maxpd). Kept out of the
+  // API reference: Doxygen 1.9.4 lists this friend but writes no entry for it (a broken link).
+  /// \cond PRIVATE
   friend Pack max(Pack a, Pack b) {
     if constexpr (lanes == 1)
       return Pack(a.r > b.r ? a.r : b.r);
     else
       return Pack(Eigen::internal::pmax(a.r, b.r));
   }
+  /// \endcond
   /// Sum of the lanes.
   Scalar sum() const {
     if constexpr (lanes == 1)

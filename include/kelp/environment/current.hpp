@@ -253,6 +253,7 @@ class CurrentModel {
   }
 
  private:
+  /// \cond PRIVATE
   /// The harmonics of one variation.
   struct Harmonics {
     std::vector<double> omega, phase;  ///< ω_k [rad/s], φ_k [rad]
@@ -317,6 +318,7 @@ class CurrentModel {
   CurrentParameters params_;
   bool varying_ = false;
   Harmonics speed_, direction_;
+  /// \endcond
 };
 
 /// \brief Double-precision current model.

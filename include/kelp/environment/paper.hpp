@@ -38,6 +38,7 @@ namespace environment {
 /// current vector (`current_velocity_ned`); with α_c = β_c = 0 it is the whole current, flowing
 /// north. \param[in] speed V_c [m/s] \param[in] alpha α_c vertical angle [rad]
 /// \param[in] beta β_c horizontal direction [rad]
+/// \return v_c [m/s], the north component of the current.
 /// \throws kelp::invalid_argument when V_c, α_c or β_c is not finite.
 template <typename Scalar>
 Scalar paper_current(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
@@ -71,6 +72,7 @@ void check_paper_wind_arguments(const Scalar& rho_air, const Scalar& wind_speed,
 /// \throws kelp::invalid_argument when ρ_air is not in (0, 1e5] kg/m³
 /// (`limits::max_fluid_density`), V_w or C_x is not finite, the area is negative or not finite,
 /// or the force overflows.
+/// \return F_wind [N], along the wind.
 template <typename Scalar>
 Scalar paper_wind_force(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cx,
                         const Scalar& frontal_area) {
@@ -82,6 +84,9 @@ Scalar paper_wind_force(const Scalar& rho_air, const Scalar& wind_speed, const S
 
 /// \brief The lateral twin of the paper's wind force: F = ½ ρ_air V_w² C_y A_lw [N], with the
 /// lateral coefficient C_y and the lateral projected area A_lw (paper, text after eq:wind).
+/// \param[in] rho_air air density [kg/m³] \param[in] wind_speed V_w [m/s]
+/// \param[in] cy C_y [-] \param[in] lateral_area A_lw [m²]
+/// \return F [N], across the hull.
 /// \throws kelp::invalid_argument as `paper_wind_force` (naming cy and lateral_area).
 template <typename Scalar>
 Scalar paper_wind_force_lateral(const Scalar& rho_air, const Scalar& wind_speed, const Scalar& cy,
@@ -99,6 +104,7 @@ Scalar paper_wind_force_lateral(const Scalar& rho_air, const Scalar& wind_speed,
 /// steepness), hence dimensionless. \param[in] amplitude A [m] \param[in] wavelength Λ [m]
 /// \throws kelp::invalid_argument when A is negative or not finite, Λ is not finite and > 0, or
 /// k overflows (A/Λ beyond 1e307).
+/// \return k [-].
 template <typename Scalar>
 Scalar paper_wave_parameter(const Scalar& amplitude, const Scalar& wavelength) {
   check_non_negative(amplitude, "amplitude");
@@ -122,6 +128,7 @@ Scalar paper_wave_parameter(const Scalar& amplitude, const Scalar& wavelength) {
 /// (`limits::max_fluid_density`), g is not in (0, 1000] m/s² (`limits::max_gravity`), B, L or T
 /// is negative or not finite, A or Λ is invalid (see `paper_wave_parameter`), or the force
 /// overflows.
+/// \return F_wave [N], the amplitude of the horizontal force along the wave's direction.
 template <typename Scalar>
 Scalar paper_wave_force(const Scalar& rho, const Scalar& g, const Scalar& beam,
                         const Scalar& length, const Scalar& draft, const Scalar& amplitude,
@@ -156,6 +163,7 @@ struct PaperWave {
 /// (`limits::max_fluid_density`), gravity is not in (0, 1000] m/s² (`limits::max_gravity`), a
 /// length or the amplitude is negative or not finite, the wavelength is not finite and > 0, the
 /// direction or phase is not finite, or the force ρ g B L T k overflows.
+/// \param w the wave and hull.
 inline void validate(const PaperWave& w) {
   detail::check_positive_at_most(w.rho, limits::max_fluid_density, "rho",
                                  "finite and in (0, 1e5] kg/m^3");
@@ -175,6 +183,9 @@ inline void validate(const PaperWave& w) {
 /// frequency ω seen from a vessel at forward speed U, β being the angle from the vessel's heading
 /// to the wave's direction of travel (β = 0 following sea, π head sea)
 /// (Fossen 2021, §10.2.2, eq. for the encounter frequency).
+/// \param omega wave frequency ω [rad/s] \param g gravity [m/s²] \param speed U [m/s]
+/// \param beta β [rad]
+/// \return ω_e [rad/s] (negative in a following sea whose waves are slower than the vessel).
 /// \throws kelp::invalid_argument when ω, U or β is not finite, g is not finite and > 0, or ω_e
 /// overflows.
 template <typename Scalar>
@@ -202,6 +213,7 @@ Scalar encounter_frequency(const Scalar& omega, const Scalar& g, const Scalar& s
 /// \param[in] speed forward speed U [m/s]
 /// \throws kelp::invalid_argument when `w` is invalid (see `validate(const PaperWave&)`), or t,
 /// ψ or U is not finite.
+/// \return (X, Y, N) [N, N, N·m], body frame.
 template <typename Scalar>
 Vector3<Scalar> paper_wave_load(const PaperWave& w, double t, const Scalar& psi,
                                 const Scalar& speed) {
@@ -247,6 +259,7 @@ Vector3<Scalar> paper_wave_load(const PaperWave& w, double t, const Scalar& psi,
 /// \throws kelp::invalid_argument when ρ is not in (0, 1e5] kg/m³ (`limits::max_fluid_density`),
 /// ∇ is negative or not finite, added_mass is not 3×3 or 3×1, R_nb is not 3×3 or the
 /// acceleration has not 3 entries, or an entry of them is not finite.
+/// \return F [N], body frame.
 template <typename Scalar, typename DerivedA, typename DerivedR, typename DerivedF>
 Vector3<Scalar> small_body_wave_force(const Scalar& rho, const Scalar& displaced_volume,
                                       const Eigen::MatrixBase<DerivedA>& added_mass,
@@ -287,6 +300,7 @@ struct SurfaceHydrostatics {
 /// (`limits::max_fluid_density`), gravity is not in (0, 1000] m/s² (`limits::max_gravity`), the
 /// waterplane area or displaced volume is negative or not finite, a metacentric height is not
 /// finite, or a stiffness ρ g A_wp, ρ g ∇ GM overflows.
+/// \param h the hydrostatics.
 inline void validate(const SurfaceHydrostatics& h) {
   detail::check_positive_at_most(h.rho, limits::max_fluid_density, "rho",
                                  "finite and in (0, 1e5] kg/m^3");
@@ -308,6 +322,8 @@ inline void validate(const SurfaceHydrostatics& h) {
 /// (∂ζ/∂x, ∂ζ/∂y) (NED, per metre north/east) and the heading ψ:
 /// θ_s = atan(s_fwd), φ_s = −atan(s_stbd), with s_fwd, s_stbd the slopes along body x and y.
 /// (A surface rising ahead lifts the bow: θ > 0; rising to starboard lifts starboard: φ < 0.)
+/// \param slope_north ∂ζ/∂x [-] \param slope_east ∂ζ/∂y [-] \param psi heading ψ [rad]
+/// \return (φ_s, θ_s) [rad]; no check, no throw.
 template <typename Scalar>
 Eigen::Matrix<Scalar, 2, 1> surface_attitude(const Scalar& slope_north, const Scalar& slope_east,
                                              const Scalar& psi) {
@@ -336,6 +352,7 @@ Eigen::Matrix<Scalar, 2, 1> surface_attitude(const Scalar& slope_north, const Sc
 /// \throws kelp::invalid_argument when `h` is invalid (see `validate(const
 /// SurfaceHydrostatics&)`); non-finite motions give non-finite loads (they come from a state the
 /// integrators check).
+/// \return τ [N, N·m], body frame.
 template <typename Scalar>
 Vector6<Scalar> surface_following_restoring(const SurfaceHydrostatics& h, const Scalar& heave,
                                             const Scalar& phi, const Scalar& theta,
@@ -356,6 +373,9 @@ Vector6<Scalar> surface_following_restoring(const SurfaceHydrostatics& h, const 
 /// to a vehicle model that already has its own (calm-water) restoring g(η). Zero in a calm sea.
 /// \throws kelp::invalid_argument when `h` is invalid (see `validate(const
 /// SurfaceHydrostatics&)`).
+/// \param h hydrostatics \param psi heading [rad] \param zeta local elevation ζ [m] (up)
+/// \param slope_north ∂ζ/∂x [-] \param slope_east ∂ζ/∂y [-]
+/// \return G η_s [N, N·m], body frame.
 template <typename Scalar>
 Vector6<Scalar> wave_restoring(const SurfaceHydrostatics& h, const Scalar& psi, const Scalar& zeta,
                                const Scalar& slope_north, const Scalar& slope_east) {
@@ -370,6 +390,7 @@ Vector6<Scalar> wave_restoring(const SurfaceHydrostatics& h, const Scalar& psi, 
 }
 
 /// \brief Checks a surface vessel's hydrostatics (`rho`, `gravity`) against the environment.
+/// \param h the hydrostatics. \param env the environment the vessel is in.
 /// \throws kelp::invalid_argument naming both values when they differ.
 template <typename Scalar>
 void check_same_water(const SurfaceHydrostatics& h, const Environment<Scalar>& env) {
@@ -377,6 +398,7 @@ void check_same_water(const SurfaceHydrostatics& h, const Environment<Scalar>& e
 }
 
 /// \brief Checks the paper's wave-load parameters (`rho`, `gravity`) against the environment.
+/// \param w the wave and hull. \param env the environment the vessel is in.
 /// \throws kelp::invalid_argument naming both values when they differ.
 template <typename Scalar>
 void check_same_water(const PaperWave& w, const Environment<Scalar>& env) {

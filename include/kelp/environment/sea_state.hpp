@@ -33,6 +33,9 @@ namespace environment {
 /// \brief JONSWAP peak enhancement recommended by DNV-RP-C205 (2010) §3.5.5.5 for a sea of
 /// significant height Hs [m] and peak period Tp [s]: γ = 5 for Tp/√Hs ≤ 3.6,
 /// exp(5.75 − 1.15 Tp/√Hs) in between, 1 for Tp/√Hs ≥ 5.
+/// \param hs significant wave height Hs [m], > 0. \param tp peak period Tp [s], > 0.
+/// \return γ in [1, 5].
+/// \throws kelp::invalid_argument when hs or tp is not finite and > 0.
 inline double dnv_peak_enhancement(double hs, double tp) {
   check_positive(hs, "significant_height");
   check_positive(tp, "peak_period");
@@ -79,6 +82,10 @@ namespace presets {
 inline SeaState calm() { return SeaState{}; }
 
 /// \brief Builds the paper's sea state from its table row (wave height read as Hs; see file).
+/// \param hs significant wave height [m], > 0 (Tp = 4.5 √Hs s, γ by dnv_peak_enhancement).
+/// \param wind mean wind speed at 10 m [m/s]. \param current current speed [m/s] (both towards
+/// the north-east, as the paper's figures). \return the sea state.
+/// \throws kelp::invalid_argument when hs is not finite and > 0.
 inline SeaState paper_sea_state(double hs, double wind, double current) {
   SeaState s;
   s.significant_height = hs;
@@ -93,15 +100,22 @@ inline SeaState paper_sea_state(double hs, double wind, double current) {
 }
 
 /// \brief The paper's moderate sea: Hs = 3 m, Tp ≈ 7.79 s, wind 3 m/s, current 0.5 m/s.
+/// \return the sea state (make_environment builds its Environment).
 inline SeaState moderate() { return paper_sea_state(3.0, 3.0, 0.5); }
 
 /// \brief The paper's rough sea: Hs = 4.5 m, Tp ≈ 9.55 s, wind 4.5 m/s, current 1.0 m/s.
+/// \return the sea state (make_environment builds its Environment).
 inline SeaState rough() { return paper_sea_state(4.5, 4.5, 1.0); }
 
 }  // namespace presets
 
 /// \brief An environment for a sea state: JONSWAP waves (and any regular waves), wind with
 /// gusts and a constant, depth-uniform current, in seawater with standard gravity.
+/// \tparam Scalar double or float.
+/// \param s the sea state (heights [m], periods [s], speeds [m/s], NED azimuths [rad]).
+/// \param o how the sea is built (wave and gust components, seed, spreading, seabed, ramp,
+/// stretching).
+/// \return the environment, ready for `sample` and the tether's and vehicles' steps.
 /// \throws kelp::invalid_argument naming the bad field.
 template <typename Scalar>
 Environment<Scalar> make_environment(const SeaState& s, const SeaStateOptions& o = {}) {

@@ -300,6 +300,7 @@ class NavigationFilterT {
     v(s.count_, s.initialized_, s.nav_.position, s.nav_.attitude, s.nav_.nu);
   }
 
+  /// \cond PRIVATE
   struct Entry {
     double t = 0.0;
     Vector3<Scalar> p = Vector3<Scalar>::Zero();
@@ -357,6 +358,7 @@ class NavigationFilterT {
   std::size_t head_ = 0, count_ = 0;
   bool initialized_ = false;
   NavigationT<Scalar> nav_;
+  /// \endcond
 };
 
 /// \brief The navigation filter in double precision.

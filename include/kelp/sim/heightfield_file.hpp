@@ -28,6 +28,8 @@ namespace sim {
 /// \throws kelp::invalid_argument naming the file and the line for an unreadable file, a
 /// missing or malformed number, a count below 2, uneven coordinates, a point off the grid, a
 /// point given twice, a missing point or extra text.
+/// \param path the file's path. \return the height field (seabed depth z [m], positive down,
+/// on a grid in NED x, y [m]).
 KELP_SIM_API kelp::environment::HeightField load_heightfield(const std::string& path);
 
 }  // namespace sim

@@ -375,7 +375,7 @@ struct Scenario {
   /// `"battery"`): on by default (the controllers' per-thruster commands drive the T200 model
   /// through a first-order lag of `thruster_time_constant` [s] when `thruster_lag`, drawing from
   /// the batteries); `propulsion` false: the controllers' wrench is applied directly (the
-  /// behaviour before issue 25). Defaults: kelp::vehicle::battery_presets.
+  /// behaviour of kelp 0.1.0). Defaults: kelp::vehicle::battery_presets.
   ///@{
   bool propulsion = true;
   bool thruster_lag = true;

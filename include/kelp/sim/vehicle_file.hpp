@@ -65,7 +65,7 @@ KELP_SIM_API std::string write_vehicle_file(const VehicleDescription& d);
 /// \brief The shipped vehicles as descriptions, built from the C++ presets (no data directory
 /// needed): "bluerov2_heavy" (vehicle::bluerov2_heavy, its battery, hull and tether point, as
 /// system::presets::paper_system uses them) and "blueboat" (vehicle::blueboat, likewise). The
-/// files data/vehicles/<name>.json hold the same descriptions (a test keeps them equal).
+/// files data/vehicles/NAME.json hold the same descriptions (a test keeps them equal).
 /// \throws kelp::invalid_argument naming the known presets for any other name.
 KELP_SIM_API VehicleDescription vehicle_preset(const std::string& name);
 

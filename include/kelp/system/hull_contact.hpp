@@ -61,6 +61,7 @@ struct HullContact {
 };
 
 /// \brief Checks hull contact parameters. \throws kelp::invalid_argument naming the field.
+/// \param h the hull box [m] and contact law.
 template <typename Scalar>
 void validate(const HullContact<Scalar>& h) {
   check_all_finite(h.center, "hull.center");
@@ -83,6 +84,7 @@ void validate(const HullContact<Scalar>& h) {
 /// Robotics, "BlueROV2 Heavy Configuration Retrofit Kit" / BlueROV2 technical details: length
 /// 457 mm, width 575 mm with the heavy configuration's outboard vertical thrusters, height
 /// 254 mm), centred on the CO (assumed: kelp's preset puts the CG at the CO and the CB 1 cm above).
+/// \return the hull box (body frame, [m]) and kelp's default contact law.
 template <typename Scalar>
 HullContact<Scalar> bluerov2_heavy_hull() {
   HullContact<Scalar> h;
@@ -94,6 +96,7 @@ HullContact<Scalar> bluerov2_heavy_hull() {
 /// product data, as in vehicle::blueboat), 0.20 m keel to deck (vehicle::blueboat's hull_height),
 /// its keel at the draft 0.077 m below the CO on the waterline (∇/A_wp, vehicle::blueboat): centre
 /// 0.023 m above the CO.
+/// \return the hull box (body frame, [m]) and kelp's default contact law.
 template <typename Scalar>
 HullContact<Scalar> blueboat_hull() {
   HullContact<Scalar> h;
@@ -147,6 +150,8 @@ void add_hull_point(const HullContact<Scalar>& hull, const vehicle::VehicleState
 /// height field) and obstacles (see the file's comment). No allocation.
 /// \param[in] hull the hull box and contact law. \param[in] env seabed and obstacles.
 /// \param[in] x the vehicle's state.
+/// \return the contact wrench (body axes, about the CO [N, N m]), the total force (NED [N])
+/// and the number of contact points in touch.
 template <typename Scalar>
 HullContactLoad<Scalar> hull_contact(const HullContact<Scalar>& hull,
                                      const environment::Environment<Scalar>& env,

@@ -106,7 +106,7 @@ struct CatenaryOptions {
   double seabed_depth = std::numeric_limits<double>::infinity();
   /// Ceres path only (kelp/ceres/catenary_solver.hpp): the solution is accepted (status converged)
   /// when max(|R1|, |R2|)/L ≤ residual_tolerance, otherwise the status is max_iterations. The
-  /// default leaves a margin under the 1e-10 for the double evaluation of the residual
+  /// default leaves a margin under the required 1e-10 for the double evaluation of the residual
   /// itself (≈ 1e-12 near taut).
   double residual_tolerance = 1e-11;
   /// Ceres path only: Levenberg–Marquardt stops once max |R_i| is about target_residual·L
@@ -750,7 +750,7 @@ class CatenaryShape {
 
  private:
   /// The queries' check of their arc length: a NaN s has no point on the line, and would give
-  /// NaN for every status (the probe found it answered silently with NaN).
+  /// NaN for every status (it used to answer silently with NaN).
   static void check_arc_length(const Scalar& s) {
     if (!is_finite(s))
       ::kelp::detail::throw_invalid_argument("CatenaryShape: arc length s must be finite");

@@ -311,7 +311,7 @@ class TetherModel {
   /// separation, so two coinciding nodes stick, and an implicit step in which they would pass
   /// through each other has no solution at all (in one dimension: the nodes cannot cross
   /// without being stopped by the damping, nor be stopped before crossing without it); Newton's
-  /// method then fails at any sub-step (issue 24: the boat's attachment point running through
+  /// method then fails at any sub-step (seen with the boat's attachment point running through
   /// the first node of a slack line in a rough sea). With the fade the damping force near
   /// l_s = 0 is (BA/l)(3/l_f²)(d·e) d (d = x_{s+1} − x_s), smooth. Physically a segment folded to
   /// a tenth of its rest length is a heap of slack cable whose chord rate is no strain rate of

@@ -21,6 +21,7 @@ namespace kelp::vehicle {
 /// \param[in] magnitudes the six positive magnitudes [kg, kg, kg, kg m², kg m², kg m²].
 /// \throws kelp::invalid_argument naming `added_mass` if there are not 6 magnitudes or a
 /// magnitude is negative or not finite.
+/// \return M_A (body axes), diagonal, with the magnitudes on its diagonal.
 template <typename Derived>
 Matrix6<typename Derived::Scalar> diagonal_added_mass(
     const Eigen::MatrixBase<Derived>& magnitudes) {
@@ -31,6 +32,7 @@ Matrix6<typename Derived::Scalar> diagonal_added_mass(
 }
 
 /// \brief Checks a full added-mass matrix: finite, symmetric, positive semi-definite.
+/// \param M_a the 6×6 added-mass matrix (body axes; kg, kg m, kg m²).
 /// \throws kelp::invalid_argument naming `added_mass`.
 template <typename Derived>
 void check_added_mass(const Eigen::MatrixBase<Derived>& M_a) {
@@ -41,6 +43,7 @@ void check_added_mass(const Eigen::MatrixBase<Derived>& M_a) {
 /// Theorem 3.2 applied to M_A; §6.3), evaluated at the velocity relative to the current.
 /// \param[in] M_a added-mass matrix (positive magnitudes), body axes.
 /// \param[in] nu_r ν_r = ν − ν_c [m/s, rad/s], body axes.
+/// \return C_A(ν_r), body axes (skew-symmetric; no check, no throw).
 template <typename DerivedM, typename DerivedNu>
 Matrix6<typename DerivedM::Scalar> added_mass_coriolis_matrix(
     const Eigen::MatrixBase<DerivedM>& M_a, const Eigen::MatrixBase<DerivedNu>& nu_r) {

@@ -71,6 +71,7 @@ struct BatteryParameters {
 /// are positive, the resistance and the hotel current non-negative, the initial SoC in [0, 1]
 /// and the OCV curve has 2 … max_points points, SoC ascending from 0 to 1, finite positive
 /// non-decreasing voltages.
+/// \param p the battery's parameters.
 inline void validate(const BatteryParameters& p) {
   check_positive(p.capacity_ah, "battery.capacity_ah");
   KELP_CHECK(p.cells_in_series >= 1 && p.cells_in_series <= 1000,
@@ -105,12 +106,14 @@ struct BatteryState {
 
 /// \brief State of charge [−] of `s`: initial_soc − charge_drawn / (3600 capacity_ah). Below 0
 /// when the pack has been drawn past its rated capacity (OCV then stays at its SoC-0 value).
+/// \param p the battery. \param s what it has delivered. \return the SoC, 1 full, 0 empty.
 inline double state_of_charge(const BatteryParameters& p, const BatteryState& s) {
   return p.initial_soc - s.charge_drawn / (3600.0 * p.capacity_ah);
 }
 
 /// \brief The pack's open-circuit voltage [V] at state of charge `soc` (clamped to [0, 1]):
 /// cells_in_series × the cell curve, linear between its points.
+/// \param p the battery. \param soc state of charge [−]. \return the OCV [V].
 inline double open_circuit_voltage(const BatteryParameters& p, double soc) {
   const OcvCurve& c = p.ocv;
   const double x = soc < 0.0 ? 0.0 : (soc > 1.0 ? 1.0 : soc);
@@ -124,6 +127,8 @@ inline double open_circuit_voltage(const BatteryParameters& p, double soc) {
 
 /// \brief Terminal voltage [V] under a current `current` [A] (discharge positive):
 /// OCV(SoC) − R I.
+/// \param p the battery. \param s its state (the SoC). \param current the load [A].
+/// \return the terminal voltage [V] (negative only for absurd currents; not clamped).
 inline double terminal_voltage(const BatteryParameters& p, const BatteryState& s, double current) {
   return open_circuit_voltage(p, state_of_charge(p, s)) - p.internal_resistance * current;
 }
@@ -139,7 +144,10 @@ inline double terminal_voltage(const BatteryParameters& p, const BatteryState& s
 /// step's voltage instead (an explicit lag of one step) would ring from step to step; this solves
 /// the coupling within the step. The returned voltage is always the point of the last load
 /// evaluation (a caller may keep what its load computed there).
+/// \tparam Load a callable `double(double V)`.
+/// \param[in] p the battery. \param[in] s its state (the SoC, hence the OCV).
 /// \param[in] load `double(double V)`, the load's current [A] at terminal voltage V (≥ 0).
+/// \param[in] guess a starting voltage [V] (NaN: start from the OCV).
 /// \returns V [V]; 0 when even at 0 V the load pulls the pack below 0.
 /// \throws kelp::numerical_error when the load returns a non-finite or negative current.
 template <typename Load>
@@ -203,6 +211,8 @@ double solve_terminal_voltage(const BatteryParameters& p, const BatteryState& s,
 
 /// \brief Draws `current` [A] at terminal voltage `voltage` [V] for `dt` [s]: the counters grow by
 /// I dt and V I dt (exact for a load held over the step); the state records V and I.
+/// \param s the battery's state, updated. \param current the load [A] (discharge positive).
+/// \param voltage the terminal voltage [V]. \param dt the step [s].
 inline void drain(BatteryState& s, double current, double voltage, double dt) {
   s.charge_drawn += current * dt;
   s.energy_drawn += voltage * current * dt;
@@ -218,12 +228,14 @@ namespace battery_presets {
 /// cells have ~20–30 mΩ DC resistance, a 4S pack of parallel groups ≈ 20–30 mΩ, plus ~10 mΩ of
 /// wiring, connectors and the power sense module). No hotel load (set `hotel_current` for the
 /// electronics and lights).
+/// \return the pack's parameters.
 inline BatteryParameters bluerov2_battery() { return BatteryParameters{}; }
 
 /// \brief The BlueBoat's pack: two bluerov2_battery() packs in parallel (31.2 Ah, 20 mΩ).
 /// Assumed from Blue Robotics' BlueBoat, which carries two of its 14.8 V Li-ion batteries wired
 /// in parallel (the product page was not available to check; the capacity scales linearly with
 /// the packs' number, their resistance inversely).
+/// \return the pack's parameters.
 inline BatteryParameters blueboat_battery() {
   BatteryParameters p;
   p.capacity_ah = 2 * 15.6;

@@ -26,6 +26,7 @@ struct DampingParameters {
   Vector6<Scalar> quadratic = Vector6<Scalar>::Zero();
 
   /// \brief The same coefficients in another scalar type.
+  /// \tparam T the new scalar (float, double, ceres::Jet). \return the converted coefficients.
   template <typename T>
   DampingParameters<T> cast() const {
     DampingParameters<T> out;
@@ -49,6 +50,7 @@ void validate(const DampingParameters<Scalar>& d) {
 /// \brief Damping matrix D(ν_r) = D_L + diag(d ∘ |ν_r|) (Fossen 2021, §6.4:
 /// linear plus quadratic "|ν|ν" drag).
 /// \param[in] p coefficients. \param[in] nu_r velocity relative to the current [m/s, rad/s], body.
+/// \return D(ν_r), body axes (no check, no throw).
 template <typename Scalar, typename Derived>
 Matrix6<Scalar> damping_matrix(const DampingParameters<Scalar>& p,
                                const Eigen::MatrixBase<Derived>& nu_r) {
@@ -61,6 +63,7 @@ Matrix6<Scalar> damping_matrix(const DampingParameters<Scalar>& p,
 /// \brief Damping force D(ν_r) ν_r [N, N m], body axes, computed without forming D. It enters the
 /// equation of motion on the left-hand side (it resists motion relative to the water).
 /// \param[in] p coefficients. \param[in] nu_r velocity relative to the current [m/s, rad/s], body.
+/// \return D(ν_r) ν_r [N, N m], body axes (no check, no throw).
 template <typename Scalar, typename Derived>
 Vector6<Scalar> damping_force(const DampingParameters<Scalar>& p,
                               const Eigen::MatrixBase<Derived>& nu_r) {

@@ -101,6 +101,7 @@ struct VehicleParameters {
   Scalar buoyancy() const { return density * gravity * displaced_volume; }
 
   /// \brief The same parameters in another scalar type (e.g. double → ceres::Jet).
+  /// \tparam T the new scalar. \return the converted parameters.
   template <typename T>
   VehicleParameters<T> cast() const {
     VehicleParameters<T> o;

@@ -14,6 +14,10 @@ namespace kelp::vehicle {
 /// environment::SurfaceHydrostatics (for the paper's
 /// wave_restoring()/surface_following_restoring()), so that the vehicle preset stays the one copy
 /// of the hull data.
+/// \tparam Scalar the parameters' scalar (the hydrostatics are doubles: value parts).
+/// \param p a surface vessel's parameters (waterplane area, displaced volume, metacentric
+/// heights, its water's density and gravity).
+/// \return the hydrostatics (SI units).
 template <typename Scalar>
 environment::SurfaceHydrostatics surface_hydrostatics(const VehicleParameters<Scalar>& p) {
   environment::SurfaceHydrostatics h;

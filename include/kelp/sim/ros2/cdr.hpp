@@ -61,6 +61,7 @@ class KELP_SIM_API CdrWriter {
   }
 
  private:
+  /// \cond PRIVATE
   template <class T>
   struct is_std_array : std::false_type {};
   template <class T, std::size_t N>
@@ -68,6 +69,7 @@ class KELP_SIM_API CdrWriter {
   void align(std::size_t a);
   void put(const void* p, std::size_t n);
   std::vector<std::uint8_t>& out_;
+  /// \endcond
 };
 
 /// \brief Reads a message back from its CDR bytes (tests, and a check of what was written).
@@ -114,6 +116,7 @@ class KELP_SIM_API CdrReader {
   std::size_t remaining() const { return n_ - pos_; }
 
  private:
+  /// \cond PRIVATE
   template <class T>
   struct is_std_array : std::false_type {};
   template <class T, std::size_t N>
@@ -122,6 +125,7 @@ class KELP_SIM_API CdrReader {
   void need(std::size_t k) const;
   const std::uint8_t* data_;
   std::size_t n_, pos_;
+  /// \endcond
 };
 
 /// \brief Message `m` as CDR bytes (encapsulation header included) in `out` (cleared first;

@@ -47,7 +47,7 @@ struct FleetVehicleSample {
   /// Its acceleration ν̇ (body FRD) for the IMU's specific force; NaN: unknown.
   Eigen::Matrix<double, 6, 1> nu_dot =
       Eigen::Matrix<double, 6, 1>::Constant(std::numeric_limits<double>::quiet_NaN());
-  int thrusters = 0;                ///< number of thrusters (0: no /<v>/thrusters topic)
+  int thrusters = 0;                ///< number of thrusters (0: no /{v}/thrusters topic)
   const double* thrust = nullptr;   ///< each thruster's thrust [N] (`thrusters` values)
   const double* command = nullptr;  ///< each thruster's command in [−1, 1] (`thrusters` values)
   Eigen::Vector3d size = Eigen::Vector3d::Constant(0.5);  ///< display box, body x, y, z [m]
@@ -89,10 +89,10 @@ struct FleetSample {
 struct FleetMessages {
   rosgraph_msgs::Clock clock;                            ///< /clock
   tf2_msgs::TFMessage tf;                                ///< /tf
-  std::vector<nav_msgs::Odometry> odom;                  ///< /<v>/odom, per vehicle
-  std::vector<sensor_msgs::Imu> imu;                     ///< /<v>/imu, per vehicle
-  std::vector<sensor_msgs::JointState> thrusters;        ///< /<v>/thrusters, per vehicle
-  std::vector<geometry_msgs::WrenchStamped> end_forces;  ///< /<t>/end_forces: 2 per tether
+  std::vector<nav_msgs::Odometry> odom;                  ///< /{v}/odom, per vehicle
+  std::vector<sensor_msgs::Imu> imu;                     ///< /{v}/imu, per vehicle
+  std::vector<sensor_msgs::JointState> thrusters;        ///< /{v}/thrusters, per vehicle
+  std::vector<geometry_msgs::WrenchStamped> end_forces;  ///< /{t}/end_forces: 2 per tether
   visualization_msgs::MarkerArray markers;               ///< /markers
   /// Each vehicle's body frame, `<v>/base_link` (kept here, so that a sample allocates nothing).
   std::vector<std::string> frames;

@@ -83,11 +83,11 @@ struct McapOptions {
 ///
 /// Each completed chunk is written with its message indexes in one system call (writev) before
 /// the next message is gathered: a process killed mid-run (SIGKILL) leaves a file without summary
-/// and footer that ends after a whole chunk and its indexes, which a streaming reader (@mcap/core's
-/// McapStreamReader) reads to the end, every message of every completed chunk; only the open
-/// chunk (at most `chunk_size` bytes) is lost. Only a kill while the kernel copies a chunk (Linux
-/// checks for one between pages) can cut it. An indexed reader needs the footer, which close()
-/// writes.
+/// and footer that ends after a whole chunk and its indexes, which a streaming reader (the
+/// McapStreamReader of \@mcap/core) reads to the end, every message of every completed chunk; only
+/// the open chunk (at most `chunk_size` bytes) is lost. Only a kill while the kernel copies a chunk
+/// (Linux checks for one between pages) can cut it. An indexed reader needs the footer, which
+/// close() writes.
 class KELP_SIM_API McapWriter {
  public:
   /// Options of a writer (McapOptions).
