@@ -70,6 +70,7 @@ class SampleClockT {
     return true;
   }
   /// \brief visit_memory(v): the last and next update times (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(last_, next_, started_)
 
  private:
@@ -115,6 +116,7 @@ class DisturbanceObserverT {
   /// \brief The current estimate d̂.
   const Vector6<Scalar>& estimate() const { return estimate_; }
   /// \brief visit_memory(v): the last navigation and the estimate (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(last_.position, last_.attitude, last_.nu, has_last_, estimate_)
 
  private:
@@ -428,11 +430,13 @@ class AuvControllerT {
   /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
   /// PIDs, the observer, the waypoints and the progress along them, the last command, the clock
   /// and the thrusters' supply voltage. For a run's checkpoint.
+  /// \tparam V a memory visitor \param v the visitor (one that restores)
   template <class V>
   void visit_memory(V& v) {
     memory(*this, v);
   }
   /// \brief visit_memory of a const controller (saving it).
+  /// \tparam V a memory visitor \param v the visitor (one that saves)
   template <class V>
   void visit_memory(V& v) const {
     memory(*this, v);
@@ -654,11 +658,13 @@ class AsvControllerT {
   /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
   /// PIDs, the observer, the target and its velocity, the course, the last command, the clock and
   /// the thrusters' supply voltage. For a run's checkpoint.
+  /// \tparam V a memory visitor \param v the visitor (one that restores)
   template <class V>
   void visit_memory(V& v) {
     memory(*this, v);
   }
   /// \brief visit_memory of a const controller (saving it).
+  /// \tparam V a memory visitor \param v the visitor (one that saves)
   template <class V>
   void visit_memory(V& v) const {
     memory(*this, v);

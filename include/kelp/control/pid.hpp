@@ -90,6 +90,7 @@ class Pid {
   const PidGains& gains() const { return gains_; }
   /// \brief visit_memory(v): the integral, the last output and error and their flags, for a
   /// run's checkpoint (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(integral_, output_, last_error_, has_last_, saturated_)
 
  private:

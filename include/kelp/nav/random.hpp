@@ -73,6 +73,7 @@ class RandomStream {
   /// \brief True with probability `p` (one uniform deviate).
   bool bernoulli(double p) { return uniform() < p; }
   /// \brief visit_memory(v): the engine's state and the spare deviate (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(engine_, spare_, has_spare_)
 
  private:

@@ -117,6 +117,7 @@ class SensorSchedule {
     next_ = t + p;
   }
   /// \brief visit_memory(v): the period and the next due time (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(period_, next_, started_)
 
  private:
@@ -207,6 +208,7 @@ class ImuSensor {
   const ImuParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream, the schedule and the biases
   /// (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(rng_, schedule_, gyro_bias_, accel_bias_)
 
  private:
@@ -247,6 +249,7 @@ class DepthSensor {
   double measure(double z) { return z + p_.bias + p_.noise * rng_.normal(); }
   const DepthParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(rng_, schedule_)
 
  private:
@@ -348,6 +351,7 @@ class Dvl {
   }
   const DvlParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(rng_, schedule_)
 
  private:
@@ -390,6 +394,7 @@ class Compass {
   }
   const CompassParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(rng_, schedule_)
 
  private:
@@ -451,6 +456,7 @@ class Gps {
   const GpsParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream, the schedule and the slow error
   /// (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(rng_, schedule_, bias_)
 
  private:
@@ -551,11 +557,13 @@ class Usbl {
 
   /// \brief Visits the noise stream, the schedule, the fixes in flight and the counts
   /// (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor (one that restores)
   template <class V>
   void visit_memory(V& v) {
     memory(*this, v);
   }
   /// \brief visit_memory of a const Usbl (saving it).
+  /// \tparam V a memory visitor \param v the visitor (one that saves)
   template <class V>
   void visit_memory(V& v) const {
     memory(*this, v);

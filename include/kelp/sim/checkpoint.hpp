@@ -47,6 +47,8 @@ struct CheckpointInfo {
 
 /// \brief Reads the checkpoint at `path` (every byte checked: magic, version, kind, CRC-32) and
 /// returns what it says about its run, e.g. the scenario to resume it with.
+/// \param path the checkpoint file (e.g. a run directory's checkpoint.bin)
+/// \returns its run's scenario, steps, time and checkpoint interval
 /// \throws state_error for a missing file or one that is not a whole checkpoint of this kelp
 /// version; kelp::error when it cannot be read.
 KELP_SIM_API CheckpointInfo read_checkpoint_info(const std::string& path);

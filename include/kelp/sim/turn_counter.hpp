@@ -86,6 +86,7 @@ class TurnCounter {
   /// \brief Largest |turns()| so far.
   double max_abs_turns() const { return max_abs_; }
   /// \brief visit_memory(v): the azimuth, the angle and the counts (kelp/core/memory.hpp).
+  /// \tparam V a memory visitor \param v the visitor
   KELP_MEMORY(azimuth_, phi_, turns_, max_abs_, started_)
 
  private:
