@@ -110,25 +110,32 @@ class Environment {
   Environment() = default;
 
   /// \brief Still water: no current, no waves, no wind, seawater, standard gravity, no seabed.
+  /// \return a still-water environment.
   static Environment calm() { return Environment(); }
 
   /// \brief An id of this object's value, new for every environment made, copied or assigned: a
   /// step that kept results computed in an environment (the explicit tether steps' last
   /// evaluation) can tell it is still the same.
+  /// \return the id.
   std::uint64_t instance_id() const { return id_.value; }
 
   /// \brief Water density ρ [kg/m³].
+  /// \return ρ [kg/m³].
   Scalar water_density() const { return water_density_; }
   /// \brief Air density ρ_air [kg/m³].
+  /// \return ρ_air [kg/m³].
   Scalar air_density() const { return air_density_; }
   /// \brief Gravitational acceleration g [m/s²].
+  /// \return g [m/s²].
   Scalar gravity() const { return gravity_; }
   /// \brief NED z of a flat seabed [m] (> 0); +infinity when there is none.
+  /// \return the depth [m], or +∞.
   Scalar seabed_depth() const { return seabed_depth_; }
 
   /// \brief Sets the water density [kg/m³] (> 0, ≤ 1e5: `limits::max_fluid_density`, far above
   /// any liquid). \throws kelp::invalid_argument naming `water_density` and the value when it is
   /// not finite or not in (0, 1e5].
+  /// \param rho the density [kg/m³]. \return *this.
   Environment& set_water_density(Scalar rho) {
     detail::check_positive_at_most(value_of(rho), limits::max_fluid_density, "water_density",
                                    "finite and in (0, 1e5] kg/m^3");
@@ -138,6 +145,7 @@ class Environment {
   /// \brief Sets the air density [kg/m³] (> 0, ≤ 1e5: `limits::max_fluid_density`).
   /// \throws kelp::invalid_argument naming `air_density` and the value when it is not finite or
   /// not in (0, 1e5].
+  /// \param rho the density [kg/m³]. \return *this.
   Environment& set_air_density(Scalar rho) {
     detail::check_positive_at_most(value_of(rho), limits::max_fluid_density, "air_density",
                                    "finite and in (0, 1e5] kg/m^3");
@@ -147,6 +155,7 @@ class Environment {
   /// \brief Sets the gravitational acceleration [m/s²] (> 0, ≤ 1000: `limits::max_gravity`).
   /// \throws kelp::invalid_argument naming `gravity` and the value when it is not finite or not
   /// in (0, 1000], or when it differs from the wave field's gravity.
+  /// \param g the acceleration [m/s²]. \return *this.
   Environment& set_gravity(Scalar g) {
     detail::check_positive_at_most(value_of(g), limits::max_gravity, "gravity",
                                    "finite and in (0, 1000] m/s^2");
@@ -156,6 +165,7 @@ class Environment {
   }
   /// \brief Sets the NED z of a flat seabed [m] (> 0, or +infinity for none).
   /// \throws kelp::invalid_argument naming `seabed_depth`.
+  /// \param depth NED z of the seabed [m]. \return *this.
   Environment& set_seabed_depth(Scalar depth) {
     KELP_CHECK(!std::isnan(value_of(depth)) && value_of(depth) > 0.0,
                "seabed_depth must be > 0 (or +infinity for no seabed)");
@@ -164,11 +174,13 @@ class Environment {
   }
   /// \brief The obstacles (cylinders, boxes, a height-field seabed) the tether and the vehicles
   /// touch, or null when there are none (the contact passes then cost nothing).
+  /// \return a pointer valid until set_obstacles() or the last copy goes, or null.
   const ObstacleSet* obstacles() const {
     return obstacles_ && !obstacles_->empty() ? obstacles_.get() : nullptr;
   }
   /// \brief Sets the obstacles (copied once; copies of this environment share them, read-only).
   /// An empty set removes them. Allocates: call it at setup or between steps.
+  /// \param obstacles the set (checked when it was built). \return *this.
   Environment& set_obstacles(const ObstacleSet& obstacles) {
     obstacles_ = obstacles.empty() ? nullptr : std::make_shared<const ObstacleSet>(obstacles);
     return *this;
@@ -176,12 +188,14 @@ class Environment {
   /// \brief Sets a constant, depth-uniform current velocity, NED [m/s].
   /// \throws kelp::invalid_argument naming `current` when not finite.
   template <typename Derived>
+  /// \param v_ned the current, NED [m/s]. \return *this.
   Environment& set_current(const Eigen::MatrixBase<Derived>& v_ned) {
     current_ = CurrentModel<Scalar>::constant(v_ned);
     return *this;
   }
 
   /// \brief Sets the current model (speed, direction, depth profile, variation).
+  /// \param current the model. \return *this.
   Environment& set_current(const CurrentModel<Scalar>& current) {
     current_ = current;
     return *this;
@@ -190,12 +204,14 @@ class Environment {
   /// relation must use this environment's gravity; its `depth` should be the seabed depth (deep
   /// water, +∞, is an accepted approximation over any seabed deeper than about half a wavelength).
   /// \throws kelp::invalid_argument naming `waves.gravity` when the gravities differ.
+  /// \param waves the wave field. \return *this.
   Environment& set_waves(const WaveField<Scalar>& waves) {
     check_wave_gravity(waves, value_of(gravity_));
     waves_ = waves;
     return *this;
   }
   /// \brief Sets the wind field (a default-constructed `WindField` is no wind).
+  /// \param wind the wind field. \return *this.
   Environment& set_wind(const WindField<Scalar>& wind) {
     wind_ = wind;
     return *this;
@@ -203,6 +219,7 @@ class Environment {
   /// \brief Sets the start-up ramp T [s] (0: none, the default): the sea comes in over [0, T]
   /// (see the file's comment). \throws kelp::invalid_argument naming `ramp` when T is not finite
   /// or negative.
+  /// \param duration T [s]. \return *this.
   Environment& set_ramp(double duration) {
     KELP_CHECK(std::isfinite(duration) && duration >= 0.0,
                "ramp must be a finite, non-negative duration [s]");
@@ -210,6 +227,7 @@ class Environment {
     return *this;
   }
   /// \brief The start-up ramp's duration T [s] (0: none).
+  /// \return T [s].
   double ramp() const { return ramp_; }
   /// \brief The ramp factor r(t) ∈ [0, 1] at time t [s] and its rate ṙ(t) [1/s]:
   /// r = ½(1 − cos(π t/T)) on [0, T), 0 before, 1 from T on (and always 1 without a ramp).
@@ -225,12 +243,16 @@ class Environment {
   /// \brief True when the water is still everywhere and at all times (no wave components and no
   /// current), so that water velocity and acceleration are zero at every point: callers such as
   /// the tether may skip their water queries.
+  /// \return whether the water never moves.
   bool is_still_water() const { return waves_.empty() && current_.is_zero(); }
   /// \brief The current model.
+  /// \return a reference valid until the next set_current().
   const CurrentModel<Scalar>& current() const { return current_; }
   /// \brief The wave field.
+  /// \return a reference valid until the next set_waves().
   const WaveField<Scalar>& waves() const { return waves_; }
   /// \brief The wind field.
+  /// \return a reference valid until the next set_wind().
   const WindField<Scalar>& wind() const { return wind_; }
 
   /// \brief Everything at NED point `p_ned` [m] and time `t` [s]: current, wave orbital velocity
@@ -239,6 +261,9 @@ class Environment {
   /// point). \throws kelp::invalid_argument when a coordinate of p_ned is NaN or ±∞ (a point
   /// without a depth or a wave phase: no sample), or when t is not finite and a wave field, a
   /// varying current or gusts read it.
+  /// \param p_ned the point, NED [m]. \param t time [s]. \param with_wind whether to sum the gusts.
+  /// \return current and wave velocity [m/s] and acceleration [m/s²] (NED), elevation [m, up],
+  /// slope [-], wind [m/s] (NED).
   EnvironmentSample<Scalar> sample(const Vector3<Scalar>& p_ned, double t,
                                    bool with_wind = true) const {
     check_all_finite(p_ned, "Environment::sample: p_ned");
@@ -252,6 +277,8 @@ class Environment {
   /// state it is given once, up front). Same values as sample() for a finite point.
   /// \throws kelp::invalid_argument when t is not finite and a wave field, a varying current or
   /// gusts read it.
+  /// \param p_ned the point, NED [m]. \param t time [s]. \param with_wind whether to sum the gusts.
+  /// \return as sample().
   EnvironmentSample<Scalar> sample_unchecked(const Vector3<Scalar>& p_ned, double t,
                                              bool with_wind) const {
     EnvironmentSample<Scalar> s;
@@ -284,6 +311,7 @@ class Environment {
 
   /// \brief Free-surface elevation ζ(x, y, t) [m], positive up (x north, y east [m], t [s]).
   /// \throws kelp::invalid_argument when there are waves and t is not finite.
+  /// \param x north [m]. \param y east [m]. \param t time [s]. \return ζ [m].
   Scalar surface_elevation(Scalar x, Scalar y, double t) const {
     if (waves_.empty()) return Scalar(0);
     double rate = 0.0;
@@ -293,6 +321,7 @@ class Environment {
 
   /// \brief Free-surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t).
   /// \throws kelp::invalid_argument when there are waves and t is not finite.
+  /// \param x north [m]. \param y east [m]. \param t time [s]. \return (∂ζ/∂x, ∂ζ/∂y) [-].
   Eigen::Matrix<Scalar, 2, 1> surface_slope(Scalar x, Scalar y, double t) const {
     double rate = 0.0;
     const double r = ramp_factor(t, rate);
@@ -321,7 +350,11 @@ class Environment {
 
   /// \brief The same, plus the free-surface elevation ζ above each point [m] (positive up), from
   /// the same wave sums: much cheaper than calling `surface_elevation` for each point.
+  /// \param[in] points 3×n NED positions [m] \param[in] t time [s]
+  /// \param[out] velocity 3×n [m/s] \param[out] acceleration 3×n [m/s²]
   /// \param[out] elevation n values [m]
+  /// \throws kelp::invalid_argument as the four-argument sample_water, or when elevation has not
+  /// one entry per point.
   void sample_water(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                     Eigen::Ref<Matrix3X<Scalar>> velocity,
                     Eigen::Ref<Matrix3X<Scalar>> acceleration,
@@ -444,6 +477,7 @@ void check_same_water(double density, double gravity, const Environment<Scalar>&
 
 /// \brief Checks a wave field's gravity (its dispersion relation) against the environment (the
 /// same test `Environment::set_waves` makes). \throws kelp::invalid_argument
+/// \param waves the wave field. \param env the environment it is meant for.
 template <typename Scalar>
 void check_same_water(const WaveField<Scalar>& waves, const Environment<Scalar>& env) {
   check_same_water(value_of(env.water_density()), waves.parameters().gravity, env, "WaveField");

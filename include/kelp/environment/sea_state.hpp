@@ -79,6 +79,7 @@ struct SeaStateOptions {
 namespace presets {
 
 /// \brief Still water: no waves, wind or current.
+/// \return the sea state.
 inline SeaState calm() { return SeaState{}; }
 
 /// \brief Builds the paper's sea state from its table row (wave height read as Hs; see file).

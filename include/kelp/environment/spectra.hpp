@@ -37,6 +37,7 @@ struct WaveSpectrum {
 /// `kelp::environment::limits`; beyond them the spectral moments and the wave numbers of the
 /// discretised sea overflow, or the JONSWAP normalisation turns the spectrum negative).
 /// \throws kelp::invalid_argument when a field is NaN, infinite or out of those bounds.
+/// \param s the spectrum (kind, Hs [m], Tp [s], γ [-]).
 inline void validate(const WaveSpectrum& s) {
   detail::check_in_range(s.significant_height, 0.0, limits::max_significant_height,
                          "significant_height", "finite and in [0, 100] m");
@@ -68,6 +69,7 @@ void check_spectrum_arguments(const Scalar& omega, const Scalar& hs, const Scala
 /// (also when ω_p/ω overflows, e.g. for a tiny Tp), never ∞ · 0 = NaN.
 /// \throws kelp::invalid_argument when ω is NaN, Hs is negative or not finite, Tp is not finite
 /// and > 0, or S(ω) overflows (Hs so large that Hs² is not finite).
+/// \return S(ω) [m² s / rad], ≥ 0.
 template <typename Scalar>
 Scalar pierson_moskowitz(const Scalar& omega, const Scalar& hs, const Scalar& tp) {
   using std::exp;
@@ -91,6 +93,7 @@ Scalar pierson_moskowitz(const Scalar& omega, const Scalar& hs, const Scalar& tp
 /// which makes the JONSWAP variance Hs²/16 to within about 1 % for 1 ≤ γ ≤ 7.
 /// \throws kelp::invalid_argument unless 1 ≤ γ ≤ 20 (`limits::max_peak_enhancement`; γ < 1 is
 /// not a peak enhancement, and A_γ reaches 0 at γ ≈ 32.6).
+/// \param gamma the peak enhancement γ [-]. \return A_γ [-], in (0.14, 1].
 inline double jonswap_normalisation(double gamma) {
   detail::check_in_range(gamma, 1.0, limits::max_peak_enhancement, "peak_enhancement",
                          "finite and in [1, 20]");
@@ -105,6 +108,7 @@ inline double jonswap_normalisation(double gamma) {
 /// \param[in] omega [rad/s] \param[in] hs [m] \param[in] tp [s] \param[in] gamma γ [-] (1–20)
 /// \throws kelp::invalid_argument when ω is NaN, Hs is negative or not finite, Tp is not finite
 /// and > 0, or γ is not in [1, 20] (γ = 0 or NaN included).
+/// \return S_J(ω) [m² s / rad], ≥ 0.
 template <typename Scalar>
 Scalar jonswap(const Scalar& omega, const Scalar& hs, const Scalar& tp, double gamma) {
   using std::exp;
@@ -123,6 +127,8 @@ Scalar jonswap(const Scalar& omega, const Scalar& hs, const Scalar& tp, double g
 
 /// \brief S(ω) of a `WaveSpectrum` [m² s / rad] (0 for ω ≤ 0).
 /// \throws kelp::invalid_argument as `pierson_moskowitz` / `jonswap` (NaN ω, bad Hs, Tp or γ).
+/// \param s the spectrum. \param omega angular frequency [rad/s].
+/// \return S(ω) [m² s / rad], ≥ 0.
 inline double spectral_density(const WaveSpectrum& s, double omega) {
   if (s.kind == SpectrumKind::pierson_moskowitz)
     return pierson_moskowitz(omega, s.significant_height, s.peak_period);
@@ -140,6 +146,7 @@ inline double spectral_density(const WaveSpectrum& s, double omega) {
 /// \param[in] depth water depth h [m] (> 0, +∞ for deep water)
 /// \throws kelp::invalid_argument when ω or g is not finite and > 0, the depth is NaN or ≤ 0,
 /// or the wave number ω²/g overflows or underflows (is not finite and > 0; e.g. ω = 1e200).
+/// \return k [rad/m], > 0.
 inline double wave_number(double omega, double g, double depth) {
   check_positive(omega, "omega");
   check_positive(g, "gravity");
@@ -169,6 +176,8 @@ inline double wave_number(double omega, double g, double depth) {
 /// ω = √(g k tanh(k h)) (deep water when h = +∞).
 /// \throws kelp::invalid_argument when k is negative or not finite, g is not finite and > 0, the
 /// depth is NaN or ≤ 0, or g k overflows.
+/// \param k wave number [rad/m]. \param g gravity [m/s²]. \param depth water depth h [m] (+∞:
+/// deep water). \return ω [rad/s], ≥ 0.
 inline double wave_frequency(double k, double g, double depth) {
   check_non_negative(k, "wave number k");
   check_positive(g, "gravity");

@@ -350,6 +350,8 @@ inline void wave_accumulate(const WaveComponentsView& c, WaveBlock& b, int m, do
   KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_avx2_exact) \
   KELP_WAVE_KERNEL_INSTANCES_AVX512_EXACT(prefix)
 #else
+/// \brief The double-precision wave kernels of this build, instantiated with `prefix`
+/// (`template` or `extern template`): here only the portable one (no x86 dispatch).
 #define KELP_WAVE_KERNEL_INSTANCES(prefix) \
   KELP_WAVE_KERNEL_INSTANCE(prefix, wave_accumulate_baseline)
 #endif

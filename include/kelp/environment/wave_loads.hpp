@@ -24,6 +24,7 @@ namespace environment {
 /// \param[in] rho water density [kg/m³] \param[in] displaced_volume the wet volume ∇ [m³] (times
 /// the submerged fraction for a body crossing the surface) \param[in] acceleration the water's
 /// acceleration a [m/s²], in the frame wanted for the force.
+/// \return F_FK [N], in the acceleration's frame.
 template <typename Scalar, typename Derived>
 Vector3<Scalar> froude_krylov_force(const Scalar& rho, const Scalar& displaced_volume,
                                     const Eigen::MatrixBase<Derived>& acceleration) {

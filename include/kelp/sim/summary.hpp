@@ -181,10 +181,13 @@ struct RunSummary {
 };
 
 /// \brief The summary as JSON text (objects' keys sorted), as summary.json holds it.
-/// \param[in] indent spaces per level, or -1 for one line.
+/// \param[in] s the summary. \param[in] indent spaces per level, or -1 for one line.
+/// \return the JSON text (UTF-8; SI units, as the summary's fields say).
 KELP_SIM_API std::string summary_json(const RunSummary& s, int indent = -1);
 
 /// \brief The solver's summary as JSON text (`tether_solver`'s object).
+/// \param[in] s the solver's summary. \param[in] indent spaces per level, or -1 for one line.
+/// \return the JSON text.
 KELP_SIM_API std::string solver_summary_json(const SolverSummary& s, int indent = -1);
 
 }  // namespace sim

@@ -49,10 +49,13 @@ class TurnCounter {
 
   /// \brief A counter that takes the tether's direction over `reference_length` [m] of line
   /// (default 2 m; 0: the attachment's own segment).
+  /// \param reference_length the length of line [m], ≥ 0.
   explicit TurnCounter(double reference_length = 2.0) : reference_(reference_length) {}
 
   /// \brief Updates the count with the vehicle state `vehicle` and the tether state `tether`,
   /// whose node `node` is the vehicle's attachment (0 or the last node).
+  /// \param vehicle the vehicle's state (NED attitude). \param tether the tether's state (NED
+  /// node positions [m]). \param node the attachment node's index.
   void update(const vehicle::VehicleStated& vehicle, const tether::TetherStated& tether, int node) {
     const Matrix3<double> r = vehicle.attitude.toRotationMatrix();
     const double heading = std::atan2(r(1, 0), r(0, 0));
@@ -82,8 +85,9 @@ class TurnCounter {
   }
 
   /// \brief Net turns since the first update (signed; clockwise seen from above is positive).
+  /// \return turns [-] (1 = 2π rad).
   double turns() const { return turns_; }
-  /// \brief Largest |turns()| so far.
+  /// \brief Largest |turns()| so far. \return turns [-].
   double max_abs_turns() const { return max_abs_; }
   /// \brief visit_memory(v): the azimuth, the angle and the counts (kelp/core/memory.hpp).
   /// \tparam V a memory visitor \param v the visitor

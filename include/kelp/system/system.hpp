@@ -140,6 +140,8 @@ struct SystemParameters {
 
 /// \brief Checks system parameters (the parts' own checks, kinematic tether ends, attachment
 /// points, the tether sub-step). \throws kelp::invalid_argument naming the field.
+/// \param p the parameters (vehicles, tether, attachment points in the body frames [m], the
+/// longest tether sub-step [s], propulsion, winch, hulls).
 template <typename Scalar>
 void validate(const SystemParameters<Scalar>& p) {
   vehicle::validate(p.asv);
@@ -168,6 +170,9 @@ void validate(const SystemParameters<Scalar>& p) {
 template <typename Scalar>
 class SystemModel {
  public:
+  /// \brief Builds the parts (vehicle models, tether model, propulsion, winch) once.
+  /// \param p the parameters (validate()). \param env the environment, copied.
+  /// \throws kelp::invalid_argument naming the field, or the vehicle whose water differs.
   SystemModel(const SystemParameters<Scalar>& p, const environment::Environment<Scalar>& env)
       : parameters_((validate(p), p)),
         environment_(env),
@@ -180,7 +185,11 @@ class SystemModel {
     if (p.auv_propulsion) auv_propulsion_.emplace(*p.auv_propulsion);
     if (p.winch) winch_.emplace(p.tether, *p.winch);
   }
+  /// \brief The parameters the system was built from. \return a reference valid as long as
+  /// the model.
   const SystemParameters<Scalar>& parameters() const { return parameters_; }
+  /// \brief The environment the system steps in. \return a reference valid until
+  /// set_environment().
   const environment::Environment<Scalar>& environment() const { return environment_; }
 
   /// \brief Replaces the environment of a built (possibly running) system: the sea state,
@@ -192,6 +201,7 @@ class SystemModel {
   /// not inside one).
   /// \throws kelp::invalid_argument naming the vehicle whose water differs; the system keeps its
   /// old environment then (strong guarantee).
+  /// \param env the new environment (same water density and gravity as the vehicles').
   void set_environment(const environment::Environment<Scalar>& env) {
     vehicle::check_same_water(asv_, env, "asv");
     vehicle::check_same_water(auv_, env, "auv");
@@ -199,22 +209,32 @@ class SystemModel {
     environment_ = std::move(copy);
   }
 
+  /// \brief The surface vehicle's model. \return a reference valid as long as the model.
   const vehicle::VehicleModel<Scalar>& asv() const { return asv_; }
+  /// \brief The underwater vehicle's model. \return a reference valid as long as the model.
   const vehicle::VehicleModel<Scalar>& auv() const { return auv_; }
+  /// \brief The tether's model at its initial node count (see tether_of() with a winch).
+  /// \return a reference valid as long as the model.
   const tether::TetherModel<Scalar>& tether() const { return tether_; }
   /// \brief The winch and its line at every node count (null without a winch).
+  /// \return a pointer valid as long as the model, or null.
   const tether::WinchModel<Scalar>* winch() const { return winch_ ? &*winch_ : nullptr; }
   /// \brief The tether model of `state`: tether() without a winch, else the winch's line with
   /// the state's node count.
+  /// \tparam State a SystemState (anything with a `tether` state).
+  /// \param state the state whose node count selects the model.
+  /// \return a reference valid as long as the model.
   template <typename State>
   const tether::TetherModel<Scalar>& tether_of(const State& state) const {
     return winch_ ? winch_->line_of(state.tether) : tether_;
   }
   /// \brief The ASV's propulsion, or null when the system has none for it.
+  /// \return a pointer valid as long as the model, or null.
   const vehicle::PropulsionModel<Scalar>* asv_propulsion() const {
     return asv_propulsion_ ? &*asv_propulsion_ : nullptr;
   }
   /// \brief The AUV's propulsion, or null when the system has none for it.
+  /// \return a pointer valid as long as the model, or null.
   const vehicle::PropulsionModel<Scalar>* auv_propulsion() const {
     return auv_propulsion_ ? &*auv_propulsion_ : nullptr;
   }
@@ -252,6 +272,7 @@ struct SystemState {
   vehicle::PropulsionState<Scalar> auv_propulsion;  ///< the AUV's; see asv_propulsion
   /// \brief Sets the clock of the system and of its parts to `t` [s] (e.g. to start a run at
   /// another time than 0).
+  /// \param t the time [s].
   void set_time(double t) {
     time = t;
     asv.time = t;
@@ -297,7 +318,7 @@ struct SystemEnergy {
   Scalar asv = Scalar(0);
   Scalar auv = Scalar(0);     ///< AUV, as `asv`
   Scalar tether = Scalar(0);  ///< tether: kinetic + elastic + weight and buoyancy (tether_energy)
-  /// \brief The sum of the parts.
+  /// \brief The sum of the parts. \return asv + auv + tether [J].
   Scalar total() const { return asv + auv + tether; }
 };
 
@@ -348,15 +369,21 @@ struct SystemReport {
 /// \brief Preallocated buffers of a system step.
 template <typename Scalar>
 struct SystemWorkspace {
-  vehicle::VehicleWorkspace<Scalar> asv, auv;  ///< vehicle buffers
-  tether::TetherWorkspace<Scalar> tether;      ///< tether buffers
+  /// \brief The vehicles' buffers (ASV, AUV).
+  ///@{
+  vehicle::VehicleWorkspace<Scalar> asv, auv;
+  ///@}
+  tether::TetherWorkspace<Scalar> tether;  ///< tether buffers
   /// The tether state at the start of a step, restored if the step fails.
   tether::StateBackup<Scalar> tether_backup;
   /// With a winch: the tether buffers of every node count (tether::WinchWorkspace); `tether`
   /// holds the current count's, swapped in and out as the winch re-meshes.
   std::optional<tether::WinchWorkspace<Scalar>> winch;
 
+  /// \brief An empty workspace (build one from the model before stepping).
   SystemWorkspace() = default;
+  /// \brief Buffers sized for `model` (allocates; step() then allocates nothing).
+  /// \param model the system to be stepped with this workspace.
   explicit SystemWorkspace(const SystemModel<Scalar>& model) : tether(model.tether()) {
     tether_backup.resize(model.tether().nodes());
     if (model.winch()) winch.emplace(*model.winch());
@@ -372,6 +399,7 @@ struct SystemWorkspace {
 /// bit (the workspace holds scratch only).
 /// \throws kelp::invalid_argument when the state's node count is outside the winch's range or
 /// the workspace was built for another system.
+/// \param model the system. \param ws its workspace, refitted. \param state the state to step.
 template <typename Scalar>
 void fit_workspace(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
                    const SystemState<Scalar>& state) {
@@ -701,6 +729,11 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
 /// needs no more).
 /// \throws kelp::invalid_argument for bad vehicle states; kelp::numerical_error when the tether's
 /// static solve does not converge.
+/// \param model the system. \param ws its workspace (the static solve's buffers).
+/// \param asv the surface vehicle's state (NED pose, body velocity), copied as given.
+/// \param auv the underwater vehicle's state, likewise. \param t the start time [s].
+/// \param options the tether's static solve (tolerance, iterations).
+/// \return the state, every part's clock at `t`.
 template <typename Scalar>
 SystemState<Scalar> initial_state(const SystemModel<Scalar>& model, SystemWorkspace<Scalar>& ws,
                                   const vehicle::VehicleState<Scalar>& asv,

@@ -46,6 +46,7 @@ Vector6<Scalar> wrench_of_force(const vehicle::VehicleState<Scalar>& vehicle,
 /// carries no ν̇ (pass one through `EndMotion::acceleration` if the caller has it).
 /// \tparam Scalar double or float. \param[in] vehicle state \param[in] r_body point, body frame [m]
 /// \throws kelp::invalid_argument for a non-finite r_body or vehicle state, or a non-unit attitude.
+/// \return the point's position [m] and velocity [m/s], NED; acceleration zero.
 template <typename Scalar, typename Derived>
 tether::EndMotion<Scalar> attachment_motion(const vehicle::VehicleState<Scalar>& vehicle,
                                             const Eigen::MatrixBase<Derived>& r_body) {
@@ -59,6 +60,9 @@ tether::EndMotion<Scalar> attachment_motion(const vehicle::VehicleState<Scalar>&
 /// moment about the CO). Add it to the vehicle's τ.
 /// \throws kelp::invalid_argument for a non-finite r_body, force or vehicle state, or a non-unit
 /// attitude.
+/// \param[in] vehicle the vehicle's state. \param[in] r_body the point, body frame [m].
+/// \param[in] force_ned the force on the vehicle at that point, NED [N].
+/// \return τ [N, N m], body axes, moment about the CO.
 template <typename Scalar, typename D1, typename D2>
 Vector6<Scalar> attachment_wrench(const vehicle::VehicleState<Scalar>& vehicle,
                                   const Eigen::MatrixBase<D1>& r_body,
@@ -71,6 +75,11 @@ Vector6<Scalar> attachment_wrench(const vehicle::VehicleState<Scalar>& vehicle,
 
 /// \brief Boundary of a tether whose start end is at `r_start_body` on `start` (e.g. the ASV) and
 /// whose far end is at `r_end_body` on `end` (e.g. the AUV).
+/// \param[in] start the start end's vehicle state. \param[in] r_start_body its attachment point,
+/// body frame [m]. \param[in] end the far end's vehicle state. \param[in] r_end_body its
+/// attachment point, body frame [m].
+/// \return both ends' motions (NED positions [m] and velocities [m/s]), as attachment_motion.
+/// \throws kelp::invalid_argument as attachment_motion.
 template <typename Scalar, typename D1, typename D2>
 tether::TetherBoundary<Scalar> tether_boundary(const vehicle::VehicleState<Scalar>& start,
                                                const Eigen::MatrixBase<D1>& r_start_body,

@@ -31,6 +31,7 @@ struct PoseRate {
 /// \brief Quaternion kinematics: ṗ = R(q) ν₁, q̇ = ½ q ⊗ (0, ν₂) (Fossen 2021, §2.2.2).
 /// \param[in] attitude unit quaternion body → NED. \param[in] nu ν = (u, v, w, p, q, r)
 /// [m/s, rad/s], body axes.
+/// \return ṗ (NED [m/s]) and q̇ (coeffs() order [1/s]).
 template <typename Scalar, typename Derived>
 PoseRate<Scalar> pose_rate(const Quaternion<Scalar>& attitude,
                            const Eigen::MatrixBase<Derived>& nu) {
@@ -51,6 +52,7 @@ PoseRate<Scalar> pose_rate(const Quaternion<Scalar>& attitude,
 /// squared norm is normal is divided by √(q·q) exactly as before.
 /// \throws nothing; a zero or non-finite quaternion is left as it is (the integrators refuse a
 /// step that ends with one: kelp::numerical_error, state unchanged).
+/// \param q the quaternion, normalised in place.
 template <typename Scalar>
 void renormalize(Quaternion<Scalar>& q) {
   using std::sqrt;

@@ -77,6 +77,8 @@ struct VehiclePreset {
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
 /// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
 /// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (see `validate(const VehicleParameters&)`).
+/// \return the parameters, the 8 thrusters' positions and directions (body frame [m]) and facing,
+/// and the PWM mapping.
 template <typename Scalar>
 VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_density),
                                      const Scalar& gravity = Scalar(standard_gravity)) {
@@ -166,6 +168,8 @@ VehiclePreset<Scalar> bluerov2_heavy(const Scalar& density = Scalar(seawater_den
 /// \param[in] density ρ [kg/m³]. \param[in] gravity g [m/s²].
 /// \throws kelp::invalid_argument naming `density` or `gravity` and the value unless ρ is in
 /// (0, 1e5] kg/m³ and g in (0, 1000] m/s² (the displaced volume is m/ρ).
+/// \return the parameters, the 2 thrusters' positions and directions (body frame [m]) and facing,
+/// and the PWM mapping.
 template <typename Scalar>
 VehiclePreset<Scalar> blueboat(const Scalar& density = Scalar(seawater_density),
                                const Scalar& gravity = Scalar(standard_gravity)) {

@@ -47,6 +47,7 @@ Vector6<Scalar> restoring_force(const Scalar& weight, const Scalar& buoyancy,
 /// Independent of yaw; equals restoring_force() for the same attitude.
 /// \param[in] weight W [N] \param[in] buoyancy B [N] \param[in] r_g CG [m], body
 /// \param[in] r_b CB [m], body \param[in] phi roll [rad] \param[in] theta pitch [rad]
+/// \return g(η) [N, N m], body axes.
 template <typename Scalar, typename DG, typename DB>
 Vector6<Scalar> restoring_force_euler(const Scalar& weight, const Scalar& buoyancy,
                                       const Eigen::MatrixBase<DG>& r_g,
@@ -73,6 +74,7 @@ Vector6<Scalar> restoring_force_euler(const Scalar& weight, const Scalar& buoyan
 /// \param[in] hull_height h [m], > 0
 /// \throws kelp::invalid_argument naming `hull_height` unless it is finite and > 0 (a parameter:
 /// the positions are not checked, a non-finite state is the integrators' to report).
+/// \return φ ∈ [0, 1].
 template <typename Scalar>
 Scalar submerged_fraction(const Scalar& z_cb, const Scalar& zeta, const Scalar& hull_height) {
   check_positive(hull_height, "hull_height");
@@ -136,6 +138,8 @@ Scalar restoring_potential_free_surface(const Scalar& weight, const Scalar& buoy
 
 /// \brief The local surface's downward normal n_s = (ζ_x, ζ_y, 1)/√(1 + ζ_x² + ζ_y²) in body axes,
 /// d = Rᵀ n_s ((R₃₁, R₃₂, R₃₃) on calm water), from the slope (∂ζ/∂x, ∂ζ/∂y) and R (body → NED).
+/// \param slope (∂ζ/∂x, ∂ζ/∂y) [-], NED. \param R rotation body → NED.
+/// \return d, a unit vector in body axes.
 template <typename Scalar, typename DS, typename DR>
 Vector3<Scalar> surface_normal_in_body(const Eigen::MatrixBase<DS>& slope,
                                        const Eigen::MatrixBase<DR>& R) {

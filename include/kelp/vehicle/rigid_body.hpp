@@ -15,6 +15,7 @@ namespace kelp::vehicle {
 /// \brief The system transformation matrix H(r) = [I₃ Sᵀ(r); 0 I₃] that moves a 6-DOF quantity
 /// from a point at `r` (body axes, relative to the CO) to the CO (Fossen 2021, §3.3, `Hmtrx`).
 /// \param[in] r lever arm [m], body axes.
+/// \return H(r), 6×6.
 template <typename Derived>
 Matrix6<typename Derived::Scalar> transformation_h(const Eigen::MatrixBase<Derived>& r) {
   using S = typename Derived::Scalar;
@@ -52,6 +53,7 @@ Matrix6<Scalar> rigid_body_mass_matrix(const Scalar& mass,
 /// \brief Rigid-body Coriolis–centripetal matrix C_RB(ν) = m2c(M_RB, ν) (Fossen 2021,
 /// Theorem 3.2). Uses the absolute velocity ν, not the relative one.
 /// \param[in] M_rb rigid-body mass matrix about the CO. \param[in] nu ν [m/s, rad/s], body axes.
+/// \return C_RB(ν), body axes (no check, no throw).
 template <typename DerivedM, typename DerivedNu>
 Matrix6<typename DerivedM::Scalar> rigid_body_coriolis_matrix(
     const Eigen::MatrixBase<DerivedM>& M_rb, const Eigen::MatrixBase<DerivedNu>& nu) {

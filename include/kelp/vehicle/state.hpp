@@ -25,15 +25,18 @@ struct VehicleState {
   double time = 0.0;
 
   /// \brief Rotation matrix body → NED.
+  /// \return R with v_NED = R v_body.
   Matrix3<Scalar> rotation() const { return attitude.toRotationMatrix(); }
 
   /// \brief NED position [m] of a point given in body coordinates `r_body` [m] relative to the CO.
+  /// \param r_body the point, body frame [m]. \return its position, NED [m].
   template <typename Derived>
   Vector3<Scalar> point_position(const Eigen::MatrixBase<Derived>& r_body) const {
     return position + attitude * Vector3<Scalar>(r_body);
   }
 
   /// \brief NED velocity [m/s] of a body-fixed point `r_body`: R (v + ω × r).
+  /// \param r_body the point, body frame [m]. \return its velocity, NED [m/s].
   template <typename Derived>
   Vector3<Scalar> point_velocity(const Eigen::MatrixBase<Derived>& r_body) const {
     const Vector3<Scalar> r(r_body);
@@ -42,8 +45,8 @@ struct VehicleState {
   }
 };
 
-using VehicleStated = VehicleState<double>;
-using VehicleStatef = VehicleState<float>;
+using VehicleStated = VehicleState<double>;  ///< \brief A double-precision vehicle state.
+using VehicleStatef = VehicleState<float>;   ///< \brief A single-precision vehicle state.
 
 /// \brief What the caller gives a vehicle for one step: wrenches held over the step
 /// (zero-order hold), body axes, about the CO. Built from its fields in order (`{tau}`,
@@ -60,12 +63,14 @@ struct VehicleInputs {
   VehicleInputs() = default;
   /// \brief The wrenches τ and τ_ext [N, N m] (a constructor rather than an aggregate, so that
   /// `{tau}` does not trip -Wmissing-field-initializers in users' builds).
+  /// \param tau_ the control wrench τ, body axes about the CO [N, N m].
+  /// \param tau_ext_ every other external wrench τ_ext, likewise.
   VehicleInputs(const Vector6<Scalar>& tau_,  // NOLINT(google-explicit-constructor)
                 const Vector6<Scalar>& tau_ext_ = Vector6<Scalar>::Zero())
       : tau(tau_), tau_ext(tau_ext_) {}
 };
 
-using VehicleInputsd = VehicleInputs<double>;
-using VehicleInputsf = VehicleInputs<float>;
+using VehicleInputsd = VehicleInputs<double>;  ///< \brief Double-precision vehicle inputs.
+using VehicleInputsf = VehicleInputs<float>;   ///< \brief Single-precision vehicle inputs.
 
 }  // namespace kelp::vehicle
