@@ -17,6 +17,7 @@
 #include "checkpoint.hpp"
 #include "fuzz_common.hpp"
 #include "kelp/sim/ros2/mcap.hpp"  // kelp::ros2::crc32
+#include "kelp/sim/version.hpp"
 #include "state_world.hpp"
 
 namespace {
@@ -26,7 +27,8 @@ namespace sim = kelp::sim;
 /// The first byte of the inputs.
 enum CheckpointInputFlags : std::uint8_t {
   sensors = 1,  ///< the scenario with navigation from sensors (else the true state)
-  seal = 2,     ///< payload length and CRC-32 rewritten to fit the rest (reach the sections)
+  seal = 2,     ///< the writer's version made this kelp's, the payload length and CRC-32
+                ///< rewritten to fit the rest (reach the sections; seeds outlive a release)
   step = 4,     ///< an accepted loop is stepped 3 times
 };
 
@@ -57,9 +59,15 @@ void put_le(std::string& b, std::size_t at, std::uint64_t v, int n) {
   for (int i = 0; i < n; ++i) b[at + std::size_t(i)] = static_cast<char>((v >> (8 * i)) & 0xFF);
 }
 
-// The payload's length and the CRC-32 set to fit the bytes (the archive's layout).
+// The writer's version set to this kelp's, then the payload's length and the CRC-32 set to fit
+// the bytes (the archive's layout: the version's length at byte 12, the version from byte 13).
 void reseal(std::string& b) {
   if (b.size() < 13) return;
+  const std::size_t n = static_cast<unsigned char>(b[12]);
+  if (b.size() >= 13 + n) {
+    const std::string v = sim::version();
+    b = b.substr(0, 12) + char(v.size()) + v + b.substr(13 + n);
+  }
   const std::size_t payload_at = 13 + static_cast<unsigned char>(b[12]) + 8;
   if (b.size() < payload_at + 4) return;
   put_le(b, payload_at - 8, b.size() - 4 - payload_at, 8);
