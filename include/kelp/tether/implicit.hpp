@@ -100,30 +100,29 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // dt.
   const int cols = model.nodes();
   {
+    // Eigen array expressions on local maps: the arithmetic of the packet loop this replaces,
+    // without its reloads of the constants through the closure after every store.
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
-    const Scalar *xn = state.position.data(), *vn = state.velocity.data();
-    const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
-    Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
-    const auto predict = [&](auto lanes, Eigen::Index j) {
-      using P = decltype(lanes);
-      const P xnj = P::load(xn + j), vnj = P::load(vn + j);
-      if (use_bdf2) {
-        const P vpj = P::load(vp + j);
-        const P xh = P::all(four_thirds) * xnj - P::all(third) * P::load(xp + j);
-        const P vg = P::all(Scalar(2)) * vnj - vpj;
-        xh.store(x0 + j);
-        (P::all(four_thirds) * vnj - P::all(third) * vpj).store(v0 + j);
-        vg.store(v1 + j);
-        (xh + P::all(gh) * vg).store(x1 + j);
-      } else {
-        const P vg = history ? P::all(Scalar(2)) * vnj - P::load(vp + j) : vnj;
-        xnj.store(x0 + j);
-        vnj.store(v0 + j);
-        vg.store(v1 + j);
-        (xnj + P::all(gh) * vg).store(x1 + j);
-      }
-    };
-    simd::for_each_pack<Scalar>(0, 3 * Eigen::Index(cols), predict);
+    const Eigen::Index len = 3 * Eigen::Index(cols);
+    using Flat = Eigen::Map<Eigen::Array<Scalar, Eigen::Dynamic, 1>>;
+    using ConstFlat = Eigen::Map<const Eigen::Array<Scalar, Eigen::Dynamic, 1>>;
+    const ConstFlat xn(state.position.data(), len), vn(state.velocity.data(), len);
+    const ConstFlat xp(state.previous_position.data(), len),
+        vp(state.previous_velocity.data(), len);
+    Flat x0(ws.x0.data(), len), v0(ws.v0.data(), len), x1(ws.x1.data(), len), v1(ws.v1.data(), len);
+    if (use_bdf2) {
+      x0 = four_thirds * xn - third * xp;
+      v0 = four_thirds * vn - third * vp;
+      v1 = Scalar(2) * vn - vp;
+    } else {
+      x0 = xn;
+      v0 = vn;
+      if (history)
+        v1 = Scalar(2) * vn - vp;
+      else
+        v1 = vn;
+    }
+    x1 = x0 + gh * v1;
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton
@@ -204,10 +203,13 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // to the scaled max-norm max_i |R_i|/a_i.
   const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& r_max,
                             bool with_jacobian) {
+    // The evaluation behind compute_forces, without its checks: the workspace and the state
+    // were checked once for the step, and a non-finite iterate shows in the residual's sum
+    // below (numerical_error: the step is retried).
     if (with_jacobian)
-      compute_forces<true>(model, ws, env, t1, x, v);
+      evaluate_forces<true>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr));
     else
-      compute_forces<false>(model, ws, env, t1, x, v);
+      evaluate_forces<false>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr));
     ++report.force_evaluations;
     // One vectorised pass over the free nodes: rhs = −R, its scaled max-norm and (for the
     // finiteness test below) its sum.
