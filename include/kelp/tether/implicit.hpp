@@ -69,6 +69,37 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
   return same;
 }
 
+/// The implicit step's predictor over the flat 3 × (N+1) arrays from index j on, in packets of P
+/// (every argument by value: no reloads after the stores); returns where it stopped. mode 2:
+/// BDF2 (x̂ = (4x_n − x_{n−1})/3, v̂ likewise, v = 2v_n − v_{n−1}); 1: backward Euler with the
+/// velocity extrapolated; 0: backward Euler from v_n. x = x̂ + γh v in every mode.
+template <typename P, typename Scalar>
+Eigen::Index predict_pass(Eigen::Index j, Eigen::Index len, int mode, Scalar four_thirds,
+                          Scalar third, Scalar gh, const Scalar* xn, const Scalar* vn,
+                          const Scalar* xp, const Scalar* vp, Scalar* x0, Scalar* v0, Scalar* x1,
+                          Scalar* v1) {
+  const P c43 = P::all(four_thirds), c13 = P::all(third), two = P::all(Scalar(2)), g = P::all(gh);
+  for (; j + P::lanes <= len; j += P::lanes) {
+    const P xnj = P::load(xn + j), vnj = P::load(vn + j);
+    if (mode == 2) {
+      const P vpj = P::load(vp + j);
+      const P xh = c43 * xnj - c13 * P::load(xp + j);
+      const P vg = two * vnj - vpj;
+      xh.store(x0 + j);
+      (c43 * vnj - c13 * vpj).store(v0 + j);
+      vg.store(v1 + j);
+      (xh + g * vg).store(x1 + j);
+    } else {
+      const P vg = mode == 1 ? two * vnj - P::load(vp + j) : vnj;
+      xnj.store(x0 + j);
+      vnj.store(v0 + j);
+      vg.store(v1 + j);
+      (xnj + g * vg).store(x1 + j);
+    }
+  }
+  return j;
+}
+
 /// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
 /// new state and returns true when Newton's method converged (or options.check_convergence is
 /// false); returns false with the state untouched otherwise. Adds its work to `report`. Inputs
@@ -100,30 +131,17 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // dt.
   const int cols = model.nodes();
   {
+    // One pass (predict_pass), its constants and pointers passed by value.
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
+    const Eigen::Index len = 3 * Eigen::Index(cols);
+    const int mode = use_bdf2 ? 2 : (history ? 1 : 0);
     const Scalar *xn = state.position.data(), *vn = state.velocity.data();
     const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
     Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
-    const auto predict = [&](auto lanes, Eigen::Index j) {
-      using P = decltype(lanes);
-      const P xnj = P::load(xn + j), vnj = P::load(vn + j);
-      if (use_bdf2) {
-        const P vpj = P::load(vp + j);
-        const P xh = P::all(four_thirds) * xnj - P::all(third) * P::load(xp + j);
-        const P vg = P::all(Scalar(2)) * vnj - vpj;
-        xh.store(x0 + j);
-        (P::all(four_thirds) * vnj - P::all(third) * vpj).store(v0 + j);
-        vg.store(v1 + j);
-        (xh + P::all(gh) * vg).store(x1 + j);
-      } else {
-        const P vg = history ? P::all(Scalar(2)) * vnj - P::load(vp + j) : vnj;
-        xnj.store(x0 + j);
-        vnj.store(v0 + j);
-        vg.store(v1 + j);
-        (xnj + P::all(gh) * vg).store(x1 + j);
-      }
-    };
-    simd::for_each_pack<Scalar>(0, 3 * Eigen::Index(cols), predict);
+    const Eigen::Index j = predict_pass<simd::Pack<Scalar, true>>(
+        0, len, mode, four_thirds, third, gh, xn, vn, xp, vp, x0, v0, x1, v1);
+    predict_pass<simd::Pack<Scalar, false>>(j, len, mode, four_thirds, third, gh, xn, vn, xp, vp,
+                                            x0, v0, x1, v1);
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton
@@ -204,10 +222,13 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // to the scaled max-norm max_i |R_i|/a_i.
   const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& r_max,
                             bool with_jacobian) {
+    // The evaluation behind compute_forces, without its checks: the workspace and the state
+    // were checked once for the step, and a non-finite iterate shows in the residual's sum
+    // below (numerical_error: the step is retried).
     if (with_jacobian)
-      compute_forces<true>(model, ws, env, t1, x, v);
+      evaluate_forces<true>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr));
     else
-      compute_forces<false>(model, ws, env, t1, x, v);
+      evaluate_forces<false>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr));
     ++report.force_evaluations;
     // One vectorised pass over the free nodes: rhs = −R, its scaled max-norm and (for the
     // finiteness test below) its sum.
