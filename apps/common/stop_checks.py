@@ -1,6 +1,6 @@
-"""What the programs' stop tests share (apps/tethered_pair/check_stop.py,
-apps/sweep/tests/check_stop.py): a list of the failed checks, and the whole-line check of a
-stopped or killed run's CSV files."""
+"""What the programs' stop and resume tests share (apps/tethered_pair/check_stop.py,
+apps/tethered_pair/check_resume.py, apps/sweep/tests/check_stop.py): a list of the failed
+checks, and the whole-line check of a stopped or killed run's CSV files."""
 
 import os
 import sys

@@ -430,17 +430,8 @@ class AuvControllerT {
   /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
   /// PIDs, the observer, the waypoints and the progress along them, the last command, the clock
   /// and the thrusters' supply voltage. For a run's checkpoint.
-  /// \tparam V a memory visitor \param v the visitor (one that restores)
-  template <class V>
-  void visit_memory(V& v) {
-    memory(*this, v);
-  }
-  /// \brief visit_memory of a const controller (saving it).
-  /// \tparam V a memory visitor \param v the visitor (one that saves)
-  template <class V>
-  void visit_memory(V& v) const {
-    memory(*this, v);
-  }
+  /// \tparam V a memory visitor \param v the visitor
+  KELP_MEMORY_BY(memory)
 
  private:
   template <class Self, class V>
@@ -658,17 +649,8 @@ class AsvControllerT {
   /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
   /// PIDs, the observer, the target and its velocity, the course, the last command, the clock and
   /// the thrusters' supply voltage. For a run's checkpoint.
-  /// \tparam V a memory visitor \param v the visitor (one that restores)
-  template <class V>
-  void visit_memory(V& v) {
-    memory(*this, v);
-  }
-  /// \brief visit_memory of a const controller (saving it).
-  /// \tparam V a memory visitor \param v the visitor (one that saves)
-  template <class V>
-  void visit_memory(V& v) const {
-    memory(*this, v);
-  }
+  /// \tparam V a memory visitor \param v the visitor
+  KELP_MEMORY_BY(memory)
 
  private:
   template <class Self, class V>

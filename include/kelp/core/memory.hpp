@@ -21,7 +21,9 @@
 /// parameters are not memory: the object is built from them as before, then restored.
 ///
 /// KELP_MEMORY(a, b, ...) declares both members for an object whose memory is a list of plain
-/// members (the common case); others write the two members themselves.
+/// members (the common case); KELP_MEMORY_BY(f) declares them as calls of the class's own static
+/// template `f(self, v)`, `self` the object (const when saving), for memory that takes more
+/// (bounds, lists, loops over members).
 #pragma once
 
 /// \brief Declares `visit_memory(v)` (const and non-const) visiting the members given, in order:
@@ -34,4 +36,16 @@
   template <class V>              \
   void visit_memory(V& v) const { \
     v(__VA_ARGS__);               \
+  }
+
+/// \brief Declares `visit_memory(v)` (const and non-const) as `f(*this, v)`, `f` a static member
+/// template of the class taking the object (const or not) and the visitor (see the file comment).
+#define KELP_MEMORY_BY(f)         \
+  template <class V>              \
+  void visit_memory(V& v) {       \
+    f(*this, v);                  \
+  }                               \
+  template <class V>              \
+  void visit_memory(V& v) const { \
+    f(*this, v);                  \
   }

@@ -280,17 +280,8 @@ class NavigationFilterT {
 
   /// \brief Visits what the filter knows (kelp/core/memory.hpp): attitude, biases, Kalman state
   /// and covariance, clock, the kept positions and the estimate. For a run's checkpoint.
-  /// \tparam V a memory visitor \param v the visitor (one that restores)
-  template <class V>
-  void visit_memory(V& v) {
-    memory(*this, v);
-  }
-  /// \brief visit_memory of a const filter (saving it).
-  /// \tparam V a memory visitor \param v the visitor (one that saves)
-  template <class V>
-  void visit_memory(V& v) const {
-    memory(*this, v);
-  }
+  /// \tparam V a memory visitor \param v the visitor
+  KELP_MEMORY_BY(memory)
 
  private:
   template <class Self, class V>

@@ -557,17 +557,8 @@ class Usbl {
 
   /// \brief Visits the noise stream, the schedule, the fixes in flight and the counts
   /// (kelp/core/memory.hpp).
-  /// \tparam V a memory visitor \param v the visitor (one that restores)
-  template <class V>
-  void visit_memory(V& v) {
-    memory(*this, v);
-  }
-  /// \brief visit_memory of a const Usbl (saving it).
-  /// \tparam V a memory visitor \param v the visitor (one that saves)
-  template <class V>
-  void visit_memory(V& v) const {
-    memory(*this, v);
-  }
+  /// \tparam V a memory visitor \param v the visitor
+  KELP_MEMORY_BY(memory)
 
  private:
   template <class Self, class V>

@@ -227,17 +227,8 @@ class EntanglementMonitor {
 
   /// \brief Visits what the monitor knows (kelp/core/memory.hpp): every obstacle's winding and
   /// contact, the events and the dropped count. For a run's checkpoint.
-  /// \tparam V a memory visitor \param v the visitor (one that restores)
-  template <class V>
-  void visit_memory(V& v) {
-    memory(*this, v);
-  }
-  /// \brief visit_memory of a const monitor (saving it).
-  /// \tparam V a memory visitor \param v the visitor (one that saves)
-  template <class V>
-  void visit_memory(V& v) const {
-    memory(*this, v);
-  }
+  /// \tparam V a memory visitor \param v the visitor
+  KELP_MEMORY_BY(memory)
 
  private:
   template <class Self, class V>

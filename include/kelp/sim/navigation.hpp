@@ -106,17 +106,8 @@ class KELP_SIM_API PairNavigation {
 
   /// \brief Visits every sensor's and filter's memory and the counts and error statistics
   /// (kelp/core/memory.hpp). For a run's checkpoint.
-  /// \tparam V a memory visitor \param v the visitor (one that restores)
-  template <class V>
-  void visit_memory(V& v) {
-    memory(*this, v);
-  }
-  /// \brief visit_memory of a const navigation (saving it).
-  /// \tparam V a memory visitor \param v the visitor (one that saves)
-  template <class V>
-  void visit_memory(V& v) const {
-    memory(*this, v);
-  }
+  /// \tparam V a memory visitor \param v the visitor
+  KELP_MEMORY_BY(memory)
 
  private:
   template <class Self, class V>
