@@ -187,6 +187,27 @@ struct LoadVisitor {
   }
 };
 
+// The checkpoint's header section (RUNH): what read_checkpoint_info returns, checked (steps in
+// range, a finite interval); the loader reads the same before the run's state.
+CheckpointInfo read_run_header(archive::Reader& r) {
+  archive::Section s = r.next(run_tag);
+  CheckpointInfo info;
+  info.kelp_version = r.writer_version();
+  info.scenario_json = std::string(s.text(max_text, "the scenario"));
+  info.scenario_file = std::string(s.text(max_text, "the scenario file"));
+  const std::uint64_t k = s.u64(), steps = s.u64();
+  if (k > steps || steps > std::uint64_t(std::numeric_limits<long>::max()))
+    s.fail("step counts out of range");
+  info.steps_taken = long(k);
+  info.total_steps = long(steps);
+  info.time = s.f64();
+  info.checkpoint_every = s.f64();
+  if (!(std::isfinite(info.checkpoint_every) && info.checkpoint_every >= 0))
+    s.fail("a checkpoint interval that is not a number >= 0");
+  s.end();
+  return info;
+}
+
 }  // namespace
 
 // The members of the loop, the log and the bag that are not theirs to visit (friend of each).
@@ -311,26 +332,14 @@ struct CheckpointAccess {
   };
 
   static Files load(archive::Reader& r, const std::string& input, ClosedLoop& l) {
-    std::uint64_t k = 0;
-    {
-      archive::Section s = r.next(run_tag);
-      const std::string_view scenario = s.text(max_text, "the scenario");
-      const std::string_view file = s.text(max_text, "the scenario file");
-      (void)file;
-      k = s.u64();
-      const std::uint64_t steps = s.u64();
-      (void)s.f64();  // the time (read_checkpoint_info's)
-      (void)s.f64();  // the interval
-      s.end();
-      if (scenario != scenario_json(l.scenario_))
-        r.fail(
-            "the checkpoint is of another scenario than the run's (its scenario differs; "
-            "resume a run with the scenario it was started with)");
-      if (steps != std::uint64_t(l.steps_))
-        r.fail("the checkpoint's run has " + std::to_string(steps) + " steps, this one " +
-               std::to_string(l.steps_));
-      if (k > steps) r.fail("the checkpoint is past its run's end");
-    }
+    const CheckpointInfo head = read_run_header(r);
+    if (head.scenario_json != scenario_json(l.scenario_))
+      r.fail(
+          "the checkpoint is of another scenario than the run's (its scenario differs; "
+          "resume a run with the scenario it was started with)");
+    if (head.total_steps != l.steps_)
+      r.fail("the checkpoint's run has " + std::to_string(head.total_steps) + " steps, this one " +
+             std::to_string(l.steps_));
     l.state_ = state_sections::read_pair(r, l.model_, input);
     kelp::system::fit_workspace(l.model_, l.workspace_, l.state_);
     const auto visit = [&](archive::Tag t, auto&& f) {
@@ -346,8 +355,9 @@ struct CheckpointAccess {
       s.end();
     };
     visit(loop_tag, [&](LoadVisitor& v) { loop_memory(l, v); });
-    if (l.k_ < 0 || std::uint64_t(l.k_) != k)
-      r.fail("the loop's step count differs from the header's (" + std::to_string(k) + ")");
+    if (l.k_ != head.steps_taken)
+      r.fail("the loop's step count differs from the header's (" +
+             std::to_string(head.steps_taken) + ")");
     l.sample_.tether_model = &l.model_.tether_of(l.state_);
     visit(auv_tag, [&](LoadVisitor& v) { v(l.auv_); });
     visit(asv_tag, [&](LoadVisitor& v) { v(l.asv_); });
@@ -547,22 +557,7 @@ ResumedFiles resume_checkpoint(const std::string& path, ClosedLoop& loop,
 CheckpointInfo read_checkpoint_info(const std::string& path) {
   const std::string bytes = read_checkpoint_file(path);
   archive::Reader r = checkpoint_reader(bytes, path);
-  archive::Section s = r.next(run_tag);
-  CheckpointInfo info;
-  info.kelp_version = r.writer_version();
-  info.scenario_json = std::string(s.text(max_text, "the scenario"));
-  info.scenario_file = std::string(s.text(max_text, "the scenario file"));
-  const std::uint64_t k = s.u64(), steps = s.u64();
-  if (k > steps || steps > std::uint64_t(std::numeric_limits<long>::max()))
-    s.fail("step counts out of range");
-  info.steps_taken = long(k);
-  info.total_steps = long(steps);
-  info.time = s.f64();
-  info.checkpoint_every = s.f64();
-  if (!(std::isfinite(info.checkpoint_every) && info.checkpoint_every >= 0))
-    s.fail("a checkpoint interval that is not a number >= 0");
-  s.end();
-  return info;
+  return read_run_header(r);
 }
 
 }  // namespace sim
