@@ -196,6 +196,7 @@ int run(const RunOptions& o) {
                      {"seed", r.seed}};
       std::string error, note;
       bool completed = true;
+      bool checkpointed = false;  // an interrupted run left runs/<hash>.checkpoint.bin
       double reached = 0;
       try {
         kelp::sim::SimulateOptions so;
@@ -236,6 +237,7 @@ int run(const RunOptions& o) {
         }
         completed = summary.completed;
         reached = summary.simulated_s;
+        checkpointed = !completed && fs::exists(so.checkpoint_file);
         result["summary"] = nlohmann::json::parse(kelp::sim::summary_json(summary));
         if (completed) fs::remove(so.checkpoint_file);
         // A stopped run's series and bag are whole, its summary.json says "completed": false;
@@ -258,7 +260,7 @@ int run(const RunOptions& o) {
         interrupted_runs.push_back({{"index", r.index},
                                     {"hash", r.hash},
                                     {"simulated_s", reached},
-                                    {"checkpoint", o.checkpoint_every > 0}});
+                                    {"checkpoint", checkpointed}});
       } else {
         simulated += r.scenario.duration;
         results[r.hash] = std::move(result);

@@ -19,6 +19,12 @@
 #if defined(__GLIBC__) || defined(__linux__)
 #include <malloc.h>  // memalign
 #endif
+#if defined(__clang__) && (defined(__x86_64__) || defined(__i386__))
+// Clang's <mm_malloc.h> (included by Eigen through the SSE headers) declares posix_memalign
+// without noexcept; declared after the definition below, that is an error, declared before it
+// is taken as the same function.
+#include <mm_malloc.h>
+#endif
 
 namespace kelp_test {
 inline std::atomic<long> g_heap_allocations{0};

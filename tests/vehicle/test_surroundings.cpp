@@ -137,10 +137,9 @@ TEST_CASE("free surface: an undamped BlueROV2 bobbing through the surface conser
   x.nu << 0.1, 0, -0.4, 0.1, 0, 0;
   const Vector6<double> zero = Vector6<double>::Zero();
   const double e0 = kv::energy(model, x);
-  double t = 0, zmin = 1, emax = 0;
+  double zmin = 1, emax = 0;
   for (int k = 0; k < 20000; ++k) {  // 20 s at 1 ms, crossings of the surface band
     kv::step_rk4(model, ws, env, x, {zero, zero}, 0.001);
-    t += 0.001;
     zmin = std::min(zmin, x.position(2));
     emax = std::max(emax, std::abs(kv::energy(model, x) - e0));
   }
@@ -233,11 +232,10 @@ TEST_CASE("free surface: a damped ROV crossing the surface never gains energy (p
   x.attitude = kelp::quaternion_from_euler(0.3, -0.2, 0.1);
   x.nu << 0.3, 0.1, -0.8, 0.4, -0.2, 0.2;  // thrown up through the surface
   const Vector6<double> zero = Vector6<double>::Zero();
-  double t = 0, e = kv::energy(model, x), rise = 0, zmin = 1;
+  double e = kv::energy(model, x), rise = 0, zmin = 1;
   int partial = 0;
   for (int k = 0; k < 10000; ++k) {  // 10 s at 1 ms
     kv::step_rk4(model, ws, env, x, {zero, zero}, 0.001);
-    t += 0.001;
     const double e1 = kv::energy(model, x);
     rise = std::max(rise, e1 - e);
     e = e1;
