@@ -377,7 +377,7 @@ struct Scenario {
   /// moving with the water at their positions (current + wave orbital velocity at t = 0; zero
   /// while the ramp holds the sea at rest) instead of at rest in moving water.
   ///@{
-  double start_ramp = 10.0;      ///< ramp-in time of the sea [s] (≥ 0; 0: none)
+  double start_ramp = 10.0;      ///< ramp-in time of the sea [s], in [0, 1e5] (0: none)
   bool start_with_water = true;  ///< start the bodies moving with the water (else at rest)
   ///@}
   /// \name Control: the preset, the paper's disturbance compensation, the PID gains, the ASV's
@@ -426,7 +426,7 @@ struct Scenario {
   ///@{
   bool propulsion = true;    ///< thrusters and batteries modelled (false: wrench applied directly)
   bool thruster_lag = true;  ///< a first-order lag between command and thrust
-  double thruster_time_constant = 0.02;                  ///< the lag's time constant [s] (> 0)
+  double thruster_time_constant = 0.02;  ///< the lag's time constant [s], in [0, 10]
   BatteryScenario asv_battery{31.2, 4, 0.02, 1.0, 0.0};  ///< the boat's battery (4S, 31.2 Ah)
   BatteryScenario auv_battery{15.6, 4, 0.04, 1.0, 0.0};  ///< the ROV's battery (4S, 15.6 Ah)
   ///@}
