@@ -61,6 +61,9 @@ class KELP_SIM_API Batch {
   /// the threads.
   /// \throws kelp::invalid_argument for n = 0, bad environment options (TetheredPairEnv), and what
   /// building a world throws (scenario_error, kelp::invalid_argument, kelp::numerical_error).
+  /// \param scenario the scenario of every world (copied) \param n the number of worlds, ≥ 1
+  /// \param seed the sea seed of world 0 (world i: seed + i)
+  /// \param options the thread count and the worlds' environment options
   Batch(const Scenario& scenario, std::size_t n, std::uint64_t seed,
         const BatchOptions& options = {});
 
@@ -68,56 +71,67 @@ class KELP_SIM_API Batch {
   Batch& operator=(const Batch&) = delete;
   ~Batch();
 
-  /// \brief Worlds n.
+  /// \brief Worlds n. \return the number of worlds
   std::size_t size() const { return worlds_.size(); }
-  /// \brief Threads stepping them (the caller's included).
+  /// \brief Threads stepping them (the caller's included). \return 1 … size()
   unsigned threads() const { return threads_; }
-  /// \brief Seed of world 0.
+  /// \brief Seed of world 0. \return the seed of the last construction or reset()
   std::uint64_t seed() const { return seed_; }
-  /// \brief Entries of one world's action (TetheredPairEnv::action_size()).
+  /// \brief Entries of one world's action. \return TetheredPairEnv::action_size()
   int action_size() const { return worlds_.front()->action_size(); }
   /// \brief World i (its loop, state, summary). Not to be used while step() runs.
+  /// \param i the world's index, < size() \return the world
+  /// \throws std::out_of_range for i ≥ size()
   const TetheredPairEnv& world(std::size_t i) const { return *worlds_.at(i); }
 
   /// \brief Advances every world by `n_steps` control periods (see the class); `actions`:
   /// null (the controllers fly) or size() × action_size() doubles, row major, each clipped to
   /// [−1, 1]. reward() then holds each world's reward summed over the call's steps.
+  /// \param n_steps control periods to advance, ≥ 0 \param actions the actions, or nullptr
   /// \throws kelp::invalid_argument for a negative n_steps or a non-finite action (nothing is
   /// stepped).
   void step(long n_steps = 1, const double* actions = nullptr);
 
   /// \brief Starts new episodes: world i rebuilt with seed `seed + i`. Allocates.
+  /// \param seed the new sea seed of world 0
   /// \throws as the constructor (the batch is then unusable until a reset succeeds).
   void reset(std::uint64_t seed);
 
   /// \name Per-world arrays (row i: world i), updated by step() and reset().
+  /// Each returns the batch's array, at a fixed address for the batch's life.
   ///@{
-  /// The ROV's position, NED [m] (n × 3).
+  /// \brief The ROV's position. \return NED [m] (n × 3)
   const Rows& auv_position() const { return auv_position_; }
-  /// The ROV's attitude, unit quaternion body → NED (w, x, y, z) (n × 4).
+  /// \brief The ROV's attitude. \return unit quaternions body → NED (w, x, y, z) (n × 4)
   const Rows& auv_attitude() const { return auv_attitude_; }
-  /// The ROV's body velocity ν (u, v, w [m/s], p, q, r [rad/s]) (n × 6).
+  /// \brief The ROV's body velocity ν. \return u, v, w [m/s], p, q, r [rad/s], body (n × 6)
   const Rows& auv_velocity() const { return auv_velocity_; }
-  /// The boat's position, NED [m] (n × 3).
+  /// \brief The boat's position. \return NED [m] (n × 3)
   const Rows& asv_position() const { return asv_position_; }
-  /// The boat's attitude (w, x, y, z) (n × 4).
+  /// \brief The boat's attitude. \return unit quaternions body → NED (w, x, y, z) (n × 4)
   const Rows& asv_attitude() const { return asv_attitude_; }
-  /// The boat's body velocity (n × 6).
+  /// \brief The boat's body velocity ν. \return u, v, w [m/s], p, q, r [rad/s], body (n × 6)
   const Rows& asv_velocity() const { return asv_velocity_; }
-  /// The tether's end forces' magnitudes [N]: column 0 on the boat, 1 on the ROV (n × 2).
+  /// \brief The tether's end forces' magnitudes.
+  /// \return [N]: column 0 on the boat, 1 on the ROV (n × 2)
   const Rows& tension() const { return tension_; }
-  /// The environments' observations (n × TetheredPairEnv::observation_size).
+  /// \brief The environments' observations (TetheredPairEnv::observation()).
+  /// \return n × TetheredPairEnv::observation_size
   const Rows& observation() const { return observation_; }
-  /// The reward summed over the last step()'s steps (n × 1; 0 after reset()).
+  /// \brief The reward summed over the last step()'s steps. \return n × 1 (0 after reset())
   const Rows& reward() const { return reward_; }
-  /// Simulation time [s] (n × 1; a terminated world's stops).
+  /// \brief Simulation time. \return [s] (n × 1; a terminated world's stops)
   const Rows& time() const { return time_; }
-  /// 1 where the episode terminated (column 0) or was truncated (column 1), else 0 (n × 2).
+  /// \brief Which episodes have ended.
+  /// \return 1 where the episode terminated (column 0) or was truncated (column 1), else 0
+  /// (n × 2)
   const Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 2, Eigen::RowMajor>& ended() const {
     return ended_;
   }
   ///@}
-  /// \brief Why world i terminated on a failed step (empty otherwise).
+  /// \brief Why world i terminated on a failed step.
+  /// \param i the world's index, < size() \return the error's message (empty otherwise)
+  /// \throws std::out_of_range for i ≥ size()
   const std::string& error(std::size_t i) const { return worlds_.at(i)->error(); }
 
  private:

@@ -61,14 +61,16 @@ struct RunMetrics {
   double late_asv_distance = 0;         ///< second half: largest ASV distance [m]
 
   /// \brief The count the means divide by (at least 1, so that an empty run gives zeros).
+  /// \return max(1, samples)
   double count() const { return std::max<double>(1, static_cast<double>(samples)); }
-  /// \brief RMS of the AUV's path error [m].
+  /// \brief RMS of the AUV's path error. \return the RMS [m] (0 without samples)
   double auv_rms_error() const { return std::sqrt(auv_squared_error_sum / count()); }
-  /// \brief RMS of the ASV's horizontal distance to the AUV [m].
+  /// \brief RMS of the ASV's horizontal distance to the AUV. \return the RMS [m]
   double asv_rms_distance() const { return std::sqrt(asv_squared_distance_sum / count()); }
-  /// \brief Mean end force at the AUV [N].
+  /// \brief Mean end force at the AUV. \return the mean [N]
   double auv_mean_tension() const { return auv_tension_sum / count(); }
   /// \brief Fraction of the samples with a slack tether at the AUV (under 0.1 N).
+  /// \return the fraction, in [0, 1]
   double slack_fraction() const { return static_cast<double>(slack_samples) / count(); }
 };
 
@@ -107,11 +109,15 @@ class KELP_SIM_API ClosedLoop {
   static constexpr double dt = 0.01;
 
   /// \brief The loop of a scenario, its world built by world_setup().
+  /// \param sc the scenario (copied) \param options the log and observers (ClosedLoopOptions)
   /// \throws scenario_error, kelp::invalid_argument (see world_setup()).
   explicit ClosedLoop(const Scenario& sc, const ClosedLoopOptions& options = {})
       : ClosedLoop(sc, world_setup(sc, options.scenario_file), options) {}
 
   /// \brief The loop of a scenario over an already built world (e.g. one a program has adjusted).
+  /// \param sc the scenario (copied; its controllers, rates, duration and mission are used)
+  /// \param world the world to run (copied), e.g. world_setup(sc) adjusted
+  /// \param options the log and observers (ClosedLoopOptions)
   /// \throws kelp::invalid_argument for a world the library refuses.
   ClosedLoop(const Scenario& sc, const WorldSetup& world, const ClosedLoopOptions& options = {});
 
@@ -131,35 +137,39 @@ class KELP_SIM_API ClosedLoop {
   }
 
   /// \brief Steps for `seconds` of simulated time (rounded to whole steps), or until the run is
-  /// over. \returns the steps taken.
+  /// over. \param seconds simulated time to run [s], finite and ≥ 0
+  /// \returns the steps taken (fewer when the run ends first).
+  /// \throws kelp::invalid_argument for a negative or non-finite `seconds`; what step() throws.
   long run_for(double seconds);
 
-  /// \brief True once the scenario's duration has been simulated.
+  /// \brief Whether the scenario's duration has been simulated.
+  /// \return true once steps_taken() reaches total_steps()
   bool done() const { return k_ >= steps_; }
-  /// \brief Steps taken so far.
+  /// \brief Steps taken so far. \return the count (0 before the first step)
   long steps_taken() const { return k_; }
-  /// \brief Steps of the whole run, `lround(duration / dt)`.
+  /// \brief Steps of the whole run. \return `lround(duration / dt)`
   long total_steps() const { return steps_; }
-  /// \brief Simulation time [s].
+  /// \brief Simulation time. \return the state's time [s]
   double time() const { return state_.time; }
 
-  /// \brief The scenario being run.
+  /// \brief The scenario being run. \return the loop's copy
   const Scenario& scenario() const { return scenario_; }
-  /// \brief The system being run.
+  /// \brief The system being run. \return its model (parameters, environment)
   const kelp::system::SystemModeld& model() const { return model_; }
-  /// \brief Its workspace (loads and reports of the last step).
+  /// \brief Its workspace. \return the loads and reports of the last step
   const kelp::system::SystemWorkspaced& workspace() const { return workspace_; }
-  /// \brief Its state.
+  /// \brief Its state. \return the current state (vehicles NED/body, tether nodes NED [m])
   const kelp::system::SystemStated& state() const { return state_; }
-  /// \brief The report of the last step (zero before the first).
+  /// \brief The report of the last step. \return the report (zero before the first step)
   const kelp::system::SystemReportd& last_report() const { return report_; }
-  /// \brief The AUV's waypoints (NED [m]).
+  /// \brief The AUV's waypoints. \return the waypoints, NED [m]
   const std::vector<kelp::Vector3<double>>& waypoints() const { return waypoints_; }
-  /// \brief The AUV's controller.
+  /// \brief The AUV's controller. \return it (its settings, leg and integrators)
   const kelp::control::AuvController& auv_controller() const { return auv_; }
-  /// \brief The ASV's controller.
+  /// \brief The ASV's controller. \return it (its settings and integrators)
   const kelp::control::AsvController& asv_controller() const { return asv_; }
   /// \brief The AUV's controller's command for the next step (applied unless overridden).
+  /// \return the command (body wrench and per-thruster commands)
   const kelp::control::AuvCommand& auv_command() const { return *auv_command_; }
   /// \brief Flies the AUV by `command` instead of its controller from the next step on (e.g. a
   /// learning agent's action, kelp::sim::PairEnv): its per-thruster commands (the ESC's, as the
@@ -167,48 +177,56 @@ class KELP_SIM_API ClosedLoop {
   /// controller keeps running (its waypoint and leg bookkeeping still defines the path error of
   /// the metrics) but its commands are not applied. Not owned: it must outlive its use; it is
   /// read at every step, so it may be changed between steps. Null: the controller flies again.
+  /// \param command the command to fly by, or nullptr
   void set_auv_override(const kelp::control::AuvCommand* command) { auv_override_ = command; }
-  /// \brief The command overriding the AUV's controller, or null.
+  /// \brief The command overriding the AUV's controller. \return it, or nullptr
   const kelp::control::AuvCommand* auv_override() const { return auv_override_; }
   /// \brief Flies the ASV by `command` instead of its controller from the next step on; see
   /// set_auv_override(). Null: the controller flies again.
+  /// \param command the command to fly by (not owned), or nullptr
   void set_asv_override(const kelp::control::AsvCommand* command) { asv_override_ = command; }
-  /// \brief The command overriding the ASV's controller, or null.
+  /// \brief The command overriding the ASV's controller. \return it, or nullptr
   const kelp::control::AsvCommand* asv_override() const { return asv_override_; }
   /// \brief Commands the winch's payout rate [m/s] by `*rate` instead of its strategy from the
   /// next step on (e.g. a ROS 2 node's /tether/cmd_payout); the winch still limits it
   /// (tether::limited_payout_rate). Ignored without a winch. Not owned, read at every step.
   /// Null: the strategy commands it again.
+  /// \param rate the commanded payout rate [m/s] (positive: paying out; not owned), or nullptr
   void set_winch_override(const double* rate) { winch_override_ = rate; }
-  /// \brief The ASV's command for the next step.
+  /// \brief The ASV's command for the next step. \return the command (applied unless overridden)
   const kelp::control::AsvCommand& asv_command() const { return *asv_command_; }
   /// \brief The sample of the current state (what a log row holds; its vehicle states point into
-  /// this loop), updated after every step.
+  /// this loop), updated after every step. \return the sample
   const LogRow& sample() const { return sample_; }
-  /// \brief The statistics so far.
+  /// \brief The statistics so far. \return the metrics (samples at the log rate)
   const RunMetrics& metrics() const { return metrics_; }
   /// \brief How hard the tether's solver has worked so far (every step's report summed).
+  /// \return the statistics
   const kelp::system::SolverStatsd& solver_stats() const { return solver_stats_; }
   /// \brief The AUV's turns about the tether at its attachment (updated at every step).
+  /// \return the counter
   const TurnCounter& turn_counter() const { return turns_; }
   /// \brief The tether's winding about each cylinder of the environment and its entanglement
-  /// events (updated at every step; kelp/sim/entanglement.hpp).
+  /// events (updated at every step; kelp/sim/entanglement.hpp). \return the monitor
   const EntanglementMonitor& entanglement() const { return entanglement_; }
   /// \brief The tether's partings so far (at most one per step; kelp/tether/failure.hpp).
+  /// \return the partings in time order (empty while the line holds)
   const std::vector<kelp::tether::LineFailured>& line_failures() const { return failures_; }
-  /// \brief The sensors and filters when the scenario's navigation mode is "sensors", else null.
+  /// \brief The sensors and filters when the scenario's navigation mode is "sensors".
+  /// \return them, or nullptr in "perfect" mode
   const PairNavigation* navigation() const { return navigation_.get(); }
 
   /// \brief The summary's `navigation` object: the mode, and with sensors the seed, the RMS
   /// errors of each vehicle's estimate over every step after t = 0 (position, 3-D and horizontal
   /// [m], heading [deg], body velocity [m/s]), the USBL's pings, losses and fixes used and the
-  /// DVL's pings by mode.
+  /// DVL's pings by mode. \return the object (the mode alone in "perfect" mode)
   NavigationSummary navigation_summary() const;
 
   /// \brief The summary's `entanglement` object: the thresholds, every cylinder's winding
   /// (`obstacles`: name, index, `max_abs_winding_rad`, `final_winding_rad`, the times of its
   /// first `entangled` and `pinned` events or null, its events) and all events in time order
   /// (`events`: event, time_s, obstacle, position_m, winding_rad or tension_difference_n).
+  /// \return the object
   EntanglementSummary entanglement_summary() const;
 
   /// \brief The run's summary as kelp-tethered-pair writes it in summary.json, without the wall
@@ -219,7 +237,7 @@ class KELP_SIM_API ClosedLoop {
   /// as used. `tether` also holds the AUV's turns about the tether (`net_turns`,
   /// `max_abs_turns`: TurnCounter) and the line's partings (`line_failures`: time, segment,
   /// position, tension; empty while it holds). Before the end (done()), `completed` is false and
-  /// `simulated_s` the time reached.
+  /// `simulated_s` the time reached. \return the summary (wall time and version unset)
   RunSummary summary() const;
 
  private:
@@ -275,6 +293,7 @@ class KELP_SIM_API ClosedLoop {
 /// the Newton budget, whether the explicit safety net was on, the counts of `stats` and the
 /// tolerance of a full tether sub-step (ImplicitOptions::acceleration_tolerance × max_tether_dt).
 /// \param[in] stats the run's statistics \param[in] p the parameters of the system that ran
+/// \return the summary (non-finite statistics as NaN)
 KELP_SIM_API SolverSummary solver_summary(const kelp::system::SolverStatsd& stats,
                                           const kelp::system::SystemParametersd& p);
 
@@ -324,6 +343,8 @@ struct SimulateOptions {
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when the
 /// log cannot be written; state_error for a checkpoint that cannot be resumed (nothing in
 /// `log_dir` is then changed).
+/// \param sc the scenario to run \param o the log, bag, checkpoint and observer options
+/// \return the summary, `completed` false when stopped
 KELP_SIM_API RunSummary simulate(const Scenario& sc, const SimulateOptions& o = {});
 
 }  // namespace sim

@@ -57,6 +57,9 @@ struct EntanglementSettings {
 };
 
 /// \brief Checks the settings. \throws kelp::invalid_argument naming the field.
+/// \param s the settings: wrap_threshold > 0, wrap_hysteresis in [0, wrap_threshold],
+/// contact_margin ≥ 0, pin_slip_speed > 0, pin_tension_difference > 0, pin_hold_time ≥ 0, all
+/// finite
 inline void validate(const EntanglementSettings& s) {
   KELP_CHECK(std::isfinite(s.wrap_threshold) && s.wrap_threshold > 0,
              "entanglement.wrap_threshold must be finite and > 0");
@@ -80,14 +83,15 @@ struct EntanglementEvent {
     entangled,  ///< |winding| passed EntanglementSettings::wrap_threshold
     pinned      ///< friction has held the line at the contact while the ROV pulls
   };
-  Kind kind = Kind::entangled;
-  double time = 0;   ///< [s]
-  int obstacle = 0;  ///< index in the monitor's axes
+  Kind kind = Kind::entangled;  ///< what happened
+  double time = 0;              ///< [s]
+  int obstacle = 0;             ///< index in the monitor's axes
   double value = 0;  ///< entangled: the winding [rad]; pinned: the tension difference [N]
   kelp::Vector3<double> position = kelp::Vector3<double>::Zero();  ///< mid contact node (NED [m])
 };
 
 /// \brief The name of an event kind as events.csv writes it ("entangled", "pinned").
+/// \param k the kind \return its name (static storage)
 inline const char* event_name(EntanglementEvent::Kind k) {
   return k == EntanglementEvent::Kind::entangled ? "entangled" : "pinned";
 }
@@ -118,6 +122,8 @@ class EntanglementMonitor {
 
   /// \brief A monitor of `axes` with `settings`; `tether_radius` [m] widens the contact test and
   /// the chord's blend radius (kelp::tether::winding_angle's b = obstacle radius + tether radius).
+  /// \param axes the obstacles' axes (NED [m]; the events' obstacle indices index it)
+  /// \param settings the events' thresholds \param tether_radius the tether's radius [m], ≥ 0
   /// \throws kelp::invalid_argument for bad settings or axes (non-finite, from == to, radius ≤ 0).
   explicit EntanglementMonitor(std::vector<EntanglementAxis> axes,
                                const EntanglementSettings& settings = {},
@@ -138,8 +144,13 @@ class EntanglementMonitor {
 
   /// \brief Updates every obstacle's winding and contact at time `t` [s] from the node positions
   /// and velocities (3×n, NED, start end first) and the segments' axial forces `tension`
-  /// (n − 1 entries [N], or empty: no `pinned` test). \returns the events this update raised
-  /// (the last ones of events()).
+  /// (n − 1 entries [N], or empty: no `pinned` test; any other size also skips it).
+  /// \tparam P, V, T Eigen expressions of doubles
+  /// \param t the time [s] \param position the node positions, 3×n, NED [m]
+  /// \param velocity the node velocities, 3×n, NED [m/s]
+  /// \param tension the segments' axial forces [N]
+  /// \returns the number of events this update raised and kept (the last ones of events()).
+  /// \throws kelp::invalid_argument when `velocity` has not n columns.
   template <typename P, typename V, typename T>
   int update(double t, const Eigen::MatrixBase<P>& position, const Eigen::MatrixBase<V>& velocity,
              const Eigen::MatrixBase<T>& tension) {
@@ -206,15 +217,18 @@ class EntanglementMonitor {
     return raised;
   }
 
-  /// \brief The axes watched.
+  /// \brief The axes watched. \return the axes, in the order the constructor got them
   const std::vector<EntanglementAxis>& axes() const { return axes_; }
   /// \brief The state of obstacle `k` (0 ≤ k < axes().size()).
+  /// \param k the obstacle's index in axes() \return its winding and contact now
+  /// \throws std::out_of_range for k ≥ axes().size()
   const ObstacleWinding& obstacle(std::size_t k) const { return state_.at(k); }
-  /// \brief The events so far, in time order (at most max_events).
+  /// \brief The events so far, in time order (at most max_events). \return the events
   const std::vector<EntanglementEvent>& events() const { return events_; }
-  /// \brief Events raised beyond max_events (not kept).
+  /// \brief Events raised beyond max_events (not kept). \return the count
   long dropped_events() const { return dropped_; }
-  /// \brief The index of the obstacle with the largest |winding| now, or −1 without obstacles.
+  /// \brief The obstacle with the largest |winding| now.
+  /// \return its index in axes() (the first of equals), or −1 without obstacles
   int most_wound() const {
     int best = -1;
     for (std::size_t k = 0; k < state_.size(); ++k)
@@ -222,7 +236,7 @@ class EntanglementMonitor {
         best = int(k);
     return best;
   }
-  /// \brief The settings.
+  /// \brief The settings. \return the thresholds the monitor was built with
   const EntanglementSettings& settings() const { return settings_; }
 
   /// \brief Visits what the monitor knows (kelp/core/memory.hpp): every obstacle's winding and

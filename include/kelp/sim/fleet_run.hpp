@@ -51,12 +51,18 @@ struct FleetWorld {
 /// locating its vehicle files. \throws scenario_error naming the file and the JSON path (an
 /// unknown preset, a vehicle file's own errors, a vehicle whose water differs from the sea's,
 /// a tether shorter than the distance between its ends).
+/// \param sc the scenario (with `fleet` set) \param file the scenario file's path
+/// \return the fleet's parameters, environment, vehicles and start (NED [m])
 KELP_SIM_API FleetWorld fleet_world(const Scenario& sc, const std::string& file);
 
 /// \brief The state a fleet run starts from: every tether at its static shape between its ends
 /// (kelp::system::initial_state from the world's start poses), and, when the scenario says so
 /// (`start_with_water`, the default), every body and node moving with the water at t = 0.
 /// `model` is built from `w` (its parameters and environment); `file` names the scenario.
+/// \param model the fleet's model, built from `w`
+/// \param ws its workspace (used to evaluate the start; its contents are overwritten)
+/// \param w the fleet's world (fleet_world()) \param sc the scenario \param file its path
+/// \return the start state at t = 0 (NED, body velocities)
 /// \throws scenario_error naming `/fleet/tethers` when a tether's static shape cannot be found.
 KELP_SIM_API kelp::system::FleetStated fleet_start_state(const kelp::system::FleetModeld& model,
                                                          kelp::system::FleetWorkspaced& ws,
@@ -75,7 +81,8 @@ struct FleetRunSummary {
   long explicit_fallbacks = 0;  ///< tether steps redone by RK4
   /// Per tether: largest end force [N], and the fraction of steps its far end was slack
   /// (< 0.5 N).
-  std::vector<double> max_tension, slack_fraction;
+  std::vector<double> max_tension,
+      slack_fraction;  ///< per tether: the fraction of steps its far end was slack (< 0.5 N)
   /// Per vehicle (NaN without a controller): the RMS distance to the point its controller
   /// steers to (its hold point, or the waypoint ahead during a survey) [m].
   std::vector<double> rms_position_error;
@@ -91,6 +98,9 @@ struct FleetRunSummary {
 /// second (LineFile), so a run killed mid-way leaves them ending on a whole line.
 /// \throws scenario_error as fleet_world(); kelp::error when a step fails (the outputs so far
 /// are closed whole).
+/// \param sc the scenario (with `fleet` set) \param file the scenario file's path
+/// \param out the output directory \param should_stop polled before every step (may be empty)
+/// \return what the run did (as summary.json says it)
 KELP_SIM_API FleetRunSummary run_fleet(const Scenario& sc, const std::string& file,
                                        const std::string& out,
                                        const std::function<bool()>& should_stop = {});

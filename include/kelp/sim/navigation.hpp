@@ -45,8 +45,8 @@ struct PairSensors {
   double asv_heave_sigma = 1.0;
 };
 
-/// \brief Checks every sensor's and filter's parameters. \throws kelp::invalid_argument naming
-/// the field.
+/// \brief Checks every sensor's and filter's parameters.
+/// \param p the sensors and filters \throws kelp::invalid_argument naming the field.
 KELP_SIM_API void validate(const PairSensors& p);
 
 /// \brief Running error statistics of one vehicle's estimate against the truth.
@@ -57,13 +57,13 @@ struct EstimateErrors {
   double velocity_squared_sum = 0;    ///< Σ |ν̂₁ − ν₁|² [m²/s²]
   double horizontal_squared_sum = 0;  ///< Σ |p̂ − p|² of the north and east parts [m²]
   double max_position = 0;            ///< largest |p̂ − p| [m]
-  /// \brief RMS position error [m].
+  /// \brief RMS position error (3-D). \return the RMS [m] (0 without samples)
   double rms_position() const { return std::sqrt(position_squared_sum / count()); }
-  /// \brief RMS horizontal position error [m].
+  /// \brief RMS horizontal position error (north, east). \return the RMS [m]
   double rms_horizontal() const { return std::sqrt(horizontal_squared_sum / count()); }
-  /// \brief RMS heading error [rad].
+  /// \brief RMS heading error. \return the RMS [rad]
   double rms_heading() const { return std::sqrt(heading_squared_sum / count()); }
-  /// \brief RMS body-velocity error [m/s].
+  /// \brief RMS body-velocity error (linear part). \return the RMS [m/s]
   double rms_velocity() const { return std::sqrt(velocity_squared_sum / count()); }
 
  private:
@@ -73,6 +73,7 @@ struct EstimateErrors {
 /// \brief The pair's sensors and filters (see the file comment).
 class KELP_SIM_API PairNavigation {
  public:
+  /// \brief The sensors and filters of a run, started at `state`.
   /// \param[in] p sensors and filters \param[in] seed the run's navigation seed
   /// \param[in] model the system \param[in] state its initial state (the filters start at the
   /// vehicles' launch positions and velocities, with the attitude from the first IMU and
@@ -80,28 +81,35 @@ class KELP_SIM_API PairNavigation {
   PairNavigation(const PairSensors& p, std::uint64_t seed, const system::SystemModeld& model,
                  const system::SystemStated& state);
 
+  /// \brief Samples the sensors due at the state's time and updates both filters (call once
   /// per step, after the step). Errors against the truth are accumulated for t > 0.
+  /// A state whose time is not after the last update's is ignored.
+  /// \param model the system (its environment: gravity, seabed, current)
+  /// \param state the true state after the step (NED, body velocities, time [s])
   void update(const system::SystemModeld& model, const system::SystemStated& state);
 
-  /// \brief The ROV's estimate.
+  /// \brief The ROV's estimate. \return position NED [m], attitude, body velocity
   const nav::Navigation& auv() const { return auv_.navigation(); }
-  /// \brief The boat's estimate.
+  /// \brief The boat's estimate. \return position NED [m], attitude, body velocity
   const nav::Navigation& asv() const { return asv_.navigation(); }
-  /// \brief The ROV's filter.
+  /// \brief The ROV's filter. \return the filter (state and covariance)
   const nav::NavigationFilter& auv_filter() const { return auv_; }
-  /// \brief The boat's filter.
+  /// \brief The boat's filter. \return the filter (state and covariance)
   const nav::NavigationFilter& asv_filter() const { return asv_; }
-  /// \brief Error statistics of the ROV's estimate.
+  /// \brief Error statistics of the ROV's estimate. \return the statistics (t > 0)
   const EstimateErrors& auv_errors() const { return auv_errors_; }
-  /// \brief Error statistics of the boat's estimate.
+  /// \brief Error statistics of the boat's estimate. \return the statistics (t > 0)
   const EstimateErrors& asv_errors() const { return asv_errors_; }
-  /// \brief USBL pings, lost pings and fixes used so far.
+  /// \brief USBL pings so far. \return the count
   long usbl_pings() const { return usbl_.pings(); }
-  long usbl_dropouts() const { return usbl_.dropouts(); }  ///< see usbl_pings()
-  long usbl_fixes() const { return usbl_fixes_; }          ///< see usbl_pings()
+  /// \brief USBL pings lost so far. \return the count
+  long usbl_dropouts() const { return usbl_.dropouts(); }
+  /// \brief USBL fixes used by the ROV's filter so far. \return the count
+  long usbl_fixes() const { return usbl_fixes_; }
   /// \brief DVL pings so far in a mode.
+  /// \param m the mode (bottom track, water track, none) \return the count
   long dvl_pings(nav::DvlMode m) const { return dvl_counts_[static_cast<int>(m)]; }
-  /// \brief The parameters.
+  /// \brief The parameters. \return the sensors and filters it was built with
   const PairSensors& parameters() const { return p_; }
 
   /// \brief Visits every sensor's and filter's memory and the counts and error statistics

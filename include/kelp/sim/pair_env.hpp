@@ -89,63 +89,80 @@ class KELP_SIM_API TetheredPairEnv {
   /// \throws kelp::invalid_argument for a control period that is not a positive multiple of
   /// 10 ms, non-positive weights or max_path_error; scenario_error, kelp::invalid_argument from
   /// the world (world_setup()).
+  /// \param scenario the scenario (copied; its duration, controllers and mission are used)
+  /// \param options the control period, the boat action, the termination and the reward
   explicit TetheredPairEnv(const Scenario& scenario, const PairEnvOptions& options = {});
 
   TetheredPairEnv(const TetheredPairEnv&) = delete;
   TetheredPairEnv& operator=(const TetheredPairEnv&) = delete;
 
-  /// \brief Entries of an action: 6, or 8 with PairEnvOptions::asv_action.
+  /// \brief Entries of an action. \return 6, or 8 with PairEnvOptions::asv_action
   int action_size() const { return options_.asv_action ? 8 : 6; }
-  /// \brief System steps (10 ms) per step().
+  /// \brief System steps (10 ms) per step(). \return control_period / ClosedLoop::dt, ≥ 1
   long substeps() const { return substeps_; }
-  /// \brief The options.
+  /// \brief The options. \return the options the environment was built with
   const PairEnvOptions& options() const { return options_; }
 
   /// \brief Starts a new episode: the scenario's world with `seed` as its sea's seed, at rest
   /// (the scenario's start), the action zero. Allocates (it builds the world).
+  /// \param seed the sea's seed (waves, gusts) of the new episode
   /// \throws as the constructor; the environment is then as it was.
   void reset(std::uint64_t seed);
 
   /// \brief Sets the action held from the next step on: `action` points to action_size()
   /// entries, each clipped to [−1, 1]. No allocation.
+  /// \param action action_size() entries (see the class), not null
   /// \throws kelp::invalid_argument for a non-finite entry (the action is then unchanged).
   void apply(const double* action);
 
   /// \brief Lets the scenario's controllers fly the vehicles (true) or the action (false, the
   /// default) from the next step on; the controllers run all along, so switching is seamless.
   /// kelp::sim::Batch flies by the controllers when it is given no actions.
+  /// \param yes true: the controllers fly; false: the action does
   void fly_by_controllers(bool yes);
-  /// \brief True when the scenario's controllers fly the vehicles (fly_by_controllers()).
+  /// \brief Who flies the vehicles (fly_by_controllers()).
+  /// \return true when the scenario's controllers do, false when the action does
   bool flown_by_controllers() const { return controllers_; }
 
   /// \brief One control period: applies `action` (see apply()) and advances the world by
   /// substeps() system steps, then observes it. Does nothing once the episode has ended
   /// (terminated() or truncated()) but return 0. No allocation.
+  /// \param action action_size() entries (see apply()), not null
   /// \returns the reward of the step (see the class).
   /// \throws kelp::invalid_argument for a bad action (nothing is stepped).
   double step(const double* action);
 
   /// \brief As step() with the action set earlier (apply()), e.g. by kelp::sim::Batch.
+  /// \return the reward of the step (0 once the episode has ended). A failed system step does
+  /// not throw: it terminates the episode (error()).
   double advance();
 
   /// \brief Writes the observation of the current state (observation_size entries) to `out`.
+  /// \param out room for observation_size doubles (layout: see the class)
   void observe(double* out) const;
 
   /// \brief The observation after the last reset() or step().
+  /// \return observation_size entries (layout and units: see the class)
   const std::array<double, observation_size>& observation() const { return obs_; }
-  /// \brief The reward of the last step (0 after reset()).
+  /// \brief The reward of the last step. \return the reward (0 after reset())
   double reward() const { return reward_; }
-  /// \brief True when the ROV left the path by more than max_path_error or a step failed.
+  /// \brief Whether the episode terminated.
+  /// \return true when the ROV left the path by more than max_path_error or a step failed
   bool terminated() const { return terminated_; }
-  /// \brief True when the scenario's duration has been simulated (and not terminated).
+  /// \brief Whether the episode was truncated.
+  /// \return true when the scenario's duration has been simulated (and not terminated)
   bool truncated() const { return !terminated_ && loop_->done(); }
-  /// \brief Why the episode terminated on a failed step (empty otherwise).
+  /// \brief Why the episode terminated on a failed step.
+  /// \return the failure's message (empty otherwise)
   const std::string& error() const { return error_; }
   /// \brief The world (state, metrics, summary; its ROV is flown by the action).
+  /// \return the closed loop of the current episode
   const ClosedLoop& loop() const { return *loop_; }
   /// \brief The ROV's command of the current action (thrusts, commands, wrench, saturation).
+  /// \return the command (body axes; [N], [N m])
   const control::AuvCommand& auv_command() const { return auv_; }
-  /// \brief The energy the ROV's battery has delivered since reset() [J] (0 without propulsion).
+  /// \brief The energy the ROV's battery has delivered since reset().
+  /// \return the energy [J] (0 without propulsion)
   double energy_drawn() const;
 
  private:

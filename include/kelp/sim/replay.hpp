@@ -51,6 +51,8 @@ struct ReplayOptions {
 
 /// \brief The ramp factor of the replay's formula: r(t) = ½(1 − cos(π t/T)) on [0, T), 0
 /// for t < 0, 1 from T on and always 1 for T = 0 (environment::Environment::ramp_factor).
+/// \param t the time [s] \param ramp the ramp's duration T [s] (≤ 0 or NaN: no ramp)
+/// \return r(t), in [0, 1]
 KELP_SIM_API double replay_ramp(double t, double ramp);
 
 /// \brief The replay data ("kelp-replay" version 1, docs/replay.md) of the run in `dir`, as JSON
@@ -66,7 +68,10 @@ KELP_SIM_API double replay_ramp(double t, double ramp);
 /// 1e-4, times to 1e-6 s); the waves and `elevation_check` keep every digit.
 /// \throws replay_error when `dir` is not a run directory or one of its files cannot be read (a
 /// fleet's: also when neither the echoed scenario nor the scenario file is there, or nodes.csv
-/// names a tether the scenario lacks); scenario_error when the echoed scenario is refused.
+/// names a tether the scenario lacks); scenario_error when the echoed scenario is refused;
+/// kelp::invalid_argument for a negative `o.elevation_samples`.
+/// \param dir the run's directory \param o the source, title and elevation samples
+/// \return the JSON text (UTF-8, one line)
 KELP_SIM_API std::string replay_data_json(const std::filesystem::path& dir,
                                           const ReplayOptions& o = {});
 
@@ -74,6 +79,7 @@ KELP_SIM_API std::string replay_data_json(const std::filesystem::path& dir,
 /// the data's JSON text (replay_data_json()).
 /// Every `<` of the JSON is written `\u003c` (it occurs only inside strings), so that no string
 /// can close the script element (`</script>`) or open an HTML comment (`<!--`).
+/// \param data_json the data's JSON text \return the script's text
 KELP_SIM_API std::string replay_script(const std::string& data_json);
 
 /// \brief The marker of the replay template replaced by replay_script() (alone inside its script
@@ -82,6 +88,8 @@ inline constexpr const char* replay_data_marker = "/*@KELP_DATA@*/";
 
 /// \brief replay.html's text: `template_text` with its data marker replaced by
 /// replay_script(data_json).
+/// \param template_text the page's template (with replay_data_marker once)
+/// \param data_json the data's JSON text (replay_data_json()) \return the page's HTML text
 /// \throws replay_error when the template has not exactly one data marker.
 KELP_SIM_API std::string replay_html(const std::string& template_text,
                                      const std::string& data_json);
@@ -89,6 +97,8 @@ KELP_SIM_API std::string replay_html(const std::string& template_text,
 /// \brief Writes `dir`/replay.html: the template at `template_path` with the run's replay data
 /// (replay_data_json()).
 /// Written to a temporary file and renamed, so a reader never sees half a page.
+/// \param dir the run's directory (replay.html is written there)
+/// \param template_path the page's template file \param o as replay_data_json()'s
 /// \returns the path of replay.html.
 /// \throws replay_error as replay_data_json(), or when the template cannot be read or has no
 /// data marker, or replay.html cannot be written; scenario_error as replay_data_json().

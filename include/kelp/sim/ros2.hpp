@@ -25,13 +25,18 @@ class KELP_SIM_API Ros2Sampler {
   /// tether::segment_axial_force, as the line-failure check does).
   /// \throws kelp::invalid_argument when the row lacks what the messages need (vehicles, the
   /// tether, the end forces).
+  /// \param r the row (its `asv`, `auv`, `tether`, `tether_model` and end forces set)
+  /// \return the sample (kelp's frames: NED, FRD), pointing into `r` and this sampler: valid
+  /// while they are and until the next call
   const ros2::RunSample& sample(const LogRow& r);
 
   /// \brief The messages of row `r` (valid until the next call).
+  /// \param r the row (as sample()) \return the messages (ROS frames: ENU, FLU)
   /// \throws kelp::invalid_argument as sample() and ros2::fill_messages.
   const ros2::Messages& messages(const LogRow& r);
 
   /// \brief The tension drawn fully red on /tether/markers [N] (default 200).
+  /// \param newtons the tension [N], > 0
   void set_tension_scale(double newtons) { s_.tension_scale = newtons; }
 
  private:
@@ -49,15 +54,18 @@ class KELP_SIM_API BagRecorder {
   /// `options` of the MCAP file (chunk size).
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument for a rate
   /// that is not > 0.
+  /// \param path the bag's file \param marker_rate markers per second [Hz], > 0
+  /// \param options the MCAP options
   BagRecorder(const std::filesystem::path& path, double marker_rate,
               const ros2::McapOptions& options = {});
   /// \brief Writes the messages of row `r` (markers when due).
   /// \throws kelp::error on a write failure, kelp::invalid_argument as Ros2Sampler.
+  /// \param r the row (as Ros2Sampler::sample())
   void record(const LogRow& r);
   /// \brief Finishes the bag (summary, index, footer).
   /// \throws kelp::error on a write failure.
   void close() { bag_.close(); }
-  /// \brief The bag being written.
+  /// \brief The bag being written. \return the writer (counts, bytes)
   const ros2::BagWriter& bag() const { return bag_; }
 
  private:

@@ -37,7 +37,9 @@ struct ScenarioOverrides {
 };
 
 /// \brief The scenario with the overrides applied.
-/// \throws kelp::invalid_argument for a non-finite duration, an unknown kernel name, or
+/// \param sc the scenario (a copy, returned changed) \param o the overrides
+/// \return the scenario with every set override applied
+/// \throws kelp::invalid_argument for a NaN duration, an unknown kernel name, or
 /// `deterministic` with a kernel other than "portable".
 KELP_SIM_API Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o);
 
@@ -74,12 +76,17 @@ struct RunOptions {
 class KELP_SIM_API RunBag {
  public:
   /// \brief The bag `file` (its directory created when it opens), markers at `marker_rate` [Hz].
+  /// Nothing is created until the first record().
+  /// \param file the bag's path (e.g. `out`/run.mcap) \param marker_rate markers per second, > 0
   RunBag(std::filesystem::path file, double marker_rate);
   ~RunBag();
   RunBag(const RunBag&) = delete;
   RunBag& operator=(const RunBag&) = delete;
   /// \brief Records sample `r`, opening the bag first if it is not open yet.
-  /// \throws kelp::error when the file cannot be written.
+  /// \param r the sample (with both vehicles, the tether and its end forces: Ros2Sampler)
+  /// \throws kelp::error when the file cannot be written; kelp::invalid_argument as
+  /// BagRecorder (a rate that is not > 0, a row that lacks what the messages need);
+  /// std::filesystem::filesystem_error when the directory cannot be created.
   void record(const LogRow& r);
   /// \brief Finishes the bag if it was opened.
   void close();
@@ -94,6 +101,8 @@ class KELP_SIM_API RunBag {
 /// \brief The run's ROS 2 bag, run.mcap in `o.out`, when the scenario asks for one
 /// (`output.mcap`, the default) and there is an output directory: `on_sample` is wrapped so that
 /// every sample is recorded before it is passed on. Close the bag after the run.
+/// \param sc the scenario (its `mcap` and node rate) \param o the run's options (`out`)
+/// \param on_sample the run's sample callback, replaced by one that records, then calls it
 /// \returns the bag, or null when none is written.
 KELP_SIM_API std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunOptions& o,
                                                   std::function<void(const LogRow&)>& on_sample);
@@ -104,6 +113,9 @@ KELP_SIM_API std::unique_ptr<RunBag> open_run_bag(const Scenario& sc, const RunO
 /// calls it, and so does a program that runs its own loop (kelp-tethered-pair --ros2), so that
 /// every run directory has the same files. \throws kelp::error when a file cannot be written
 /// (replay_error for replay.html).
+/// \param summary the run's summary (its `kelp_version` set from `o.version`)
+/// \param o the run's options (`out`, `version`, `replay_template`; nothing without `out`)
+/// \param source the program named in replay.html
 KELP_SIM_API void finish_run(RunSummary& summary, const RunOptions& o,
                              const std::string& source = "kelp-tethered-pair");
 
@@ -111,6 +123,8 @@ KELP_SIM_API void finish_run(RunSummary& summary, const RunOptions& o,
 /// ROS 2 run's `ros2` object): `summary_text` is written as summary.json as it is (no
 /// `kelp_version` is added), then replay.html as finish_run() writes it.
 /// \throws kelp::error when a file cannot be written (replay_error for replay.html).
+/// \param summary_text summary.json's text \param o the run's options (`out`, `replay_template`)
+/// \param source the program named in replay.html
 KELP_SIM_API void finish_run_with(const std::string& summary_text, const RunOptions& o,
                                   const std::string& source = "kelp-tethered-pair");
 
@@ -125,6 +139,8 @@ KELP_SIM_API void finish_run_with(const std::string& summary_text, const RunOpti
 /// has its summary and footer, summary.json says `"completed": false` and the time reached.
 /// With `o.checkpoint_every` it also leaves checkpoint.bin, from which `o.resume` continues it
 /// (kelp/sim/checkpoint.hpp): the files of a resumed run are those of a run never stopped.
+/// \param sc the scenario (apply_overrides() first for a command line's)
+/// \param o the output directory, version, observers, replay, stop and checkpoint options
 /// \returns the summary (summary.json's content: summary_json()).
 /// \throws scenario_error, kelp::invalid_argument, kelp::numerical_error; kelp::error when a
 /// file cannot be written (replay_error for replay.html).

@@ -60,11 +60,14 @@ struct LogRow {
       Eigen::Matrix<double, 8, 1>::Constant(none);  ///< [N], motor order
   Eigen::Matrix<double, 8, 1> auv_command =
       Eigen::Matrix<double, 8, 1>::Constant(none);  ///< normalised
-  double tension_asv = 0, tension_auv = 0;          ///< tether force on each vehicle [N]
+  double tension_asv = 0,  ///< magnitude of the tether's force on the ASV [N]
+      tension_auv = 0;     ///< magnitude of the tether's force on the AUV [N]
   /// \name Winch: the unstretched line out [m], and with a winch its payout rate [m/s] and the
   /// pull at the winch [N] (NaN without a winch).
   ///@{
-  double tether_length = none, payout_rate = none, winch_pull = none;
+  double tether_length = none,  ///< unstretched line out [m]
+      payout_rate = none,       ///< winch payout rate [m/s] (positive: paying out)
+      winch_pull = none;        ///< pull at the winch [N]
   ///@}
   /// \name Propulsion: each battery's terminal voltage [V] and state of charge, each thruster's
   /// current [A] (NaN without a propulsion model).
@@ -81,27 +84,34 @@ struct LogRow {
   /// The tether's winding angle [rad] about the obstacle it is most wound round now (the
   /// largest |winding|; kelp/sim/entanglement.hpp), and that obstacle's index among the
   /// scenario's cylinders (NaN without cylinders).
-  double tether_winding = none, winding_obstacle = none;
+  double tether_winding = none,  ///< the winding angle [rad] (signed)
+      winding_obstacle = none;   ///< the obstacle's index among the cylinders (NaN: none)
   /// \name For the ROS 2 messages (kelp/sim/ros2.hpp; not in timeseries.csv): the tether's force
   /// on each vehicle (NED [N], system::SystemReport), the AUV's last acceleration ν̇ (body, its
   /// IMU's specific force), gravity [m/s²], and the tether's line model and state (pointed to:
   /// they must outlive the call). NaN / null when the program does not give them.
   ///@{
+  /// The tether's force on the ASV, NED [N].
   kelp::Vector3<double> force_on_asv = kelp::Vector3<double>::Constant(none);
+  /// The tether's force on the AUV, NED [N].
   kelp::Vector3<double> force_on_auv = kelp::Vector3<double>::Constant(none);
+  /// The AUV's last acceleration ν̇, body axes ([m/s²], [rad/s²]).
   kelp::Vector6<double> auv_nu_dot = kelp::Vector6<double>::Constant(none);
-  double gravity = none;
-  const kelp::tether::TetherModeld* tether_model = nullptr;
-  const kelp::tether::TetherStated* tether = nullptr;
+  double gravity = none;  ///< gravitational acceleration g [m/s²]
+  const kelp::tether::TetherModeld* tether_model = nullptr;  ///< the line model (or null)
+  const kelp::tether::TetherStated* tether = nullptr;  ///< the line's state, NED [m] (or null)
   ///@}
 };
 
 /// \brief The columns of timeseries.csv, in order (documented in
 /// apps/tethered_pair/README.md); for_each_value gives a row's values in the same order.
+/// \return the names (a static list, built once)
 KELP_SIM_API const std::vector<std::string>& timeseries_columns();
 
 /// \brief Calls `f(value)` for each value of row `r`, in timeseries_columns()' order (what
 /// RunLog::row writes and kelp's Python package returns as columns). No allocation.
+/// \tparam F a callable taking a double
+/// \param r the row (its `asv` and `auv` must not be null) \param f called once per column
 template <typename F>
 void for_each_value(const LogRow& r, F&& f) {
   const Eigen::Vector3d ea = kelp::euler_from_quaternion(r.asv->attitude);
@@ -164,6 +174,8 @@ class KELP_SIM_API LineFile {
  public:
   LineFile() = default;
   /// \brief Opens `path` (see open()).
+  /// \param path the file to create or truncate
+  /// \throws kelp::error naming the file when it cannot be created.
   explicit LineFile(const std::filesystem::path& path) { open(path); }
   /// \brief Writes out and closes (close()), errors swallowed: call close() to see them.
   ~LineFile();
@@ -171,11 +183,13 @@ class KELP_SIM_API LineFile {
   LineFile& operator=(const LineFile&) = delete;
 
   /// \brief Creates (or truncates) `path` for writing.
+  /// \param path the file
   /// \throws kelp::error naming the file when it cannot be created.
   void open(const std::filesystem::path& path);
-  /// \brief Is a file open?
+  /// \brief Is a file open? \return true between open() and close()
   bool is_open() const { return fd_ >= 0; }
   /// \brief The text gathered: append the current line's text to it.
+  /// \return the buffer (ended lines not yet written, then the current line)
   std::string& text() { return text_; }
   /// \brief Ends the current line (a newline); writes the gathered lines out once they fill a
   /// block. \throws kelp::error when the file cannot be written.
@@ -199,6 +213,7 @@ class KELP_SIM_API LineFile {
 /// directory, so the same file system), then renamed over it. A reader, or a process killed at any
 /// point, sees the old file (or none) or the new one whole, never a part (summary.json,
 /// replay.html). \throws kelp::error naming the file when it cannot be written.
+/// \param path the file to replace \param text its new content
 KELP_SIM_API void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
 /// \brief timeseries.csv, nodes.csv and events.csv of a run, in a directory (the columns are
@@ -206,18 +221,22 @@ KELP_SIM_API void write_file_atomically(const std::filesystem::path& path, const
 class KELP_SIM_API RunLog {
  public:
   /// \brief Creates `dir` (and its parents) and the three files in it, each with its header line.
+  /// \param dir the run's directory (existing files in it are truncated)
   /// \throws kelp::error when the files cannot be opened for writing; std::filesystem's error
   /// when the directory cannot be created.
   explicit RunLog(const std::filesystem::path& dir);
 
   /// \brief Appends one row to timeseries.csv (and writes every file's lines out when the row is
   /// a simulated second or more after the last time they were).
+  /// \param r the row (its `asv` and `auv` must not be null)
   /// \throws kelp::error when a file cannot be written.
   void row(const LogRow& r);
 
   /// \brief Appends the tether's parting to events.csv
   /// (`t,event,segment,x,y,z,tension,obstacle,winding`, event `line_parted`): its time [s],
   /// segment, position NED [m] and axial force [N] (no obstacle, winding `nan`). Written at once.
+  /// \param f the parting (tether/failure.hpp)
+  /// \throws kelp::error when the file cannot be written.
   void line_parted(const kelp::tether::LineFailured& f);
 
   /// \brief Appends an entanglement event to events.csv (kelp/sim/entanglement.hpp): `entangled`
@@ -225,6 +244,12 @@ class KELP_SIM_API RunLog {
   /// (`tension`: the axial force on the ROV's side of the contact less the boat's [N]); its
   /// time [s], no segment (`nan`), the contact's position NED [m], the obstacle's name and the
   /// winding about it then [rad]. Written at once.
+  /// \param t time [s] \param event the event's name (`entangled` or `pinned`)
+  /// \param position the contact's position, NED [m]
+  /// \param tension the tension difference [N] (`pinned`), or NaN
+  /// \param obstacle the obstacle's name (written as is: no commas)
+  /// \param winding the winding about it [rad]
+  /// \throws kelp::error when the file cannot be written.
   void entanglement(double t, const char* event, const kelp::Vector3<double>& position,
                     double tension, const std::string& obstacle, double winding);
 

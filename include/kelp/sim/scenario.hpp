@@ -42,6 +42,10 @@ struct ChoiceName {
 
 /// \brief The name of `value` in the table `names`, or `unknown` (by default nullptr) when the
 /// table lacks it (a value cast from an integer).
+/// \tparam E the enumeration \tparam N the table's length
+/// \param value the enumerator to look up \param names its table (e.g. sea_names)
+/// \param unknown what to return for a value the table lacks
+/// \return the name (static storage, from the table), or `unknown`. No throw.
 template <class E, std::size_t N>
 constexpr const char* choice_name(E value, const ChoiceName<E> (&names)[N],
                                   const char* unknown = nullptr) {
@@ -117,25 +121,44 @@ inline constexpr ChoiceName<kelp::simd::KernelPath> kernel_path_names[] = {
     {kelp::simd::KernelPath::avx2, "avx2"},
     {kelp::simd::KernelPath::avx512, "avx512"}};
 
+/// \name Names of the choices
 /// \brief A choice's name in scenario files ("invalid" for a value outside the enumeration).
 /// @{
+
+/// \brief The name of a NavigationMode (navigation_mode_names).
+/// \param x the mode \return "perfect", "sensors" or "invalid" (static storage)
 inline const char* to_string(NavigationMode x) {
   return choice_name(x, navigation_mode_names, "invalid");
 }
+/// \brief The name of a Sea (sea_names).
+/// \param x the sea \return "calm", "moderate", "rough", "custom" or "invalid" (static storage)
 inline const char* to_string(Sea x) { return choice_name(x, sea_names, "invalid"); }
+/// \brief The name of a TetherKind (tether_kind_names).
+/// \param x the kind \return "rov_tether", "bead_chain" or "invalid" (static storage)
 inline const char* to_string(TetherKind x) { return choice_name(x, tether_kind_names, "invalid"); }
+/// \brief The name of a ControlPreset (control_preset_names).
+/// \param x the preset \return "kelp", "paper" or "invalid" (static storage)
 inline const char* to_string(ControlPreset x) {
   return choice_name(x, control_preset_names, "invalid");
 }
+/// \brief The name of a tether::LineModel (line_model_names).
+/// \param x the model \return "kelp", "moordyn" or "invalid" (static storage)
 inline const char* to_string(kelp::tether::LineModel x) {
   return choice_name(x, line_model_names, "invalid");
 }
+/// \brief The name of a control::WinchStrategy (winch_strategy_names).
+/// \param x the strategy
+/// \return "hold", "constant_tension", "slack", "depth_following" or "invalid" (static storage)
 inline const char* to_string(kelp::control::WinchStrategy x) {
   return choice_name(x, winch_strategy_names, "invalid");
 }
+/// \brief The name of a simd::KernelPath (kernel_path_names).
+/// \param x the path \return "auto", "portable", "avx2", "avx512" or "invalid" (static storage)
 inline const char* to_string(kelp::simd::KernelPath x) {
   return choice_name(x, kernel_path_names, "invalid");
 }
+/// \brief The name of an environment::WaveStretching (wave_stretching_names).
+/// \param x the stretching \return "vertical", "wheeler" or "invalid" (static storage)
 inline const char* to_string(kelp::environment::WaveStretching x) {
   return choice_name(x, wave_stretching_names, "invalid");
 }
@@ -164,22 +187,31 @@ struct BatteryScenario {
 /// (kelp::control::TetherManagementSettings; the strategy is Scenario::winch_strategy).
 /// Lengths in m, speeds in m/s, forces in N.
 struct WinchScenario {
-  bool enabled = false;  ///< a `winch` object was given
-  double max_speed = 0.5, max_acceleration = 0.5, max_pull = 400;
-  double min_length = 5, max_length = 60;
-  double tension_low = 5, tension_high = 25, tension_gain = 0.02;
-  double slack = 0.3;
-  double extra_length = 3, length_per_depth = 1, length_per_offset = 1, length_gain = 0.5;
+  bool enabled = false;        ///< a `winch` object was given
+  double max_speed = 0.5,      ///< largest line speed, in or out [m/s] (> 0)
+      max_acceleration = 0.5,  ///< largest change of line speed [m/s²] (> 0)
+      max_pull = 400;          ///< largest pull it reels in against [N] (> 0)
+  double min_length = 5,       ///< shortest line it leaves out [m] (≥ one segment)
+      max_length = 60;         ///< longest line it pays out [m] (≥ min_length)
+  double tension_low = 5,      ///< constant_tension: the band's low end [N]
+      tension_high = 25,       ///< constant_tension: the band's high end [N] (> tension_low)
+      tension_gain = 0.02;     ///< constant_tension: payout rate per N outside the band [m/s/N]
+  double slack = 0.3;          ///< slack: line out over the attachments' distance, minus 1 [-]
+  double extra_length = 3,     ///< depth_following: line out at depth 0 and no offset [m]
+      length_per_depth = 1,    ///< depth_following: line out per metre of depth [m/m]
+      length_per_offset = 1,   ///< depth_following: per metre of horizontal offset [m/m]
+      length_gain = 0.5;       ///< slack, depth_following: payout rate per m of length error [1/s]
 };
 
 /// \brief A regular (Airy) wave of a custom sea (`"sea": {"regular": {...}}`;
 /// environment::RegularWave): on top of the JONSWAP sea, or alone when significant_height is 0.
 /// Exactly one of period and wavelength; deep water, like the scenario's spectral waves.
 struct RegularWaveScenario {
-  bool enabled = false;                      ///< a `regular` object was given
-  double height = 0;                         ///< crest-to-trough height H [m]
-  std::optional<double> period, wavelength;  ///< T [s] or λ [m]
-  double direction = 0;                      ///< NED azimuth it travels towards [rad]
+  bool enabled = false;          ///< a `regular` object was given
+  double height = 0;             ///< crest-to-trough height H [m]
+  std::optional<double> period,  ///< period T [s] (unset: from wavelength)
+      wavelength;                ///< wavelength λ [m] (unset: from period)
+  double direction = 0;          ///< NED azimuth it travels towards [rad]
   double phase = 0;  ///< φ [rad]: ζ = (H/2) cos(k (x cos β + y sin β) − ω t + φ)
 };
 
@@ -223,9 +255,11 @@ struct FleetVehicleScenario {
 
 /// \brief A free point mass of a fleet scenario (kelp::system::PointMassParameters).
 struct FleetPointMassScenario {
-  std::string name;                                             ///< unique
-  double mass = 0, volume = 0, added_mass_coefficient = 0.5;    ///< [kg], [m³], [-]
-  double drag_area = 0;                                         ///< C_d A [m²]
+  std::string name;                  ///< unique
+  double mass = 0,                   ///< its mass [kg]
+      volume = 0,                    ///< its displaced volume [m³] (buoyancy)
+      added_mass_coefficient = 0.5;  ///< added mass over displaced water's mass [-]
+  double drag_area = 0;              ///< C_d A [m²]
   kelp::Vector3<double> start = kelp::Vector3<double>::Zero();  ///< NED [m]
 };
 
@@ -239,10 +273,13 @@ struct FleetAnchorScenario {
 /// \brief A winch at a fleet tether's start end, paying out or reeling in at a constant
 /// commanded rate within its limits (kelp::tether::WinchParameters).
 struct FleetWinchScenario {
-  bool enabled = false;                                            ///< a `winch` object was given
-  double max_speed = 0.5, max_acceleration = 0.5, max_pull = 400;  ///< [m/s], [m/s²], [N]
-  double min_length = 5, max_length = 60;                          ///< [m]
-  double payout_rate = 0;  ///< commanded [m/s] (positive: paying out; 0 at either limit)
+  bool enabled = false;        ///< a `winch` object was given
+  double max_speed = 0.5,      ///< largest line speed, in or out [m/s]
+      max_acceleration = 0.5,  ///< largest change of line speed [m/s²]
+      max_pull = 400;          ///< largest pull it reels in against [N]
+  double min_length = 5,       ///< shortest line it leaves out [m]
+      max_length = 60;         ///< longest line it pays out [m]
+  double payout_rate = 0;      ///< commanded [m/s] (positive: paying out; 0 at either limit)
 };
 
 /// \brief A tether of a fleet scenario, between two named ends (a vehicle, a point mass or an
@@ -252,13 +289,20 @@ struct FleetTetherScenario {
   std::string from;  ///< the start end's owner (the winch's side)
   std::string to;    ///< the far end's owner
   /// Attachment points on vehicles, body axes [m] (unset: the vehicle's file's attachment).
-  std::optional<kelp::Vector3<double>> from_point, to_point;
-  double length = 10;           ///< unstretched [m]
+  std::optional<kelp::Vector3<double>> from_point,
+      to_point;        ///< the far end's attachment on a vehicle, body axes [m] (unset: its file's)
+  double length = 10;  ///< unstretched [m]
   double segment_length = 0.5;  ///< [m]
-  /// The cable: the ROV tether preset (kelp::tether::presets::rov_tether) with these overrides.
-  std::optional<double> diameter, mass_per_length, axial_stiffness, internal_damping_ratio,
-      normal_drag, tangential_drag, breaking_strength;
-  FleetWinchScenario winch;  ///< a winch at the start end (when enabled)
+  /// The cable: the ROV tether preset (kelp::tether::presets::rov_tether) with these overrides
+  /// (unset: the preset's; tether::TetherParameters has their meaning). The diameter [m].
+  std::optional<double> diameter,
+      mass_per_length,         ///< mass per unstretched length [kg/m]
+      axial_stiffness,         ///< EA [N]
+      internal_damping_ratio,  ///< internal damping as a ratio of critical [-]
+      normal_drag,             ///< normal drag coefficient C_dn [-]
+      tangential_drag,         ///< tangential drag coefficient C_dt [-]
+      breaking_strength;       ///< tension at which it parts [N] (0: never)
+  FleetWinchScenario winch;    ///< a winch at the start end (when enabled)
 };
 
 /// \brief A fleet scenario's parts (`"fleet": {...}`): with it, a scenario runs these vehicles,
@@ -291,9 +335,9 @@ struct Scenario {
   ///@}
   /// \name Tether: its length, its kind ("rov_tether" or "bead_chain") and segment length [m].
   ///@{
-  double tether_length = 10.0;
-  TetherKind tether_kind = TetherKind::rov_tether;
-  double segment_length = 0.5;
+  double tether_length = 10.0;                      ///< unstretched length [m] (`tether.length`)
+  TetherKind tether_kind = TetherKind::rov_tether;  ///< the cable's preset (`tether.kind`)
+  double segment_length = 0.5;  ///< nominal segment length [m] (`tether.segment_length`)
   ///@}
   /// \name Cable properties overriding the kind's (unset: keep the preset's; see
   /// tether::TetherParameters for the units).
@@ -322,7 +366,9 @@ struct Scenario {
   /// \name Vehicles: attachment points (body axes from the CO [m]) and the AUV's start (NED;
   /// unset: the paper's start, 5 m down astern of the boat).
   ///@{
-  kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08}, auv_attachment{-0.2, 0, -0.05};
+  kelp::Vector3<double> asv_attachment{-0.5, 0, 0.08},  ///< on the boat, body axes from its CO [m]
+      auv_attachment{-0.2, 0, -0.05};                   ///< on the ROV, body axes from its CO [m]
+  /// The ROV's start position, NED [m] (unset: 5 m down astern of the boat, the paper's).
   std::optional<kelp::Vector3<double>> auv_start;
   ///@}
   /// \name Start (`"start": {"ramp": 10, "with_water": true}`): the sea (waves, current, wind)
@@ -331,8 +377,8 @@ struct Scenario {
   /// moving with the water at their positions (current + wave orbital velocity at t = 0; zero
   /// while the ramp holds the sea at rest) instead of at rest in moving water.
   ///@{
-  double start_ramp = 10.0;
-  bool start_with_water = true;
+  double start_ramp = 10.0;      ///< ramp-in time of the sea [s], in [0, 1e5] (0: none)
+  bool start_with_water = true;  ///< start the bodies moving with the water (else at rest)
   ///@}
   /// \name Control: the preset, the paper's disturbance compensation, the PID gains, the ASV's
   /// thrust clip [N] and the controllers' rates [Hz].
@@ -355,8 +401,9 @@ struct Scenario {
   /// \name Mission: NED waypoints [m]; empty: a square of side `square_side` at `depth` from the
   /// start.
   ///@{
-  std::vector<kelp::Vector3<double>> waypoints;
-  double depth = 5.0, square_side = 8.0;
+  std::vector<kelp::Vector3<double>> waypoints;  ///< the ROV's waypoints, NED [m] (empty: square)
+  double depth = 5.0,                            ///< the default square's depth, NED z [m]
+      square_side = 8.0;                         ///< the default square's side [m]
   ///@}
   /// \name Output: rows of timeseries.csv and snapshots of nodes.csv per simulated second [Hz].
   ///@{
@@ -377,11 +424,11 @@ struct Scenario {
   /// the batteries); `propulsion` false: the controllers' wrench is applied directly (the
   /// behaviour of kelp 0.1.0). Defaults: kelp::vehicle::battery_presets.
   ///@{
-  bool propulsion = true;
-  bool thruster_lag = true;
-  double thruster_time_constant = 0.02;
-  BatteryScenario asv_battery{31.2, 4, 0.02, 1.0, 0.0};
-  BatteryScenario auv_battery{15.6, 4, 0.04, 1.0, 0.0};
+  bool propulsion = true;    ///< thrusters and batteries modelled (false: wrench applied directly)
+  bool thruster_lag = true;  ///< a first-order lag between command and thrust
+  double thruster_time_constant = 0.02;  ///< the lag's time constant [s], in [0, 10]
+  BatteryScenario asv_battery{31.2, 4, 0.02, 1.0, 0.0};  ///< the boat's battery (4S, 31.2 Ah)
+  BatteryScenario auv_battery{15.6, 4, 0.04, 1.0, 0.0};  ///< the ROV's battery (4S, 15.6 Ah)
   ///@}
   /// \name Obstacles and seabed (`"obstacles": [...]`, `"seabed": {...}`; none by default).
   ///@{
@@ -415,21 +462,28 @@ struct Scenario {
 
 /// \brief The scenario's obstacles (cylinders, boxes, height-field seabed) as an ObstacleSet
 /// (cylinders first, then boxes: the set's flat indices). Empty when the scenario has none.
+/// \param[in] s the scenario (its `cylinders`, `boxes` and `heightfield`; NED [m])
+/// \return the set (the flat seabed, `seabed_depth`, is not part of it)
 /// \throws kelp::invalid_argument for an obstacle the set refuses (parse_scenario checks them).
 KELP_SIM_API kelp::environment::ObstacleSet obstacle_set(const Scenario& s);
 
 /// \brief Reads and validates a scenario from JSON text.
 /// \param[in] text the JSON text \param[in] file names the scenario in error messages
-/// \throws scenario_error naming the file, the JSON path and what was expected.
+/// \return the scenario, every field the text leaves out at its default
+/// \throws scenario_error naming the file, the JSON path and what was expected (also for JSON
+/// nested too deep or not valid JSON).
 KELP_SIM_API Scenario parse_scenario(const std::string& text, const std::string& file);
 
-/// \brief Reads a scenario file. \throws scenario_error naming the file (also when it cannot be
-/// read).
+/// \brief Reads a scenario file (parse_scenario() of its text).
+/// \param[in] file the file's path (also names it in errors)
+/// \return the scenario \throws scenario_error naming the file (also when it cannot be read).
 KELP_SIM_API Scenario load_scenario(const std::string& file);
 
 /// \brief The scenario as JSON text, every field with its value (echoed in the run's summary; it
 /// reads back through parse_scenario to the same scenario); `kernel` only when it is not "auto".
+/// \param[in] s the scenario
 /// \param[in] indent spaces per level, or -1 (the default) for one line.
+/// \return the JSON text (UTF-8).
 KELP_SIM_API std::string scenario_json(const Scenario& s, int indent = -1);
 
 }  // namespace sim

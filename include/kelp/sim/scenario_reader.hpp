@@ -38,6 +38,9 @@ inline constexpr int max_json_depth = 64;
 /// \brief Nesting depth of the arrays and objects in JSON text (brackets inside strings do not
 /// count); the scan stops as soon as the depth exceeds `limit`. Exact for valid JSON. Readers of
 /// files that embed scenarios (e.g. kelp-sweep's sweep files) check it before parsing.
+/// \param text the JSON text (not validated) \param limit the depth at which to stop scanning
+/// \return the deepest nesting found (0: no array or object), or limit + 1 once it exceeds
+/// `limit`
 KELP_SIM_API int json_depth(const std::string& text, int limit);
 
 }  // namespace sim

@@ -34,10 +34,13 @@ namespace kelp {
 namespace sim {
 
 /// \brief The pair's state as a state file's bytes.
+/// \param state the state (NED positions [m], body velocities, clocks [s])
+/// \return the file's bytes (binary, docs/state-files.md)
 /// \throws state_error when the state could not be loaded back (sizes that do not fit together,
 /// NaN or infinity where a step refuses them, clocks that differ: the loader's checks).
 KELP_SIM_API std::string save_state(const kelp::system::SystemStated& state);
 /// \brief A fleet's state as a state file's bytes. \throws state_error as the pair's.
+/// \param state the fleet's state \return the file's bytes (binary, docs/state-files.md)
 KELP_SIM_API std::string save_state(const kelp::system::FleetStated& state);
 
 /// \brief The pair's state from a state file's bytes, checked against `model`: its tether's
@@ -46,6 +49,7 @@ KELP_SIM_API std::string save_state(const kelp::system::FleetStated& state);
 /// before its first step.
 /// \param bytes the file's bytes (untrusted) \param model the system it is for
 /// \param input names the input in errors
+/// \return the state, bit for bit as saved
 /// \throws state_error naming what is wrong (nothing else is changed).
 KELP_SIM_API kelp::system::SystemStated load_state(std::string_view bytes,
                                                    const kelp::system::SystemModeld& model,
@@ -53,6 +57,8 @@ KELP_SIM_API kelp::system::SystemStated load_state(std::string_view bytes,
 /// \brief A fleet's state from a state file's bytes, checked against `model` (its vehicle, point
 /// mass and tether counts, each tether's node count, each vehicle's thrusters). With winches,
 /// call system::fit_workspace(model, ws, state) before its first step.
+/// \param bytes the file's bytes (untrusted) \param model the fleet it is for
+/// \param input names the input in errors \return the state, bit for bit as saved
 /// \throws state_error naming what is wrong.
 KELP_SIM_API kelp::system::FleetStated load_state(std::string_view bytes,
                                                   const kelp::system::FleetModeld& model,
@@ -62,10 +68,14 @@ KELP_SIM_API kelp::system::FleetStated load_state(std::string_view bytes,
 /// together, finite where a step needs it, equal clocks) but not against a system: the step
 /// then checks what depends on the system (the node count, the thruster counts). For a reader
 /// that has no model at hand (Python's pickle).
+/// \param bytes the file's bytes (untrusted) \param input names the input in errors
+/// \return the state, bit for bit as saved
 /// \throws state_error naming what is wrong.
 KELP_SIM_API kelp::system::SystemStated load_system_state(std::string_view bytes,
                                                           const std::string& input = "state");
 /// \brief A fleet's state from a state file's bytes, checked on its own (see load_system_state).
+/// \param bytes the file's bytes (untrusted) \param input names the input in errors
+/// \return the state, bit for bit as saved
 /// \throws state_error naming what is wrong.
 KELP_SIM_API kelp::system::FleetStated load_fleet_state(std::string_view bytes,
                                                         const std::string& input = "state");
@@ -75,15 +85,25 @@ KELP_SIM_API kelp::system::FleetStated load_fleet_state(std::string_view bytes,
 /// either its old content or the whole new state, whatever happens meanwhile.
 /// \throws state_error for a state that cannot be saved; kelp::error naming the path when the
 /// file cannot be written (`path` is then unchanged and no temporary file is left).
+/// \param path the file to write \param state the state
 KELP_SIM_API void save_state_file(const std::string& path, const kelp::system::SystemStated& state);
 /// \brief Writes a fleet's state to `path` atomically (see the pair's).
+/// \param path the file to write \param state the fleet's state
+/// \throws state_error for a state that cannot be saved; kelp::error naming the path when the
+/// file cannot be written.
 KELP_SIM_API void save_state_file(const std::string& path, const kelp::system::FleetStated& state);
 
 /// \brief load_state of the file `path` (errors name the path).
-/// \throws kelp::error naming the path when it cannot be read; state_error as load_state.
+/// \param path the file to read (at most max_state_file_bytes) \param model the system it is for
+/// \return the state
+/// \throws kelp::error naming the path when it cannot be read; state_error as load_state (also
+/// for a file larger than max_state_file_bytes).
 KELP_SIM_API kelp::system::SystemStated load_state_file(const std::string& path,
                                                         const kelp::system::SystemModeld& model);
 /// \brief load_state of a fleet's file `path` (errors name the path).
+/// \param path the file to read (at most max_state_file_bytes) \param model the fleet it is for
+/// \return the state
+/// \throws kelp::error naming the path when it cannot be read; state_error as load_state.
 KELP_SIM_API kelp::system::FleetStated load_state_file(const std::string& path,
                                                        const kelp::system::FleetModeld& model);
 

@@ -23,14 +23,17 @@ namespace sim {
 
 /// \brief True once a stop has been requested (request_stop(), or a signal caught by the
 /// handlers of install_stop_handlers()), until clear_stop().
+/// \return whether a stop is requested (one atomic load; any thread, async-signal-safe)
 KELP_SIM_API bool stop_requested() noexcept;
 
 /// \brief The signal that requested the stop (SIGINT, SIGTERM), or 0 when none was requested or
 /// request_stop() was called without one.
+/// \return the signal's number, or 0
 KELP_SIM_API int stop_signal() noexcept;
 
 /// \brief Requests a stop, naming `signal` (0: none). Async-signal-safe: it stores into one
 /// lock-free atomic. The first request's signal is kept.
+/// \param signal the signal's number (SIGINT, SIGTERM), or 0 for a request without one
 KELP_SIM_API void request_stop(int signal = 0) noexcept;
 
 /// \brief Withdraws the request (e.g. between the runs of a test). It does not reinstall
@@ -45,6 +48,7 @@ KELP_SIM_API void install_stop_handlers();
 
 /// \brief The exit status of a program whose run was stopped: 128 + stop_signal() (130 for
 /// SIGINT, 143 for SIGTERM), or 130 when the stop named no signal.
+/// \return the status to pass to exit() or return from main()
 KELP_SIM_API int interrupted_exit_status() noexcept;
 
 }  // namespace sim

@@ -43,6 +43,7 @@ struct VehicleDescription {
 /// \brief Reads a vehicle description from JSON text (docs/vehicle-files.md) and checks it with
 /// the library's own checks (vehicle::validate for the parameters, the propulsion and the hull).
 /// \param[in] json_text the JSON text \param[in] name_for_errors names the file in messages
+/// \return the description (FRD body axes, SI units), checked
 /// \throws scenario_error (a kelp::invalid_argument) whose message names the file and the JSON
 /// path, e.g. `rov.json: /propulsion/thrusters/3/model: unknown thruster model "t300" (allowed:
 /// "t200", {"curve": ...})`: a wrong type, an unknown key, a missing required key (`mass_kg`,
@@ -52,24 +53,30 @@ struct VehicleDescription {
 KELP_SIM_API VehicleDescription parse_vehicle(const std::string& json_text,
                                               const std::string& name_for_errors);
 
-/// \brief Reads a vehicle file. \throws scenario_error naming the file (also when it cannot be
-/// read) and the JSON path (see parse_vehicle).
+/// \brief Reads a vehicle file (parse_vehicle() of its text).
+/// \param[in] path the file (also names it in errors) \return the description, checked
+/// \throws scenario_error naming the file (also when it cannot be read) and the JSON path (see
+/// parse_vehicle).
 KELP_SIM_API VehicleDescription read_vehicle_file(const std::string& path);
 
 /// \brief The description as JSON text (2-space indent), every field written; numbers in the
 /// shortest form that reads back to the same double, so parse_vehicle(write_vehicle_file(d))
 /// equals d bit for bit. \throws kelp::invalid_argument when `d` does not pass the checks of
 /// parse_vehicle.
+/// \param[in] d the description \return the JSON text (UTF-8; write it to a file to keep it)
 KELP_SIM_API std::string write_vehicle_file(const VehicleDescription& d);
 
 /// \brief The shipped vehicles as descriptions, built from the C++ presets (no data directory
 /// needed): "bluerov2_heavy" (vehicle::bluerov2_heavy, its battery, hull and tether point, as
 /// system::presets::paper_system uses them) and "blueboat" (vehicle::blueboat, likewise). The
 /// files data/vehicles/NAME.json hold the same descriptions (a test keeps them equal).
+/// \param[in] name "bluerov2_heavy" or "blueboat" (vehicle_preset_names())
+/// \return the description
 /// \throws kelp::invalid_argument naming the known presets for any other name.
 KELP_SIM_API VehicleDescription vehicle_preset(const std::string& name);
 
 /// \brief Names of the presets vehicle_preset() knows.
+/// \return the names ("bluerov2_heavy", "blueboat")
 KELP_SIM_API std::vector<std::string> vehicle_preset_names();
 
 /// \brief Choices the SDF importer cannot take from the file.
@@ -113,11 +120,15 @@ struct SdfImport {
 /// \throws scenario_error naming the file and the element for an unreadable file, malformed XML,
 /// no model or link, a missing or non-positive mass, a missing inertia, a thruster whose joint is
 /// missing or whose command cannot be normalised, a bad number; or the library's checks' errors
-/// with the file name prefixed.
+/// with the file name prefixed. kelp::error when kelp::sim was built without tinyxml2.
+/// \param[in] path the `.sdf` file (also names it in errors)
+/// \param[in] options what the file cannot say (body link, propeller speed, density, g, …)
+/// \return the description and the list of what it does not carry
 KELP_SIM_API SdfImport import_sdf(const std::string& path, const SdfImportOptions& options = {});
 
 /// \brief import_sdf() of SDF text. \param[in] xml_text the SDF \param[in] name_for_errors names
-/// the file in messages. \throws as import_sdf().
+/// the file in messages. \param[in] options as import_sdf()'s
+/// \return the description and the list of what it does not carry \throws as import_sdf().
 KELP_SIM_API SdfImport parse_sdf(const std::string& xml_text, const std::string& name_for_errors,
                                  const SdfImportOptions& options = {});
 

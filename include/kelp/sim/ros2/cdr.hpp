@@ -36,9 +36,12 @@ inline constexpr std::array<std::uint8_t, 4> cdr_le_header = {0x00, 0x01, 0x00, 
 class KELP_SIM_API CdrWriter {
  public:
   /// \brief Starts a message in `out` (cleared, then the encapsulation header).
+  /// \param out the buffer, kept by reference: it must outlive the writer
   explicit CdrWriter(std::vector<std::uint8_t>& out);
 
   /// \brief Writes a primitive, string, sequence, fixed array or message.
+  /// \tparam T bool, an arithmetic type, std::string, std::vector, std::array or a message
+  /// struct of messages.hpp \param v the value, appended with its alignment padding
   template <class T>
   void operator()(const T& v) {
     if constexpr (std::is_same_v<T, bool>) {
@@ -76,11 +79,13 @@ class KELP_SIM_API CdrWriter {
 class KELP_SIM_API CdrReader {
  public:
   /// \brief Reads from `n` bytes at `data`.
+  /// \param data the bytes (not copied: they must outlive the reader) \param n their count
   /// \throws kelp::error when the encapsulation header is not CDR_LE.
   CdrReader(const std::uint8_t* data, std::size_t n);
 
   /// \brief Reads a primitive, string, sequence, fixed array or message.
   /// \throws kelp::error on truncated or malformed data.
+  /// \tparam T as CdrWriter's \param v the value, overwritten
   template <class T>
   void operator()(T& v) {
     if constexpr (std::is_same_v<T, bool>) {
@@ -112,7 +117,7 @@ class KELP_SIM_API CdrReader {
     }
   }
 
-  /// \brief Bytes not read yet.
+  /// \brief Bytes not read yet. \return the count [bytes]
   std::size_t remaining() const { return n_ - pos_; }
 
  private:
@@ -130,6 +135,8 @@ class KELP_SIM_API CdrReader {
 
 /// \brief Message `m` as CDR bytes (encapsulation header included) in `out` (cleared first;
 /// its capacity is kept, so a reused buffer does not allocate once large enough).
+/// \tparam M a message struct of messages.hpp \param m the message \param out the bytes
+/// \throws kelp::error on a big-endian host.
 template <class M>
 void serialize(const M& m, std::vector<std::uint8_t>& out) {
   const std::uint16_t probe = 1;
@@ -143,6 +150,9 @@ void serialize(const M& m, std::vector<std::uint8_t>& out) {
 /// \brief Message `m` from CDR bytes (the whole buffer must be used, up to 3 bytes of final
 /// padding).
 /// \throws kelp::error on a wrong header, truncated data or trailing bytes.
+/// \tparam M a message struct of messages.hpp
+/// \param data the bytes, encapsulation header first \param n their count
+/// \param m the message, overwritten (partly, when it throws)
 template <class M>
 void deserialize(const std::uint8_t* data, std::size_t n, M& m) {
   CdrReader r(data, n);

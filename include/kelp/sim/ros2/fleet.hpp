@@ -4,17 +4,17 @@
 ///
 /// The topics, named after the scenario's parts (`<v>` a vehicle, `<t>` a tether):
 ///
-/// | topic | type | QoS | what |
-/// |---|---|---|---|
-/// | `/clock` | rosgraph_msgs/msg/Clock | clock | simulation time |
-/// | `/tf` | tf2_msgs/msg/TFMessage | tf | world → `<v>/base_link` per vehicle, world → `<p>` per
-/// point mass | | `/<v>/odom` | nav_msgs/msg/Odometry | state | pose in `world`, twist in
-/// `<v>/base_link` | | `/<v>/imu` | sensor_msgs/msg/Imu | sensor data | orientation, rates,
-/// specific force | | `/<v>/thrusters` | sensor_msgs/msg/JointState | sensor data | per thruster:
-/// command (velocity), thrust [N] (effort); vehicles with thrusters only | | `/<t>/end_forces` |
-/// geometry_msgs/msg/WrenchStamped | sensor data | two a sample: the start end's, then the far
-/// end's | | `/markers` | visualization_msgs/msg/MarkerArray | state | a LINE_STRIP per tether (ns
-/// its name, coloured by tension), a CUBE per vehicle, a SPHERE per point mass |
+/// - `/clock` (rosgraph_msgs/msg/Clock, QoS clock): simulation time;
+/// - `/tf` (tf2_msgs/msg/TFMessage, QoS tf): world → `<v>/base_link` per vehicle, world → `<p>`
+///   per point mass;
+/// - `/<v>/odom` (nav_msgs/msg/Odometry, QoS state): pose in `world`, twist in `<v>/base_link`;
+/// - `/<v>/imu` (sensor_msgs/msg/Imu, QoS sensor data): orientation, rates, specific force;
+/// - `/<v>/thrusters` (sensor_msgs/msg/JointState, QoS sensor data): per thruster, command
+///   (velocity) and thrust [N] (effort); vehicles with thrusters only;
+/// - `/<t>/end_forces` (geometry_msgs/msg/WrenchStamped, QoS sensor data): two a sample, the
+///   start end's, then the far end's;
+/// - `/markers` (visualization_msgs/msg/MarkerArray, QoS state): a LINE_STRIP per tether (ns its
+///   name, coloured by tension), a CUBE per vehicle, a SPHERE per point mass.
 ///
 /// The messages are those of the pair's topics (kelp/sim/ros2/messages.hpp) with the same frames
 /// (REP 103 / REP 105: `world` ENU, bodies FLU) and the same formulas; an end wrench is the
@@ -60,11 +60,13 @@ struct FleetTetherSample {
   const Eigen::Matrix<double, 3, Eigen::Dynamic>* nodes = nullptr;
   /// Axial tension of each segment [N] (nodes − 1 values); null: drawn uncoloured.
   const Eigen::VectorXd* tensions = nullptr;
-  /// The tether's force on what holds its start end and its far end, NED [N].
-  Eigen::Vector3d force_at_start = Eigen::Vector3d::Zero(), force_at_end = Eigen::Vector3d::Zero();
+  /// The tether's force on what holds its start end, NED [N].
+  Eigen::Vector3d force_at_start = Eigen::Vector3d::Zero(),
+                  force_at_end = Eigen::Vector3d::Zero();  ///< the same at its far end, NED [N]
   /// The vehicle (index into FleetSample::vehicles) holding each end; −1: an anchor, a point
-  /// mass or free (the wrench is then given in `world`).
-  int start_vehicle = -1, end_vehicle = -1;
+  /// mass or free (the wrench is then given in `world`). This one: the start end's.
+  int start_vehicle = -1,
+      end_vehicle = -1;  ///< the vehicle holding the far end (index, or −1 as start_vehicle)
 };
 
 /// \brief One point mass of a fleet sample.
@@ -103,6 +105,7 @@ struct FleetMessages {
 /// \throws kelp::invalid_argument when a vehicle state or a tether's nodes are missing, a tether
 /// has fewer than 2 nodes or tensions of the wrong size, an end names a vehicle that is not
 /// there, a name is not a ROS name (is_ros_name), or the time is one ros2::to_time refuses.
+/// \param s the sample (kelp's frames: NED, FRD) \param m the messages, overwritten
 KELP_SIM_API void fill_fleet_messages(const FleetSample& s, FleetMessages& m);
 
 /// \brief A fleet's ROS 2 bag (MCAP, profile `ros2`): the topics of this file's table, one
@@ -113,6 +116,8 @@ class KELP_SIM_API FleetBagWriter {
   /// vehicles, their thrusters, its tethers; the values are not read).
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument for a name that
   /// is not a ROS name or used twice among the vehicles or among the tethers.
+  /// \param path the bag's file \param layout a sample of the fleet (its names and counts)
+  /// \param options the MCAP options
   FleetBagWriter(const std::filesystem::path& path, const FleetSample& layout,
                  const McapOptions& options = {});
 
@@ -120,13 +125,14 @@ class KELP_SIM_API FleetBagWriter {
   /// the same parts); `markers` false leaves /markers out (a bag may carry them at a lower rate).
   /// \throws kelp::error on a write failure; kelp::invalid_argument when `m` does not have the
   /// layout's parts.
+  /// \param m the sample's messages \param markers whether to write /markers
   void write(const FleetMessages& m, bool markers = true);
 
   /// \brief Finishes the file (summary, index, footer).
   /// \throws kelp::error on a write failure.
   void close() { mcap_.close(); }
 
-  /// \brief The underlying MCAP writer (counts, bytes).
+  /// \brief The underlying MCAP writer (counts, bytes). \return the writer
   const McapWriter& mcap() const { return mcap_; }
 
  private:

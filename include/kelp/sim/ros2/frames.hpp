@@ -22,16 +22,19 @@ namespace kelp {
 namespace ros2 {
 
 /// \brief A world vector (position [m], velocity, force [N]) from NED to ENU: (y, x, −z).
+/// \param v the vector in NED (x north, y east, z down) \return it in ENU (x east, y north, z up)
 inline Eigen::Vector3d ned_to_enu(const Eigen::Vector3d& v) { return {v.y(), v.x(), -v.z()}; }
 
 /// \brief A body vector (velocity, angular velocity, force, moment, acceleration) from FRD
 /// (x forward, y starboard, z down) to FLU (x forward, y left, z up): (x, −y, −z).
+/// \param v the vector in FRD body axes \return it in FLU body axes
 inline Eigen::Vector3d frd_to_flu(const Eigen::Vector3d& v) { return {v.x(), -v.y(), -v.z()}; }
 
 /// \brief An attitude from kelp's (body FRD → NED) to ROS's (body FLU → ENU):
 /// q_EN ⊗ q ⊗ q_FRD←FLU, with the sign chosen so that w ≥ 0 (the same rotation either way; one
 /// sign keeps bags and live topics identical).
 /// \param[in] q unit quaternion rotating FRD body vectors into NED (vehicle::VehicleState).
+/// \return the unit quaternion rotating FLU body vectors into ENU, w ≥ 0
 KELP_SIM_API Eigen::Quaterniond ned_frd_to_enu_flu(const Eigen::Quaterniond& q);
 
 }  // namespace ros2

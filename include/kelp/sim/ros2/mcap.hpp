@@ -47,6 +47,9 @@ namespace ros2 {
 ///
 /// Table-driven, eight bytes a step ("slicing by 8": table k gives the CRC of a byte followed by
 /// k zero bytes), since every byte of a bag goes through it twice (chunk and data section CRCs).
+/// \param data the bytes (may be null when n is 0) \param n their count
+/// \param crc the CRC of the bytes before them (0 to start)
+/// \return the CRC of everything so far (pass it as `crc` to continue). No throw.
 KELP_SIM_API std::uint32_t crc32(const void* data, std::size_t n, std::uint32_t crc = 0);
 
 /// \brief The MCAP magic bytes, at the start and the end of every file.
@@ -55,17 +58,17 @@ inline constexpr std::array<std::uint8_t, 8> mcap_magic = {0x89, 'M',  'C',  'A'
 
 /// \brief MCAP record opcodes (the specification's "Records").
 enum class McapOp : std::uint8_t {
-  header = 0x01,
-  footer = 0x02,
-  schema = 0x03,
-  channel = 0x04,
-  message = 0x05,
-  chunk = 0x06,
-  message_index = 0x07,
-  chunk_index = 0x08,
-  statistics = 0x0B,
-  summary_offset = 0x0E,
-  data_end = 0x0F
+  header = 0x01,          ///< Header: profile and library
+  footer = 0x02,          ///< Footer: summary offsets and CRC
+  schema = 0x03,          ///< Schema: a message type's definition
+  channel = 0x04,         ///< Channel: a topic on a schema
+  message = 0x05,         ///< Message: one message on a channel
+  chunk = 0x06,           ///< Chunk: a block of schemas, channels and messages
+  message_index = 0x07,   ///< Message Index: a chunk's messages of one channel
+  chunk_index = 0x08,     ///< Chunk Index: where a chunk is and what it holds
+  statistics = 0x0B,      ///< Statistics: counts and time range
+  summary_offset = 0x0E,  ///< Summary Offset: where each group of the summary is
+  data_end = 0x0F         ///< Data End: the data section's CRC
 };
 
 /// \brief Options of an McapWriter.
@@ -95,6 +98,8 @@ class KELP_SIM_API McapWriter {
 
   McapWriter() = default;
   /// \brief Opens `path` for writing (see open()).
+  /// \param path the file to create \param options the profile, library and chunk size
+  /// \throws kelp::error when the file cannot be written.
   explicit McapWriter(const std::filesystem::path& path, const McapOptions& options = {});
   McapWriter(const McapWriter&) = delete;
   McapWriter& operator=(const McapWriter&) = delete;
@@ -102,13 +107,17 @@ class KELP_SIM_API McapWriter {
   ~McapWriter();
 
   /// \brief Creates `path` and writes the magic and the Header record.
+  /// \param path the file to create (truncated when it exists)
+  /// \param options the profile, library and chunk size
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument when open.
   void open(const std::filesystem::path& path, const McapOptions& options = {});
 
-  /// \brief Is a file open?
+  /// \brief Is a file open? \return true between open() and close()
   bool is_open() const { return file_ != nullptr; }
 
   /// \brief Adds a schema (a Schema record in the data section and the summary).
+  /// \param name the type's name (e.g. "nav_msgs/msg/Odometry")
+  /// \param encoding the schema encoding (e.g. "ros2msg") \param data the schema's text
   /// \returns its id (1, 2, …).
   /// \throws kelp::error on a write failure; kelp::invalid_argument when not open.
   std::uint16_t add_schema(const std::string& name, const std::string& encoding,
@@ -116,6 +125,9 @@ class KELP_SIM_API McapWriter {
 
   /// \brief Adds a channel on schema `schema_id` (a Channel record in the data section and the
   /// summary).
+  /// \param schema_id an id add_schema() returned \param topic the topic's name
+  /// \param message_encoding the messages' encoding (e.g. "cdr")
+  /// \param metadata the channel's metadata (e.g. `offered_qos_profiles`)
   /// \returns its id (1, 2, …).
   /// \throws kelp::error on a write failure; kelp::invalid_argument when not open or for an
   /// unknown schema.
@@ -124,14 +136,18 @@ class KELP_SIM_API McapWriter {
                             const std::map<std::string, std::string>& metadata = {});
 
   /// \brief Writes a message on `channel` at `log_time` [ns] (publish time the same).
+  /// \param channel an id add_channel() returned \param sequence the message's sequence number
+  /// on its channel \param log_time its time [ns] \param data its serialised bytes (CDR for
+  /// ROS 2) \param size their count
   /// \throws kelp::error on a write failure; kelp::invalid_argument when not open or for an
   /// unknown channel.
   void write(std::uint16_t channel, std::uint32_t sequence, std::uint64_t log_time,
              const std::uint8_t* data, std::size_t size);
 
-  /// \brief Messages written so far.
+  /// \brief Messages written so far. \return the count
   std::uint64_t message_count() const { return messages_; }
   /// \brief Bytes written to the file so far (the open chunk not included).
+  /// \return the count [bytes]
   std::uint64_t bytes_written() const { return pos_; }
 
   /// \brief Writes the last chunk, Data End, the summary, the summary offsets, the footer and
@@ -173,6 +189,7 @@ class KELP_SIM_API McapWriter {
 /// policies as rmw's integer enum values: history keep_last = 1, reliability reliable = 1 /
 /// best_effort = 2, durability transient_local = 1 / volatile = 2, liveliness automatic = 1;
 /// deadline, lifespan and lease duration 0 s = rmw's "default").
+/// \param q the QoS \return the YAML text
 KELP_SIM_API std::string offered_qos_yaml(const Qos& q);
 
 /// \brief A ROS 2 bag (MCAP, profile `ros2`) of kelp's topics (ros2::topics()): one schema a
@@ -181,10 +198,14 @@ KELP_SIM_API std::string offered_qos_yaml(const Qos& q);
 class KELP_SIM_API BagWriter {
  public:
   /// \brief Creates the bag at `path` with every topic's schema and channel.
+  /// \param path the file to create \param options the MCAP options (profile `ros2`)
   /// \throws kelp::error when the file cannot be written.
   explicit BagWriter(const std::filesystem::path& path, const McapOptions& options = {});
 
   /// \brief Writes one message on topic `id`, logged at its stamp.
+  /// \tparam M the topic's message struct (messages.hpp)
+  /// \param id the topic \param m the message (serialised as CDR) \param stamp its log time
+  /// \throws kelp::error on a write failure.
   template <class M>
   void write(TopicId id, const M& m, const builtin_interfaces::Time& stamp) {
     serialize(m, buf_);
@@ -194,13 +215,15 @@ class KELP_SIM_API BagWriter {
 
   /// \brief Writes every message of a sample; `markers` false leaves /tether/markers out (a
   /// bag may carry the markers at a lower rate than the states).
+  /// \param m the sample's messages (fill_messages()) \param markers whether to write the markers
+  /// \throws kelp::error on a write failure.
   void write(const Messages& m, bool markers = true);
 
   /// \brief Finishes the file (summary, index, footer).
   /// \throws kelp::error on a write failure.
   void close() { mcap_.close(); }
 
-  /// \brief The underlying MCAP writer (counts, bytes).
+  /// \brief The underlying MCAP writer (counts, bytes). \return the writer
   const McapWriter& mcap() const { return mcap_; }
 
  private:

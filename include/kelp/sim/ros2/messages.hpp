@@ -53,6 +53,8 @@ struct Time {
   std::int32_t sec = 0;                                                     ///< [s]
   std::uint32_t nanosec = 0;                                                ///< [ns], in [0, 1e9)
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.sec);
@@ -66,6 +68,8 @@ struct Duration {
   std::int32_t sec = 0;                                                        ///< [s]
   std::uint32_t nanosec = 0;                                                   ///< [ns]
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.sec);
@@ -84,6 +88,8 @@ struct Header {
   builtin_interfaces::Time stamp;                          ///< simulation time
   std::string frame_id;                                    ///< TF frame of the data
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.stamp);
@@ -95,8 +101,13 @@ struct ColorRGBA {
   static constexpr const char* type_name = "std_msgs/msg/ColorRGBA";  ///< ROS type name
   static constexpr const char* definition =
       "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n";  ///< `.msg` text
-  float r = 0, g = 0, b = 0, a = 0;                    ///< red, green, blue, alpha
+  float r = 0,                                         ///< red, [0, 1]
+      g = 0,                                           ///< green, [0, 1]
+      b = 0,                                           ///< blue, [0, 1]
+      a = 0;                                           ///< alpha (opacity), [0, 1]; 0 is invisible
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.r);
@@ -113,8 +124,12 @@ namespace geometry_msgs {
 struct Vector3 {
   static constexpr const char* type_name = "geometry_msgs/msg/Vector3";           ///< ROS type name
   static constexpr const char* definition = "float64 x\nfloat64 y\nfloat64 z\n";  ///< `.msg` text
-  double x = 0, y = 0, z = 0;                                                     ///< components
+  double x = 0,  ///< x component (ENU: east; FLU: forward)
+      y = 0,     ///< y component (ENU: north; FLU: left)
+      z = 0;     ///< z component (ENU: up; FLU: up)
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.x);
@@ -126,8 +141,12 @@ struct Vector3 {
 struct Point {
   static constexpr const char* type_name = "geometry_msgs/msg/Point";             ///< ROS type name
   static constexpr const char* definition = "float64 x\nfloat64 y\nfloat64 z\n";  ///< `.msg` text
-  double x = 0, y = 0, z = 0;  ///< coordinates [m]
+  double x = 0,  ///< x [m] (ENU: east)
+      y = 0,     ///< y [m] (ENU: north)
+      z = 0;     ///< z [m] (ENU: up)
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.x);
@@ -140,8 +159,13 @@ struct Quaternion {
   static constexpr const char* type_name = "geometry_msgs/msg/Quaternion";  ///< ROS type name
   static constexpr const char* definition =
       "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n";  ///< `.msg` text
-  double x = 0, y = 0, z = 0, w = 1;                           ///< components
+  double x = 0,                                                ///< vector part, x
+      y = 0,                                                   ///< vector part, y
+      z = 0,                                                   ///< vector part, z
+      w = 1;                                                   ///< scalar part
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.x);
@@ -158,6 +182,8 @@ struct Pose {
   Point position;                                  ///< [m]
   Quaternion orientation;                          ///< body → parent frame
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.position);
@@ -172,6 +198,8 @@ struct PoseWithCovariance {
   Pose pose;                                                                        ///< the pose
   std::array<double, 36> covariance{};  ///< row-major 6×6 (x, y, z, rot x, rot y, rot z)
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.pose);
@@ -185,6 +213,8 @@ struct Twist {
   Vector3 linear;                                                                   ///< [m/s]
   Vector3 angular;                                                                  ///< [rad/s]
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.linear);
@@ -200,6 +230,8 @@ struct TwistWithCovariance {
   Twist twist;                                  ///< the twist
   std::array<double, 36> covariance{};          ///< row-major 6×6
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.twist);
@@ -214,6 +246,8 @@ struct Transform {
   Vector3 translation;                               ///< [m]
   Quaternion rotation;                               ///< child → parent
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.translation);
@@ -229,6 +263,8 @@ struct TransformStamped {
   std::string child_frame_id;                                                  ///< child frame
   Transform transform;  ///< child's pose in the parent frame
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -243,6 +279,8 @@ struct Wrench {
   Vector3 force;                                                                  ///< [N]
   Vector3 torque;                                                                 ///< [N m]
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.force);
@@ -257,6 +295,8 @@ struct WrenchStamped {
   std_msgs::Header header;                        ///< frame of the wrench
   Wrench wrench;                                  ///< force and moment about the frame's origin
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -278,6 +318,8 @@ struct Odometry {
   geometry_msgs::PoseWithCovariance pose;                 ///< body pose in the world frame
   geometry_msgs::TwistWithCovariance twist;               ///< body velocity in body axes
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -307,6 +349,8 @@ struct Imu {
   geometry_msgs::Vector3 linear_acceleration;              ///< specific force [m/s²], body axes
   std::array<double, 9> linear_acceleration_covariance{};  ///< row-major
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -331,6 +375,8 @@ struct JointState {
   std::vector<double> velocity;   ///< velocities (kelp: the normalised command)
   std::vector<double> effort;     ///< efforts (kelp: the thrust [N])
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -349,6 +395,8 @@ struct CompressedImage {
   std::string format;                                           ///< e.g. "png"
   std::vector<std::uint8_t> data;                               ///< the image
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -367,6 +415,8 @@ struct TFMessage {
       "geometry_msgs/TransformStamped[] transforms\n";      ///< `.msg` text
   std::vector<geometry_msgs::TransformStamped> transforms;  ///< the transforms
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.transforms);
@@ -381,8 +431,11 @@ struct UVCoordinate {
   static constexpr const char* type_name =
       "visualization_msgs/msg/UVCoordinate";                           ///< ROS type name
   static constexpr const char* definition = "float32 u\nfloat32 v\n";  ///< `.msg` text
-  float u = 0, v = 0;                                                  ///< texture coordinates
+  float u = 0,  ///< texture coordinate u, [0, 1]
+      v = 0;    ///< texture coordinate v, [0, 1]
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.u);
@@ -396,6 +449,8 @@ struct MeshFile {
   std::string filename;            ///< file name (its extension gives the format)
   std::vector<std::uint8_t> data;  ///< the file
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.filename);
@@ -441,6 +496,8 @@ struct Marker {
   MeshFile mesh_file;                            ///< (unused)
   bool mesh_use_embedded_materials = false;      ///< MESH_RESOURCE's materials
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.header);
@@ -470,6 +527,8 @@ struct MarkerArray {
   static constexpr const char* definition = "Marker[] markers\n";                 ///< `.msg` text
   std::vector<Marker> markers;                                                    ///< the markers
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.markers);
@@ -485,6 +544,8 @@ struct Clock {
   static constexpr const char* definition = "builtin_interfaces/Time clock\n";  ///< `.msg` text
   builtin_interfaces::Time clock;  ///< the current (simulation) time
   /// \brief Calls f on each field, in the `.msg` order.
+  /// \tparam S this struct, const or not \tparam F a callable taking every field's type
+  /// \param m the message \param f called with a reference to each field
   template <class S, class F>
   static void fields(S& m, F&& f) {
     f(m.clock);
@@ -533,6 +594,8 @@ void direct_dependencies(std::set<std::string>& out) {
 /// \brief The ros2msg schema of message type T: its `.msg` text, then each type it uses (in
 /// name order, depth first, each once) after a line of 80 `=` and a line `MSG: pkg/Name`: the
 /// text rosbag2's MCAP storage writes (MCAP registry, schema encoding `ros2msg`).
+/// \tparam T a message struct of this header (e.g. nav_msgs::Odometry)
+/// \return the schema's text (UTF-8, lines ended by `\n`)
 template <class T>
 std::string schema_text();
 
@@ -592,9 +655,15 @@ std::string schema_text() {
 // ------------------------------------------------------------------------------------------------
 
 /// \brief A QoS reliability policy (rmw_qos_reliability_policy_t's values, rmw/types.h).
-enum class Reliability : int { reliable = 1, best_effort = 2 };
+enum class Reliability : int {
+  reliable = 1,    ///< RMW_QOS_POLICY_RELIABILITY_RELIABLE: every message delivered
+  best_effort = 2  ///< RMW_QOS_POLICY_RELIABILITY_BEST_EFFORT: messages may be dropped
+};
 /// \brief A QoS durability policy (rmw_qos_durability_policy_t's values, rmw/types.h).
-enum class Durability : int { transient_local = 1, durability_volatile = 2 };
+enum class Durability : int {
+  transient_local = 1,     ///< RMW_QOS_POLICY_DURABILITY_TRANSIENT_LOCAL: kept for late joiners
+  durability_volatile = 2  ///< RMW_QOS_POLICY_DURABILITY_VOLATILE: not kept
+};
 
 /// \brief The QoS a topic is published with (history is always keep-last).
 struct Qos {
@@ -617,16 +686,16 @@ inline constexpr Qos clock_qos{Reliability::best_effort, Durability::durability_
 
 /// \brief The topics kelp publishes, in the order of TopicId.
 enum class TopicId : int {
-  clock,
-  tf,
-  boat_odom,
-  rov_odom,
-  rov_imu,
-  end_forces,
-  markers,
-  rov_thrusters,
-  boat_thrusters,
-  count
+  clock,           ///< /clock (rosgraph_msgs/msg/Clock)
+  tf,              ///< /tf (tf2_msgs/msg/TFMessage)
+  boat_odom,       ///< /boat/odom (nav_msgs/msg/Odometry)
+  rov_odom,        ///< /rov/odom (nav_msgs/msg/Odometry)
+  rov_imu,         ///< /rov/imu (sensor_msgs/msg/Imu)
+  end_forces,      ///< /tether/end_forces (geometry_msgs/msg/WrenchStamped)
+  markers,         ///< /tether/markers (visualization_msgs/msg/MarkerArray)
+  rov_thrusters,   ///< /rov/thrusters (sensor_msgs/msg/JointState)
+  boat_thrusters,  ///< /boat/thrusters (sensor_msgs/msg/JointState)
+  count            ///< the number of topics (not a topic)
 };
 
 /// \brief A topic: its ROS name, ROS type and QoS.
@@ -638,6 +707,7 @@ struct Topic {
 };
 
 /// \brief Every topic kelp publishes (the README's "With ROS 2" table).
+/// \return the topics, indexed by TopicId (a static table)
 KELP_SIM_API const std::array<Topic, static_cast<int>(TopicId::count)>& topics();
 
 // ------------------------------------------------------------------------------------------------
@@ -645,10 +715,12 @@ KELP_SIM_API const std::array<Topic, static_cast<int>(TopicId::count)>& topics()
 // ------------------------------------------------------------------------------------------------
 
 /// \brief ROS time of a simulation time t ≥ 0 [s] (nanoseconds rounded to nearest).
+/// \param t the time [s], finite, in [0, 2³¹) \return seconds and nanoseconds (< 10⁹)
 /// \throws kelp::invalid_argument for a negative, non-finite or too large (≥ 2³¹ s) time.
 KELP_SIM_API builtin_interfaces::Time to_time(double t);
 
 /// \brief Nanoseconds of a ROS time (the MCAP log time of a message stamped with it).
+/// \param t the time (sec ≥ 0) \return sec · 10⁹ + nanosec [ns]
 inline std::uint64_t to_nanoseconds(const builtin_interfaces::Time& t) {
   return static_cast<std::uint64_t>(t.sec) * 1000000000ULL + t.nanosec;
 }
@@ -720,6 +792,7 @@ inline constexpr const char* rov_frame = "rov/base_link";    ///< the ROV's body
 /// - /rov/thrusters, /boat/thrusters: name, velocity = normalised command, effort = thrust [N].
 /// \throws kelp::invalid_argument when a vehicle or the nodes are missing, fewer than 2 nodes, a
 /// time ros2::to_time refuses, or tensions of the wrong size.
+/// \param s the sample (kelp's frames: NED, FRD) \param m the messages, overwritten
 KELP_SIM_API void fill_messages(const RunSample& s, Messages& m);
 
 }  // namespace ros2

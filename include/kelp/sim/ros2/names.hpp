@@ -14,6 +14,8 @@ namespace ros2 {
 /// digits and single underscores, not ending with one, at most 64 characters? (The ROS 2 design
 /// article "Topic and Service name mapping to DDS": a token holds alphanumerics and
 /// underscores, does not start with a digit and has no repeated underscores.)
+/// \param name the candidate (ASCII only: any other byte makes it false)
+/// \return true when it is such a name
 inline bool is_ros_name(const std::string& name) {
   if (name.empty() || name.size() > 64) return false;
   const auto letter = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); };
