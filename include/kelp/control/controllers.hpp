@@ -347,7 +347,8 @@ class AuvControllerT {
   /// \param t the time [s], non-decreasing from call to call.
   /// \return the command (recomputed or held); the reference stays valid for the object's
   /// life.
-  /// \throws kelp::invalid_argument when the navigation gives a non-finite error or rate to a PID.
+  /// \throws kelp::invalid_argument when a PID's error, or the wrench or thrust computed from
+  /// the navigation, is not finite (a non-finite navigation).
   const AuvCommandT<Scalar>& update(const NavigationT<Scalar>& nav, double t) {
     double dt = 0.0;
     if (!clock_.due(t, settings_.period, dt)) return command_;
@@ -628,7 +629,8 @@ class AsvControllerT {
   /// \param t the time [s], non-decreasing from call to call.
   /// \return the command (recomputed or held); the reference stays valid for the object's
   /// life.
-  /// \throws kelp::invalid_argument when the navigation gives a non-finite error or rate to a PID.
+  /// \throws kelp::invalid_argument when a PID's error, or the wrench or thrust computed from
+  /// the navigation, is not finite (a non-finite navigation).
   const AsvCommandT<Scalar>& update(const NavigationT<Scalar>& nav,
                                     const Vector3<Scalar>& auv_position, double t) {
     double dt = 0.0;

@@ -204,8 +204,8 @@ KELP_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
 }
 
 /// e^x for x ≤ 0 (x below −700 is treated as −700, giving ≈ 1e-304 instead of a subnormal).
-/// \param x the exponent, x ≤ 0 (positive x is not checked, and is accurate only while
-/// x·log2 e rounds to n ≤ 0).
+/// \param x the exponent, x ≤ 0 (the contract: a positive x is not checked, and passes
+/// unchanged to fast_exp_nonpositive_unchecked).
 /// \return e^x, at least ≈ 1e-304.
 KELP_ALWAYS_INLINE inline double fast_exp_nonpositive(double x) {
   // max(x, −700) written with fabs: GCC (without -ffast-math) does not if-convert a compare here,

@@ -170,8 +170,9 @@ Vector3<Scalar> line_momentum(const TetherModel<Scalar>& model, const TetherStat
 /// \tparam Scalar double or float.
 /// \param from the model of N segments that fits `in`.
 /// \param in the state before (its winch_length, or l when 0, must exceed l).
-/// \param[out] out the state after, already sized for N + 1 segments (N + 2 columns); every
-/// field is written.
+/// \param[out] out the state after, already sized for N + 1 segments (N + 2 columns): positions,
+/// velocities, clock, winch fields and parted flags are written, the history and the kept Newton
+/// matrix cleared (previous_position and previous_velocity keep their old content).
 /// \param[in,out] report counts the insertion and adds the kinetic energy lost [J].
 /// \throws kelp::invalid_argument when `out` has the wrong size or segment 0 is not longer
 /// than l (nothing written then).
@@ -231,8 +232,8 @@ void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
 /// \tparam Scalar double or float.
 /// \param from the model of N ≥ 2 segments that fits `in`.
 /// \param in the state before.
-/// \param[out] out the state after, already sized for N − 1 segments (N columns); every field
-/// is written.
+/// \param[out] out the state after, already sized for N − 1 segments (N columns), written as by
+/// insert_winch_node().
 /// \param[in,out] report counts the removal, adds the kinetic energy lost [J] and the impulses
 /// handed to the ends, NED [N s].
 /// \throws kelp::invalid_argument when N < 2 or `out` has the wrong size (nothing written then).
