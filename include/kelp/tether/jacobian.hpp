@@ -409,7 +409,8 @@ struct ForceJacobian {
 
   /// \brief Sink of detail::force_jacobian_blocks: adds c·a to ∂F_i/∂x_j.
   /// \param i block row (node), \param j block column (node), |i − j| ≤ 2, both in [0, N].
-  /// \param a the 3×3 block [N/m]. \param c its factor (±1 for a segment's two nodes).
+  /// \param a the 3×3 block [N/m]. \param c its factor (kelp's assembly passes ±1: the sign
+  /// with which the block enters).
   void x(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dfdx, i, j, c * a); }
   /// \brief Sink: adds c·a to ∂F_i/∂v_j.
   /// \param i block row, \param j block column, as x().
