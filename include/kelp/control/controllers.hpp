@@ -92,7 +92,10 @@ template <typename Scalar>
 class DisturbanceObserverT {
  public:
   DisturbanceObserverT() = default;
-  /// \param[in] model the vehicle's own model \param[in] time_constant of the low-pass [s]
+  /// \brief An observer of the vehicle `model`, estimate zero.
+  /// \param[in] model the vehicle's own model (kept by reference: it must outlive the observer)
+  /// \param[in] time_constant of the low-pass [s], finite and > 0
+  /// \throws kelp::invalid_argument for a time constant not finite and > 0.
   DisturbanceObserverT(const vehicle::VehicleModel<Scalar>& model, double time_constant)
       : model_(&model), tau_(time_constant) {
     check_positive(time_constant, "observer time_constant");
@@ -285,8 +288,12 @@ using AuvCommand = AuvCommandT<double>;
 template <typename Scalar>
 class AuvControllerT {
  public:
+  /// \brief A controller holding the origin at heading 0 until hold() or follow().
   /// \param[in] model the AUV's own model (for the disturbance observer; kept by reference)
   /// \param[in] thrusters its allocation \param[in] s settings
+  /// \throws kelp::invalid_argument for bad settings (PID gains, a period, max_thrust,
+  /// max_horizontal_error, acceptance_radius or observer time constant not finite and > 0) or a
+  /// thruster chain the settings do not fit (thruster_facing's size, the voltage).
   AuvControllerT(const vehicle::VehicleModel<Scalar>& model,
                  const vehicle::ThrusterAllocation<Scalar>& thrusters,
                  const AuvControllerSettings& s = {})
@@ -580,8 +587,14 @@ using AsvCommand = AsvCommandT<double>;
 template <typename Scalar>
 class AsvControllerT {
  public:
+  /// \brief A controller keeping station at the origin, heading 0, until station() or
+  /// follow_auv().
   /// \param[in] model the ASV's own model (for the observer; kept by reference)
   /// \param[in] thrusters its two thrusters (port first) \param[in] s settings
+  /// \throws kelp::invalid_argument for bad settings (PID gains; period, thrust_clip,
+  /// arrive_radius, max_speed, target_velocity_time_constant, observer time constant not finite
+  /// and > 0; position_gain, turn_speed negative; a non-finite follow_offset), a thruster count
+  /// other than two, thrusters not side by side, or a chain the settings do not fit.
   AsvControllerT(const vehicle::VehicleModel<Scalar>& model,
                  const vehicle::ThrusterAllocation<Scalar>& thrusters,
                  const AsvControllerSettings& s = {})
