@@ -20,12 +20,14 @@ namespace kelp {
 /// Step functions take `dt` as `identity_t<Scalar>`: `Scalar` is deduced from the model alone, and
 /// a literal such as `0.01` (a `double`) converts to `float` for a float model instead of making
 /// the deduction conflict.
+/// \tparam T any type.
 template <class T>
 struct identity {
   using type = T;  ///< The wrapped type, unchanged.
 };
 
 /// \brief `T` in a non-deduced context; see `kelp::identity`.
+/// \tparam T any type.
 template <class T>
 using identity_t = typename identity<T>::type;
 

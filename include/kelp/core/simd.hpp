@@ -24,6 +24,7 @@
 namespace kelp::simd {
 
 /// \brief True when Eigen vectorises `Scalar` with the current compiler flags.
+/// \tparam Scalar the lane type (double and float vectorise on x86-64).
 template <typename Scalar>
 constexpr bool vectorized = bool(Eigen::internal::packet_traits<Scalar>::Vectorizable) &&
                             (Eigen::internal::packet_traits<Scalar>::size > 1);
@@ -200,6 +201,8 @@ struct Mask {
 /// \param a left operand.
 /// \param b right operand.
 /// \return the mask of the lanes where a > b.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> greater(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -214,6 +217,8 @@ Mask<Scalar, Wide> greater(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
 /// \param a left operand.
 /// \param b right operand.
 /// \return the mask of the lanes where a >= b.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> greater_equal(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -229,6 +234,8 @@ Mask<Scalar, Wide> greater_equal(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
 /// \param a lanes taken where `k` is true.
 /// \param b lanes taken where `k` is false.
 /// \return the blended pack.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Pack<Scalar, Wide> select(Mask<Scalar, Wide> k, Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   if constexpr (Pack<Scalar, Wide>::lanes == 1)
@@ -242,6 +249,8 @@ Pack<Scalar, Wide> select(Mask<Scalar, Wide> k, Pack<Scalar, Wide> a, Pack<Scala
 /// \param a first mask.
 /// \param b second mask.
 /// \return true in the lanes where both are true.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> operator&&(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -256,6 +265,8 @@ Mask<Scalar, Wide> operator&&(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
 /// \param a left operand.
 /// \param b right operand.
 /// \return the mask of the lanes where a < b.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> less(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   return greater(b, a);
@@ -265,6 +276,8 @@ Mask<Scalar, Wide> less(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
 /// \param a first mask.
 /// \param b second mask.
 /// \return true in the lanes where either is true.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> operator||(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -278,6 +291,8 @@ Mask<Scalar, Wide> operator||(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
 /// \brief True when any lane is true.
 /// \param k the mask.
 /// \return whether at least one lane of `k` is true.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 bool any(Mask<Scalar, Wide> k) {
   if constexpr (Pack<Scalar, Wide>::lanes == 1)

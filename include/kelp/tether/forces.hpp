@@ -773,6 +773,10 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// \throws kelp::invalid_argument when `ws` was not built for `model` (TetherWorkspace::fits),
 /// x or v is not 3×(N+1), or t, x or v is not finite (O(N) check; the integrators call the
 /// evaluation behind it directly, after checking the state once per step).
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \tparam DX an Eigen 3×(N+1) matrix type (positions, NED [m]).
+/// \tparam DV an Eigen 3×(N+1) matrix type (velocities, NED [m/s]).
 template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
 void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {

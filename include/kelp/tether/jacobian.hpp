@@ -469,6 +469,11 @@ struct ForceJacobian {
 /// \param[in] x, v node positions and velocities 3×(N+1) \param[in] d vector of the mass term
 /// (3×(N+1)) \param[out] jac zeroed, then filled.
 /// \throws kelp::invalid_argument when the sizes do not fit the model.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \tparam DX an Eigen 3×(N+1) matrix type (positions).
+/// \tparam DV an Eigen 3×(N+1) matrix type (velocities).
+/// \tparam DD an Eigen 3×(N+1) matrix type (the mass term's vector).
 template <typename Scalar, typename Env, typename DX, typename DV, typename DD>
 void force_jacobian(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                     const Env& env, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v,

@@ -40,6 +40,7 @@ inline Eigen::Index newton_factor_size(int nodes) {
 /// It lives in the state because it determines the next step's iterates: saving and restoring a
 /// state restores it too, so a run is reproduced bit for bit. A state built from a model has it
 /// sized and empty (`gh` = 0: the next implicit step forms a new one).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct KeptNewtonMatrix {
   /// Factorisation (detail::factor_solve_block_tridiagonal's layout).
@@ -228,6 +229,7 @@ struct TetherBoundary {
 };
 
 /// \brief Forces the tether exerts on its two attachment points, NED [N] (zero for a free end).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct EndForces {
   /// On the start attachment point (node 0).
