@@ -60,6 +60,11 @@ class SampleClockT {
  public:
   /// \brief True when an update is due at time t [s]; `dt` is then the time since the last one
   /// (T on the first).
+  /// \param t the time now [s]; calls must not go back in time.
+  /// \param period the controller's period T [s], > 0 (not checked here).
+  /// \param[out] dt set when due: the time since the last update [s], at least 1e-6 s (`period`
+  /// on the first call); left unchanged otherwise.
+  /// \return true when the controller should update now (within 1e-9 s of the schedule).
   bool due(Time t, Time period, Time& dt) {
     if (started_ && t < next_ - 1e-9) return false;
     dt = started_ ? std::max(t - last_, Time(1e-6)) : period;
@@ -87,13 +92,23 @@ template <typename Scalar>
 class DisturbanceObserverT {
  public:
   DisturbanceObserverT() = default;
-  /// \param[in] model the vehicle's own model \param[in] time_constant of the low-pass [s]
+  /// \brief An observer of the vehicle `model`, estimate zero.
+  /// \param[in] model the vehicle's own model (kept by reference: it must outlive the observer)
+  /// \param[in] time_constant of the low-pass [s], finite and > 0
+  /// \throws kelp::invalid_argument for a time constant not finite and > 0.
   DisturbanceObserverT(const vehicle::VehicleModel<Scalar>& model, double time_constant)
       : model_(&model), tau_(time_constant) {
     check_positive(time_constant, "observer time_constant");
   }
   /// \brief Updates the estimate from the navigation at this update, the wrench applied since
   /// the last one and the time since [s]. Returns d̂ (body wrench [N, N m]).
+  /// \param nav the vehicle's navigation now (its body velocity ν [m/s, rad/s] is what is
+  /// differentiated).
+  /// \param applied the body wrench [N, N m] the vehicle applied since the last update.
+  /// \param dt the time since the last update [s], > 0 (not checked).
+  /// \return d̂, the low-passed body disturbance wrench [N, N m] (zero until the second update;
+  /// unchanged for a default-constructed observer). The reference stays valid for the object's
+  /// life.
   const Vector6<Scalar>& update(const NavigationT<Scalar>& nav, const Vector6<Scalar>& applied,
                                 double dt) {
     if (model_ == nullptr) return estimate_;
@@ -114,6 +129,7 @@ class DisturbanceObserverT {
     return estimate_;
   }
   /// \brief The current estimate d̂.
+  /// \return d̂, body wrench [N, N m].
   const Vector6<Scalar>& estimate() const { return estimate_; }
   /// \brief visit_memory(v): the last navigation and the estimate (kelp/core/memory.hpp).
   /// \tparam V a memory visitor \param v the visitor
@@ -146,6 +162,7 @@ struct AllocationScales {
   double vertical = 1.0;    ///< the vertical group (Z, K, M); split saturation only
   double total = 1.0;       ///< the whole (the sum of the groups with split saturation)
   /// \brief True when any factor is below 1 (the wrench was not delivered in full).
+  /// \return whether horizontal, vertical or total is below 1.
   bool saturated() const { return horizontal < 1.0 || vertical < 1.0 || total < 1.0; }
 };
 
@@ -271,8 +288,12 @@ using AuvCommand = AuvCommandT<double>;
 template <typename Scalar>
 class AuvControllerT {
  public:
+  /// \brief A controller holding the origin at heading 0 until hold() or follow().
   /// \param[in] model the AUV's own model (for the disturbance observer; kept by reference)
   /// \param[in] thrusters its allocation \param[in] s settings
+  /// \throws kelp::invalid_argument for bad settings (PID gains, a period, max_thrust,
+  /// max_horizontal_error, acceptance_radius or observer time constant not finite and > 0) or a
+  /// thruster chain the settings do not fit (thruster_facing's size, the voltage).
   AuvControllerT(const vehicle::VehicleModel<Scalar>& model,
                  const vehicle::ThrusterAllocation<Scalar>& thrusters,
                  const AuvControllerSettings& s = {})
@@ -297,6 +318,9 @@ class AuvControllerT {
   }
 
   /// \brief Hold this NED position and heading [rad].
+  /// \param position the position to hold, NED [m]; clears the waypoints.
+  /// \param heading the heading to hold [rad] (yaw about NED down, 0 = north).
+  /// \throws kelp::invalid_argument for a non-finite position or heading (nothing changes).
   void hold(const Vector3<Scalar>& position, double heading) {
     check_all_finite(position, "hold position");
     check_finite(heading, "hold heading");
@@ -305,6 +329,8 @@ class AuvControllerT {
     heading_ = heading;
   }
   /// \brief Follow these NED waypoints in order, facing the direction of travel; hold the last.
+  /// \param waypoints the points, NED [m], at least one; copied. The first leg starts where the
+  /// vehicle is at the next update.
   /// \throws kelp::invalid_argument for an empty list or a non-finite point.
   void follow(const std::vector<Vector3<Scalar>>& waypoints) {
     KELP_CHECK(!waypoints.empty(), "follow: the waypoint list is empty");
@@ -316,12 +342,20 @@ class AuvControllerT {
     leg_ = static_cast<std::size_t>(-1);
   }
   /// \brief Index of the waypoint being flown to (== count when all are reached).
+  /// \return the index into the list given to follow() (0 when holding).
   std::size_t next_waypoint() const { return waypoints_.empty() ? 0 : next_; }
   /// \brief The current target position, NED [m].
+  /// \return the held position or the waypoint being flown to, NED [m].
   const Vector3<Scalar>& target() const { return target_; }
 
   /// \brief The command at time t [s] for navigation `nav`: recomputed every `period`, held in
   /// between. No allocation.
+  /// \param nav the AUV's navigation (NED position, attitude, body velocity over ground).
+  /// \param t the time [s], non-decreasing from call to call.
+  /// \return the command (recomputed or held); the reference stays valid for the object's
+  /// life.
+  /// \throws kelp::invalid_argument when a PID's error, or the wrench or thrust computed from
+  /// the navigation, is not finite (a non-finite navigation).
   const AuvCommandT<Scalar>& update(const NavigationT<Scalar>& nav, double t) {
     double dt = 0.0;
     if (!clock_.due(t, settings_.period, dt)) return command_;
@@ -415,16 +449,22 @@ class AuvControllerT {
     return command_;
   }
   /// \brief The last command.
+  /// \return what update() last returned (zero thrust before the first update).
   const AuvCommandT<Scalar>& command() const { return command_; }
   /// \brief Sets the thrusters' supply voltage [V] (e.g. the battery's, each step): the inverse
   /// and the saturation use it from the next update on.
+  /// \param volts the supply voltage [V], finite, in [0, 20].
   /// \throws kelp::invalid_argument outside [0, 20] V or not finite (nothing changes).
   void set_voltage(double volts) { thrusters_.set_voltage(volts); }
   /// \brief The thrusters' supply voltage [V].
+  /// \return the voltage [V] the inverse uses (AsvControllerSettings / AuvControllerSettings
+  /// `voltage` until set_voltage()).
   double voltage() const { return thrusters_.voltage(); }
   /// \brief The thruster chain (curve, facing, voltage) the inverse uses.
+  /// \return the controller's own chain (valid for the object's life).
   const vehicle::ThrusterChain<Scalar>& thruster_chain() const { return thrusters_; }
   /// \brief The disturbance estimate (zero unless compensating).
+  /// \return d̂, body wrench [N, N m].
   const Vector6<Scalar>& disturbance_estimate() const { return observer_.estimate(); }
 
   /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the
@@ -527,7 +567,11 @@ struct AsvControllerSettings {
 /// \tparam Scalar the controller's scalar (double or float).
 template <typename Scalar>
 struct AsvCommandT {
-  double left = 0.0, right = 0.0;  ///< thrust of the port and starboard thrusters [N]
+  /// \brief Thrust asked of the port (left) and starboard (right) thrusters [N], each within
+  /// ±thrust_clip (before the thruster curve's own saturation).
+  ///@{
+  double left = 0.0, right = 0.0;
+  ///@}
   Eigen::Matrix<Scalar, 2, 1> command = Eigen::Matrix<Scalar, 2, 1>::Zero();  ///< normalised
   Vector6<Scalar> wrench = Vector6<Scalar>::Zero();          ///< body wrench delivered
   Vector3<Scalar> position_error = Vector3<Scalar>::Zero();  ///< target − position, NED [m]
@@ -543,8 +587,14 @@ using AsvCommand = AsvCommandT<double>;
 template <typename Scalar>
 class AsvControllerT {
  public:
+  /// \brief A controller keeping station at the origin, heading 0, until station() or
+  /// follow_auv().
   /// \param[in] model the ASV's own model (for the observer; kept by reference)
   /// \param[in] thrusters its two thrusters (port first) \param[in] s settings
+  /// \throws kelp::invalid_argument for bad settings (PID gains; period, thrust_clip,
+  /// arrive_radius, max_speed, target_velocity_time_constant, observer time constant not finite
+  /// and > 0; position_gain, turn_speed negative; a non-finite follow_offset), a thruster count
+  /// other than two, thrusters not side by side, or a chain the settings do not fit.
   AsvControllerT(const vehicle::VehicleModel<Scalar>& model,
                  const vehicle::ThrusterAllocation<Scalar>& thrusters,
                  const AsvControllerSettings& s = {})
@@ -572,6 +622,9 @@ class AsvControllerT {
   }
 
   /// \brief Keep station at this NED point (z ignored) and heading [rad].
+  /// \param point the station, NED [m].
+  /// \param heading the heading held within arrive_radius (pursuit law) [rad].
+  /// \throws kelp::invalid_argument for a non-finite point or heading (nothing changes).
   void station(const Vector3<Scalar>& point, double heading) {
     check_all_finite(point, "station point");
     check_finite(heading, "station heading");
@@ -583,6 +636,14 @@ class AsvControllerT {
   void follow_auv() { follow_ = true; }
 
   /// \brief The command at time t [s] from the boat's navigation and the AUV's position (USBL).
+  /// Recomputed every `period`, held in between.
+  /// \param nav the boat's navigation (NED position, attitude, body velocity over ground).
+  /// \param auv_position the AUV's position, NED [m] (used when following, see follow_auv()).
+  /// \param t the time [s], non-decreasing from call to call.
+  /// \return the command (recomputed or held); the reference stays valid for the object's
+  /// life.
+  /// \throws kelp::invalid_argument when a PID's error, or the wrench or thrust computed from
+  /// the navigation, is not finite (a non-finite navigation).
   const AsvCommandT<Scalar>& update(const NavigationT<Scalar>& nav,
                                     const Vector3<Scalar>& auv_position, double t) {
     double dt = 0.0;
@@ -631,19 +692,26 @@ class AsvControllerT {
     return command_;
   }
   /// \brief The last command.
+  /// \return what update() last returned (zero before the first update).
   const AsvCommandT<Scalar>& command() const { return command_; }
   /// \brief Sets the thrusters' supply voltage [V] (e.g. the battery's, each step): the inverse
   /// uses it from the next update on.
+  /// \param volts the supply voltage [V], finite, in [0, 20].
   /// \throws kelp::invalid_argument outside [0, 20] V or not finite (nothing changes).
   void set_voltage(double volts) { thrusters_.set_voltage(volts); }
   /// \brief The thrusters' supply voltage [V].
+  /// \return the voltage [V] the inverse uses (AsvControllerSettings / AuvControllerSettings
+  /// `voltage` until set_voltage()).
   double voltage() const { return thrusters_.voltage(); }
   /// \brief The thruster chain (curve, facing, voltage) the inverse uses.
+  /// \return the controller's own chain (valid for the object's life).
   const vehicle::ThrusterChain<Scalar>& thruster_chain() const { return thrusters_; }
   /// \brief The current target position, NED [m].
+  /// \return the station, or the AUV's position plus follow_offset at the last update [m].
   const Vector3<Scalar>& target() const { return target_; }
   /// \brief The target's estimated velocity over ground (AsvLaw::track; zero until two updates
   /// have seen it), NED [m/s].
+  /// \return the low-passed velocity, NED [m/s], z = 0.
   const Vector3<Scalar>& target_velocity() const { return target_velocity_; }
 
   /// \brief Visits what the controller remembers between updates (kelp/core/memory.hpp): the

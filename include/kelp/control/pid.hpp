@@ -32,6 +32,9 @@ struct PidGains {
 };
 
 /// \brief Checks PID gains: finite, non-negative, positive limits.
+/// \param g the gains: kp, ki, kd finite and ≥ 0; output_limit and integral_limit > 0 (+∞
+/// allowed).
+/// \param what the name the message gives the gains (e.g. "auv.surge").
 /// \throws kelp::invalid_argument naming `what`.field.
 inline void validate(const PidGains& g, const char* what = "pid") {
   const std::string w(what);
@@ -46,11 +49,21 @@ inline void validate(const PidGains& g, const char* what = "pid") {
 class Pid {
  public:
   Pid() = default;
+  /// \brief A controller with gains `g`, integral and memory cleared.
+  /// \param g the gains, checked by validate(const PidGains&, const char*).
+  /// \param what the name the error message gives the gains.
   /// \throws kelp::invalid_argument for bad gains.
   explicit Pid(const PidGains& g, const char* what = "pid") : gains_((validate(g, what), g)) {}
 
   /// \brief One update with error e and time step dt [s] (> 0); `rate` is ė if measured (else
   /// NaN: the backward difference of e, zero on the first update). Returns the clamped output.
+  /// \param e the error, setpoint − measurement, in the controlled quantity's unit; finite.
+  /// \param dt the time since the last update [s], > 0.
+  /// \param rate ė [unit of e per s] when measured (for a position error, minus the velocity);
+  /// NaN or any non-finite value for the backward difference.
+  /// \return u, clamped to ±output_limit (the unit of e times kp's).
+  /// \throws kelp::invalid_argument when e is not finite or dt is not finite and > 0 (the state
+  /// is then unchanged).
   double update(double e, double dt, double rate = std::numeric_limits<double>::quiet_NaN()) {
     check_finite(e, "pid error");
     check_positive(dt, "pid dt");
@@ -74,12 +87,16 @@ class Pid {
   }
   /// \brief Sets the integral back (e.g. to its value before an update whose output an actuator
   /// downstream could not deliver: anti-windup for saturation after allocation).
+  /// \param value the new ∫e dt [unit of e × s]; not checked against integral_limit.
   void set_integral(double value) { integral_ = value; }
   /// \brief The integral ∫e dt.
+  /// \return ∫e dt [unit of e × s], within ±integral_limit unless set_integral() put it outside.
   double integral() const { return integral_; }
   /// \brief The last output.
+  /// \return the value update() last returned (0 before the first update and after reset()).
   double output() const { return output_; }
   /// \brief True when the last output was clamped.
+  /// \return whether |u| before clamping exceeded output_limit at the last update.
   bool saturated() const { return saturated_; }
   /// \brief Clears the integral and the derivative memory.
   void reset() {
@@ -87,6 +104,7 @@ class Pid {
     has_last_ = saturated_ = false;
   }
   /// \brief The gains.
+  /// \return the gains given to the constructor (all zero and unlimited when default-constructed).
   const PidGains& gains() const { return gains_; }
   /// \brief visit_memory(v): the integral, the last output and error and their flags, for a
   /// run's checkpoint (kelp/core/memory.hpp).

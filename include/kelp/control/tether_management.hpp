@@ -33,6 +33,8 @@ enum class WinchStrategy {
 };
 
 /// \brief Name of a strategy ("hold", "constant_tension", "slack", "depth_following").
+/// \param s the strategy.
+/// \return its name, a string literal ("unknown" for a value outside the enum); never throws.
 inline const char* winch_strategy_name(WinchStrategy s) {
   switch (s) {
     case WinchStrategy::hold:
@@ -48,6 +50,8 @@ inline const char* winch_strategy_name(WinchStrategy s) {
 }
 
 /// \brief The strategy of a name (see winch_strategy_name).
+/// \param name the name, exactly as winch_strategy_name() spells it (case-sensitive).
+/// \return the strategy.
 /// \throws kelp::invalid_argument for another name.
 inline WinchStrategy winch_strategy_from_name(const std::string& name) {
   for (WinchStrategy s : {WinchStrategy::hold, WinchStrategy::constant_tension,
@@ -59,21 +63,28 @@ inline WinchStrategy winch_strategy_from_name(const std::string& name) {
 
 /// \brief Settings of the tether management (all magnitudes positive).
 struct TetherManagementSettings {
-  WinchStrategy strategy = WinchStrategy::depth_following;
-  /// Constant tension: the band of the pull at the winch [N].
+  WinchStrategy strategy = WinchStrategy::depth_following;  ///< the strategy winch_command() uses
+  /// \brief Constant tension: the band [tension_low, tension_high] of the pull at the winch [N]
+  /// (0 ≤ low < high).
+  ///@{
   double tension_low = 5.0, tension_high = 25.0;
+  ///@}
   /// Constant tension: payout rate per newton outside the band [m/s/N].
   double tension_gain = 0.02;
   /// Slack: line out over the distance between the attachment points, minus 1 [-].
   double slack = 0.3;
-  /// Depth following: line out = extra_length + length_per_depth · depth +
-  /// length_per_offset · horizontal offset [m].
+  /// \brief Depth following: line out = extra_length [m] + length_per_depth [m/m] · depth +
+  /// length_per_offset [m/m] · horizontal offset (all ≥ 0).
+  ///@{
   double extra_length = 3.0, length_per_depth = 1.0, length_per_offset = 1.0;
+  ///@}
   /// Slack and depth following: payout rate per metre of length error [1/s].
   double length_gain = 0.5;
 };
 
 /// \brief Checks the settings.
+/// \param s the settings: every magnitude finite and ≥ 0, tension_high > tension_low (the
+/// strategy itself is not checked).
 /// \throws kelp::invalid_argument naming the field.
 inline void validate(const TetherManagementSettings& s) {
   const auto finite_nonneg = [](double x, const char* name) {
@@ -102,6 +113,10 @@ struct TetherManagementInput {
 };
 
 /// \brief The target line out of a length strategy [m] (the current length for the others).
+/// \param s the settings (strategy and its parameters; not validated here).
+/// \param in the measurements; slack uses the straight distance hypot(depth, horizontal_offset),
+/// depth following a negative depth as 0.
+/// \return the unstretched length the strategy aims at [m].
 inline double target_length(const TetherManagementSettings& s, const TetherManagementInput& in) {
   switch (s.strategy) {
     case WinchStrategy::slack:
@@ -115,6 +130,11 @@ inline double target_length(const TetherManagementSettings& s, const TetherManag
 }
 
 /// \brief The commanded payout rate [m/s] (positive: pay out); the winch limits it.
+/// \param s the settings (strategy and its parameters; not validated here).
+/// \param in the measurements (pull [N] for constant tension, length, depth and offset [m] for
+/// the length strategies).
+/// \return hold: 0; constant tension: tension_gain × the pull's distance outside the band
+/// (signed, 0 inside it); slack and depth following: length_gain × (target_length − length).
 inline double winch_command(const TetherManagementSettings& s, const TetherManagementInput& in) {
   switch (s.strategy) {
     case WinchStrategy::hold:

@@ -29,6 +29,8 @@ namespace kelp::simd {
 /// Round to nearest (ties to even) for |x| < 2^51 without a branch or an intrinsic: adding and
 /// subtracting 1.5·2^52 pushes the fraction out of the mantissa. A translation unit compiled with
 /// -ffast-math (-fassociative-math) may fold this away; kelp's kernels must not be built so.
+/// \param x the value, |x| < 2^51 (larger values come back wrong, not rounded).
+/// \return the integer nearest to x, as a double.
 KELP_ALWAYS_INLINE inline double round_nearest(double x) {
   constexpr double magic = 6755399441055744.0;  // 1.5 * 2^52
   return (x + magic) - magic;
@@ -37,6 +39,11 @@ KELP_ALWAYS_INLINE inline double round_nearest(double x) {
 /// sin and cos of x (|x| ≤ 1e5 for full accuracy) up to a common sign: sin x = ±s, cos x = ±c,
 /// with the sign bit of ± in `sign` (0 or 2^63, to be applied by XOR, see `flip_sign`). A
 /// caller that multiplies both by one factor applies the sign once, to that factor.
+/// \param x the angle [rad]; accurate for |x| ≤ 1e5, see kFastSinCosLimit.
+/// \param[out] s ±sin x.
+/// \param[out] c ±cos x (the same sign as `s`).
+/// \param[out] sign 0 when s and c are sin x and cos x, 2^63 (the sign bit) when they are
+/// −sin x and −cos x.
 KELP_ALWAYS_INLINE inline void fast_sincos_unsigned(double x, double& s, double& c,
                                                     std::uint64_t& sign) {
   constexpr double inv_pi = 0.318309886183790671538;
@@ -77,6 +84,9 @@ KELP_ALWAYS_INLINE inline void fast_sincos_unsigned(double x, double& s, double&
 }
 
 /// x with its sign bit XORed with `sign` (0 or 2^63): x or −x without a branch.
+/// \param x the value.
+/// \param sign 0 (keep) or 2^63 (negate), as given by fast_sincos_unsigned().
+/// \return x or −x (NaN and zeros included: only the sign bit changes).
 KELP_ALWAYS_INLINE inline double flip_sign(double x, std::uint64_t sign) {
   std::uint64_t b;
   std::memcpy(&b, &x, sizeof b);
@@ -86,6 +96,9 @@ KELP_ALWAYS_INLINE inline double flip_sign(double x, std::uint64_t sign) {
 }
 
 /// sin and cos of x (|x| ≤ 1e5 for full accuracy).
+/// \param x the angle [rad]; see kFastSinCosLimit for the range.
+/// \param[out] s sin x.
+/// \param[out] c cos x.
 KELP_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
   std::uint64_t sign;
   fast_sincos_unsigned(x, s, c, sign);
@@ -99,6 +112,8 @@ KELP_ALWAYS_INLINE inline void fast_sincos(double x, double& s, double& c) {
 /// n·h2 are exact for |n| < 2^27 (|x| < 8e8 rad), so the reduced phase carries only the rounding
 /// of x itself and ≲ 1e-16 rad of its own. Used to bring a wave phase φ − ω t (formed in double)
 /// into the range where `fast_sincos` and a single-precision cast are accurate, however large t.
+/// \param x the angle [rad], |x| ≤ kWrapTwoPiLimit.
+/// \return the equivalent angle in [−π, π] [rad].
 KELP_ALWAYS_INLINE inline double wrap_two_pi(double x) {
   constexpr double inv_two_pi = 0.15915494309189535;
   constexpr double h1 = 6.283185243606567;       // 26 significant bits
@@ -123,6 +138,8 @@ inline constexpr double kFastSinCosLimit = 1.0e6;
 /// (which reduce by a many-digit 2π, Payne–Hanek): atan2(sin x, cos x). Slow (three library
 /// calls): the fallback of `wrap_two_pi` beyond `kWrapTwoPiLimit`, e.g. t = 1e17 s. NaN or ±Inf
 /// give NaN (callers reject non-finite times before).
+/// \param x the angle [rad], any finite value.
+/// \return the equivalent angle in [−π, π] [rad].
 inline KELP_COLD double reduce_phase_exact(double x) {
   return std::atan2(std::sin(x), std::cos(x));
 }
@@ -130,6 +147,8 @@ inline KELP_COLD double reduce_phase_exact(double x) {
 /// x reduced to [−π, π] for any finite x: `wrap_two_pi` within its exact range (one compare,
 /// well predicted), `reduce_phase_exact` beyond it. For one-off reductions; loops hoist the
 /// range check out instead.
+/// \param x the angle [rad], any finite value.
+/// \return the equivalent angle in [−π, π] [rad].
 inline double reduce_phase(double x) {
   return std::fabs(x) <= kWrapTwoPiLimit ? wrap_two_pi(x) : reduce_phase_exact(x);
 }
@@ -140,6 +159,10 @@ inline double reduce_phase(double x) {
 /// multiply-add instead of two): the relative error then grows by |n|·2.3e-17 (≤ 2.3e-14 at
 /// x = −700), so the absolute error |x|·1.44·2.3e-17·e^x stays below 1.3e-17 for every x ≤ 0.
 /// The wave kernel sums terms a e^{−kz}, for which that absolute bound is what counts.
+/// \tparam kSplitLn2 true: ln 2 in two parts (full relative accuracy); false: one part (see
+/// above).
+/// \param x the exponent, −708 ≤ x ≤ 0; outside it the result is wrong (no check).
+/// \return e^x.
 template <bool kSplitLn2 = true>
 KELP_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
   constexpr double log2e = 1.44269504088896340736;
@@ -181,6 +204,9 @@ KELP_ALWAYS_INLINE inline double fast_exp_nonpositive_unchecked(double x) {
 }
 
 /// e^x for x ≤ 0 (x below −700 is treated as −700, giving ≈ 1e-304 instead of a subnormal).
+/// \param x the exponent, x ≤ 0 (the contract: a positive x is not checked, and passes
+/// unchanged to fast_exp_nonpositive_unchecked).
+/// \return e^x, at least ≈ 1e-304.
 KELP_ALWAYS_INLINE inline double fast_exp_nonpositive(double x) {
   // max(x, −700) written with fabs: GCC (without -ffast-math) does not if-convert a compare here,
   // and a branch would stop the loop around this function from vectorising. For x ≥ −700 the

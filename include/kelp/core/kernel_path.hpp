@@ -126,6 +126,8 @@ inline bool kernel_supported(KernelPath p) {
 
 /// \brief The concrete paths this program can take on this CPU, narrowest first (always starts
 /// with `portable`).
+/// \return `portable`, then `avx2` and `avx512` where kernel_supported(); never throws (other
+/// than std::bad_alloc).
 inline std::vector<KernelPath> supported_kernels() {
   std::vector<KernelPath> v;
   for (KernelPath p : {KernelPath::portable, KernelPath::avx2, KernelPath::avx512})
@@ -134,6 +136,7 @@ inline std::vector<KernelPath> supported_kernels() {
 }
 
 /// \brief The widest path the CPU runs (what `automatic` becomes without a policy).
+/// \return `avx512`, `avx2` or `portable`; ignores the process' policy; never throws.
 inline KernelPath widest_kernel() {
   return kernel_supported(KernelPath::avx512) ? KernelPath::avx512
          : kernel_supported(KernelPath::avx2) ? KernelPath::avx2
@@ -255,6 +258,8 @@ inline KernelPath resolve_kernel(KernelPath requested = KernelPath::automatic) {
 }
 
 /// \brief The path kernels without a choice of their own take now: `resolve_kernel()`.
+/// \return a concrete path (never `automatic`).
+/// \throws kelp::invalid_argument from kernel_policy() (a bad KELP_KERNEL).
 inline KernelPath active_kernel() { return resolve_kernel(KernelPath::automatic); }
 
 /// \brief 16 hex digits identifying the C library's math as this process computes it: a hash of
@@ -262,6 +267,8 @@ inline KernelPath active_kernel() { return resolve_kernel(KernelPath::automatic)
 /// among them 24 at which glibc 2.36's FMA and SSE2 builds differ. Two processes with different
 /// fingerprints (another C library version, or glibc's FMA build on one CPU and its SSE2 build on
 /// another) may give different results whatever kernel path they take. About 2000 calls, ~50 µs.
+/// \return 16 lower-case hex digits (FNV-1a of the result bits); the same in every call of one
+/// process.
 inline std::string math_library_fingerprint() {
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the result bits
   const auto mix = [&h](double r) {

@@ -32,6 +32,7 @@ Matrix3<typename Derived::Scalar> skew(const Eigen::MatrixBase<Derived>& a) {
 /// \brief Rotation matrix R_zyx(φ, θ, ψ) from body to NED (Fossen 2021, eq. 2.18).
 /// \param[in] phi roll [rad] \param[in] theta pitch [rad] \param[in] psi yaw [rad]
 /// \return R with v_NED = R v_body (orthonormal, det 1).
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 Matrix3<Scalar> rotation_zyx(const Scalar& phi, const Scalar& theta, const Scalar& psi) {
   using std::cos;
@@ -50,6 +51,7 @@ Matrix3<Scalar> rotation_zyx(const Scalar& phi, const Scalar& theta, const Scala
 /// \param phi roll φ [rad] \param theta pitch θ [rad]
 /// \return T_zyx, mapping body rates ω = (p, q, r) [rad/s] to Euler rates (φ̇, θ̇, ψ̇) [rad/s];
 /// its entries are infinite or NaN at θ = ±90° (no check, no throw).
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 Matrix3<Scalar> euler_rate_matrix(const Scalar& phi, const Scalar& theta) {
   using std::cos;
@@ -66,6 +68,7 @@ Matrix3<Scalar> euler_rate_matrix(const Scalar& phi, const Scalar& theta) {
 /// \brief Unit quaternion for zyx Euler angles (φ, θ, ψ): q = q_z(ψ) q_y(θ) q_x(φ).
 /// \param phi roll [rad] \param theta pitch [rad] \param psi yaw [rad]
 /// \return the unit quaternion rotating body vectors into NED (the rotation of rotation_zyx).
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 Quaternion<Scalar> quaternion_from_euler(const Scalar& phi, const Scalar& theta,
                                          const Scalar& psi) {
@@ -81,6 +84,7 @@ Quaternion<Scalar> quaternion_from_euler(const Scalar& phi, const Scalar& theta,
 /// \brief zyx Euler angles (φ, θ, ψ) [rad] of a unit quaternion; θ ∈ [−π/2, π/2].
 /// \param q a unit quaternion rotating body vectors into NED (not checked).
 /// \return (φ, θ, ψ) [rad]: φ and ψ in [−π, π], θ in [−π/2, π/2].
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 Vector3<Scalar> euler_from_quaternion(const Quaternion<Scalar>& q) {
   using std::asin;
@@ -102,6 +106,7 @@ Vector3<Scalar> euler_from_quaternion(const Quaternion<Scalar>& q) {
 /// \param q the attitude, a unit quaternion (body → NED).
 /// \param omega body angular velocity (p, q, r) [rad/s], body frame.
 /// \return q̇ [1/s] as (ẋ, ẏ, ż, ẇ).
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar, typename Derived>
 Eigen::Matrix<Scalar, 4, 1> quaternion_rate(const Quaternion<Scalar>& q,
                                             const Eigen::MatrixBase<Derived>& omega) {
@@ -116,6 +121,7 @@ Eigen::Matrix<Scalar, 4, 1> quaternion_rate(const Quaternion<Scalar>& q,
 /// η = (x, y, z, φ, θ, ψ) NED and ν = (u, v, w, p, q, r) body (Fossen 2021, eq. 2.53).
 /// \param phi roll [rad] \param theta pitch [rad] \param psi yaw [rad]
 /// \return J = diag(R_zyx, T_zyx); singular at θ = ±90°, like euler_rate_matrix.
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 Matrix6<Scalar> kinematics_euler(const Scalar& phi, const Scalar& theta, const Scalar& psi) {
   Matrix6<Scalar> J = Matrix6<Scalar>::Zero();

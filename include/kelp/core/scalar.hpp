@@ -20,12 +20,14 @@ namespace kelp {
 /// Step functions take `dt` as `identity_t<Scalar>`: `Scalar` is deduced from the model alone, and
 /// a literal such as `0.01` (a `double`) converts to `float` for a float model instead of making
 /// the deduction conflict.
+/// \tparam T any type.
 template <class T>
 struct identity {
   using type = T;  ///< The wrapped type, unchanged.
 };
 
 /// \brief `T` in a non-deduced context; see `kelp::identity`.
+/// \tparam T any type.
 template <class T>
 using identity_t = typename identity<T>::type;
 
@@ -50,6 +52,9 @@ bool is_finite(const Scalar& x) {
 }
 
 /// \brief True when every coefficient of an Eigen expression has a finite value part.
+/// \tparam Derived an Eigen expression type (any shape; empty gives true).
+/// \param m the matrix or vector.
+/// \return whether no coefficient is NaN or ±Inf.
 template <typename Derived>
 bool all_finite(const Derived& m) {
   for (Eigen::Index j = 0; j < m.cols(); ++j)
@@ -59,18 +64,30 @@ bool all_finite(const Derived& m) {
 }
 
 /// \brief Throws `kelp::invalid_argument` naming `field` unless `x` is finite.
+/// \tparam Scalar as value_of.
+/// \param x the value checked.
+/// \param field the name the message gives (e.g. "TetherParameters::length").
+/// \throws kelp::invalid_argument "<field> must be finite".
 template <typename Scalar>
 void check_finite(const Scalar& x, const char* field) {
   if (!is_finite(x)) detail::throw_invalid_argument(std::string(field) + " must be finite");
 }
 
 /// \brief Throws `kelp::invalid_argument` naming `field` unless every coefficient is finite.
+/// \tparam Derived an Eigen expression type.
+/// \param m the matrix or vector checked.
+/// \param field the name the message gives (e.g. "TetherParameters::length").
+/// \throws kelp::invalid_argument "<field> must be finite".
 template <typename Derived>
 void check_all_finite(const Derived& m, const char* field) {
   if (!all_finite(m)) detail::throw_invalid_argument(std::string(field) + " must be finite");
 }
 
 /// \brief Throws `kelp::invalid_argument` naming `field` unless `x` is finite and > 0.
+/// \tparam Scalar as value_of.
+/// \param x the value checked.
+/// \param field the name the message gives (e.g. "TetherParameters::length").
+/// \throws kelp::invalid_argument "<field> must be finite and > 0".
 template <typename Scalar>
 void check_positive(const Scalar& x, const char* field) {
   if (!(is_finite(x) && value_of(x) > 0.0))
@@ -78,6 +95,10 @@ void check_positive(const Scalar& x, const char* field) {
 }
 
 /// \brief Throws `kelp::invalid_argument` naming `field` unless `x` is finite and >= 0.
+/// \tparam Scalar as value_of.
+/// \param x the value checked.
+/// \param field the name the message gives (e.g. "TetherParameters::length").
+/// \throws kelp::invalid_argument "<field> must be finite and >= 0".
 template <typename Scalar>
 void check_non_negative(const Scalar& x, const char* field) {
   if (!(is_finite(x) && value_of(x) >= 0.0))
@@ -87,6 +108,11 @@ void check_non_negative(const Scalar& x, const char* field) {
 /// \brief Throws `kelp::invalid_argument` naming `field` and the bound unless `x` ≤ `bound`
 /// (NaN fails). For parameters whose finite but absurd values would overflow what is computed
 /// from them; the bound is part of the documented contract of the parameter.
+/// \tparam Scalar as value_of.
+/// \param x the value checked.
+/// \param bound the largest value allowed (in the unit of `x`).
+/// \param field the name the message gives (e.g. "TetherParameters::length").
+/// \throws kelp::invalid_argument "<field> must be <= <bound> (got <x>)".
 template <typename Scalar>
 void check_at_most(const Scalar& x, double bound, const char* field) {
   if (!(value_of(x) <= bound)) {
@@ -98,6 +124,11 @@ void check_at_most(const Scalar& x, double bound, const char* field) {
 
 /// \brief Throws `kelp::invalid_argument` naming `field` and the bound unless `x` ≥ `bound`
 /// (NaN fails).
+/// \tparam Scalar as value_of.
+/// \param x the value checked.
+/// \param bound the smallest value allowed (in the unit of `x`).
+/// \param field the name the message gives (e.g. "TetherParameters::length").
+/// \throws kelp::invalid_argument "<field> must be >= <bound> (got <x>)".
 template <typename Scalar>
 void check_at_least(const Scalar& x, double bound, const char* field) {
   if (!(value_of(x) >= bound)) {

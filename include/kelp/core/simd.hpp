@@ -24,6 +24,7 @@
 namespace kelp::simd {
 
 /// \brief True when Eigen vectorises `Scalar` with the current compiler flags.
+/// \tparam Scalar the lane type (double and float vectorise on x86-64).
 template <typename Scalar>
 constexpr bool vectorized = bool(Eigen::internal::packet_traits<Scalar>::Vectorizable) &&
                             (Eigen::internal::packet_traits<Scalar>::size > 1);
@@ -50,41 +51,60 @@ struct RawPack<Scalar, true> {
 };
 }  // namespace detail
 
-/// \brief `Lanes` values of `Scalar` processed together: the widest Eigen packet of at most 32
+/// \brief `lanes` values of `Scalar` processed together: the widest Eigen packet of at most 32
 /// bytes when `Wide`, a plain scalar otherwise (the same code then handles remainders and odd
 /// cases).
+///
+/// \tparam Scalar the lane type (double or float vectorise; any other type, e.g. ceres::Jet,
+/// gives one lane).
+/// \tparam Wide true for the widest packet, false for one lane (the remainder of a loop).
 template <typename Scalar, bool Wide>
 struct Pack {
+  /// The storage: an Eigen packet type (e.g. `Packet4d`), or `Scalar` itself for one lane.
   using Raw = typename detail::RawPack<Scalar, Wide && vectorized<Scalar>>::type;
+  /// Number of `Scalar` values in the pack (1 when not `Wide` or not vectorised).
   static constexpr int lanes = Eigen::internal::unpacket_traits<Raw>::size;
-  Raw r;
+  Raw r;  ///< The lanes (read them with store() or sum(), not by indexing).
 
   Pack() = default;
+  /// \brief Wraps a raw packet (or, for one lane, a scalar) without conversion.
+  /// \param raw the lane values.
   explicit Pack(Raw raw) : r(raw) {}
-  /// All lanes set to `s`.
+  /// \brief All lanes set to `s`.
+  /// \param s the value of every lane.
+  /// \return the broadcast pack.
   static Pack all(Scalar s) { return Pack(Eigen::internal::pset1<Raw>(s)); }
-  /// Lanes from `p[0], p[stride], p[2 stride], …`.
+  /// \brief Lanes from `p[0], p[stride], p[2 stride], …`.
+  /// \param p the first value; `p[(lanes - 1) stride]` must be readable.
+  /// \param stride distance between lanes in elements (3 for one component of a column-major
+  /// 3×N matrix).
+  /// \return the gathered pack.
   static Pack gather(const Scalar* p, Eigen::Index stride) {
     if constexpr (lanes == 1)
       return Pack(*p);
     else
       return Pack(Eigen::internal::pgather<Scalar, Raw>(p, stride));
   }
-  /// Lanes from `p[0], p[1], …` (no alignment needed).
+  /// \brief Lanes from `p[0], p[1], …` (no alignment needed).
+  /// \param p the first of `lanes` consecutive readable values.
+  /// \return the loaded pack.
   static Pack load(const Scalar* p) {
     if constexpr (lanes == 1)
       return Pack(*p);
     else
       return Pack(Eigen::internal::ploadu<Raw>(p));
   }
-  /// Stores the lanes to `p[0], p[stride], …`.
+  /// \brief Stores the lanes to `p[0], p[stride], …`.
+  /// \param p where lane 0 goes; `p[(lanes - 1) stride]` must be writable.
+  /// \param stride distance between lanes in elements.
   void scatter(Scalar* p, Eigen::Index stride) const {
     if constexpr (lanes == 1)
       *p = r;
     else
       Eigen::internal::pscatter<Scalar, Raw>(p, r, stride);
   }
-  /// Stores the lanes to `p[0], p[1], …` (no alignment needed).
+  /// \brief Stores the lanes to `p[0], p[1], …` (no alignment needed).
+  /// \param p the first of `lanes` consecutive writable values.
   void store(Scalar* p) const {
     if constexpr (lanes == 1)
       *p = r;
@@ -97,7 +117,13 @@ struct Pack {
   friend Pack operator*(Pack a, Pack b) { return Pack(Eigen::internal::pmul(a.r, b.r)); }
   friend Pack operator/(Pack a, Pack b) { return Pack(Eigen::internal::pdiv(a.r, b.r)); }
   friend Pack operator-(Pack a) { return Pack(Eigen::internal::pnegate(a.r)); }
+  /// \brief Lane-wise `*this = *this + b`.
+  /// \param b the pack added.
+  /// \return `*this`.
   Pack& operator+=(Pack b) { return *this = *this + b; }
+  /// \brief Lane-wise `*this = *this - b`.
+  /// \param b the pack subtracted.
+  /// \return `*this`.
   Pack& operator-=(Pack b) { return *this = *this - b; }
   friend Pack sqrt(Pack a) {
     if constexpr (lanes == 1) {
@@ -117,14 +143,16 @@ struct Pack {
       return Pack(Eigen::internal::pmax(a.r, b.r));
   }
   /// \endcond
-  /// Sum of the lanes.
+  /// \brief Sum of the lanes.
+  /// \return the sum (its rounding follows Eigen's reduction order, not left to right).
   Scalar sum() const {
     if constexpr (lanes == 1)
       return r;
     else
       return Eigen::internal::predux(r);
   }
-  /// Largest lane.
+  /// \brief Largest lane.
+  /// \return the largest value (NaN handling as Eigen's `predux_max`).
   Scalar max_lane() const {
     if constexpr (lanes == 1)
       return r;
@@ -144,6 +172,13 @@ struct Pack {
 /// \brief Calls `f(Pack<Scalar, true>(), j)` for j = begin, begin + lanes, … while a whole packet
 /// fits before `end`, then `f(Pack<Scalar, false>(), j)` for each remaining j: a loop body
 /// written once for both widths.
+///
+/// \tparam Scalar the lane type.
+/// \tparam F a callable taking `(Pack<Scalar, W>, Eigen::Index j)` for both W; the pack
+/// argument carries only its type (the lanes are j, j + 1, …, j + lanes − 1).
+/// \param begin first index.
+/// \param end one past the last index (nothing is done when `end <= begin`).
+/// \param f the loop body.
 template <typename Scalar, typename F>
 void for_each_pack(Eigen::Index begin, Eigen::Index end, F&& f) {
   using Wide = Pack<Scalar, true>;
@@ -153,14 +188,21 @@ void for_each_pack(Eigen::Index begin, Eigen::Index end, F&& f) {
 }
 
 /// \brief Lane-wise comparison result.
+/// \tparam Scalar the lane type of the packs compared.
+/// \tparam Wide the width of the packs compared (see Pack).
 template <typename Scalar, bool Wide>
 struct Mask {
-  using P = Pack<Scalar, Wide>;
-  typename P::Raw m;  // all bits set where true (packets), or 1/0 (scalar)
-  bool scalar_value = false;
+  using P = Pack<Scalar, Wide>;  ///< The pack type this mask selects lanes of.
+  typename P::Raw m;  ///< Packets: all bits set in the lanes that are true (unused for one lane).
+  bool scalar_value = false;  ///< One lane: the result (unused for packets).
 };
 
 /// \brief a > b lane-wise (false where either is NaN).
+/// \param a left operand.
+/// \param b right operand.
+/// \return the mask of the lanes where a > b.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> greater(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -172,6 +214,11 @@ Mask<Scalar, Wide> greater(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
 }
 
 /// \brief a >= b lane-wise (false where either is NaN).
+/// \param a left operand.
+/// \param b right operand.
+/// \return the mask of the lanes where a >= b.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> greater_equal(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -183,6 +230,12 @@ Mask<Scalar, Wide> greater_equal(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
 }
 
 /// \brief Lane-wise `k ? a : b`.
+/// \param k the mask (from greater(), less(), …).
+/// \param a lanes taken where `k` is true.
+/// \param b lanes taken where `k` is false.
+/// \return the blended pack.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Pack<Scalar, Wide> select(Mask<Scalar, Wide> k, Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   if constexpr (Pack<Scalar, Wide>::lanes == 1)
@@ -193,6 +246,11 @@ Pack<Scalar, Wide> select(Mask<Scalar, Wide> k, Pack<Scalar, Wide> a, Pack<Scala
 }
 
 /// \brief Lane-wise logical and.
+/// \param a first mask.
+/// \param b second mask.
+/// \return true in the lanes where both are true.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> operator&&(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -204,12 +262,22 @@ Mask<Scalar, Wide> operator&&(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
 }
 
 /// \brief a < b lane-wise (false where either is NaN).
+/// \param a left operand.
+/// \param b right operand.
+/// \return the mask of the lanes where a < b.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> less(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
   return greater(b, a);
 }
 
 /// \brief Lane-wise logical or.
+/// \param a first mask.
+/// \param b second mask.
+/// \return true in the lanes where either is true.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> operator||(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -221,6 +289,10 @@ Mask<Scalar, Wide> operator||(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
 }
 
 /// \brief True when any lane is true.
+/// \param k the mask.
+/// \return whether at least one lane of `k` is true.
+/// \tparam Scalar the lane type.
+/// \tparam Wide the pack width (see Pack).
 template <typename Scalar, bool Wide>
 bool any(Mask<Scalar, Wide> k) {
   if constexpr (Pack<Scalar, Wide>::lanes == 1)

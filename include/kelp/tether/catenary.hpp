@@ -55,6 +55,8 @@ enum class CatenaryStatus {
 };
 
 /// \brief A short lower-case name of a status ("converged", "taut", ...), for logs and messages.
+/// \param status the status.
+/// \return its name as spelled in the enum, a string literal ("unknown" outside the enum).
 inline const char* to_string(CatenaryStatus status) {
   switch (status) {
     case CatenaryStatus::converged:
@@ -138,6 +140,7 @@ struct CatenaryResult {
   Scalar taut_tension = Scalar(0);
 
   /// \brief True when a, c describe the line (converged or vertical).
+  /// \return false for taut (a straight line: no a, c), invalid_input and max_iterations.
   bool ok() const {
     return status == CatenaryStatus::converged || status == CatenaryStatus::vertical;
   }
@@ -571,12 +574,18 @@ CatenaryResult<Scalar> solve_catenary(Scalar D, Scalar dz, Scalar L,
 template <typename Scalar>
 class CatenaryShape {
  public:
-  using Vector3S = Vector3<Scalar>;
+  using Vector3S = Vector3<Scalar>;  ///< A 3-vector of the shape's scalar (NED points, forces).
 
   /// \brief An invalid shape (status invalid_input); use catenary_between() to build one.
   CatenaryShape() = default;
 
   /// \brief Solves the catenary between `start_ned` and `end_ned`; see catenary_between().
+  /// Never throws: bad inputs give status `invalid_input`.
+  /// \param start_ned start attachment point, NED [m].
+  /// \param end_ned end attachment point, NED [m].
+  /// \param L unstretched length [m].
+  /// \param w submerged weight per length [N/m] (< 0: buoyant).
+  /// \param options solver options (EA for a taut line, seabed_depth for seabed contact).
   CatenaryShape(const Vector3S& start_ned, const Vector3S& end_ned, Scalar L, Scalar w,
                 const CatenaryOptions<Scalar>& options = {})
       : start_(start_ned), end_(end_ned), L_(L), w_(w) {
@@ -616,23 +625,31 @@ class CatenaryShape {
   }
 
   /// \brief The solver's status (see CatenaryStatus).
+  /// \return converged, taut, vertical, max_iterations or invalid_input.
   CatenaryStatus status() const { return result_.status; }
   /// \brief The full solve result in the (mirrored, for w < 0) paper plane: a, c, iterations,
   /// residual, taut tension (for a grounded line see the class description).
+  /// \return the result (a [m], c [m], taut_tension [N]).
   const CatenaryResult<Scalar>& result() const { return result_; }
   /// \brief Horizontal tension H = a·|w| [N], the same all along the line (0 when vertical, taut or
   /// invalid; for max_iterations that of the last iterate, like the shape and the end forces).
+  /// \return H [N], ≥ 0.
   Scalar horizontal_tension() const { return H_; }
   /// \brief Horizontal distance between the ends D [m].
+  /// \return D [m] (0 for an invalid input).
   Scalar horizontal_distance() const { return D_; }
   /// \brief Unstretched length L [m].
+  /// \return L [m], as given.
   Scalar length() const { return L_; }
   /// \brief Submerged weight per length w [N/m] (< 0: buoyant).
+  /// \return w [N/m], as given.
   Scalar weight_per_length() const { return w_; }
   /// \brief True when part of the line rests on the seabed (options.seabed_depth).
+  /// \return whether the grounded shape applies.
   bool on_seabed() const { return grounded_; }
   /// \brief Length resting on the seabed L_b [m] (0 when not on the seabed); the seabed carries
   /// its weight w·L_b.
+  /// \return L_b [m], ≥ 0.
   Scalar grounded_length() const { return grounded_ ? Lb_ : Scalar(0.0); }
 
   /// \brief The NED point [m] at unstretched arc length s ∈ [0, L] from the start end.
@@ -642,6 +659,7 @@ class CatenaryShape {
   /// z(x) = a cosh((x−c)/a) − a cosh(c/a) = 2a sinh(x/(2a)) sinh((x−2c)/(2a)).
   /// Taut: linear interpolation. Grounded: see the class description.
   /// \param[in] s arc length [m] from the start, finite (meant in [0, L]).
+  /// \return the point, NED [m] (NaN for status invalid_input).
   /// \throws kelp::invalid_argument when s is NaN or ±Inf (a shape of status `invalid_input`
   /// answers a finite s with NaN, its documented status value).
   Vector3S point_at(Scalar s) const {
@@ -673,6 +691,7 @@ class CatenaryShape {
   /// \brief The vertex of the catenary in NED [m]: the lowest point of the curve for w ≥ 0, the
   /// highest for w < 0. It may lie beyond the ends (then it is not on the cable). Grounded: the
   /// first touchdown point. NaN when taut or invalid.
+  /// \return the vertex, NED [m].
   Vector3S vertex() const {
     const Scalar nan = Scalar(std::numeric_limits<double>::quiet_NaN());
     if (grounded_) return grounded_point(s1_);
@@ -686,6 +705,7 @@ class CatenaryShape {
   /// \brief The deepest point of the cable itself, NED [m]: the vertex when it lies between the
   /// ends of a hanging line, otherwise the deeper end (always an end for a buoyant or taut line);
   /// the first touchdown point when grounded.
+  /// \return the point with the largest NED z on the cable [m] (NaN when invalid).
   Vector3S lowest_point() const {
     const Vector3S deeper_end = end_.z() > start_.z() ? end_ : start_;
     if (grounded_) return vertex();
@@ -709,14 +729,17 @@ class CatenaryShape {
   /// Slack line: H toward the end horizontally and H·sinh(c/a) = |w|·(arc length from the start to
   /// the vertex) downwards (upwards for a buoyant line), i.e. the cable tension T = H cosh(c/a)
   /// along the tangent. Taut, vertical and grounded: see the class description.
+  /// \return the force, NED [N] (NaN when invalid).
   Vector3S force_on_start() const { return end_force(true); }
 
   /// \brief Force the cable exerts on the end attachment point, NED [N] (see force_on_start()).
+  /// \return the force, NED [N] (NaN when invalid).
   Vector3S force_on_end() const { return end_force(false); }
 
   /// \brief Tension magnitude [N] at arc length s: H cosh((x(s) − c)/a) = |w|√(a² + σ²) for a
   /// slack line (σ the arc length from the vertex); H on the grounded part.
   /// \param[in] s arc length [m] from the start, finite (meant in [0, L]).
+  /// \return the tension [N] (taut: result().taut_tension; NaN for status invalid_input).
   /// \throws kelp::invalid_argument when s is NaN or ±Inf (a shape of status `invalid_input`
   /// answers a finite s with NaN, its documented status value).
   Scalar tension_at(Scalar s) const {
@@ -940,6 +963,7 @@ class CatenaryShape {
 /// \param[in] w submerged weight per length [N/m]: weight minus buoyancy, w = (m' − ρ A) g
 ///   (w > 0 hangs, w < 0 is buoyant and arches upwards, w = 0 gives the shape with zero tension).
 /// \param[in] options solver options (EA sets the tension of a taut line).
+/// \return the shape; check its status() before using it.
 template <typename Scalar>
 CatenaryShape<Scalar> catenary_between(const Vector3<Scalar>& start_ned,
                                        const Vector3<Scalar>& end_ned, Scalar L, Scalar w,

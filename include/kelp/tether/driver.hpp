@@ -25,6 +25,7 @@ namespace kelp::tether {
 /// Built from its fields in order (`{Integrator::rk4}`, `{Integrator::bdf2, newton}`), each
 /// defaulted (a constructor rather than an aggregate, so that giving the leading fields only does
 /// not trip -Wmissing-field-initializers in users' builds).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct StepOptions {
   /// Time-stepping scheme.
@@ -33,6 +34,8 @@ struct StepOptions {
   ImplicitOptions<Scalar> implicit;
 
   /// \brief The options of the fields, in order.
+  /// \param integrator_ the scheme (default BDF2).
+  /// \param implicit_ the implicit schemes' Newton settings (default ImplicitOptions{}).
   StepOptions(Integrator integrator_ = Integrator::bdf2,  // NOLINT(google-explicit-constructor)
               const ImplicitOptions<Scalar>& implicit_ = {})
       : integrator(integrator_), implicit(implicit_) {}
@@ -40,6 +43,7 @@ struct StepOptions {
 
 /// \brief How advance() advances a tether: the longest sub-step, the scheme and its Newton
 /// settings. Built from its fields in order (`{0.01, Integrator::rk4}`), each defaulted.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct AdvanceOptions {
   /// Longest sub-step [s], > 0: advance() takes ⌈duration / max_dt⌉ equal sub-steps.
@@ -50,6 +54,9 @@ struct AdvanceOptions {
   ImplicitOptions<Scalar> implicit;
 
   /// \brief The options of the fields, in order.
+  /// \param max_dt_ the longest sub-step [s] (default 0.01; checked > 0 by advance()).
+  /// \param integrator_ the scheme (default BDF2).
+  /// \param implicit_ the implicit schemes' Newton settings (default ImplicitOptions{}).
   AdvanceOptions(double max_dt_ = 0.01,  // NOLINT(google-explicit-constructor)
                  Integrator integrator_ = Integrator::bdf2,
                  const ImplicitOptions<Scalar>& implicit_ = {})
@@ -65,6 +72,18 @@ struct AdvanceOptions {
 /// StepReport::failure say so.
 /// \throws as the individual steps; kelp::invalid_argument for an Integrator value outside the
 /// enumeration.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type: kelp::environment::Environment or any type with its duck-typed
+/// interface (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model` (TetherWorkspace(model)); end_forces,
+/// end_node_forces and end_impulse are set.
+/// \param[in] env the water (density, gravity, kinematics, seabed), queried at the step's times.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] boundary the kinematic ends' motion over the step, NED, from the state's time.
+/// \param[in] dt the step [s], > 0.
+/// \param[in] options the scheme and its Newton settings.
+/// \return the step's report (with partings = 1 and the failure when the line parted).
 template <typename Scalar, typename Env>
 StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                         const Env& env, TetherState<Scalar>& state,
@@ -103,6 +122,20 @@ StepReport<Scalar> step(const TetherModel<Scalar>& model, TetherWorkspace<Scalar
 /// the state is restored to its value at entry, history included, and the error rethrown. No heap
 /// allocation. \returns the sum of the sub-steps' reports (committed steps, Newton iterations,
 /// worst residual, retries).
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type: kelp::environment::Environment or any type with its duck-typed
+/// interface (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model`; end_forces at the end, end_impulse summed.
+/// \param[in] env the water.
+/// \param[in,out] state advanced by `duration` on success, restored (history included) on failure.
+/// \param[in] boundary the kinematic ends' motion from the state's time, NED (extrapolated over
+/// the whole interval: constant acceleration).
+/// \param[in] duration the interval [s], > 0.
+/// \param[in] options the longest sub-step, the scheme and its Newton settings.
+/// \throws kelp::invalid_argument for a duration or max_dt not finite and > 0, more than
+/// INT_MAX sub-steps, or bad input to a step; kelp::numerical_error when a sub-step fails (the
+/// state is restored first).
 template <typename Scalar, typename Env>
 StepReport<Scalar> advance(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                            const Env& env, TetherState<Scalar>& state,

@@ -103,6 +103,18 @@ void end_evaluation(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
 /// End forces (`ws.end_forces`) are those at the end of the step (TetherWorkspace::end_forces).
 /// \throws kelp::invalid_argument for bad input; kelp::numerical_error (state unchanged) when
 /// the result is not finite.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type: kelp::environment::Environment or any type with its duck-typed
+/// interface (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model` (TetherWorkspace(model)); end_forces,
+/// end_node_forces and end_impulse are set.
+/// \param[in] env the water (density, gravity, kinematics, seabed), queried at the step's times.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] boundary the kinematic ends' motion over the step, NED, from the state's time.
+/// \param[in] dt the step [s], > 0 (estimate_stable_dt gives a stable one).
+/// \return the work done (1 sub-step; 1 force evaluation, 2 when the previous step's end
+/// evaluation could not be reused).
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
                                          TetherWorkspace<Scalar>& ws, const Env& env,
@@ -126,6 +138,17 @@ StepReport<Scalar> step_symplectic_euler(const TetherModel<Scalar>& model,
 
 /// \brief One explicit-midpoint (RK2) step of length `dt` [s]. End forces are those at the end of
 /// the step. \throws as step_symplectic_euler.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type: kelp::environment::Environment or any type with its duck-typed
+/// interface (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model` (TetherWorkspace(model)); end_forces,
+/// end_node_forces and end_impulse are set.
+/// \param[in] env the water (density, gravity, kinematics, seabed), queried at the step's times.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] boundary the kinematic ends' motion over the step, NED, from the state's time.
+/// \param[in] dt the step [s], > 0.
+/// \return the work done (1 sub-step; 2 or 3 force evaluations, see step_symplectic_euler).
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,
@@ -188,6 +211,17 @@ void rk4_stage_update(TetherWorkspace<Scalar>& ws, const Matrix3X<Scalar>& vs, S
 /// Four force evaluations (each also giving the accelerations M⁻¹F in its last pass), each
 /// followed by one vectorised pass for the stage's state update, and the end state's (which the
 /// next step takes as its first). \throws as step_symplectic_euler.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type: kelp::environment::Environment or any type with its duck-typed
+/// interface (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model` (TetherWorkspace(model)); end_forces,
+/// end_node_forces and end_impulse are set.
+/// \param[in] env the water (density, gravity, kinematics, seabed), queried at the step's times.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] boundary the kinematic ends' motion over the step, NED, from the state's time.
+/// \param[in] dt the step [s], > 0.
+/// \return the work done (1 sub-step and its force evaluations).
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_rk4(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                             const Env& env, TetherState<Scalar>& state,

@@ -37,6 +37,7 @@
 namespace kelp::tether {
 
 /// \brief Where and when a line parted.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct LineFailure {
   /// Simulation time at the end of the step in which the axial force exceeded the breaking
@@ -54,6 +55,11 @@ struct LineFailure {
 /// compute_forces evaluates it: EA/l·max(0, l_s − l) plus the faded dashpot σ(l_s)·BA/l·u·Δv,
 /// clamped at zero unless compressive_damping; 0 for a parted segment; segment 0 at a winch with
 /// its own rest length. No check of `s`.
+/// \tparam Scalar double or float.
+/// \param model the tether (EA/l, BA/l, dashpot fade, compressive_damping).
+/// \param state the state (positions NED [m], velocities [m/s], winch length, parted flags).
+/// \param s the segment, 0 ≤ s < N, between nodes s and s + 1.
+/// \return T_s [N] (≥ 0 unless compressive_damping).
 template <typename Scalar>
 Scalar segment_axial_force(const TetherModel<Scalar>& model, const TetherState<Scalar>& state,
                            int s) {
@@ -81,6 +87,12 @@ Scalar segment_axial_force(const TetherModel<Scalar>& model, const TetherState<S
 /// event in `event`. Does nothing when the line cannot part (TetherModel::can_part) or no segment
 /// is over the strength. O(N), no heap allocation (unless `state.parted` is empty).
 /// \returns true when the line parted.
+/// \tparam Scalar double or float.
+/// \param model the tether (its breaking strength).
+/// \param[in,out] state the committed state: a flag is set in `parted`, the kept Newton matrix
+/// cleared, when the line parts.
+/// \param[out] event set only when the line parts: time [s], segment, axial force [N] and
+/// midpoint (NED [m]).
 template <typename Scalar>
 bool part_if_overloaded(const TetherModel<Scalar>& model, TetherState<Scalar>& state,
                         LineFailure<Scalar>& event) {

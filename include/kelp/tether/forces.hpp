@@ -773,6 +773,10 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// \throws kelp::invalid_argument when `ws` was not built for `model` (TetherWorkspace::fits),
 /// x or v is not 3×(N+1), or t, x or v is not finite (O(N) check; the integrators call the
 /// evaluation behind it directly, after checking the state once per step).
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \tparam DX an Eigen 3×(N+1) matrix type (positions, NED [m]).
+/// \tparam DV an Eigen 3×(N+1) matrix type (velocities, NED [m/s]).
 template <bool WithJacobian = false, typename Scalar, typename Env, typename DX, typename DV>
 void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                     double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v) {
@@ -798,6 +802,13 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
 /// 1/a and b/(a+b) from compute_forces (constants along the wet part of the line).
 /// \throws kelp::invalid_argument when `ws` was not built for `model`, `acc` is not 3×(N+1) or
 /// an end acceleration is not finite.
+/// \tparam Scalar double or float.
+/// \tparam DA a writable Eigen 3×(N+1) matrix type.
+/// \param[in] model the tether.
+/// \param[in] ws the workspace holding the last compute_forces (forces, tangents, masses).
+/// \param[in] a_start the prescribed acceleration of a kinematic start end, NED [m/s²].
+/// \param[in] a_end the prescribed acceleration of a kinematic far end, NED [m/s²].
+/// \param[out] acc the node accelerations, NED [m/s²], 3×(N+1).
 template <typename Scalar, typename DA>
 void accelerations_from_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                                const Vector3<Scalar>& a_start, const Vector3<Scalar>& a_end,
@@ -831,6 +842,11 @@ Vector3<Scalar> node_inertia(const TetherWorkspace<Scalar>& ws, int i, const Vec
 /// `compute_forces`: F_end = F_node − M_node a_end (the negative of the constraint force that
 /// holds the end node on its prescribed path), NED [N]. Zero for a free end.
 /// \throws kelp::invalid_argument when `ws` was not built for `model` or `boundary` is not finite.
+/// \tparam Scalar double or float.
+/// \param[in] model the tether.
+/// \param[in] ws the workspace holding the last compute_forces.
+/// \param[in] boundary the end motion at the evaluation's instant (its accelerations are used).
+/// \return the forces on the start and far attachment points, NED [N].
 template <typename Scalar>
 EndForces<Scalar> end_forces_from_workspace(const TetherModel<Scalar>& model,
                                             const TetherWorkspace<Scalar>& ws,
@@ -869,6 +885,12 @@ void set_end_node_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scala
 /// stretched segments + bending EI/l Σ (1 − u_{i−1}·u_i). Ignores the seabed spring. Recomputes the
 /// tangents and wetness itself.
 /// \throws kelp::invalid_argument when the state does not fit the model or is not finite.
+/// \tparam Scalar double or float.
+/// \tparam Env the environment type (water_density(), gravity(), surface_elevation()).
+/// \param model the tether.
+/// \param env the water (density, gravity, surface elevation at the state's time).
+/// \param state the state (positions NED [m], velocities [m/s], winch length, parted segments).
+/// \return the energy [J], relative to the sea surface (z = 0) for the weight.
 template <typename Scalar, typename Env>
 Scalar tether_energy(const TetherModel<Scalar>& model, const Env& env,
                      const TetherState<Scalar>& state) {

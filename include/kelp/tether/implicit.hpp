@@ -617,7 +617,13 @@ StepReport<Scalar> step_implicit(const TetherModel<Scalar>& model, TetherWorkspa
 /// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
 /// \param[in] boundary the kinematic ends' motion. \param[in] dt step [s], > 0.
 /// \param[in] options Newton settings.
-/// \throws see above.
+/// \return the work done (sub-steps, Newton iterations, factorisations and reuses, worst
+/// residual [m/s], retries).
+/// \throws kelp::invalid_argument for bad input (state, boundary, dt, options, a workspace not
+/// built for the model); kelp::numerical_error (state unchanged) when the result is not finite
+/// or Newton's method does not converge even in sub-steps.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_implicit_euler(const TetherModel<Scalar>& model,
                                        TetherWorkspace<Scalar>& ws, const Env& env,
@@ -630,6 +636,18 @@ StepReport<Scalar> step_implicit_euler(const TetherModel<Scalar>& model,
 /// \brief One second-order BDF step of length `dt` [s] (Integrator::bdf2): the Newton scheme
 /// above with γ = 2/3 (backward Euler on the first step or after a change of dt).
 /// Parameters and throws as step_implicit_euler().
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type: kelp::environment::Environment or any type with its duck-typed
+/// interface (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model` (TetherWorkspace(model)); end_forces,
+/// end_node_forces and end_impulse are set.
+/// \param[in] env the water (density, gravity, kinematics, seabed), queried at the step's times.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] boundary the kinematic ends' motion over the step, NED, from the state's time.
+/// \param[in] dt the step [s], > 0.
+/// \param[in] options Newton settings.
+/// \return the work done, as step_implicit_euler().
 template <typename Scalar, typename Env>
 StepReport<Scalar> step_bdf2(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws,
                              const Env& env, TetherState<Scalar>& state,

@@ -33,6 +33,10 @@ namespace kelp::tether {
 /// \param[in] start_ned node 0, NED [m] \param[in] end_ned node N, NED [m]
 /// \param[out] status catenary status (optional)
 /// \throws kelp::invalid_argument naming `start_ned` / `end_ned` when not finite.
+/// \return a state at the model's time 0, at rest, without history; the end nodes exactly at
+/// `start_ned` and `end_ned`.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
 template <typename Scalar, typename Env>
 TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, const Env& env,
                                            const Vector3<Scalar>& start_ned,
@@ -71,6 +75,9 @@ TetherState<Scalar> catenary_initial_state(const TetherModel<Scalar>& model, con
 /// Positions, time and integrator history are left as they are. \param[in] model the tether
 /// \param[in] env environment (`sample_water(points, t, velocity, acceleration)`)
 /// \param[in,out] state the tether's state
+/// \throws kelp::invalid_argument when the state's size does not match the model.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
 template <typename Scalar, typename Env>
 void move_with_water(const TetherModel<Scalar>& model, const Env& env, TetherState<Scalar>& state) {
   KELP_CHECK(state.position.cols() == model.segments() + 1 &&
@@ -84,6 +91,16 @@ void move_with_water(const TetherModel<Scalar>& model, const Env& env, TetherSta
 /// `start_ned`, `end_ned` (free ends of the model stay free). Returns the solve's result (check
 /// `converged`); the state is written to `state` when the solve returns.
 /// \throws as catenary_initial_state and solve_static_equilibrium, with `state` unchanged.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model` (scratch of the solve).
+/// \param[in] env the water (weight, buoyancy, seabed; currents load the line as in a step).
+/// \param[in] start_ned node 0, NED [m].
+/// \param[in] end_ned node N, NED [m].
+/// \param[out] state the equilibrium (or the solve's last iterate when it did not converge).
+/// \param[in] options the static solve's settings.
+/// \return the solve's result (StaticResult: check `converged`).
 template <typename Scalar, typename Env>
 [[nodiscard]] StaticResult<Scalar> static_initial_state(const TetherModel<Scalar>& model,
                                                         TetherWorkspace<Scalar>& ws, const Env& env,

@@ -376,31 +376,62 @@ inline Eigen::Index band_block_index(int i, int j) { return 5 * Eigen::Index(i) 
 /// \brief The blocks of the whole Jacobian of the node forces (see force_jacobian): for every
 /// node i and |i − j| ≤ 2, ∂F_i/∂x_j [N/m], ∂F_i/∂v_j [N s/m] and ∂(M_i(x) d_i)/∂x_j [kg/s]
 /// for the vector d given to force_jacobian. Sized once for a model (no allocation afterwards).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct ForceJacobian {
-  /// Block store, 9 × 5(N+1): column 5i + (j − i + 2) is block (i, j) column-major.
+  /// \brief Block stores of ∂F/∂x [N/m], ∂F/∂v [N s/m] and ∂(M d)/∂x [kg/s], 9 × 5(N+1) each:
+  /// column 5i + (j − i + 2) is block (i, j) column-major.
+  ///@{
   Eigen::Matrix<Scalar, 9, Eigen::Dynamic> dfdx, dfdv, dmdx;
+  ///@}
 
   ForceJacobian() = default;
   /// \brief Zero blocks sized for `model`.
+  /// \param model the tether (its node count).
   explicit ForceJacobian(const TetherModel<Scalar>& model) {
     for (auto* m : {&dfdx, &dfdv, &dmdx}) m->setZero(9, 5 * Eigen::Index(model.nodes()));
   }
   /// \brief ∂F_i/∂x_j (zero beyond |i − j| ≤ 2).
+  /// \param i the node whose force, 0 ≤ i ≤ N (not checked below 0).
+  /// \param j the node whose position.
+  /// \return the 3×3 block [N/m], NED.
   Matrix3<Scalar> dF_dx(int i, int j) const { return block(dfdx, i, j); }
   /// \brief ∂F_i/∂v_j (zero beyond |i − j| ≤ 2).
+  /// \param i the node whose force, 0 ≤ i ≤ N (not checked below 0).
+  /// \param j the node whose velocity.
+  /// \return the 3×3 block [N s/m], NED.
   Matrix3<Scalar> dF_dv(int i, int j) const { return block(dfdv, i, j); }
   /// \brief ∂(M_i d_i)/∂x_j (zero beyond |i − j| ≤ 1).
+  /// \param i the node whose mass matrix, 0 ≤ i ≤ N (not checked below 0).
+  /// \param j the node whose position.
+  /// \return the 3×3 block [kg/s], NED.
   Matrix3<Scalar> dMd_dx(int i, int j) const { return block(dmdx, i, j); }
 
-  /// Sink of detail::force_jacobian_blocks.
+  /// \brief Sink of detail::force_jacobian_blocks: adds c·a to ∂F_i/∂x_j.
+  /// \param i block row (node), \param j block column (node), |i − j| ≤ 2, both in [0, N].
+  /// \param a the 3×3 block [N/m]. \param c its factor (kelp's assembly passes ±1: the sign
+  /// with which the block enters).
   void x(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dfdx, i, j, c * a); }
+  /// \brief Sink: adds c·a to ∂F_i/∂v_j.
+  /// \param i block row, \param j block column, as x().
+  /// \param a the 3×3 block [N s/m]. \param c its factor.
   void v(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dfdv, i, j, c * a); }
+  /// \brief Sink: adds c·a to ∂(M_i d_i)/∂x_j.
+  /// \param i block row, \param j block column, as x().
+  /// \param a the 3×3 block [kg/s]. \param c its factor.
   void m(int i, int j, const Matrix3<Scalar>& a, Scalar c) { add(dmdx, i, j, c * a); }
+  /// \brief Sink: x(i, j, ax, c) and v(i, j, av, c) together.
+  /// \param i block row, \param j block column, as x().
+  /// \param ax the ∂F/∂x block [N/m]. \param av the ∂F/∂v block [N s/m].
+  /// \param c their factor.
   void xv(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av, Scalar c) {
     x(i, j, ax, c);
     v(i, j, av, c);
   }
+  /// \brief Sink: x(), v() and m() of one block (i, j) together.
+  /// \param i block row, \param j block column, as x().
+  /// \param ax the ∂F/∂x block [N/m]. \param av the ∂F/∂v block [N s/m].
+  /// \param am the ∂(M d)/∂x block [kg/s]. \param c their factor.
   void xvm(int i, int j, const Matrix3<Scalar>& ax, const Matrix3<Scalar>& av,
            const Matrix3<Scalar>& am, Scalar c) {
     x(i, j, ax, c);
@@ -438,6 +469,11 @@ struct ForceJacobian {
 /// \param[in] x, v node positions and velocities 3×(N+1) \param[in] d vector of the mass term
 /// (3×(N+1)) \param[out] jac zeroed, then filled.
 /// \throws kelp::invalid_argument when the sizes do not fit the model.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \tparam DX an Eigen 3×(N+1) matrix type (positions).
+/// \tparam DV an Eigen 3×(N+1) matrix type (velocities).
+/// \tparam DD an Eigen 3×(N+1) matrix type (the mass term's vector).
 template <typename Scalar, typename Env, typename DX, typename DV, typename DD>
 void force_jacobian(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                     const Env& env, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v,

@@ -162,6 +162,12 @@ struct TetherParameters {
 /// μ the mass per length in air (MoorDyn v2, Line.cpp: the material damping c = −BA_in · L/N ·
 /// sqrt(E ρ) with E = EA/A and ρ = μ/A, times A). The segment's dashpot BA/l = ζ sqrt(EA μ) is
 /// then the same for any number of segments.
+/// \tparam Scalar double, float or an automatic-differentiation type.
+/// \param ratio the damping ratio ζ [-] (≥ 0).
+/// \param segment_length the unstretched segment length l = L/N [m].
+/// \param axial_stiffness EA [N].
+/// \param mass_per_length μ, mass per unit unstretched length in air [kg/m].
+/// \return BA [N s].
 template <typename Scalar>
 Scalar internal_damping_from_ratio(const Scalar& ratio, const Scalar& segment_length,
                                    const Scalar& axial_stiffness, const Scalar& mass_per_length) {
@@ -170,6 +176,8 @@ Scalar internal_damping_from_ratio(const Scalar& ratio, const Scalar& segment_le
 }
 
 /// \brief Checks tether parameters.
+/// \tparam Scalar double or float.
+/// \param p the parameters.
 /// \throws kelp::invalid_argument naming the offending field: segments in [1, 100000]; length,
 /// diameter, mass_per_length, axial_stiffness, friction_velocity finite and > 0; the rest finite
 /// and ≥ 0 (breaking_strength may be +∞); every magnitude at most its bound in
@@ -231,6 +239,8 @@ template <typename Scalar>
 class TetherModel {
  public:
   /// \brief Validates `p` (see validate(const TetherParameters&)) and precomputes constants.
+  /// \param p the parameters (copied; a damping ratio is converted to BA, and LineModel::moordyn
+  /// resolved, see parameters()).
   /// \throws kelp::invalid_argument naming the offending field.
   explicit TetherModel(const TetherParameters<Scalar>& p) : p_(p) {
     validate(p);
@@ -274,33 +284,50 @@ class TetherModel {
 
   /// \brief The parameters the model was built from, as the model uses them: with
   /// LineModel::moordyn, `compressive_damping` is true and `seabed_damping_depth` 0.
+  /// \return the model's copy; `internal_damping` holds BA [N s] and `internal_damping_ratio` 0.
   const TetherParameters<Scalar>& parameters() const { return p_; }
   /// \brief True when the forces carry the added-mass rate terms (see compute_forces): kelp's line
   /// model with Cat ≠ Can. False for LineModel::moordyn and whenever Cat = Can (the added mass is
   /// then isotropic and does not turn with the tangent).
+  /// \return whether compute_forces adds the rate terms.
   bool added_mass_rate_terms() const { return rate_terms_; }
   /// \brief True when the line can part: a breaking strength that is positive and finite.
+  /// \return whether part_if_overloaded() can part this line.
   bool can_part() const {
     return p_.breaking_strength > Scalar(0) && is_finite(p_.breaking_strength);
   }
   /// \brief Number of segments N.
+  /// \return N ≥ 1.
   int segments() const { return p_.segments; }
   /// \brief Number of nodes N + 1.
+  /// \return N + 1 ≥ 2 (the columns of a TetherState's position matrix).
   int nodes() const { return p_.segments + 1; }
   /// \brief Unstretched segment length l = L/N [m].
+  /// \return l [m].
   Scalar segment_length() const { return l_; }
   /// \brief 1/l [1/m].
+  /// \return 1/l [1/m].
   Scalar inverse_segment_length() const { return inv_l_; }
   /// \brief EA/l [N/m]: the axial spring constant of one segment.
+  /// \return EA/l [N/m].
   Scalar axial_spring() const { return ea_over_l_; }
   /// \brief BA/l [N s/m]: the axial damper constant of one segment.
+  /// \return BA/l [N s/m] (0 without internal damping).
   Scalar axial_damper() const { return ba_over_l_; }
   /// \brief Fraction of the rest length l below which kelp's line model fades its dashpot out:
   /// see dashpot_fade().
   static constexpr double kDashpotFadeFraction = 0.1;
   /// \brief Segment length l_f [m] below which the dashpot fades out (l/10 in kelp's line
   /// model; 0, no fade, in LineModel::moordyn): see dashpot_fade().
+  /// \return l_f [m].
   Scalar dashpot_fade_length() const { return fade_length_; }
+  /// \brief The value of dashpot_fade(): the dashpot's factor σ and its slope.
+  struct Fade {
+    /// \brief σ [-] in [0, 1], and dσ/dl_s [1/m].
+    ///@{
+    Scalar value, slope;
+    ///@}
+  };
   /// \brief The dashpot's factor σ(l_s) and its slope dσ/dl_s [1/m] for a segment of length
   /// l_s [m]: the damping tension is σ(l_s) BA·ε̇. σ = ρ²(3 − 2ρ), ρ = l_s/l_f, below l_f
   /// (a smoothstep: σ(0) = 0, σ(l_f) = 1, zero slope at both), 1 above it and without a fade.
@@ -318,9 +345,8 @@ class TetherModel {
   /// its material (the dashpot models the material's damping of a stretching cable); the fade
   /// changes nothing while every segment is longer than l/10 (MoorDyn's validation cases, a
   /// line in tension).
-  struct Fade {
-    Scalar value, slope;
-  };
+  /// \param ls the segment's stretched length l_s [m] (≥ 0).
+  /// \return σ(l_s) and dσ/dl_s; {1, 0} at or above l_f, and always without a fade.
   Fade dashpot_fade(Scalar ls) const {
     if (!(ls < fade_length_)) return {Scalar(1), Scalar(0)};
     const Scalar r = ls * inv_fade_length_;
@@ -328,24 +354,38 @@ class TetherModel {
             Scalar(6) * r * (Scalar(1) - r) * inv_fade_length_};
   }
   /// \brief 1/l_f [1/m] (0 without a fade).
+  /// \return 1/l_f [1/m].
   Scalar inverse_dashpot_fade_length() const { return inv_fade_length_; }
   /// \brief Cross-section area A = π d²/4 [m²].
+  /// \return A [m²].
   Scalar area() const { return area_; }
   /// \brief Structural mass of node i [kg] (μ times its share of length, plus the point mass of a
   /// free end).
+  /// \param i the node, 0 ≤ i ≤ N (not checked).
+  /// \return the node's mass [kg], without added mass.
   Scalar node_mass(int i) const { return node_mass_(i); }
   /// \brief Smallest structural node mass [kg]: a lower bound on every eigenvalue of every node
   /// mass matrix (added mass only adds to it).
+  /// \return min_i node_mass(i) [kg].
   Scalar min_node_mass() const { return min_node_mass_; }
   /// \brief Displaced volume of node i [m³] (A times its share of length).
+  /// \param i the node, 0 ≤ i ≤ N (not checked).
+  /// \return the volume [m³] (end point masses add none).
   Scalar node_volume(int i) const { return node_volume_(i); }
   /// \brief Length of line lumped at node i [m] (l, or l/2 at the ends).
+  /// \param i the node, 0 ≤ i ≤ N (not checked).
+  /// \return the unstretched length [m].
   Scalar node_length(int i) const { return node_length_(i); }
   /// \brief Index of the first node integrated (0 if the start end is free, else 1).
+  /// \return 0 or 1.
   int first_free_node() const { return first_free_; }
   /// \brief Index of the last node integrated (N if the far end is free, else N − 1).
+  /// \return N or N − 1.
   int last_free_node() const { return last_free_; }
   /// \brief Submerged weight per unit length w = (μ − ρA) g [N/m] (negative: buoyant line).
+  /// \param water_density ρ [kg/m³].
+  /// \param gravity g [m/s²].
+  /// \return w [N/m], per unit unstretched length.
   Scalar submerged_weight_per_length(Scalar water_density, Scalar gravity) const {
     return (p_.mass_per_length - water_density * area_) * gravity;
   }
@@ -359,11 +399,13 @@ class TetherModel {
   bool rate_terms_ = false;
 };
 
-/// \brief Double-precision aliases.
+/// \brief Double-precision parameters.
 using TetherParametersd = TetherParameters<double>;
+/// \brief Double-precision model.
 using TetherModeld = TetherModel<double>;
-/// \brief Single-precision aliases.
+/// \brief Single-precision parameters.
 using TetherParametersf = TetherParameters<float>;
+/// \brief Single-precision model.
 using TetherModelf = TetherModel<float>;
 
 }  // namespace kelp::tether

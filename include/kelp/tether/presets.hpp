@@ -36,6 +36,10 @@ namespace kelp::tether::presets {
 /// practical segment length.
 /// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m, a segment length not
 /// finite and > 0, or more than 100000 segments.
+/// \tparam Scalar double or float.
+/// \param length the unstretched length L [m], in (0, 1e5].
+/// \param max_segment_length the longest segment [m] (default 0.25 m): N = ⌈L / it⌉, at least 1.
+/// \return the parameters (not yet validated: TetherModel does that).
 template <typename Scalar>
 TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = Scalar(0.25)) {
   check_positive(length, "length");
@@ -76,6 +80,9 @@ TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = S
 /// line's own loads below 1e-6 (the joints' ±1.5 rad limits and 0.05 damping have no lumped-mass
 /// counterpart and are left out). `length` is rounded to whole beads (at least one segment).
 /// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m.
+/// \tparam Scalar double or float.
+/// \param length the wanted length [m], in (0, 1e5]; rounded to a multiple of 0.5 m.
+/// \return the parameters, with `length` the rounded one.
 template <typename Scalar>
 TetherParameters<Scalar> bead_chain(Scalar length) {
   check_positive(length, "length");

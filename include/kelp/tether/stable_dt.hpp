@@ -42,8 +42,9 @@ struct StableDtOptions {
   bool seabed_contact = false;
 };
 
-/// \brief Double- and single-precision aliases.
+/// \brief Double-precision options.
 using StableDtOptionsd = StableDtOptions<double>;
+/// \brief Single-precision options.
 using StableDtOptionsf = StableDtOptions<float>;
 
 namespace detail {
@@ -165,6 +166,9 @@ inline bool line_stable(Integrator integ, double h, const LinearisedLine& line) 
 /// \param[in] water_density ρ [kg/m³], checked only (kept for the callers of earlier versions,
 /// where it lowered the frequency by the tangential added mass).
 /// \throws kelp::invalid_argument for a water density ρ outside [0, 1e5] kg/m³ or NaN.
+/// \tparam Scalar double, float or ceres::Jet (computed on the value parts).
+/// \param[in] model the tether (EA, EI, l and the free nodes' structural masses).
+/// \return √(ω²_a + ω²_b) [rad/s], ≥ 0 (a value, no derivative parts for a Jet).
 template <typename Scalar>
 Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_density) {
   detail::check_water_density(water_density);
@@ -221,11 +225,14 @@ Scalar highest_axial_frequency(const TetherModel<Scalar>& model, Scalar water_de
 /// A line of one segment with a free end has one free node (two with both ends free) and a
 /// finite step like any other; a line of one segment between two kinematic ends has none and is
 /// refused (see below).
+/// \tparam Scalar double, float or ceres::Jet (computed on the value parts).
+/// \param[in] model the tether.
+/// \param[in] integrator the scheme the step is for.
 /// \param[in] options water density (drag), safety factor, speed bound, seabed contact.
 /// \return the step [s]; +infinity for the implicit schemes (unconditionally stable for the
 /// linearised line; choose dt for accuracy, e.g. 10 ms).
 /// \throws kelp::invalid_argument for ρ outside [0, 1e5] kg/m³ or NaN, a safety factor outside
-/// (0, 1], a negative or non-finite speed bound, an Integrator value outside the enumeration,
+/// (0, 1], a speed bound not finite in [0, 1e6] m/s, an Integrator value outside the enumeration,
 /// a line without a free node (one segment with both ends kinematic: nothing is integrated, so
 /// no step is limited by stability, whatever the scheme), or RK2 on a line without internal
 /// damping (BA = 0: its axial modes grow at every step; give the line internal damping, e.g.
@@ -281,6 +288,10 @@ Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrato
 /// speed, no seabed contact). \param[in] water_density ρ [kg/m³] for the drag (0: in air).
 /// \param[in] safety factor in (0, 1] on the stability limit.
 /// \throws as estimate_stable_dt(const TetherModel&, Integrator, const StableDtOptions&).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param[in] model the tether.
+/// \param[in] integrator the scheme the step is for.
+/// \return the step [s]; +infinity for the implicit schemes.
 template <typename Scalar>
 Scalar estimate_stable_dt(const TetherModel<Scalar>& model, Integrator integrator,
                           Scalar water_density = Scalar(kelp::seawater_density),

@@ -40,6 +40,7 @@ inline Eigen::Index newton_factor_size(int nodes) {
 /// It lives in the state because it determines the next step's iterates: saving and restoring a
 /// state restores it too, so a run is reproduced bit for bit. A state built from a model has it
 /// sized and empty (`gh` = 0: the next implicit step forms a new one).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct KeptNewtonMatrix {
   /// Factorisation (detail::factor_solve_block_tridiagonal's layout).
@@ -58,6 +59,8 @@ struct KeptNewtonMatrix {
   int backoff = 0;
 
   /// \brief True when a factorisation is kept and sized for `nodes` nodes.
+  /// \param nodes the tether's node count N + 1.
+  /// \return whether `gh` > 0 and both buffers have the sizes resize(nodes) gives them.
   bool holds(int nodes) const {
     return gh > Scalar(0) && factor.size() == detail::newton_factor_size(nodes) &&
            branch.size() == nodes - 1;
@@ -70,6 +73,7 @@ struct KeptNewtonMatrix {
     backoff = 0;
   }
   /// \brief Sizes the buffers for `nodes` nodes, nothing kept.
+  /// \param nodes the tether's node count N + 1, ≥ 2 (not checked here).
   void resize(int nodes) {
     factor.setZero(detail::newton_factor_size(nodes));
     branch.setZero(nodes - 1);
@@ -126,6 +130,8 @@ struct TetherState {
 
   TetherState() = default;
   /// \brief Zero state sized for `model`, no history.
+  /// \param model the tether (its node and segment counts); all nodes at the origin, at rest,
+  /// time 0, an intact line, no winch.
   explicit TetherState(const TetherModel<Scalar>& model)
       : position(Matrix3X<Scalar>::Zero(3, model.nodes())),
         velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
@@ -136,9 +142,11 @@ struct TetherState {
   }
 
   /// \brief Number of parted segments (0 for an intact line). O(N).
+  /// \return the count of nonzero flags in `parted`.
   int parted_segments() const { return parted.size() ? int(parted.template cast<int>().sum()) : 0; }
 
   /// \brief True when the state carries the previous step (BDF2 history).
+  /// \return whether previous_dt > 0.
   bool has_history() const { return previous_dt > 0.0; }
   /// \brief Forgets the integrator history: the next implicit step starts with backward Euler.
   /// Call it after editing `position` or `velocity` by hand. The kept Newton matrix is dropped
@@ -153,6 +161,7 @@ struct TetherState {
 ///
 /// Within a step of length h starting at t₀ the end is taken at p + v τ + ½ a τ², with velocity
 /// v + a τ (τ = t − t₀).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct EndMotion {
   /// Position at the start of the step, NED [m].
@@ -171,18 +180,26 @@ struct EndMotion {
   Vector3<Scalar> direction = Vector3<Scalar>::Zero();
 
   /// \brief Position τ seconds into the step.
+  /// \param tau time since the start of the step τ [s].
+  /// \return p + v τ + ½ a τ², NED [m].
   Vector3<Scalar> position_at(Scalar tau) const {
     return position + tau * velocity + (Scalar(0.5) * tau * tau) * acceleration;
   }
   /// \brief Velocity τ seconds into the step.
+  /// \param tau time since the start of the step τ [s].
+  /// \return v + a τ, NED [m/s].
   Vector3<Scalar> velocity_at(Scalar tau) const { return velocity + tau * acceleration; }
   /// \brief The same motion seen from τ seconds into the step (position and velocity at τ).
+  /// \param tau time since the start of the step τ [s].
+  /// \return the motion starting at position_at(τ) with velocity_at(τ); the same acceleration
+  /// and direction.
   EndMotion after(Scalar tau) const {
     return {position_at(tau), velocity_at(tau), acceleration, direction};
   }
 };
 
 /// \brief Prescribed motion of both ends (an entry is ignored when that end is free).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct TetherBoundary {
   /// Node 0 (start, e.g. the ASV attachment point).
@@ -191,8 +208,16 @@ struct TetherBoundary {
   EndMotion<Scalar> end;
 
   /// \brief The same end motions seen from τ seconds into the step (for sub-steps).
+  /// \param tau time since the start of the step τ [s].
+  /// \return both ends' EndMotion::after(τ).
   TetherBoundary after(Scalar tau) const { return {start.after(tau), end.after(tau)}; }
   /// \brief Both ends fixed at the given NED points [m].
+  /// \tparam D1 an Eigen 3-vector expression type.
+  /// \tparam D2 an Eigen 3-vector expression type.
+  /// \param start_ned node 0's position, NED [m].
+  /// \param end_ned node N's position, NED [m].
+  /// \return the boundary with zero velocities and accelerations, both ends pinned (no
+  /// direction); not checked for finiteness (see check_boundary()).
   template <typename D1, typename D2>
   static TetherBoundary fixed(const Eigen::MatrixBase<D1>& start_ned,
                               const Eigen::MatrixBase<D2>& end_ned) {
@@ -204,6 +229,7 @@ struct TetherBoundary {
 };
 
 /// \brief Forces the tether exerts on its two attachment points, NED [N] (zero for a free end).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct EndForces {
   /// On the start attachment point (node 0).
@@ -225,15 +251,27 @@ inline void check_node_count(int nodes, const char* who) {
 
 /// \brief A copy of a TetherState kept in preallocated buffers (no allocation when saved or
 /// restored once sized), so that a failed driver or step can put the state back bit for bit.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct StateBackup {
+  /// \brief Saved TetherState::position, velocity, previous_position, previous_velocity
+  /// (3 × (N+1), NED [m], [m/s]).
+  ///@{
   Matrix3X<Scalar> position, velocity, previous_position, previous_velocity;
+  ///@}
+  /// \brief Saved TetherState::time, time_carry, previous_dt [s].
+  ///@{
   double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
-  KeptNewtonMatrix<Scalar> newton;
-  SegmentFlags parted;
+  ///@}
+  KeptNewtonMatrix<Scalar> newton;  ///< saved TetherState::newton
+  SegmentFlags parted;              ///< saved TetherState::parted
+  /// \brief Saved TetherState::winch_length [m] and payout_rate [m/s].
+  ///@{
   Scalar winch_length = Scalar(0), payout_rate = Scalar(0);
+  ///@}
 
   /// \brief Sizes the buffers for `nodes` nodes.
+  /// \param nodes the tether's node count N + 1.
   /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1].
   void resize(int nodes) {
     detail::check_node_count(nodes, "StateBackup::resize");
@@ -243,6 +281,7 @@ struct StateBackup {
     parted.setZero(nodes - 1);
   }
   /// \brief Copies `s` (history and kept Newton matrix included).
+  /// \param s the state to save; no allocation when the buffers already have its sizes.
   void save(const TetherState<Scalar>& s) {
     position = s.position;
     velocity = s.velocity;
@@ -262,6 +301,7 @@ struct StateBackup {
     parted = s.parted;
   }
   /// \brief Puts the saved state back into `s`.
+  /// \param[out] s the state overwritten with the saved one (every field save() copied).
   void restore(TetherState<Scalar>& s) const {
     s.position = position;
     s.velocity = velocity;
@@ -287,6 +327,7 @@ struct StateBackup {
 /// Built from a model; every step reuses these buffers, so no heap allocation happens in a step.
 /// Fields are public so that tests and diagnostics can read intermediate quantities; their
 /// content is valid after the last force evaluation.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct TetherWorkspace {
   // --- per evaluation, per node -------------------------------------------------------------
@@ -343,10 +384,16 @@ struct TetherWorkspace {
   /// factor_whole_newton_matrix, its block LU factor: column 5i + (j − i + 2) holds the 3×3 block
   /// (i, j), |i − j| ≤ 2, column-major (assemble_whole_newton_matrix)
   Eigen::Matrix<Scalar, 9, Eigen::Dynamic> newton_lu;
-  /// A Newton factorisation formed in the current step (ImplicitOptions::newton = simplified),
-  /// swapped into TetherState::newton when the step is committed, and its segment branches
+  /// \brief A Newton factorisation formed in the current step (ImplicitOptions::newton =
+  /// simplified), swapped into TetherState::newton when the step is committed, and its segment
+  /// branches (as KeptNewtonMatrix::factor and branch).
+  ///@{
   VectorX<Scalar> newton_factor, newton_branch;
-  Matrix3X<Scalar> rhs, delta;    ///< Newton right-hand side and correction
+  ///@}
+  /// \brief Newton right-hand side (−R, forces [N]) and correction (velocity [m/s]).
+  ///@{
+  Matrix3X<Scalar> rhs, delta;
+  ///@}
   Matrix3X<Scalar> rhs_true;      ///< −R saved while the active-set passes modify rhs
   VectorX<Scalar> seg_true_k_uu;  ///< seg_k_uu saved while the active-set passes modify it
   VectorX<Scalar> seg_true_c_uu;  ///< seg_c_uu saved while the active-set passes modify it
@@ -357,23 +404,34 @@ struct TetherWorkspace {
   SegmentFlags parted;
   /// True when any entry of `parted` is set (the force passes then take their general path)
   bool any_parted = false;
-  /// Unit clamp directions of the start and far end (EndMotion::direction; zero: pinned) the
-  /// force evaluation uses, copied from the boundary by every step (detail::load_clamps); set
-  /// them the same way before calling compute_forces by hand on a clamped line
+  /// \brief Unit clamp directions of the start and far end (EndMotion::direction; zero:
+  /// pinned), NED, that the force evaluation uses, copied from the boundary by every step
+  /// (detail::load_clamps); set them the same way before calling compute_forces by hand on a
+  /// clamped line.
+  ///@{
   Vector3<Scalar> clamp_start = Vector3<Scalar>::Zero(), clamp_end = Vector3<Scalar>::Zero();
+  ///@}
   /// \brief True when segment s has parted (in the flags of the last detail::load_parted).
+  /// \param s the segment, 0 ≤ s < N (not checked).
+  /// \return whether `any_parted` and parted(s) is set.
   bool is_parted(int s) const { return any_parted && parted(s) != 0; }
   /// Branch of segment s in the Newton step's linear model: 0 no force (slack, or clamped at
   /// zero), 1 dashpot only (slack), 2 elastic plus dashpot (taut)
   VectorX<Scalar> seg_branch;
-  Matrix3X<Scalar> x0, v0, x1, v1, xs, vs;  ///< integrator stages and Newton/line-search iterates
+  /// \brief Integrator stages and Newton / line-search iterates: positions (x…, NED [m]) and
+  /// velocities (v…, NED [m/s]), 3 × (N+1) each.
+  ///@{
+  Matrix3X<Scalar> x0, v0, x1, v1, xs, vs;
+  ///@}
   /// compute_forces' scratch, one contiguous column per component: T_s u_s of each segment
   /// (columns 0–2), each node's force before the added-mass coupling to its neighbours (3–5),
   /// and that coupling term (6–8)
   Eigen::Matrix<Scalar, Eigen::Dynamic, 9> pass_buffer;
-  /// Copies of positions and velocities given to compute_forces as expressions rather than as
-  /// column-major storage
+  /// \brief Copies of positions and velocities given to compute_forces as expressions rather
+  /// than as column-major storage.
+  ///@{
   Matrix3X<Scalar> x_eval, v_eval;
+  ///@}
   /// State at entry of a driver (`advance`, `solve_static_equilibrium`), restored if it fails
   StateBackup<Scalar> entry_backup;
   /// State at entry of an implicit step that is retried in sub-steps, restored if they fail
@@ -409,12 +467,16 @@ struct TetherWorkspace {
   /// state, same objects, same winch length). Set it false to force a fresh evaluation, e.g.
   /// after changing a custom environment in place between two steps.
   bool end_evaluated = false;
-  double end_evaluation_time = 0.0;
-  const void* end_model = nullptr;
+  double end_evaluation_time = 0.0;  ///< time of the kept end evaluation [s] (end_evaluated)
+  const void* end_model = nullptr;   ///< address of the model it was made with (identity only)
+  /// Address of the environment it was made with (identity only, never dereferenced)
   const void* end_environment = nullptr;
-  std::uint64_t end_environment_id = 0;
-  Scalar end_winch_length = Scalar(0);
+  std::uint64_t end_environment_id = 0;  ///< that environment's instance id (0: none)
+  Scalar end_winch_length = Scalar(0);   ///< TetherWorkspace::winch_length it used [m]
+  /// \brief Positions (NED [m]) and velocities (NED [m/s]) of the kept end evaluation.
+  ///@{
   Matrix3X<Scalar> end_position, end_velocity;
+  ///@}
   /// Impulse the tether delivered to its attachment points over the last step (the step
   /// functions) or the last `advance` (summed over its sub-steps) [N s]: the end force weighted
   /// as the integrator weights the node forces in its momentum update (symplectic Euler h F(t),
@@ -429,11 +491,13 @@ struct TetherWorkspace {
 
   TetherWorkspace() = default;
   /// \brief Buffers sized for `model`.
+  /// \param model the tether the workspace serves (its node count only; no reference kept).
   explicit TetherWorkspace(const TetherModel<Scalar>& model) { resize(model.nodes()); }
 
   /// \brief (Re)allocates every buffer for `nodes` nodes (outside any step).
   /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1]
   /// (a tether has at least one segment; the buffers are left as they were).
+  /// \param nodes the node count N + 1 (TetherModel::nodes()).
   void resize(int nodes) {
     detail::check_node_count(nodes, "TetherWorkspace::resize");
     for_each_buffer(*this, nodes,
@@ -451,6 +515,8 @@ struct TetherWorkspace {
 
   /// \brief True when every buffer has the size resize(nodes) gives it (false for a
   /// default-constructed workspace, one built for another tether, or one edited by hand). O(1).
+  /// \param nodes the node count N + 1 to compare with.
+  /// \return whether the workspace can serve a tether of `nodes` nodes.
   bool fits(int nodes) const {
     bool ok = nodes >= 2;
     for_each_buffer(*this, nodes, [&ok](const auto& m, Eigen::Index rows, Eigen::Index cols) {
@@ -630,7 +696,11 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 
 /// \brief Checks that a state fits the model and is finite (its history too, when it has one).
 /// \throws kelp::invalid_argument naming `state.position` / `state.velocity` / `state.time` /
-/// `state.previous_position` / `state.previous_velocity` / `state.previous_dt`.
+/// `state.previous_position` / `state.previous_velocity` / `state.previous_dt` (or the
+/// sizes: segments + 1 columns, `state.parted` empty or one flag per segment).
+/// \tparam Scalar double or float.
+/// \param model the tether the state must fit.
+/// \param state the state checked (TetherState::winch_length and payout_rate are not).
 template <typename Scalar>
 void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
   KELP_CHECK(state.position.rows() == 3 && state.velocity.rows() == 3 &&
@@ -653,6 +723,9 @@ void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& st
 }
 
 /// \brief Checks that the boundary motion is finite.
+/// \tparam Scalar double or float.
+/// \param b the boundary: every position, velocity, acceleration and direction of both ends
+/// (also those of a free end, which the steps ignore).
 /// \throws kelp::invalid_argument naming the field.
 template <typename Scalar>
 void check_boundary(const TetherBoundary<Scalar>& b) {
@@ -667,6 +740,15 @@ void check_boundary(const TetherBoundary<Scalar>& b) {
 }
 
 /// \brief Straight-line state: nodes evenly spaced from `start_ned` to `end_ned`, at rest.
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam D1 an Eigen 3-vector expression type.
+/// \tparam D2 an Eigen 3-vector expression type.
+/// \param model the tether.
+/// \param start_ned node 0's position, NED [m].
+/// \param end_ned node N's position, NED [m] (any distance: the line may start stretched or
+/// slack).
+/// \return a state at time 0 without history, an intact line, no winch.
+/// \throws kelp::invalid_argument when either point is not finite.
 template <typename Scalar, typename D1, typename D2>
 TetherState<Scalar> straight_line_state(const TetherModel<Scalar>& model,
                                         const Eigen::MatrixBase<D1>& start_ned,
@@ -680,13 +762,17 @@ TetherState<Scalar> straight_line_state(const TetherModel<Scalar>& model,
   return s;
 }
 
-/// \brief Double-precision aliases.
+/// \brief Double-precision state.
 using TetherStated = TetherState<double>;
+/// \brief Double-precision workspace.
 using TetherWorkspaced = TetherWorkspace<double>;
+/// \brief Double-precision boundary.
 using TetherBoundaryd = TetherBoundary<double>;
-/// \brief Single-precision aliases.
+/// \brief Single-precision state.
 using TetherStatef = TetherState<float>;
+/// \brief Single-precision workspace.
 using TetherWorkspacef = TetherWorkspace<float>;
+/// \brief Single-precision boundary.
 using TetherBoundaryf = TetherBoundary<float>;
 
 }  // namespace kelp::tether

@@ -22,6 +22,7 @@
 namespace kelp::tether {
 
 /// \brief Settings of the static-equilibrium solve.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct StaticOptions {
   /// Converged when max_i |F_i| ≤ this [N]; ≤ 0 selects 1e-7 × the line's weight in air.
@@ -35,10 +36,13 @@ struct StaticOptions {
 };
 
 /// \brief Outcome of the static-equilibrium solve.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct StaticResult {
-  bool converged = false;       ///< residual below tolerance
-  int iterations = 0;           ///< Newton iterations used
+  bool converged = false;  ///< residual below tolerance
+  /// Pseudo steps attempted (each one implicit step solved by Newton; a step retried shorter
+  /// counts again)
+  int iterations = 0;
   Scalar residual = Scalar(0);  ///< final max_i |F_i| over free nodes [N]
 };
 
@@ -56,6 +60,18 @@ struct StaticResult {
 /// force_tolerance, an initial_pseudo_dt not finite and > 0, max_iterations < 1), before the
 /// state is touched; kelp::numerical_error if the iteration produces non-finite values (state
 /// unchanged).
+/// \tparam Scalar double or float (deduced from the model).
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace built for `model`; end_forces and end_node_forces hold the
+/// static end forces, NED [N], on return.
+/// \param[in] env the water, queried at the state's time.
+/// \param[in,out] state the starting shape; on return the last iterate, at rest, its history
+/// cleared, its time unchanged.
+/// \param[in] boundary the end positions, NED [m] (velocities and accelerations ignored: the ends
+/// are held still).
+/// \param[in] options tolerance, pseudo-step limit, first pseudo step.
+/// \return whether it converged, the pseudo steps taken and the final residual [N].
 template <typename Scalar, typename Env>
 [[nodiscard]] StaticResult<Scalar> solve_static_equilibrium(
     const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,

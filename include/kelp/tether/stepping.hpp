@@ -32,6 +32,8 @@ enum class Integrator {
 };
 
 /// \brief Name of an integrator ("symplectic_euler", "rk2", "rk4", "implicit_euler", "bdf2").
+/// \param i the scheme.
+/// \return its name, a string literal ("unknown" outside the enum).
 inline const char* integrator_name(Integrator i) {
   switch (i) {
     case Integrator::symplectic_euler:
@@ -49,12 +51,16 @@ inline const char* integrator_name(Integrator i) {
 }
 
 /// \brief True for a value of the enumeration (false for an out-of-range cast).
+/// \param i the value checked.
+/// \return whether `i` is one of the five schemes.
 inline bool is_valid(Integrator i) {
   return static_cast<int>(i) >= static_cast<int>(Integrator::symplectic_euler) &&
          static_cast<int>(i) <= static_cast<int>(Integrator::bdf2);
 }
 
 /// \brief True for the Newton-solved schemes.
+/// \param i the scheme.
+/// \return true for implicit_euler and bdf2.
 inline bool is_implicit(Integrator i) {
   return i == Integrator::implicit_euler || i == Integrator::bdf2;
 }
@@ -81,6 +87,8 @@ enum class JacobianKind {
 };
 
 /// \brief Name of a Jacobian kind ("symmetric", "whole", "adaptive").
+/// \param k the kind.
+/// \return its name, a string literal (any value outside the enum reads "adaptive").
 inline const char* jacobian_kind_name(JacobianKind k) {
   return k == JacobianKind::symmetric ? "symmetric"
                                       : (k == JacobianKind::whole ? "whole" : "adaptive");
@@ -100,11 +108,14 @@ enum class NewtonMethod {
 };
 
 /// \brief Name of a Newton method ("exact", "simplified").
+/// \param m the method.
+/// \return its name, a string literal (any value outside the enum reads "simplified").
 inline const char* newton_method_name(NewtonMethod m) {
   return m == NewtonMethod::exact ? "exact" : "simplified";
 }
 
 /// \brief Newton settings of the implicit schemes.
+/// \tparam Scalar double or float (the tolerances' type).
 template <typename Scalar>
 struct ImplicitOptions {
   /// Maximum Newton corrections per step (each: one solve with the Newton matrix, factored anew
@@ -183,6 +194,7 @@ struct ImplicitOptions {
 };
 
 /// \brief What one step (or one driver call) did.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct StepReport {
   /// Steps committed (1 unless an implicit step was retried in sub-steps, or a driver took
@@ -215,6 +227,8 @@ struct StepReport {
 
   /// \brief Adds another step's report: counts add up, the residual is the worst, the first
   /// parting is kept.
+  /// \param o the report added.
+  /// \return `*this`.
   StepReport& operator+=(const StepReport& o) {
     substeps += o.substeps;
     force_evaluations += o.force_evaluations;

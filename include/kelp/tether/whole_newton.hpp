@@ -68,6 +68,19 @@ struct NewtonMatrixSink {
 /// J = ∂R/∂v = M + γh ∂(M d)/∂x − γh ∂F/∂v − (γh)² ∂F/∂x, d = v − v̂, over the free nodes, into
 /// `ws.newton_lu` (block (i, j), |i − j| ≤ 2, at column 5i + j − i + 2; other columns zero).
 ///
+/// \tparam Scalar double or float.
+/// \tparam Env the environment type (kelp/tether/lumped_mass.hpp).
+/// \tparam DX an Eigen 3×(N+1) matrix type.
+/// \tparam DV an Eigen 3×(N+1) matrix type.
+/// \tparam DD an Eigen 3×(N+1) matrix type.
+/// \param[in] model the tether.
+/// \param[in,out] ws the workspace: reads the last compute_forces (masses, tangents, Jacobian
+/// ingredients), writes `newton_lu`.
+/// \param[in] env the water (its kinematics' derivatives at the nodes).
+/// \param[in] x the iterate's positions x̂ + γh v, NED [m], 3×(N+1).
+/// \param[in] v the iterate's velocities, NED [m/s], 3×(N+1).
+/// \param[in] d v − v̂, the velocity change from the predictor [m/s], 3×(N+1) (for ∂(M d)/∂x).
+/// \param[in] gh γh [s]: γ = 1 for backward Euler, 2/3 for BDF2, h the step.
 /// \param[in] branches when not null, the branch of every segment (TetherWorkspace::seg_branch
 /// values: 0, 1, 2) replaces the one compute_forces took (active set, whole_newton_direction).
 /// Preconditions: the last compute_forces of `ws` was at (x, v) with the water the step holds.
@@ -106,6 +119,10 @@ void assemble_whole_newton_matrix(const TetherModel<Scalar>& model, TetherWorksp
 /// positive definite, when the skew part is moderate). A pivot block that is not finite or
 /// numerically singular (|det U_ii| ≤ ε·‖U_ii‖³, ε of Scalar) is refused.
 /// \throws kelp::numerical_error naming the node; the implicit steps then halve the step.
+/// \tparam Scalar double or float.
+/// \param[in] model the tether (its free nodes).
+/// \param[in,out] ws the workspace whose `newton_lu` holds the assembled matrix; overwritten by
+/// its factor (also on a throw: re-assemble before using it again).
 template <typename Scalar>
 void factor_whole_newton_matrix(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws) {
   using std::abs;
@@ -145,6 +162,14 @@ void factor_whole_newton_matrix(const TetherModel<Scalar>& model, TetherWorkspac
 /// \brief Solves A δ = rhs with the factor of factor_whole_newton_matrix, over the free nodes:
 /// reads `rhs` (3×(N+1), free columns), writes the free columns of `delta` (may alias `rhs`).
 /// O(N), no heap allocation.
+/// \tparam Scalar double or float.
+/// \tparam DR an Eigen 3×(N+1) matrix type.
+/// \tparam DD a writable Eigen 3×(N+1) matrix type.
+/// \param[in] model the tether (its free nodes).
+/// \param[in] ws the workspace whose `newton_lu` holds the factor.
+/// \param[in] rhs the right-hand side (ws.rhs: −R, forces [N]), 3×(N+1).
+/// \param[out] delta the solution δ (velocity correction [m/s]) in its free columns; the
+/// kinematic end columns are not written.
 template <typename Scalar, typename DR, typename DD>
 void solve_whole_newton_matrix(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                                const Eigen::MatrixBase<DR>& rhs, Eigen::MatrixBase<DD>& delta) {

@@ -32,6 +32,7 @@ namespace kelp::tether {
 /// \brief A winch on the start end (node 0) of a tether (all magnitudes positive).
 ///
 /// Defaults: a small electric ROV tether winch (0.5 m/s line speed, 0.5 m/s², 400 N pull).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct WinchParameters {
   /// Shortest unstretched line the winch leaves out [m] (≥ one nominal segment).
@@ -59,6 +60,9 @@ struct WinchParameters {
 /// max_length ≥ min_length and ≤ limits::max_length; speeds, acceleration, pull finite and > 0;
 /// 0.1 ≤ remove_ratio < 1 < insert_ratio ≤ 3 and insert_ratio − remove_ratio ≥ 1 (so that
 /// after either re-mesh segment 0 lies inside the band and a re-mesh cannot undo itself at once).
+/// \tparam Scalar double or float.
+/// \param w the winch parameters.
+/// \param l the line's nominal segment length [m] (TetherParameters length / segments).
 template <typename Scalar>
 void validate(const WinchParameters<Scalar>& w, Scalar l) {
   check_positive(w.min_length, "winch.min_length");
@@ -82,6 +86,7 @@ void validate(const WinchParameters<Scalar>& w, Scalar l) {
 /// collision does; ≥ 0 when the ends are at rest), and the momentum [N s] they handed to each
 /// kinematic end (a removed node's share that goes to an end node whose velocity is
 /// prescribed: the vehicle carrying that end takes it).
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct RemeshReport {
   int inserted = 0;  ///< nodes inserted
@@ -93,6 +98,8 @@ struct RemeshReport {
   /// Momentum handed to the far end's body [N s] (NED).
   Vector3<Scalar> impulse_on_end = Vector3<Scalar>::Zero();
   /// \brief Accumulates another report.
+  /// \param o the report added (counts, energy and impulses summed).
+  /// \return `*this`.
   RemeshReport& operator+=(const RemeshReport& o) {
     inserted += o.inserted;
     removed += o.removed;
@@ -105,6 +112,11 @@ struct RemeshReport {
 
 /// \brief Structural mass of node i of `state` [kg] (TetherModel::node_mass with the winch
 /// segment's share).
+/// \tparam Scalar double or float.
+/// \param model the line model that fits `state` (its node count).
+/// \param state the state (its TetherState::winch_length; 0: no winch).
+/// \param i the node, 0 ≤ i ≤ N (not checked).
+/// \return m_i [kg], added mass excluded.
 template <typename Scalar>
 Scalar node_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& state, int i) {
   return model.node_mass(i) + model.parameters().mass_per_length *
@@ -112,6 +124,10 @@ Scalar node_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& st
 }
 
 /// \brief Unstretched length of the line [m]: (N − 1)·l + l_w with a winch, N·l without.
+/// \tparam Scalar double or float.
+/// \param model the line model that fits `state`.
+/// \param state the state (its TetherState::winch_length l_w; 0: no winch).
+/// \return the line out [m].
 template <typename Scalar>
 Scalar unstretched_length(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
   const Scalar l = model.segment_length();
@@ -120,6 +136,10 @@ Scalar unstretched_length(const TetherModel<Scalar>& model, const TetherState<Sc
 }
 
 /// \brief Structural mass of the line Σ m_i [kg] (point masses of free ends included).
+/// \tparam Scalar double or float.
+/// \param model the line model that fits `state`.
+/// \param state the state (its winch length).
+/// \return Σ m_i [kg], added mass excluded.
 template <typename Scalar>
 Scalar line_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
   Scalar m(0);
@@ -128,6 +148,10 @@ Scalar line_mass(const TetherModel<Scalar>& model, const TetherState<Scalar>& st
 }
 
 /// \brief Linear momentum of the line Σ m_i v_i [kg m/s] (structural masses, NED).
+/// \tparam Scalar double or float.
+/// \param model the line model that fits `state`.
+/// \param state the state (velocities NED [m/s], winch length).
+/// \return Σ m_i v_i, NED [kg m/s] (kinematic end nodes included).
 template <typename Scalar>
 Vector3<Scalar> line_momentum(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
   Vector3<Scalar> p = Vector3<Scalar>::Zero();
@@ -143,6 +167,15 @@ Vector3<Scalar> line_momentum(const TetherModel<Scalar>& model, const TetherStat
 /// v₁)/l_w: mass and momentum are conserved exactly, kinetic energy is lost (Jensen). The
 /// integrator history restarts (see docs/equations.md: the BDF2 choice). Parted flags follow
 /// their segments.
+/// \tparam Scalar double or float.
+/// \param from the model of N segments that fits `in`.
+/// \param in the state before (its winch_length, or l when 0, must exceed l).
+/// \param[out] out the state after, already sized for N + 1 segments (N + 2 columns): positions,
+/// velocities, clock, winch fields and parted flags are written, the history and the kept Newton
+/// matrix cleared (previous_position and previous_velocity keep their old content).
+/// \param[in,out] report counts the insertion and adds the kinetic energy lost [J].
+/// \throws kelp::invalid_argument when `out` has the wrong size or segment 0 is not longer
+/// than l (nothing written then).
 template <typename Scalar>
 void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar>& in,
                        TetherState<Scalar>& out, RemeshReport<Scalar>& report) {
@@ -195,6 +228,15 @@ void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
 /// the share of a kinematic node (node 0 always, node 2 when it is a kinematic far end), whose
 /// velocity is prescribed, goes to the body that carries it (report.impulse_on_start / _end).
 /// Mass and momentum (line plus those impulses) are conserved exactly. The history restarts.
+/// Node 0 is taken as kinematic (a winch sits on a body).
+/// \tparam Scalar double or float.
+/// \param from the model of N ≥ 2 segments that fits `in`.
+/// \param in the state before.
+/// \param[out] out the state after, already sized for N − 1 segments (N columns), written as by
+/// insert_winch_node().
+/// \param[in,out] report counts the removal, adds the kinetic energy lost [J] and the impulses
+/// handed to the ends, NED [N s].
+/// \throws kelp::invalid_argument when N < 2 or `out` has the wrong size (nothing written then).
 template <typename Scalar>
 void remove_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar>& in,
                        TetherState<Scalar>& out, RemeshReport<Scalar>& report) {
@@ -242,12 +284,16 @@ void remove_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
 /// \brief The winch and the line at every segment count it can reach: one TetherModel per
 /// count N in [min_segments, max_segments], all with the nominal segment length
 /// l = line.length / line.segments (the line's initial length and count). Built once; constant.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 class WinchModel {
  public:
   /// \throws kelp::invalid_argument naming the field (validate(TetherParameters),
   /// validate(WinchParameters)); the start end must be kinematic (the winch sits on a body), and
   /// the line's initial length must be within [min_length, max_length].
+  /// \param line the tether as it starts (its length and segment count set l and the initial
+  /// count; every other parameter is shared by all counts).
+  /// \param w the winch.
   WinchModel(const TetherParameters<Scalar>& line, const WinchParameters<Scalar>& w) : winch_(w) {
     validate(line);
     l_ = line.length / Scalar(line.segments);
@@ -273,15 +319,23 @@ class WinchModel {
     initial_n_ = line.segments;
   }
   /// \brief The winch's parameters.
+  /// \return the parameters given to the constructor.
   const WinchParameters<Scalar>& winch() const { return winch_; }
   /// \brief Nominal segment length l [m].
+  /// \return l [m], the same for every count.
   Scalar segment_length() const { return l_; }
-  /// \brief Fewest and most segments the line can have.
+  /// \brief Fewest segments the line can have (at min_length).
+  /// \return the smallest count N ≥ 1.
   int min_segments() const { return min_n_; }
+  /// \brief Most segments the line can have (at max_length).
+  /// \return the largest count N.
   int max_segments() const { return max_n_; }
   /// \brief Segment count of the line as built.
+  /// \return TetherParameters::segments of the constructor's line.
   int initial_segments() const { return initial_n_; }
   /// \brief The line with `segments` segments.
+  /// \param segments the count N, in [min_segments(), max_segments()].
+  /// \return its model (valid for the WinchModel's life).
   /// \throws kelp::invalid_argument outside [min_segments, max_segments].
   const TetherModel<Scalar>& line(int segments) const {
     KELP_CHECK(segments >= min_n_ && segments <= max_n_,
@@ -289,6 +343,9 @@ class WinchModel {
     return models_[std::size_t(segments - min_n_)];
   }
   /// \brief The line model that fits `state` (its column count).
+  /// \param state a state of the winch line.
+  /// \return line(columns − 1).
+  /// \throws kelp::invalid_argument when the state's count is outside the winch's range.
   const TetherModel<Scalar>& line_of(const TetherState<Scalar>& state) const {
     return line(int(state.position.cols()) - 1);
   }
@@ -304,7 +361,8 @@ class WinchModel {
 /// StateBackup per segment count of the WinchModel, built once (about 1.6 kB per node and count
 /// in double). The slot of the current count is lent out: its buffers are the caller's
 /// (kelp::system keeps them in SystemWorkspace::tether and SystemState::tether) and
-/// `lend`/`swap_count` move buffers by swapping, never by copying.
+/// `lend` and advance_winch() move buffers by swapping, never by copying.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct WinchWorkspace {
   std::vector<TetherWorkspace<Scalar>> line;  ///< workspace per segment count
@@ -314,6 +372,7 @@ struct WinchWorkspace {
 
   WinchWorkspace() = default;
   /// \brief Buffers for every count of `model`.
+  /// \param model the winch line (its range of counts; no reference kept).
   explicit WinchWorkspace(const WinchModel<Scalar>& model) : min_n(model.min_segments()) {
     const int k = model.max_segments() - model.min_segments() + 1;
     line.reserve(std::size_t(k));
@@ -326,6 +385,8 @@ struct WinchWorkspace {
     }
   }
   /// \brief Slot index of `segments`.
+  /// \param segments a count N ≥ min_n (not checked).
+  /// \return N − min_n, the index into `line`, `spare` and `backup`.
   std::size_t slot(int segments) const { return std::size_t(segments - min_n); }
 
   /// \brief Makes `ws` (the line buffers lent out, sized for the count last stepped) the
@@ -336,6 +397,10 @@ struct WinchWorkspace {
   /// buffers (at most one: the count lent before). Call it between steps.
   /// \throws kelp::invalid_argument when `segments` is outside the model's range or `ws` holds
   /// no count of it (nothing changed then).
+  /// \param model the winch line the workspace was built for.
+  /// \param[in,out] ws the line buffers lent out (sized for one of the model's counts); on
+  /// return sized for `segments`.
+  /// \param segments the count N of the state to be stepped next.
   void lend(const WinchModel<Scalar>& model, TetherWorkspace<Scalar>& ws, int segments) {
     KELP_CHECK(segments >= model.min_segments() && segments <= model.max_segments() &&
                    model.min_segments() == min_n &&
@@ -362,6 +427,14 @@ struct WinchWorkspace {
 /// `command`: at most max_acceleration·dt away, at most max_speed in magnitude, not reeling in
 /// while the pull at the winch is at least max_pull, and neither past max_length nor below
 /// min_length over the step from the unstretched length `length` [m].
+/// \tparam Scalar double or float.
+/// \param w the winch.
+/// \param rate the payout rate now [m/s] (positive: paying out).
+/// \param command the commanded payout rate [m/s].
+/// \param pull the pull at the winch [N] (winch_pull()).
+/// \param length the unstretched line out now [m].
+/// \param dt the step [s], > 0 (not checked).
+/// \return the payout rate over the step [m/s].
 template <typename Scalar>
 Scalar limited_payout_rate(const WinchParameters<Scalar>& w, Scalar rate, Scalar command,
                            Scalar pull, Scalar length, double dt) {
@@ -378,6 +451,11 @@ Scalar limited_payout_rate(const WinchParameters<Scalar>& w, Scalar rate, Scalar
 /// \brief A payout rate [m/s] that brings the unstretched length from `length` to `target` [m]
 /// as fast as the winch allows and stops there: ±√(2 a |e|), at most max_speed (the
 /// time-optimal profile under the acceleration limit; limited_payout_rate limits it further).
+/// \tparam Scalar double or float.
+/// \param w the winch (max_speed, max_acceleration).
+/// \param length the unstretched line out now [m].
+/// \param target the line out wanted [m].
+/// \return the payout rate [m/s], positive to pay out, 0 at the target.
 template <typename Scalar>
 Scalar payout_rate_for_length(const WinchParameters<Scalar>& w, Scalar length, Scalar target) {
   using std::abs;
@@ -389,6 +467,10 @@ Scalar payout_rate_for_length(const WinchParameters<Scalar>& w, Scalar length, S
 
 /// \brief Pull of the line at the winch [N]: the elastic tension of segment 0 in `state`,
 /// EA·max(0, |x₁ − x₀| − l_w)/l_w (from the state alone, so that a restored state reproduces it).
+/// \tparam Scalar double or float.
+/// \param model the line model that fits `state` (EA, l).
+/// \param state the state (nodes 0 and 1, winch_length; 0: l).
+/// \return the pull [N], ≥ 0 (no dashpot term).
 template <typename Scalar>
 Scalar winch_pull(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
   const Scalar lw = state.winch_length > Scalar(0) ? state.winch_length : model.segment_length();
@@ -422,6 +504,15 @@ void winch_switch(WinchWorkspace<Scalar>& w, TetherState<Scalar>& state,
 /// nodes 0 and 1, whose masses grow or shrink with it).
 /// \throws kelp::invalid_argument for a non-finite command or dt ≤ 0, or when the state does
 /// not fit the winch (nothing changed then).
+/// \tparam Scalar double or float.
+/// \param model the winch line.
+/// \param[in,out] w the winch's buffers (built for `model`).
+/// \param[in,out] state the line's state, of a count in the model's range; its winch_length
+/// (0 is read as l) and payout_rate are updated, and its buffers swapped on a re-mesh.
+/// \param[in,out] ws the line's workspace, sized for the state's count; swapped with it.
+/// \param command the commanded payout rate [m/s] (positive: pay out).
+/// \param dt the line's coming step [s], > 0.
+/// \return the re-meshes done (nodes inserted and removed, energy lost, impulses to the ends).
 template <typename Scalar>
 RemeshReport<Scalar> advance_winch(const WinchModel<Scalar>& model, WinchWorkspace<Scalar>& w,
                                    TetherState<Scalar>& state, TetherWorkspace<Scalar>& ws,
@@ -456,15 +547,21 @@ RemeshReport<Scalar> advance_winch(const WinchModel<Scalar>& model, WinchWorkspa
   return report;
 }
 
-/// \brief Double-precision aliases.
+/// \brief Double-precision winch parameters.
 using WinchParametersd = WinchParameters<double>;
+/// \brief Double-precision winch model.
 using WinchModeld = WinchModel<double>;
+/// \brief Double-precision winch buffers.
 using WinchWorkspaced = WinchWorkspace<double>;
+/// \brief Double-precision re-mesh report.
 using RemeshReportd = RemeshReport<double>;
-/// \brief Single-precision aliases.
+/// \brief Single-precision winch parameters.
 using WinchParametersf = WinchParameters<float>;
+/// \brief Single-precision winch model.
 using WinchModelf = WinchModel<float>;
+/// \brief Single-precision winch buffers.
 using WinchWorkspacef = WinchWorkspace<float>;
+/// \brief Single-precision re-mesh report.
 using RemeshReportf = RemeshReport<float>;
 
 }  // namespace kelp::tether

@@ -58,9 +58,16 @@ struct Winding {
 
 /// \brief The winding angle of the line with nodes `nodes` (3×n, NED [m], start end first) about
 /// the axis through `from` and `to` (see the file's definition). No allocation.
+/// \tparam Derived an Eigen matrix type of 3 rows (double or float), e.g. TetherState::position.
+/// \param[in] nodes the node positions, 3×n, NED [m], node 0 (the start end) first.
+/// \param[in] from a point on the axis, NED [m] (e.g. the foot of a pile).
+/// \param[in] to another point on the axis, NED [m]; the angles are right-handed about
+/// from → to.
 /// \param[in] blend_radius b [m] (> 0): the distance from the axis within which the chord's
 /// angle is faded out (the obstacle's radius, or its radius plus the tether's).
 /// \throws kelp::invalid_argument for non-finite input, from == to, or b ≤ 0.
+/// \return the winding W and its parts S, C [rad] and d_c [m] (all 0 with fewer than two nodes
+/// off the axis).
 template <typename Derived>
 Winding winding_angle(const Eigen::MatrixBase<Derived>& nodes, const Vector3<double>& from,
                       const Vector3<double>& to, double blend_radius) {
