@@ -330,6 +330,7 @@ struct PwmMapping {
 
 /// \brief Throws kelp::invalid_argument naming the field unless min < neutral < max and
 /// 0 ≤ deadband < min(max − neutral, neutral − min).
+/// \param m PWM mapping [µs] (all values finite).
 template <typename Scalar>
 void validate(const PwmMapping<Scalar>& m) {
   check_finite(m.min_us, "min_us");
