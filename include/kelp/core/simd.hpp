@@ -193,6 +193,8 @@ Pack<Scalar, Wide> select(Mask<Scalar, Wide> k, Pack<Scalar, Wide> a, Pack<Scala
 }
 
 /// \brief Lane-wise logical and.
+/// \param a, b Masks of the same pack type.
+/// \return A mask true in the lanes where both are true.
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> operator&&(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
@@ -210,6 +212,8 @@ Mask<Scalar, Wide> less(Pack<Scalar, Wide> a, Pack<Scalar, Wide> b) {
 }
 
 /// \brief Lane-wise logical or.
+/// \param a, b Masks of the same pack type.
+/// \return A mask true in the lanes where either is true.
 template <typename Scalar, bool Wide>
 Mask<Scalar, Wide> operator||(Mask<Scalar, Wide> a, Mask<Scalar, Wide> b) {
   Mask<Scalar, Wide> k;
