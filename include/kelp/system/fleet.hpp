@@ -520,8 +520,10 @@ struct FleetWorkspace {
   FleetReport<Scalar> report;                               ///< the last step's report
   // The step's scratch: inputs after propulsion, a failed step's restore copies, the tether
   // forces on each vehicle and point mass.
-  std::vector<vehicle::VehicleInputs<Scalar>> inputs;  ///< per vehicle: inputs after propulsion
-  /// Per vehicle: its propulsion state at the start of the step (restored after a throw).
+  /// Per vehicle: the step's inputs, the propulsion's mean wrench added to τ [N, N m] (body).
+  std::vector<vehicle::VehicleInputs<Scalar>> inputs;
+  /// Per vehicle: a copy of its propulsion state advanced over the step, committed to the state
+  /// only when the whole step succeeds.
   std::vector<vehicle::PropulsionState<Scalar>> propulsion;
   /// Per vehicle: its state at the start of the step (restored after a throw).
   std::vector<vehicle::VehicleState<Scalar>> vehicles_before;
