@@ -33,6 +33,8 @@ namespace environment {
 /// (Fossen 2021, §8.3, 3-D irrotational current). With α_c = 0 the current is horizontal and
 /// flows towards the azimuth β_c. \param[in] speed V_c [m/s] \param[in] alpha α_c [rad]
 /// \param[in] beta β_c [rad]
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return v_c^n, NED [m/s].
 /// \throws kelp::invalid_argument when V_c, α_c or β_c is not finite.
 template <typename Scalar>
 Vector3<Scalar> current_velocity_ned(const Scalar& speed, const Scalar& alpha, const Scalar& beta) {
@@ -64,6 +66,9 @@ struct CurrentProfile {
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the bad field of a profile.
+/// \param p Profile to check: depth finite > 0 unless uniform, exponent finite > 0,
+/// bottom_ratio finite ≥ 0.
+/// \throws kelp::invalid_argument naming the bad field.
 inline void validate(const CurrentProfile& p) {
   if (p.kind != CurrentProfileKind::uniform) check_positive(p.depth, "profile.depth");
   check_positive(p.exponent, "profile.exponent");
@@ -92,6 +97,8 @@ Scalar profile_factor_unchecked(const CurrentProfile& p, const Scalar& z) {
 /// \brief Profile factor f(z) ∈ [0, 1] at NED depth z [m]: 1 above the surface (z ≤ 0),
 /// the profile in between, and its seabed value at and below z = h (z = ±∞ give those limits).
 /// \param[in] p a validated profile. \param[in] z NED depth [m], not NaN.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return f(z) [-]: 1 for a uniform profile; 0 (power law) or r (linear) at the seabed.
 /// \throws kelp::invalid_argument when z is NaN (it has no depth, so no factor in [0, 1]).
 template <typename Scalar>
 Scalar profile_factor(const CurrentProfile& p, const Scalar& z) {
@@ -128,6 +135,7 @@ struct CurrentParameters {
 };
 
 /// \brief Throws `kelp::invalid_argument` naming the bad field of `p`.
+/// \param p Current parameters to check.
 /// \throws kelp::invalid_argument when the speed is not in [0, 50] m/s
 /// (`limits::max_current_speed`), a direction or angle is not finite, the profile is invalid, a
 /// variation's time constant is not finite and > 0, its σ is negative or not finite, its bounds
@@ -183,6 +191,8 @@ class CurrentModel {
   CurrentModel() = default;
 
   /// \brief Builds the current and draws its harmonics.
+  /// \param p Current parameters (copied); the harmonics are drawn from p.seed only when a
+  /// variation's σ > 0.
   /// \throws kelp::invalid_argument naming the bad field (see `validate(const
   /// CurrentParameters&)`), or naming a variation's σ and time constant with their values when
   /// its amplitude or a frequency is not finite (e.g. σ = 1e300).
@@ -198,6 +208,9 @@ class CurrentModel {
   /// \brief A constant current of the given NED velocity [m/s], uniform in depth.
   /// \throws kelp::invalid_argument naming `current` when not finite or not 3 entries, or
   /// naming the speed when |v| > 50 m/s.
+  /// \tparam Derived Any Eigen vector expression with 3 entries.
+  /// \param v_ned Current velocity, NED [m/s] (a vertical component gives α_c ≠ 0).
+  /// \return A current without variation whose velocity is v_ned at every depth and time.
   template <typename Derived>
   static CurrentModel constant(const Eigen::MatrixBase<Derived>& v_ned) {
     KELP_CHECK(v_ned.size() == 3, "current must have 3 entries (NED)");
@@ -215,22 +228,31 @@ class CurrentModel {
   }
 
   /// \brief The parameters the current was built from.
+  /// \return The parameters (default ones for the default-constructed, zero current).
   const CurrentParameters& parameters() const { return params_; }
   /// \brief True when the current is zero everywhere and always.
+  /// \return True when the nominal speed is 0 and neither speed nor direction varies.
   bool is_zero() const { return params_.speed == 0.0 && !varying_; }
 
   /// \brief Surface speed V_c(t) [m/s] at time t [s].
+  /// \param t Time [s].
+  /// \return V_c(t) [m/s], within the speed variation's bounds.
   /// \throws kelp::invalid_argument when the current varies and t is not finite.
   double speed_at(double t) const {
     return varying_ ? speed_.value(t, params_.speed, params_.speed_variation) : params_.speed;
   }
   /// \brief Direction β_c(t) [rad] at time t [s].
+  /// \param t Time [s].
+  /// \return β_c(t) [rad], NED azimuth the current flows towards (not wrapped), within the
+  /// direction variation's bounds.
   /// \throws kelp::invalid_argument when the current varies and t is not finite.
   double direction_at(double t) const {
     return varying_ ? direction_.value(t, params_.direction, params_.direction_variation)
                     : params_.direction;
   }
   /// \brief Current velocity at the surface, NED [m/s], at time t [s].
+  /// \param t Time [s].
+  /// \return current_velocity_ned(V_c(t), α_c, β_c(t)) [m/s].
   /// \throws kelp::invalid_argument when the current varies and t is not finite.
   Vector3<Scalar> surface_velocity(double t) const {
     return current_velocity_ned(Scalar(speed_at(t)), Scalar(params_.vertical_angle),
@@ -244,6 +266,10 @@ class CurrentModel {
   /// finite. The samplers of the steps (Environment::sample_water, sample_unchecked) apply the
   /// profile without this check: there a NaN node gives NaN, which the step reports as
   /// numerical_error with the state unchanged.
+  /// \tparam Derived Any Eigen vector expression with 3 entries.
+  /// \param p Point, NED [m] (only its depth z = p(2) matters).
+  /// \param t Time [s].
+  /// \return Current velocity, NED [m/s].
   template <typename Derived>
   Vector3<Scalar> velocity(const Eigen::MatrixBase<Derived>& p, double t) const {
     KELP_CHECK(p.size() == 3, "CurrentModel::velocity: p must have 3 entries");

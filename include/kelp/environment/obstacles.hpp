@@ -52,6 +52,8 @@ struct ContactProperties {
 };
 
 /// \brief Checks contact properties; `where` names the obstacle in the message.
+/// \param c Contact law to check.
+/// \param where Name of the obstacle, prefixed to the message (e.g. "cylinder 'pile'").
 /// \throws kelp::invalid_argument: stiffness finite > 0, damping, friction, damping_depth finite
 /// ≥ 0, friction_velocity finite > 0, each at most 1e13 (friction at most 100).
 inline void validate(const ContactProperties& c, const std::string& where) {
@@ -93,6 +95,7 @@ struct Box {
   ContactProperties contact;                                      ///< its contact law
 
   /// \brief Rotation from the box's axes to NED.
+  /// \return R = Rz(yaw) Ry(pitch) Rx(roll), mapping a vector in the box's axes to NED.
   Eigen::Matrix3d rotation() const {
     return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
             Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
@@ -115,10 +118,14 @@ struct HeightField {
   std::vector<double> depth;  ///< rows × cols, row-major (row i = north index) [m]
 
   /// \brief Depth of node (i, j) [m].
+  /// \param i North index, 0 ≤ i < rows (not checked).
+  /// \param j East index, 0 ≤ j < cols (not checked).
+  /// \return The seabed's NED z at the node [m] (positive down).
   double at(int i, int j) const {
     return depth[std::size_t(i) * std::size_t(cols) + std::size_t(j)];
   }
   /// \brief Shallowest and deepest node [m].
+  /// \return (least, greatest) depth over the nodes [m]; `depth` must not be empty.
   std::pair<double, double> depth_range() const {
     const auto mm = std::minmax_element(depth.begin(), depth.end());
     return {*mm.first, *mm.second};
@@ -127,6 +134,7 @@ struct HeightField {
 
 /// \brief Checks a height field: rows, cols ≥ 2, rows·cols depths, all finite (depths > 0 are
 /// not required: a shoal may rise above the mean sea level), spacing finite > 0, origin finite.
+/// \param h Height field to check (also: at most 1e8 nodes, |depth| ≤ 1e5 m).
 /// \throws kelp::invalid_argument naming the field.
 inline void validate(const HeightField& h) {
   KELP_CHECK(h.rows >= 2 && h.cols >= 2, "heightfield: rows and cols must be >= 2");
@@ -165,10 +173,20 @@ struct Proximity {
 /// minimisation of |p(s) − q(t)|² over the unit square: the interior stationary point when the
 /// segments are not parallel, else the edges (Ericson, Real-Time Collision Detection, 2005,
 /// §5.1.9, gives the same case analysis).
+/// \tparam Scalar double, float or an automatic-differentiation type.
 template <typename Scalar>
 struct SegmentPair {
-  Scalar s, t, distance2;
+  Scalar s,       ///< parameter of the closest point on p: p0 + s (p1 − p0), in [0, 1]
+      t,          ///< parameter of the closest point on q: q0 + t (q1 − q0), in [0, 1]
+      distance2;  ///< squared distance between the two closest points [m²]
 };
+/// \brief Closest points of two segments p0→p1 and q0→q1 (see SegmentPair).
+/// \tparam Scalar double, float or an automatic-differentiation type.
+/// \param p0 Start of the first segment [m].
+/// \param p1 End of the first segment [m] (equal to p0: a point).
+/// \param q0 Start of the second segment [m].
+/// \param q1 End of the second segment [m] (equal to q0: a point).
+/// \return s, t and the squared distance; parallel segments give s = 0 when that is a minimum.
 template <typename Scalar>
 SegmentPair<Scalar> closest_segment_segment(const Vector3<Scalar>& p0, const Vector3<Scalar>& p1,
                                             const Vector3<Scalar>& q0, const Vector3<Scalar>& q1) {
@@ -210,6 +228,12 @@ SegmentPair<Scalar> closest_segment_segment(const Vector3<Scalar>& p0, const Vec
 /// surface, the closest point on the segment (t) and on the axis, the normal from the axis.
 /// When the segment crosses the axis the normal is any unit vector perpendicular to the axis
 /// (the contact force then cannot be resolved: keep penetrations below the radius).
+/// \tparam Scalar Scalar of the query (double or float).
+/// \param a Start of the segment, NED [m].
+/// \param b End of the segment, NED [m] (equal to a: a point).
+/// \param c The cylinder.
+/// \return Proximity: distance negative inside the capsule; on_obstacle is the closest point on
+/// the axis (not on the surface).
 template <typename Scalar>
 Proximity<Scalar> segment_capsule(const Vector3<Scalar>& a, const Vector3<Scalar>& b,
                                   const Cylinder& c) {
@@ -236,6 +260,10 @@ Proximity<Scalar> segment_capsule(const Vector3<Scalar>& a, const Vector3<Scalar
 }
 
 /// \brief Point p against a cylinder taken as a capsule (see segment_capsule).
+/// \tparam Scalar Scalar of the query (double or float).
+/// \param p The point, NED [m].
+/// \param c The cylinder.
+/// \return Proximity with t = 0 and on_query = p.
 template <typename Scalar>
 Proximity<Scalar> point_capsule(const Vector3<Scalar>& p, const Cylinder& c) {
   return segment_capsule<Scalar>(p, p, c);
@@ -283,6 +311,11 @@ Scalar box_local(const Vector3<Scalar>& l, const Vector3<Scalar>& h, Vector3<Sca
 
 /// \brief Point p against a box: signed distance, closest surface point, outward normal
 /// (inside: towards the nearest face).
+/// \tparam Scalar Scalar of the query (double or float).
+/// \param p The point, NED [m].
+/// \param box The box (sharp edges: no rounding).
+/// \return Proximity with t = 0, on_query = p, on_obstacle on the box's surface [m] and the
+/// normal in NED.
 template <typename Scalar>
 Proximity<Scalar> point_box(const Vector3<Scalar>& p, const Box& box) {
   const Matrix3<Scalar> R = box.rotation().cast<Scalar>();
@@ -309,6 +342,13 @@ Proximity<Scalar> point_box(const Vector3<Scalar>& p, const Box& box) {
 /// With `rounding` r > 0 the box's edges and corners are rounded by r (the distance to the box
 /// shrunk by r on every side, less r): the same faces, but a normal that turns continuously
 /// round an edge, also for a segment a little inside (up to r deep), which a contact law needs.
+/// \tparam Scalar Scalar of the query (double or float).
+/// \param a Start of the segment, NED [m].
+/// \param b End of the segment, NED [m] (equal to a: a point).
+/// \param box The box.
+/// \param rounding Edge rounding r [m], 0 ≤ r < least half extent (ObstacleSet::box_rounding
+/// gives the one contact uses); 0: sharp edges.
+/// \return Proximity of the point of the segment with the least signed distance, less r.
 template <typename Scalar>
 Proximity<Scalar> segment_box(const Vector3<Scalar>& a, const Vector3<Scalar>& b, const Box& box,
                               double rounding = 0.0) {
@@ -393,12 +433,20 @@ Proximity<Scalar> segment_box(const Vector3<Scalar>& a, const Vector3<Scalar>& b
 /// ∂h/∂east and the unit normal pointing up into the water, (h_n, h_e, −1)/√(1 + h_n² + h_e²).
 /// Bilinear in the cell that holds the point; the edge depth outside the grid (slope 0 across
 /// the edge).
+/// \tparam Scalar double, float or an automatic-differentiation type.
 template <typename Scalar>
 struct SeabedSample {
-  Scalar depth;
-  Scalar slope_north, slope_east;
-  Vector3<Scalar> normal;
+  Scalar depth;            ///< seabed depth h, NED z [m] (positive down)
+  Scalar slope_north,      ///< ∂h/∂north [-]
+      slope_east;          ///< ∂h/∂east [-]
+  Vector3<Scalar> normal;  ///< unit normal, NED, pointing up into the water (z < 0)
 };
+/// \brief Samples a height-field seabed at a horizontal point (see SeabedSample).
+/// \tparam Scalar double, float or an automatic-differentiation type.
+/// \param hf The height field (valid: see validate(const HeightField&)).
+/// \param north North coordinate of the point [m].
+/// \param east East coordinate of the point [m].
+/// \return Depth, slopes and normal there (bilinear; edge depth and zero slope outside the grid).
 template <typename Scalar>
 SeabedSample<Scalar> sample_heightfield(const HeightField& hf, const Scalar& north,
                                         const Scalar& east) {
@@ -431,6 +479,10 @@ SeabedSample<Scalar> sample_heightfield(const HeightField& hf, const Scalar& nor
 /// \brief Point p against a height-field seabed: signed distance measured along the local
 /// normal, (h − z)/√(1 + |∇h|²) (positive above the seabed, the first-order distance to the
 /// local plane), the point straight below or above on the seabed, and the normal up into the water.
+/// \tparam Scalar Scalar of the query (double or float).
+/// \param p The point, NED [m].
+/// \param hf The height field.
+/// \return Proximity with t = 0, on_query = p, on_obstacle = (p.x, p.y, h).
 template <typename Scalar>
 Proximity<Scalar> point_heightfield(const Vector3<Scalar>& p, const HeightField& hf) {
   const SeabedSample<Scalar> s = sample_heightfield<Scalar>(hf, p.x(), p.y());
@@ -444,16 +496,24 @@ Proximity<Scalar> point_heightfield(const Vector3<Scalar>& p, const HeightField&
 
 /// \brief Which obstacle of an ObstacleSet: a cylinder or a box, by index.
 struct ObstacleRef {
-  enum Kind : std::uint8_t { cylinder = 0, box = 1 };
-  Kind kind;
-  int index;
+  /// \brief The kind of obstacle referred to.
+  enum Kind : std::uint8_t {
+    cylinder = 0,  ///< an entry of ObstacleSet::cylinders()
+    box = 1        ///< an entry of ObstacleSet::boxes()
+  };
+  Kind kind;  ///< cylinder or box
+  int index;  ///< index in ObstacleSet::cylinders() or ObstacleSet::boxes(), by kind
 };
 
 /// \brief Axis-aligned bounding box (NED [m]).
 struct Aabb {
+  /// Least corner, NED [m] (+∞: the empty box).
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  /// Greatest corner, NED [m] (−∞: the empty box).
   Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
   /// \brief True when the two boxes overlap (touching counts).
+  /// \param o The other box.
+  /// \return True when the boxes share a point on every axis (never for an empty box).
   bool overlaps(const Aabb& o) const {
     return lo.x() <= o.hi.x() && o.lo.x() <= hi.x() && lo.y() <= o.hi.y() && o.lo.y() <= hi.y() &&
            lo.z() <= o.hi.z() && o.lo.z() <= hi.z();
@@ -471,8 +531,11 @@ struct Aabb {
 /// far ones. Built when obstacles are added (allocates); queries allocate nothing.
 class ObstacleSet {
  public:
-  /// \brief Adds a cylinder. \throws kelp::invalid_argument (ends finite and distinct, radius
-  /// finite > 0, contact properties valid; names the cylinder).
+  /// \brief Adds a cylinder and rebuilds the broad phase (allocates).
+  /// \param c The cylinder (copied).
+  /// \return *this, for chaining.
+  /// \throws kelp::invalid_argument (ends finite and distinct, radius finite in (0, 1e4] m,
+  /// contact properties valid; names the cylinder).
   ObstacleSet& add(const Cylinder& c) {
     const std::string where = "cylinder '" + c.name + "'";
     KELP_CHECK(c.from.allFinite() && c.to.allFinite(), where + ": from and to must be finite");
@@ -484,8 +547,11 @@ class ObstacleSet {
     rebuild();
     return *this;
   }
-  /// \brief Adds a box. \throws kelp::invalid_argument (centre and angles finite, half extents
-  /// finite > 0, contact properties valid; names the box).
+  /// \brief Adds a box and rebuilds the broad phase (allocates).
+  /// \param b The box (copied).
+  /// \return *this, for chaining.
+  /// \throws kelp::invalid_argument (centre and angles finite, half extents finite in
+  /// (0, 1e5] m, contact properties valid; names the box).
   ObstacleSet& add(const Box& b) {
     const std::string where = "box '" + b.name + "'";
     KELP_CHECK(b.center.allFinite(), where + ": center must be finite");
@@ -499,7 +565,10 @@ class ObstacleSet {
     rebuild();
     return *this;
   }
-  /// \brief Sets the height-field seabed. \throws kelp::invalid_argument (see validate).
+  /// \brief Sets (replaces) the height-field seabed.
+  /// \param h The height field (copied).
+  /// \return *this, for chaining.
+  /// \throws kelp::invalid_argument (see validate(const HeightField&)).
   ObstacleSet& set_seabed(const HeightField& h) {
     validate(h);
     seabed_ = h;
@@ -514,29 +583,44 @@ class ObstacleSet {
     has_seabed_ = false;
   }
 
+  /// \brief The cylinders.
+  /// \return The cylinders in the order added (the index is ObstacleRef::index).
   const std::vector<Cylinder>& cylinders() const { return cylinders_; }
+  /// \brief The boxes.
+  /// \return The boxes in the order added (the index is ObstacleRef::index).
   const std::vector<Box>& boxes() const { return boxes_; }
   /// \brief The height-field seabed, or null.
+  /// \return A pointer valid until the seabed is set or cleared, or nullptr without one.
   const HeightField* seabed() const { return has_seabed_ ? &seabed_ : nullptr; }
   /// \brief Shallowest depth of the height field [m] (+∞ without one): a point above it cannot
   /// touch the seabed.
+  /// \return The least node depth [m], or +∞.
   double seabed_shallowest() const {
     return has_seabed_ ? seabed_shallowest_ : std::numeric_limits<double>::infinity();
   }
   /// \brief Number of cylinders and boxes.
+  /// \return cylinders().size() + boxes().size() (the height field is not counted).
   int size() const { return int(cylinders_.size() + boxes_.size()); }
   /// \brief True when there are no cylinders, no boxes and no height field.
+  /// \return True when nothing can be touched.
   bool empty() const { return size() == 0 && !has_seabed_; }
   /// \brief Bounding box of all cylinders and boxes (empty box when none).
+  /// \return The union of the obstacles' boxes, NED [m] (the height field is not included).
   const Aabb& bounds() const { return bounds_; }
   /// \brief Bounding box of one obstacle.
+  /// \param r The obstacle (index in range, not checked).
+  /// \return Its axis-aligned box, NED [m] (a cylinder's includes its radius).
   const Aabb& bounds(ObstacleRef r) const { return aabb_[std::size_t(flat(r))]; }
   /// \brief Contact law of one obstacle.
+  /// \param r The obstacle (index in range, not checked).
+  /// \return Its contact properties.
   const ContactProperties& contact(ObstacleRef r) const {
     return r.kind == ObstacleRef::cylinder ? cylinders_[std::size_t(r.index)].contact
                                            : boxes_[std::size_t(r.index)].contact;
   }
   /// \brief Name of one obstacle.
+  /// \param r The obstacle (index in range, not checked).
+  /// \return Its name (may be empty).
   const std::string& name(ObstacleRef r) const {
     return r.kind == ObstacleRef::cylinder ? cylinders_[std::size_t(r.index)].name
                                            : boxes_[std::size_t(r.index)].name;
@@ -544,6 +628,9 @@ class ObstacleSet {
 
   /// \brief Calls `visit(ObstacleRef)` once for every cylinder or box whose bounding box
   /// overlaps `q` (broad phase; the caller then asks for the exact proximity). No allocation.
+  /// \tparam Visit A callable taking an ObstacleRef.
+  /// \param q Query box, NED [m].
+  /// \param visit Called once per obstacle near `q`, in no particular order.
   template <typename Visit>
   void for_each_near(const Aabb& q, Visit&& visit) const {
     if (aabb_.empty() || !bounds_.overlaps(q)) return;
@@ -566,6 +653,11 @@ class ObstacleSet {
 
   /// \brief Proximity of the segment a→b (a point when a = b) to one obstacle, as contact sees
   /// it: a cylinder as a capsule, a box with its edges rounded by box_rounding().
+  /// \tparam Scalar Scalar of the query (double or float).
+  /// \param r The obstacle (index in range, not checked).
+  /// \param a Start of the segment, NED [m].
+  /// \param b End of the segment, NED [m].
+  /// \return See segment_capsule and segment_box.
   template <typename Scalar>
   Proximity<Scalar> proximity(ObstacleRef r, const Vector3<Scalar>& a,
                               const Vector3<Scalar>& b) const {
@@ -578,6 +670,8 @@ class ObstacleSet {
   /// A sharp edge turns the contact normal abruptly from one face to the next as a line slides
   /// over it, a force that jumps and that Newton's method cannot converge on; rounded, the normal
   /// turns over the rounding as the line wraps the edge.
+  /// \param box The box.
+  /// \return The rounding radius [m].
   static double box_rounding(const Box& box) {
     return std::min(0.05, 0.25 * box.half_extents.minCoeff());
   }

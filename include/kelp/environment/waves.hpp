@@ -75,6 +75,10 @@ struct RegularWave {
 
 /// \brief Wave number k [rad/m] of a regular wave in water of depth h (+∞: deep) and gravity g:
 /// 2π/λ, or the root of the dispersion relation for ω = 2π/T (`wave_number`).
+/// \param w The wave (wavelength > 0, else period > 0 is used; not checked: see validate).
+/// \param g Gravitational acceleration [m/s²].
+/// \param depth Water depth h [m] (+∞: deep water).
+/// \return k [rad/m].
 inline double regular_wave_number(const RegularWave& w, double g, double depth) {
   if (w.wavelength > 0.0) return 2.0 * kelp::pi / w.wavelength;
   return wave_number(2.0 * kelp::pi / w.period, g, depth);
@@ -82,6 +86,10 @@ inline double regular_wave_number(const RegularWave& w, double g, double depth) 
 
 /// \brief Angular frequency ω [rad/s] of a regular wave: 2π/T, or ω = √(g k tanh(k h)) for
 /// k = 2π/λ (`wave_frequency`).
+/// \param w The wave (wavelength > 0, else period > 0 is used; not checked: see validate).
+/// \param g Gravitational acceleration [m/s²].
+/// \param depth Water depth h [m] (+∞: deep water).
+/// \return ω [rad/s].
 inline double regular_wave_frequency(const RegularWave& w, double g, double depth) {
   if (w.wavelength > 0.0) return wave_frequency(2.0 * kelp::pi / w.wavelength, g, depth);
   return 2.0 * kelp::pi / w.period;
@@ -95,6 +103,9 @@ inline double regular_wave_frequency(const RegularWave& w, double g, double dept
 /// 0), direction or phase is not finite, or the wave is steeper than the breaking limit
 /// H/λ = tanh(k h)/7 (Miche 1944; Michell's 1893 deep-water 1/7 when h is infinite; linear
 /// theory is meaningless beyond).
+/// \param w The wave to check.
+/// \param g Gravitational acceleration [m/s²] (the field's; assumed valid).
+/// \param depth Water depth h [m] (+∞: deep water; the field's, assumed valid).
 inline void validate(const RegularWave& w, double g, double depth) {
   detail::check_in_range(w.height, 0.0, limits::max_significant_height, "regular.height",
                          "finite and in [0, 100] m");
@@ -167,7 +178,10 @@ struct WaveFieldParameters {
 /// (`limits::max_spreading`),
 /// omega_min_factor is not finite and > 0, omega_max_factor is not finite and > omega_min_factor
 /// or makes the highest wave number overflow, depth is NaN or ≤ 0, or gravity is not in (0, 1000]
-/// m/s² (`limits::max_gravity`).
+/// m/s² (`limits::max_gravity`); also when stretching is not a WaveStretching value, there are
+/// more than 2^20 regular waves or one of them is invalid (see `validate(const RegularWave&,
+/// double, double)`).
+/// \param p Wave field parameters to check.
 inline void validate(const WaveFieldParameters& p) {
   validate(p.spectrum);
   KELP_CHECK(
@@ -196,6 +210,7 @@ inline void validate(const WaveFieldParameters& p) {
 }
 
 /// \brief Elevation and orbital kinematics at one point.
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 struct WaveKinematics {
   Scalar elevation = Scalar(0);                            ///< ζ at the point's (x, y) [m], up
@@ -234,6 +249,8 @@ class WaveField {
   /// WaveFieldParameters&)`), or naming the spectrum's parameters and their values when a derived
   /// quantity of the discretised sea (a frequency, wave number or amplitude) is not finite, or a
   /// wave number is 0.
+  /// \param p Spectrum, discretisation and regular waves (copied). Regular waves of height 0 add
+  /// no component.
   explicit WaveField(const WaveFieldParameters& p) : params_(p) {
     validate(p);
     const std::size_t n_spectral =
@@ -294,43 +311,62 @@ class WaveField {
   }
 
   /// \brief True for a calm sea (no components).
+  /// \return size() == 0.
   bool empty() const { return omega_.empty(); }
   /// \brief Number of components.
+  /// \return The spectral components (0 when Hs = 0, else n_components) followed by one per
+  /// regular wave of height > 0.
   std::size_t size() const { return omega_.size(); }
   /// \brief The parameters the field was built from.
+  /// \return The parameters (default ones for the calm default-constructed field).
   const WaveFieldParameters& parameters() const { return params_; }
   /// \brief Angular frequency ω_j [rad/s] of component j.
+  /// \param j Component index, < size() (not checked).
+  /// \return ω_j [rad/s].
   double omega(std::size_t j) const { return omega_[j]; }
   /// \brief Wave number k_j [rad/m] of component j.
+  /// \param j Component index, < size() (not checked).
+  /// \return k_j [rad/m].
   double wave_number_of(std::size_t j) const { return k_[j]; }
   /// \brief Amplitude a_j [m] of component j.
+  /// \param j Component index, < size() (not checked).
+  /// \return a_j [m] (half the height of a regular wave).
   double amplitude(std::size_t j) const { return amp_[j]; }
   /// \brief Phase φ_j [rad] of component j.
+  /// \param j Component index, < size() (not checked).
+  /// \return φ_j [rad] (a regular wave's reduced to [−π, π]).
   double phase(std::size_t j) const { return phase_[j]; }
   /// \brief Direction β_j [rad] (NED azimuth travelled towards) of component j.
+  /// \param j Component index, < size() (not checked).
+  /// \return β_j [rad].
   double direction(std::size_t j) const { return dir_[j]; }
   /// \brief Pins the instruction path of this field's batch kernel (kelp/core/kernel_path.hpp):
   /// `portable` gives the same bits on every CPU (the deterministic mode); `automatic` (the
   /// default) follows the process' policy (`simd::set_kernel_policy`, the `KELP_KERNEL`
   /// environment variable), else the widest path the CPU runs. Copies of the field keep it.
+  /// \param path The path to pin, or `automatic` to unpin.
   /// \throws kelp::invalid_argument when the CPU (or the build) lacks `path`.
   void set_kernel(simd::KernelPath path) {
     if (path != simd::KernelPath::automatic) simd::resolve_kernel(path);  // checks support
     kernel_ = path;
   }
   /// \brief The path set by `set_kernel` (`automatic` unless pinned).
+  /// \return The pinned path, or `automatic`.
   simd::KernelPath kernel() const { return kernel_; }
   /// \brief The concrete path this field's queries take now (`kernel()`, or the process' policy
   /// or the widest path when that is `automatic`).
+  /// \return A concrete path (never `automatic`).
   /// \throws kelp::invalid_argument for a bad `KELP_KERNEL` (see `simd::kernel_policy`).
   simd::KernelPath active_kernel() const {
     return kernel_ == simd::KernelPath::automatic ? simd::active_kernel() : kernel_;
   }
   /// \brief `set_kernel(on ? portable : automatic)` (kept for existing callers).
+  /// \param on True: pin the portable path; false: unpin.
   void set_force_baseline_kernel(bool on) {
     set_kernel(on ? simd::KernelPath::portable : simd::KernelPath::automatic);
   }
   /// \brief Variance of the discretised elevation Σ a_j²/2 [m²] (≈ Hs²/16).
+  /// \return Σ a_j²/2 [m²] over all components, regular waves included (0 for a calm sea).
   double variance() const {
     double v = 0.0;
     for (double a : amp_) v += 0.5 * a * a;
@@ -341,6 +377,7 @@ class WaveField {
   /// to [−π, π] (time is a double for every Scalar, so the phase does not lose precision as t
   /// grows, nor with a single-precision model; beyond the fast reduction's range, t ≳ 1e8 s, it
   /// is reduced as exactly as std::cos would). \param[in] j component \param[in] t time [s]
+  /// \return φ_j − ω_j t reduced to [−π, π] [rad].
   /// \throws kelp::invalid_argument when t is not finite.
   double time_phase(std::size_t j, double t) const {
     const double x = phase_[j] - omega_[j] * t;
@@ -352,6 +389,7 @@ class WaveField {
   /// \brief Surface elevation ζ(x, y, t) [m], positive up.
   /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s] (a double for
   /// every Scalar)
+  /// \return ζ [m], positive up (0 for a calm sea).
   /// \throws kelp::invalid_argument when t is not finite (a NaN x or y gives NaN).
   Scalar elevation(const Scalar& x, const Scalar& y, double t) const {
     if constexpr (std::is_floating_point_v<Scalar>) {
@@ -378,6 +416,7 @@ class WaveField {
   /// \brief Surface slope (∂ζ/∂x, ∂ζ/∂y) [-] at (x, y, t): the rise of the surface per metre
   /// north and per metre east.
   /// \param[in] x NED north [m] \param[in] y NED east [m] \param[in] t time [s]
+  /// \return (∂ζ/∂x, ∂ζ/∂y) [-].
   /// \throws kelp::invalid_argument when t is not finite (a NaN x or y gives NaN).
   Eigen::Matrix<Scalar, 2, 1> slope(const Scalar& x, const Scalar& y, double t) const {
     if constexpr (std::is_floating_point_v<Scalar>) {
@@ -414,6 +453,9 @@ class WaveField {
 
   /// \brief Elevation, orbital velocity and acceleration at NED point `p` and time `t`.
   /// \param[in] p NED position [m] \param[in] t time [s]
+  /// \tparam Derived Any Eigen vector expression with 3 entries.
+  /// \return Elevation, velocity, acceleration, and (this query only) velocity gradient and
+  /// slope; all zero for a calm sea.
   /// \throws kelp::invalid_argument when t is not finite (a NaN position gives NaN).
   template <typename Derived>
   WaveKinematics<Scalar> kinematics(const Eigen::MatrixBase<Derived>& p, double t) const {
@@ -455,7 +497,10 @@ class WaveField {
 
   /// \brief The same, plus the surface elevation ζ(x_i, y_i, t) above each point [m] (the sums
   /// share the phases, so this costs a few per cent more, far less than separate `elevation`
-  /// calls). \param[out] elevation n values [m], positive up
+  /// calls).
+  /// \param[in] points 3×n NED [m] \param[in] t time [s]
+  /// \param[out] velocity 3×n NED [m/s] \param[out] acceleration 3×n NED [m/s²]
+  /// \param[out] elevation n values [m], positive up
   /// \throws kelp::invalid_argument as the overload above, or when elevation has not n entries.
   void kinematics(const Eigen::Ref<const Matrix3X<Scalar>>& points, double t,
                   Eigen::Ref<Matrix3X<Scalar>> velocity, Eigen::Ref<Matrix3X<Scalar>> acceleration,

@@ -33,6 +33,11 @@ namespace environment {
 /// with L = 1800 m and the surface drag coefficient κ = 0.0026 (Harris 1971, as given in
 /// Fossen 2021 §10.1.3). Its integral over f ∈ (0, ∞) is ≈ 0.01736 U₁₀² (σ_u ≈ 0.13 U₁₀).
 /// S = 0 for f ≤ 0 or U₁₀ ≤ 0.
+/// \param f Frequency [Hz].
+/// \param u10 Mean wind speed U₁₀ at 10 m [m/s].
+/// \param length Length scale L [m] (default 1800 m).
+/// \param kappa Surface drag coefficient κ [-] (default 0.0026).
+/// \return S(f) [(m/s)²/Hz], ≥ 0.
 /// \throws kelp::invalid_argument when f or U₁₀ is not finite, or L or κ is not finite and > 0.
 inline double harris_spectrum(double f, double u10, double length = 1800.0, double kappa = 0.0026) {
   check_finite(f, "harris_spectrum: f");
@@ -49,6 +54,10 @@ inline double harris_spectrum(double f, double u10, double length = 1800.0, doub
 /// \f$ S(f) = \frac{320 (U_{10}/10)^2 (z/10)^{0.45}}{(1 + \tilde f^n)^{5/(3n)}},\quad
 /// \tilde f = 172 f (z/10)^{2/3} (U_{10}/10)^{-3/4},\ n = 0.468 \f$
 /// (NORSOK N-003 (2007) §6.3; DNV-RP-C205 (2010) eq. 2.3.2.12). S = 0 for f ≤ 0 or U₁₀ ≤ 0.
+/// \param f Frequency [Hz].
+/// \param u10 Mean wind speed U₁₀ at 10 m [m/s].
+/// \param z Height above the sea surface [m] (default 10 m).
+/// \return S(f) [(m/s)²/Hz], ≥ 0.
 /// \throws kelp::invalid_argument when f or U₁₀ is not finite, or z is not finite and > 0.
 inline double norsepp_spectrum(double f, double u10, double z = 10.0) {
   check_finite(f, "norsepp_spectrum: f");
@@ -83,6 +92,7 @@ struct WindParameters {
 /// \throws kelp::invalid_argument when the speed is not in [0, 200] m/s
 /// (`limits::max_wind_speed`), the direction is not finite, n_components is not in [1, 2^20]
 /// (`limits::max_components`), f_min is not finite and > 0, or f_max is not finite and > f_min.
+/// \param p Wind parameters to check.
 inline void validate(const WindParameters& p) {
   detail::check_in_range(p.speed, 0.0, limits::max_wind_speed, "wind speed",
                          "finite and in [0, 200] m/s");
@@ -103,6 +113,7 @@ class WindField {
   /// \brief No wind.
   WindField() = default;
   /// \brief Builds the gust components.
+  /// \param p Wind parameters (copied); no gust components when gust is `none` or the speed 0.
   /// \throws kelp::invalid_argument naming the bad field, or naming f_min and f_max with their
   /// values when a gust frequency or amplitude is not finite (e.g. f_max = 1e300).
   explicit WindField(const WindParameters& p) : params_(p) {
@@ -144,8 +155,10 @@ class WindField {
   }
 
   /// \brief The parameters the field was built from.
+  /// \return The parameters (default ones, no wind, for the default-constructed field).
   const WindParameters& parameters() const { return params_; }
   /// \brief Variance of the discretised gust Σ a_j²/2 [(m/s)²].
+  /// \return Σ a_j²/2 [(m/s)²] (0 without gusts).
   double gust_variance() const {
     double v = 0.0;
     for (double a : amp_) v += 0.5 * a * a;
@@ -154,6 +167,8 @@ class WindField {
   /// \brief Wind speed U(t) = U₁₀ + u_g(t) [m/s] at time t [s].
   /// Time is a double for every Scalar; the phase is formed in double and reduced to [−π, π]
   /// (exactly, for any finite t; the fast reduction while |t| is below about 1e8/ω_max s).
+  /// \param t Time [s].
+  /// \return U(t) [m/s] (may be negative in a strong gust lull; not clamped).
   /// \throws kelp::invalid_argument when the field has gusts and t is not finite.
   Scalar speed(double t) const {
     double u = params_.speed, sn, cs;
@@ -165,6 +180,8 @@ class WindField {
     return Scalar(u);
   }
   /// \brief Wind velocity (air motion) at 10 m, NED [m/s], at time t [s]; horizontal.
+  /// \param t Time [s].
+  /// \return U(t) (cos β, sin β, 0), β the mean direction [m/s]; zero when U₁₀ = 0.
   /// \throws kelp::invalid_argument as `speed`.
   Vector3<Scalar> velocity(double t) const {
     if (params_.speed == 0.0) return Vector3<Scalar>::Zero();
@@ -211,9 +228,14 @@ struct ConstantWindCoefficients {
   double cy = 0.0;  ///< c_y [-] (≥ 0)
   double cn = 0.0;  ///< c_n [-]
   /// \brief (C_X, C_Y, C_N) at the relative wind angle γ_rw [rad].
+  /// \param gamma Relative wind angle γ_rw [rad] (0: head wind).
+  /// \return (C_X, C_Y, C_N) [-].
   /// \throws kelp::invalid_argument when γ_rw is not finite.
   Eigen::Vector3d operator()(double gamma) const { return at(gamma); }
   /// \brief The same for any scalar (a `ceres::Jet` γ keeps its derivatives).
+  /// \tparam Scalar double, float or ceres::Jet.
+  /// \param gamma Relative wind angle γ_rw [rad].
+  /// \return (C_X, C_Y, C_N) [-].
   /// \throws kelp::invalid_argument when γ_rw is not finite.
   template <typename Scalar>
   Vector3<Scalar> at(const Scalar& gamma) const {
@@ -221,6 +243,9 @@ struct ConstantWindCoefficients {
     return at_unchecked(gamma);
   }
   /// \brief `at` without the check (for callers that validated their inputs).
+  /// \tparam Scalar double, float or ceres::Jet.
+  /// \param gamma Relative wind angle γ_rw [rad] (a NaN gives NaN).
+  /// \return (C_X, C_Y, C_N) [-].
   template <typename Scalar>
   Vector3<Scalar> at_unchecked(const Scalar& gamma) const {
     using std::cos;
@@ -235,14 +260,18 @@ struct ConstantWindCoefficients {
 /// symmetry). Fill it from Isherwood (1972) or wind-tunnel data for the hull at hand; the values
 /// use the sign convention of `ConstantWindCoefficients` (C_X < 0 in a head wind).
 struct TabulatedWindCoefficients {
-  std::vector<double> angle;       ///< γ_rw [rad], strictly increasing, from 0 to π
-  std::vector<double> cx, cy, cn;  ///< coefficients at those angles [-]
+  std::vector<double> angle;  ///< γ_rw [rad], strictly increasing, from 0 to π
+  std::vector<double> cx,     ///< C_X at those angles [-]
+      cy,                     ///< C_Y at those angles [-]
+      cn;                     ///< C_N at those angles [-]
 
   /// \brief (C_X, C_Y, C_N) at γ_rw [rad] (any finite value; wrapped to (−π, π]).
   /// \throws kelp::invalid_argument when γ_rw is not finite, or when the table is too short or
   /// its columns differ in length (the O(1) part of `validate(const
   /// TabulatedWindCoefficients&)`, checked on every call so a malformed table never reads out of
   /// bounds).
+  /// \param gamma Relative wind angle γ_rw [rad].
+  /// \return Interpolated (C_X, C_Y, C_N) [-].
   Eigen::Vector3d operator()(double gamma) const {
     check_finite(gamma, "relative wind angle gamma");
     KELP_CHECK(angle.size() >= 2, "wind table angle needs at least 2 entries");
@@ -263,6 +292,8 @@ struct TabulatedWindCoefficients {
 /// \brief Throws `kelp::invalid_argument` unless the table `t` is well formed: at least two
 /// angles, running strictly increasing from 0 to π, and as many cx, cy, cn entries as angles,
 /// all finite.
+/// \param t Table to check (first angle within 1e-9 of 0, last within 1e-6 of π).
+/// \throws kelp::invalid_argument naming the bad column.
 inline void validate(const TabulatedWindCoefficients& t) {
   KELP_CHECK(t.angle.size() >= 2, "wind table angle needs at least 2 entries");
   KELP_CHECK(t.cx.size() == t.angle.size() && t.cy.size() == t.angle.size() &&
@@ -326,6 +357,9 @@ Vector3<Scalar> wind_load_unchecked(const Coefficients& coefficients, const Wind
 /// \param[in] coefficients coefficient model \param[in] areas projected areas and length
 /// \param[in] rho_air [kg/m³] \param[in] wind_ned wind velocity (air motion) NED [m/s]
 /// \param[in] psi heading [rad] \param[in] u surge velocity [m/s] \param[in] v sway velocity [m/s]
+/// \tparam Scalar double, float or ceres::Jet.
+/// \tparam Derived Any Eigen vector expression with 3 entries.
+/// \return (X, Y, N), body frame [N, N, N·m]; zero when V_rw = 0.
 /// \throws kelp::invalid_argument when ρ_air is not in (0, 1e5] kg/m³
 /// (`limits::max_fluid_density`), an area or L_oa is negative or not finite, wind_ned has not 3
 /// entries or one is not finite, or ψ, u or v is not finite.

@@ -23,6 +23,9 @@ struct NavigationT {
 using Navigation = NavigationT<double>;
 
 /// \brief A perfect navigation solution from a simulated state.
+/// \tparam Scalar double or float.
+/// \param x The simulated (true) vehicle state.
+/// \return Its position, attitude and body velocity, without error.
 template <typename Scalar>
 NavigationT<Scalar> navigation_of(const vehicle::VehicleState<Scalar>& x) {
   return {x.position, x.attitude, x.nu};

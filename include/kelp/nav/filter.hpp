@@ -73,7 +73,9 @@ struct FilterSettings {
   double initial_current_sigma = 0.5;      ///< [m/s]
 };
 
-/// \brief Checks filter settings. \throws kelp::invalid_argument naming the field.
+/// \brief Checks filter settings.
+/// \param s Settings: gains and noises finite ≥ 0, history in (0, 600] s, initial σ finite > 0.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const FilterSettings& s) {
   detail::check_sigma(s.tilt_gain, "filter.tilt_gain");
   detail::check_sigma(s.heading_gain, "filter.heading_gain");
@@ -111,6 +113,13 @@ class NavigationFilterT {
 
   /// \brief Starts the filter at a known NED position and velocity [m, m/s], with the attitude
   /// from an IMU sample at rest-like conditions (roll and pitch from gravity) and a heading [rad].
+  /// May be called again to restart: it resets the covariance, biases and history.
+  /// \param position NED position [m].
+  /// \param velocity NED velocity over ground [m/s].
+  /// \param heading Yaw ψ [rad].
+  /// \param imu An IMU sample: its specific force gives roll and pitch, its time the filter's
+  /// clock, its angular rate the first body rate.
+  /// \throws kelp::invalid_argument when position, velocity or heading is not finite.
   void initialize(const Vector3<Scalar>& position, const Vector3<Scalar>& velocity, double heading,
                   const ImuSample& imu) {
     check_all_finite(position, "initialize: position");
@@ -140,10 +149,13 @@ class NavigationFilterT {
     refresh();
   }
   /// \brief True once initialize() was called.
+  /// \return Whether the filter has been initialized.
   bool initialized() const { return initialized_; }
 
   /// \brief Integrates an IMU sample (attitude, then position and velocity over the time since
   /// the last one).
+  /// \param m The sample; one not later than the last (dt ≤ 0) only updates the body rate.
+  /// \throws kelp::invalid_argument when the filter was not initialized.
   void predict(const ImuSample& m) {
     KELP_CHECK(initialized_, "NavigationFilter::predict: call initialize() first");
     const double dt = m.t - t_;
@@ -188,6 +200,9 @@ class NavigationFilterT {
   }
 
   /// \brief A depth fix z [m] of noise σ [m].
+  /// \param z Depth, NED z [m] (positive down).
+  /// \param sigma Its standard deviation [m] (at least 1e-4 m is assumed).
+  /// Ignored before initialize().
   void update_depth(double z, double sigma) {
     Eigen::Matrix<Scalar, 1, n> H = Eigen::Matrix<Scalar, 1, n>::Zero();
     H(0, 2) = Scalar(1);
@@ -198,6 +213,9 @@ class NavigationFilterT {
   }
 
   /// \brief A bottom-lock velocity (body axes, over ground) [m/s] of noise σ [m/s] per axis.
+  /// \param v Velocity over ground in body axes [m/s].
+  /// \param sigma Its standard deviation per axis [m/s] (at least 1e-4 m/s is assumed).
+  /// Ignored before initialize().
   void update_body_velocity(const Vector3<Scalar>& v, double sigma) {
     const Matrix3<Scalar> Rt = q_.toRotationMatrix().transpose();
     Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
@@ -208,6 +226,9 @@ class NavigationFilterT {
 
   /// \brief A water-track velocity (body axes, relative to the water) [m/s] of noise σ [m/s]
   /// (the filter adds its `water_track_noise`). Used only when the filter estimates the current.
+  /// \param v Velocity relative to the water in body axes [m/s].
+  /// \param sigma The DVL's standard deviation per axis [m/s].
+  /// Ignored before initialize().
   void update_water_velocity(const Vector3<Scalar>& v, double sigma) {
     if (!s_.estimate_current) return;
     const Matrix3<Scalar> Rt = q_.toRotationMatrix().transpose();
@@ -222,6 +243,8 @@ class NavigationFilterT {
 
   /// \brief A compass heading ψ [rad]; `dt` [s] is the time since the last one (the correction
   /// is a rate).
+  /// \param psi Measured heading ψ [rad] (any value; the error is wrapped to (−π, π]).
+  /// \param dt Time since the last heading update [s]; the correction is heading_gain·e·dt.
   void update_heading(double psi, double dt) {
     const double e = kelp::wrap_angle(psi - kelp::heading_of(q_));
     const Vector3<Scalar> axis = q_.conjugate() * Vector3<Scalar>::UnitZ();  // NED z in body
@@ -232,6 +255,10 @@ class NavigationFilterT {
 
   /// \brief A horizontal position fix (north, east) [m] of noise σ per axis [m] (e.g. a GPS fix,
   /// whose altitude is much worse than its horizontal position).
+  /// \param p North, east [m].
+  /// \param sigma Standard deviation per axis [m] (at least 1e-4 m is assumed).
+  /// \param measured_at Time of the measurement [s] (see update_position).
+  /// Ignored before initialize().
   void update_horizontal_position(const Eigen::Matrix<Scalar, 2, 1>& p, double sigma,
                                   double measured_at) {
     Eigen::Matrix<Scalar, 2, n> H = Eigen::Matrix<Scalar, 2, n>::Zero();
@@ -242,6 +269,11 @@ class NavigationFilterT {
 
   /// \brief A position fix (NED) [m] of noise σ per axis [m], measured at time `measured_at`
   /// [s] (earlier than now for a late fix; compared with the estimate of then).
+  /// \param p NED position [m].
+  /// \param sigma Standard deviation per axis [m] (each at least 1e-4 m is assumed).
+  /// \param measured_at Time of the measurement [s]; times older than the kept history use its
+  /// oldest estimate.
+  /// Ignored before initialize().
   void update_position(const Vector3<Scalar>& p, const Vector3<Scalar>& sigma, double measured_at) {
     Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
     H.template block<3, 3>(0, 0).setIdentity();
@@ -253,14 +285,21 @@ class NavigationFilterT {
 
   /// \brief The estimate as the controllers take it: NED position, attitude, body velocity
   /// over ground (linear from the Kalman velocity, angular from the gyroscope less its bias).
+  /// \return The estimate (valid once initialized).
   const NavigationT<Scalar>& navigation() const { return nav_; }
   /// \brief The Kalman state (p, v, b_a, c).
+  /// \return p NED [m], v NED [m/s], b_a body [m/s²], c north, east [m/s].
   const StateVector& state() const { return x_; }
   /// \brief Its covariance.
+  /// \return The 11×11 covariance of state(), in the squares of its units.
   const Covariance& covariance() const { return P_; }
   /// \brief The gyroscope bias estimate [rad/s].
+  /// \return The bias, body axes [rad/s].
   const Vector3<Scalar>& gyro_bias() const { return gyro_bias_; }
   /// \brief The position estimate at time t [s] (within the kept history; clamped to it).
+  /// \param t Time [s].
+  /// \return NED position [m], interpolated between kept estimates and moved by the corrections
+  /// since; the current estimate for t at or after the last sample.
   Vector3<Scalar> position_at(double t) const {
     if (count_ == 0) return x_.template segment<3>(0);
     const std::size_t cap = history_.size();

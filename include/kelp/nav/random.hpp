@@ -24,6 +24,8 @@
 namespace kelp::nav {
 
 /// \brief One SplitMix64 step: advances `x` and returns the next 64-bit output.
+/// \param[in,out] x Generator state, advanced by the golden-ratio increment.
+/// \return The next output (a bijective mix of the new state).
 inline std::uint64_t splitmix64(std::uint64_t& x) {
   std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -32,6 +34,9 @@ inline std::uint64_t splitmix64(std::uint64_t& x) {
 }
 
 /// \brief The seed of stream `stream` of a run seeded with `seed` (SplitMix64 of both).
+/// \param seed The run's seed.
+/// \param stream The stream's number (one per sensor).
+/// \return The seed of the stream's mt19937_64 engine.
 inline std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
   std::uint64_t x = seed;
   const std::uint64_t a = splitmix64(x);
@@ -43,16 +48,20 @@ inline std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
 class RandomStream {
  public:
   /// \brief Stream `stream` of the run seeded with `seed`.
+  /// \param seed The run's seed.
+  /// \param stream The stream's number (see stream_seed).
   explicit RandomStream(std::uint64_t seed = 1, std::uint64_t stream = 0)
       : engine_(stream_seed(seed, stream)) {}
 
   /// \brief A uniform deviate in the open interval (0, 1) (53 random bits).
+  /// \return (n + 0.5)/2^53 for the engine's top 53 bits n.
   double uniform() {
     return (static_cast<double>(engine_() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
   }
 
   /// \brief A standard normal deviate (mean 0, variance 1), Marsaglia's polar method; the
   /// second deviate of each pair is kept for the next call.
+  /// \return A deviate of N(0, 1).
   double normal() {
     if (has_spare_) {
       has_spare_ = false;
@@ -71,6 +80,8 @@ class RandomStream {
   }
 
   /// \brief True with probability `p` (one uniform deviate).
+  /// \param p Probability [-] (≤ 0: never, ≥ 1: always; a NaN: never).
+  /// \return The draw.
   bool bernoulli(double p) { return uniform() < p; }
   /// \brief visit_memory(v): the engine's state and the spare deviate (kelp/core/memory.hpp).
   /// \tparam V a memory visitor \param v the visitor

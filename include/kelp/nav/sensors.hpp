@@ -98,10 +98,14 @@ inline void check_sigma(double x, const std::string& field) {
 /// between two due times samples nothing; a late call samples at once and keeps the phase).
 class SensorSchedule {
  public:
+  /// \brief A schedule of period 1 s.
   SensorSchedule() = default;
-  /// \param[in] rate samples per second [Hz]
+  /// \brief A schedule of the given rate.
+  /// \param[in] rate samples per second [Hz] (> 0; not checked: the sensors validate it)
   explicit SensorSchedule(double rate) : period_(1.0 / rate) {}
   /// \brief True when a sample is due at time t [s] (then the next one is scheduled).
+  /// \param t Time [s] (non-decreasing from call to call).
+  /// \return True at the first call and when t has reached the next due time (within 1 ns).
   bool due(double t) {
     if (started_ && t < next_ - 1e-9) return false;
     next_ = started_ ? next_ + period_ : t + period_;
@@ -110,8 +114,11 @@ class SensorSchedule {
     return true;
   }
   /// \brief The sampling period [s].
+  /// \return 1/rate [s] (or the last period given to reschedule).
   double period() const { return period_; }
   /// \brief Schedules the next sample one period `p` [s] after `t` [s] (and keeps that period).
+  /// \param t Time of the sample just taken [s].
+  /// \param p The new period [s] (> 0).
   void reschedule(double t, double p) {
     period_ = p;
     next_ = t + p;
@@ -140,7 +147,9 @@ struct ImuParameters {
   double accel_bias_initial = 0.0;                ///< σ of the turn-on bias [m/s²]
 };
 
-/// \brief Checks IMU parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks IMU parameters.
+/// \param p Parameters: rate in (0, 1e4] Hz, every density, walk and σ finite ≥ 0.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const ImuParameters& p) {
   detail::check_rate(p.rate, "imu.rate");
   detail::check_sigma(p.gyro_noise_density, "imu.gyro_noise_density");
@@ -161,6 +170,7 @@ struct ImuSample {
 /// \brief The specific force an ideal accelerometer at the CO reads [m/s², body axes]:
 /// f = ν̇₁ + ω × ν₁ − Rᵀ (0, 0, g) (at rest and level: (0, 0, −g)).
 /// \param[in] x the vehicle's state \param[in] nu_dot its ν̇ (body) \param[in] gravity g [m/s²]
+/// \return f, body axes [m/s²].
 inline Vector3<double> specific_force(const vehicle::VehicleStated& x,
                                       const Vector6<double>& nu_dot, double gravity) {
   const Vector3<double> v = x.nu.head<3>(), w = x.nu.tail<3>();
@@ -179,6 +189,12 @@ class ImuSensor {
     for (int i = 0; i < 3; ++i) accel_bias_(i) = p.accel_bias_initial * rng_.normal();
   }
   /// \brief Samples when due at time t [s]: returns true and fills `out`.
+  /// \param x The vehicle's true state.
+  /// \param nu_dot Its true body acceleration ν̇ [m/s², rad/s²].
+  /// \param gravity g [m/s²].
+  /// \param t Time [s].
+  /// \param[out] out The sample, written only when due.
+  /// \return True when a sample was due.
   bool sample(const vehicle::VehicleStated& x, const Vector6<double>& nu_dot, double gravity,
               double t, ImuSample& out) {
     if (!schedule_.due(t)) return false;
@@ -187,6 +203,10 @@ class ImuSensor {
   }
   /// \brief One sample of the given true angular rate and specific force (body) at time t,
   /// regardless of the schedule; advances the biases by one period.
+  /// \param omega True angular rate, body axes [rad/s].
+  /// \param force True specific force, body axes [m/s²] (see specific_force).
+  /// \param t Time stamp of the sample [s].
+  /// \return The sample: truth + bias + white noise of σ = density·√rate.
   ImuSample measure(const Vector3<double>& omega, const Vector3<double>& force, double t) {
     const double sg = p_.gyro_noise_density * std::sqrt(p_.rate);
     const double sa = p_.accel_noise_density * std::sqrt(p_.rate);
@@ -201,10 +221,13 @@ class ImuSensor {
     return s;
   }
   /// \brief The gyroscope's true bias now [rad/s].
+  /// \return The bias, body axes [rad/s].
   const Vector3<double>& gyro_bias() const { return gyro_bias_; }
   /// \brief The accelerometer's true bias now [m/s²].
+  /// \return The bias, body axes [m/s²].
   const Vector3<double>& accel_bias() const { return accel_bias_; }
   /// \brief The parameters.
+  /// \return The parameters the sensor was built with.
   const ImuParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream, the schedule and the biases
   /// (kelp/core/memory.hpp).
@@ -227,7 +250,9 @@ struct DepthParameters {
   double bias = 0.0;     ///< constant offset [m]
 };
 
-/// \brief Checks depth-sensor parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks depth-sensor parameters.
+/// \param p Parameters: rate in (0, 1e4] Hz, noise finite ≥ 0, bias finite.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const DepthParameters& p) {
   detail::check_rate(p.rate, "depth.rate");
   detail::check_sigma(p.noise, "depth.noise");
@@ -237,16 +262,27 @@ inline void validate(const DepthParameters& p) {
 /// \brief A pressure depth sensor at the CO: z + bias + white noise.
 class DepthSensor {
  public:
+  /// \brief A depth sensor with its own noise stream.
+  /// \param[in] p parameters \param[in] seed run seed \param[in] stream the sensor's stream
+  /// number \throws kelp::invalid_argument for bad parameters.
   DepthSensor(const DepthParameters& p, std::uint64_t seed, std::uint64_t stream)
       : p_((validate(p), p)), rng_(seed, stream), schedule_(p.rate) {}
   /// \brief Samples the depth z [m] when due at time t: true and `out` [m].
+  /// \param z True depth of the CO, NED z [m].
+  /// \param t Time [s].
+  /// \param[out] out The reading [m], written only when due.
+  /// \return True when a sample was due.
   bool sample(double z, double t, double& out) {
     if (!schedule_.due(t)) return false;
     out = measure(z);
     return true;
   }
   /// \brief One reading of depth z [m], regardless of the schedule.
+  /// \param z True depth, NED z [m].
+  /// \return z + bias + noise [m].
   double measure(double z) { return z + p_.bias + p_.noise * rng_.normal(); }
+  /// \brief The parameters.
+  /// \return The parameters the sensor was built with.
   const DepthParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
   /// \tparam V a memory visitor \param v the visitor
@@ -273,7 +309,10 @@ struct DvlParameters {
   double water_track_distance = 3.0;  ///< the tracked water's distance below the DVL [m]
 };
 
-/// \brief Checks DVL parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks DVL parameters.
+/// \param p Parameters: rates in (0, 1e4] Hz, max_altitude finite > min_altitude, the others
+/// finite ≥ 0.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const DvlParameters& p) {
   detail::check_rate(p.bottom_rate, "dvl.bottom_rate");
   detail::check_rate(p.water_rate, "dvl.water_rate");
@@ -306,10 +345,16 @@ struct DvlSample {
 /// (or nothing).
 class Dvl {
  public:
+  /// \brief A DVL with its own noise stream.
+  /// \param[in] p parameters \param[in] seed run seed \param[in] stream the sensor's stream
+  /// number \throws kelp::invalid_argument for bad parameters.
   Dvl(const DvlParameters& p, std::uint64_t seed, std::uint64_t stream)
       : p_((validate(p), p)), rng_(seed, stream), schedule_(p.bottom_rate) {}
 
   /// \brief The mode at an altitude [m] (+inf: no seabed).
+  /// \param altitude Height of the DVL above the seabed [m].
+  /// \return bottom within [min_altitude, max_altitude], else water (or none when water
+  /// tracking is off).
   DvlMode mode_at(double altitude) const {
     if (altitude >= p_.min_altitude && altitude <= p_.max_altitude) return DvlMode::bottom;
     return p_.water_track ? DvlMode::water : DvlMode::none;
@@ -317,6 +362,12 @@ class Dvl {
 
   /// \brief Pings when due at time t: true and `out` (whose mode may be `none`). The rate
   /// follows the mode of the ping.
+  /// \param x The vehicle's true state.
+  /// \param env The environment: its seabed depth gives the altitude, its current and waves the
+  /// tracked water's velocity.
+  /// \param t Time [s].
+  /// \param[out] out The fix, written only when due.
+  /// \return True when a ping was due.
   bool sample(const vehicle::VehicleStated& x, const environment::Environmentd& env, double t,
               DvlSample& out) {
     if (!schedule_.due(t)) return false;
@@ -336,6 +387,11 @@ class Dvl {
   }
   /// \brief One fix in `mode` given the water's NED velocity below [m/s], regardless of the
   /// schedule.
+  /// \param x The vehicle's true state.
+  /// \param mode The mode of the fix (none: an empty fix, no noise drawn).
+  /// \param water Velocity of the tracked water, NED [m/s] (used in water mode only).
+  /// \param t Time stamp [s].
+  /// \return The fix, body axes (its altitude is left 0: sample fills it).
   DvlSample measure(const vehicle::VehicleStated& x, DvlMode mode, const Vector3<double>& water,
                     double t) {
     DvlSample s;
@@ -349,6 +405,8 @@ class Dvl {
     for (int i = 0; i < 3; ++i) s.velocity(i) = v(i) + s.sigma * rng_.normal();
     return s;
   }
+  /// \brief The parameters.
+  /// \return The parameters the sensor was built with.
   const DvlParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
   /// \tparam V a memory visitor \param v the visitor
@@ -369,7 +427,9 @@ struct CompassParameters {
   double bias = 0.0;            ///< constant offset [rad]
 };
 
-/// \brief Checks compass parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks compass parameters.
+/// \param p Parameters: rate in (0, 1e4] Hz, noise finite ≥ 0, bias finite.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const CompassParameters& p) {
   detail::check_rate(p.rate, "compass.rate");
   detail::check_sigma(p.noise, "compass.noise");
@@ -379,19 +439,30 @@ inline void validate(const CompassParameters& p) {
 /// \brief A heading sensor: ψ + bias + white noise, wrapped to (−π, π].
 class Compass {
  public:
+  /// \brief A compass with its own noise stream.
+  /// \param[in] p parameters \param[in] seed run seed \param[in] stream the sensor's stream
+  /// number \throws kelp::invalid_argument for bad parameters.
   Compass(const CompassParameters& p, std::uint64_t seed, std::uint64_t stream)
       : p_((validate(p), p)), rng_(seed, stream), schedule_(p.rate) {}
   /// \brief Samples the heading of attitude `q` when due at time t: true and `out` [rad].
+  /// \param q True attitude, body → NED.
+  /// \param t Time [s].
+  /// \param[out] out The heading [rad] in (−π, π], written only when due.
+  /// \return True when a sample was due.
   bool sample(const Quaternion<double>& q, double t, double& out) {
     if (!schedule_.due(t)) return false;
     out = measure(heading_of(q));
     return true;
   }
   /// \brief One reading of heading ψ [rad], regardless of the schedule.
+  /// \param psi True heading [rad].
+  /// \return ψ + bias + noise, wrapped to (−π, π] [rad].
   double measure(double psi) {
     const double a = psi + p_.bias + p_.noise * rng_.normal();
     return std::atan2(std::sin(a), std::cos(a));
   }
+  /// \brief The parameters.
+  /// \return The parameters the sensor was built with.
   const CompassParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream and the schedule (kelp/core/memory.hpp).
   /// \tparam V a memory visitor \param v the visitor
@@ -416,7 +487,9 @@ struct GpsParameters {
   double vertical_factor = 2.0;  ///< vertical σ / horizontal σ [-]
 };
 
-/// \brief Checks GPS parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks GPS parameters.
+/// \param p Parameters: rate in (0, 1e4] Hz, bias_time finite > 0, the others finite ≥ 0.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const GpsParameters& p) {
   detail::check_rate(p.rate, "gps.rate");
   detail::check_sigma(p.noise, "gps.noise");
@@ -428,12 +501,20 @@ inline void validate(const GpsParameters& p) {
 /// \brief A GPS antenna at the CO: position + Gauss–Markov error + white noise.
 class Gps {
  public:
+  /// \brief A GPS with its own noise stream; the slow error starts at a draw of its stationary
+  /// distribution.
+  /// \param[in] p parameters \param[in] seed run seed \param[in] stream the sensor's stream
+  /// number \throws kelp::invalid_argument for bad parameters.
   Gps(const GpsParameters& p, std::uint64_t seed, std::uint64_t stream)
       : p_((validate(p), p)), rng_(seed, stream), schedule_(p.rate) {
     scale_ << 1.0, 1.0, p.vertical_factor;
     for (int i = 0; i < 3; ++i) bias_(i) = p.bias_sigma * scale_(i) * rng_.normal();
   }
   /// \brief Samples the NED position `p` when due at time t: true and `out` [m].
+  /// \param p True NED position of the antenna [m].
+  /// \param t Time [s].
+  /// \param[out] out The fix, NED [m], written only when due.
+  /// \return True when a sample was due.
   bool sample(const Vector3<double>& p, double t, Vector3<double>& out) {
     if (!schedule_.due(t)) return false;
     out = measure(p);
@@ -441,6 +522,8 @@ class Gps {
   }
   /// \brief One fix of NED position `p` [m], regardless of the schedule; advances the slow
   /// error by one period (exact discretisation of the first-order Gauss–Markov process).
+  /// \param p True NED position [m].
+  /// \return p + slow error + white noise, NED [m].
   Vector3<double> measure(const Vector3<double>& p) {
     const double a = std::exp(-1.0 / (p_.rate * p_.bias_time));
     const double b = p_.bias_sigma * std::sqrt(1.0 - a * a);
@@ -450,9 +533,13 @@ class Gps {
     return out;
   }
   /// \brief The slow error now [m].
+  /// \return The Gauss–Markov error, NED [m].
   const Vector3<double>& bias() const { return bias_; }
   /// \brief σ of one fix per axis (white and slow parts together) [m].
+  /// \return √(noise² + bias_sigma²) times (1, 1, vertical_factor) [m].
   Vector3<double> sigma() const { return std::hypot(p_.noise, p_.bias_sigma) * scale_; }
+  /// \brief The parameters.
+  /// \return The parameters the sensor was built with.
   const GpsParameters& parameters() const { return p_; }
   /// \brief visit_memory(v): the noise stream, the schedule and the slow error
   /// (kelp/core/memory.hpp).
@@ -482,7 +569,10 @@ struct UsblParameters {
 /// \brief The most fixes in flight at once (latency × rate must stay below it).
 inline constexpr int usbl_queue_capacity = 64;
 
-/// \brief Checks USBL parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks USBL parameters.
+/// \param p Parameters: rate in (0, 1e4] Hz, noise and latency finite ≥ 0, latency × rate below
+/// usbl_queue_capacity − 2, dropout in [0, 1), max_range finite > 0.
+/// \throws kelp::invalid_argument naming the field.
 inline void validate(const UsblParameters& p) {
   detail::check_rate(p.rate, "usbl.rate");
   detail::check_sigma(p.noise_floor, "usbl.noise_floor");
@@ -512,12 +602,18 @@ struct UsblFix {
 /// per NED axis), is delivered `latency` later. Fixes wait in a fixed queue (no allocation).
 class Usbl {
  public:
+  /// \brief A USBL with its own noise stream and an empty queue.
+  /// \param[in] p parameters \param[in] seed run seed \param[in] stream the sensor's stream
+  /// number \throws kelp::invalid_argument for bad parameters.
   Usbl(const UsblParameters& p, std::uint64_t seed, std::uint64_t stream)
       : p_((validate(p), p)), rng_(seed, stream), schedule_(p.rate) {}
 
-  /// \brief Pings when due at time t [s]. \param[in] rov, boat true NED positions [m]
+  /// \brief Pings when due at time t [s]; a fix not lost is queued for poll().
+  /// \param[in] rov true NED position of the ROV [m]
+  /// \param[in] boat true NED position of the boat [m]
   /// \param[in] boat_estimate the boat's own position estimate [m] \param[in] heading_error the
-  /// boat's heading estimate minus its true heading [rad]. \returns true when a ping was due.
+  /// boat's heading estimate minus its true heading [rad]. \param[in] t time [s]
+  /// \returns true when a ping was due (even if its fix was lost).
   bool sample(const Vector3<double>& rov, const Vector3<double>& boat,
               const Vector3<double>& boat_estimate, double heading_error, double t) {
     if (!schedule_.due(t)) return false;
@@ -542,6 +638,9 @@ class Usbl {
     return true;
   }
   /// \brief Takes the oldest fix delivered by time t [s]: true and `out`.
+  /// \param t Time [s].
+  /// \param[out] out The fix, written only when one was delivered by t.
+  /// \return True when a fix was taken (call again for more).
   bool poll(double t, UsblFix& out) {
     if (size_ == 0 || queue_[head_].delivered_at > t + 1e-9) return false;
     out = queue_[head_];
@@ -550,9 +649,13 @@ class Usbl {
     return true;
   }
   /// \brief Pings so far.
+  /// \return The number of due pings, lost ones included.
   long pings() const { return pings_; }
   /// \brief Pings lost so far.
+  /// \return The pings lost to dropout or range.
   long dropouts() const { return dropouts_; }
+  /// \brief The parameters.
+  /// \return The parameters the sensor was built with.
   const UsblParameters& parameters() const { return p_; }
 
   /// \brief Visits the noise stream, the schedule, the fixes in flight and the counts

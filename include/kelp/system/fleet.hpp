@@ -60,6 +60,7 @@ enum class EndKind {
 };
 
 /// \brief One end of a tether in a fleet.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct TetherEnd {
   EndKind kind = EndKind::anchor;  ///< what the end is fixed to
@@ -69,16 +70,24 @@ struct TetherEnd {
   Vector3<Scalar> point = Vector3<Scalar>::Zero();
 
   /// \brief The body point `r_body` [m] of vehicle `i`.
+  /// \param i Index of the vehicle in FleetParameters::vehicles.
+  /// \param r_body Attachment point, body frame, from the vehicle's CO [m].
+  /// \return The end (checked by validate(const FleetParameters<Scalar>&)).
   static TetherEnd on_vehicle(int i, const Vector3<Scalar>& r_body) {
     return {EndKind::vehicle, i, r_body};
   }
   /// \brief A fixed point `p_ned` [m].
+  /// \param p_ned The anchor's position, NED [m].
+  /// \return The end.
   static TetherEnd at_anchor(const Vector3<Scalar>& p_ned) { return {EndKind::anchor, -1, p_ned}; }
   /// \brief Point mass `i`.
+  /// \param i Index of the point mass in FleetParameters::point_masses.
+  /// \return The end (the line attaches at the mass's centre).
   static TetherEnd on_point_mass(int i) {
     return {EndKind::point_mass, i, Vector3<Scalar>::Zero()};
   }
   /// \brief A free end.
+  /// \return The end (the line's end node moves under the tether's own end point mass).
   static TetherEnd hanging_free() { return {EndKind::free, -1, Vector3<Scalar>::Zero()}; }
 };
 
@@ -96,7 +105,10 @@ struct PointMassParameters {
   Scalar drag_area = Scalar(0);
 };
 
-/// \brief Checks point-mass parameters. \throws kelp::invalid_argument naming the field.
+/// \brief Checks point-mass parameters.
+/// \tparam Scalar double or float.
+/// \param p Parameters: mass finite > 0; volume, added_mass_coefficient, drag_area finite ≥ 0.
+/// \throws kelp::invalid_argument naming the field.
 template <typename Scalar>
 void validate(const PointMassParameters<Scalar>& p) {
   check_positive(p.mass, "point_mass.mass");
@@ -154,6 +166,9 @@ struct FleetParameters {
 
 /// \brief The tethered pair as a fleet: vehicles "asv" (0) and "auv" (1), tether "tether" from
 /// the ASV's attachment point (with the pair's winch) to the AUV's.
+/// \tparam Scalar double or float.
+/// \param pair The pair's parameters (not validated here; FleetModel checks the result).
+/// \return The fleet: no point masses, the pair's integrator settings.
 template <typename Scalar>
 FleetParameters<Scalar> fleet_of(const SystemParameters<Scalar>& pair) {
   FleetParameters<Scalar> f;
@@ -205,6 +220,9 @@ tether::TetherParameters<Scalar> line_of(const FleetTether<Scalar>& t) {
 
 /// \brief Checks fleet parameters: every part's own checks, unique names, end indices in
 /// range, at most one free end per tether and no winch on a free end.
+/// \tparam Scalar double or float.
+/// \param p The fleet's parameters (also: max_tether_dt finite > 0, coupling_corrections in
+/// [0, 16], valid tether_options).
 /// \throws kelp::invalid_argument naming the part ("tethers[1] (tms-rov).end: ...").
 template <typename Scalar>
 void validate(const FleetParameters<Scalar>& p) {
@@ -248,9 +266,15 @@ void validate(const FleetParameters<Scalar>& p) {
 /// \brief A fleet built once from FleetParameters and an environment (copied: the one source
 /// of water density and gravity; every vehicle is checked against it).
 /// \throws kelp::invalid_argument naming the part.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 class FleetModel {
  public:
+  /// \brief Validates the parameters and builds every part's model.
+  /// \param p The fleet's parameters (copied).
+  /// \param env The environment (copied); every vehicle's water density and gravity must be its.
+  /// \throws kelp::invalid_argument naming the part (see validate(const
+  /// FleetParameters<Scalar>&)), or the vehicle whose water differs from the environment's.
   FleetModel(const FleetParameters<Scalar>& p, const environment::Environment<Scalar>& env)
       : parameters_((validate(p), p)), environment_(env) {
     vehicles_.reserve(p.vehicles.size());
@@ -271,9 +295,14 @@ class FleetModel {
         if (e->kind == EndKind::vehicle) ++loads_[std::size_t(e->index)];
     }
   }
+  /// \brief The parameters the fleet was built from.
+  /// \return The parameters, as given (the tethers' end modes not yet set from their ends).
   const FleetParameters<Scalar>& parameters() const { return parameters_; }
+  /// \brief The environment the fleet steps in.
+  /// \return The environment (the last one set).
   const environment::Environment<Scalar>& environment() const { return environment_; }
   /// \brief Replaces the environment between steps (as SystemModel::set_environment).
+  /// \param env The new environment (copied); same water density and gravity as the vehicles'.
   /// \throws kelp::invalid_argument naming the vehicle whose water differs (strong guarantee).
   void set_environment(const environment::Environment<Scalar>& env) {
     for (std::size_t i = 0; i < vehicles_.size(); ++i)
@@ -281,43 +310,70 @@ class FleetModel {
     environment::Environment<Scalar> copy(env);
     environment_ = std::move(copy);
   }
-  int vehicle_count() const { return int(vehicles_.size()); }                    ///< N
-  int point_mass_count() const { return int(parameters_.point_masses.size()); }  ///< P
-  int tether_count() const { return int(tethers_.size()); }                      ///< M
+  /// \brief The number of vehicles.
+  /// \return N.
+  int vehicle_count() const { return int(vehicles_.size()); }
+  /// \brief The number of point masses.
+  /// \return P.
+  int point_mass_count() const { return int(parameters_.point_masses.size()); }
+  /// \brief The number of tethers.
+  /// \return M.
+  int tether_count() const { return int(tethers_.size()); }
   /// \brief Vehicle i's model.
+  /// \param i Vehicle index in [0, N) (not checked).
+  /// \return Its model.
   const vehicle::VehicleModel<Scalar>& vehicle(int i) const { return vehicles_[std::size_t(i)]; }
   /// \brief Vehicle i's propulsion, or null.
+  /// \param i Vehicle index in [0, N) (not checked).
+  /// \return Its propulsion model, or nullptr without one.
   const vehicle::PropulsionModel<Scalar>* propulsion(int i) const {
     const auto& p = propulsion_[std::size_t(i)];
     return p ? &*p : nullptr;
   }
   /// \brief Vehicle i's hull, or null.
+  /// \param i Vehicle index in [0, N) (not checked).
+  /// \return Its hull contact, or nullptr without one.
   const HullContact<Scalar>* hull(int i) const {
     const auto& h = parameters_.vehicles[std::size_t(i)].hull;
     return h ? &*h : nullptr;
   }
   /// \brief Tether k's line at its initial node count.
+  /// \param k Tether index in [0, M) (not checked).
+  /// \return Its line model (end modes set from its ends).
   const tether::TetherModel<Scalar>& tether(int k) const { return tethers_[std::size_t(k)]; }
   /// \brief Tether k's winch, or null.
+  /// \param k Tether index in [0, M) (not checked).
+  /// \return Its winch model, or nullptr without one.
   const tether::WinchModel<Scalar>* winch(int k) const {
     const auto& w = winches_[std::size_t(k)];
     return w ? &*w : nullptr;
   }
   /// \brief Tether k's line model for its state (its winch's line at the state's node count).
+  /// \param k Tether index in [0, M) (not checked).
+  /// \param s The tether's state.
+  /// \return tether(k) without a winch, else the winch's line of s's node count.
   const tether::TetherModel<Scalar>& tether_of(int k, const tether::TetherState<Scalar>& s) const {
     const auto* w = winch(k);
     return w ? w->line_of(s) : tether(k);
   }
   /// \brief The number of tether ends on vehicle i.
+  /// \param i Vehicle index in [0, N) (not checked).
+  /// \return The count (a tether with both ends on i counts twice).
   int loads_on(int i) const { return loads_[std::size_t(i)]; }
-  /// \brief The index of the vehicle, point mass or tether called `name`, or −1.
+  /// \brief The index of the vehicle called `name`, or −1.
+  /// \param name The vehicle's name (FleetVehicle::name).
+  /// \return Its index in FleetParameters::vehicles, or −1.
   int vehicle_index(const std::string& name) const { return find(parameters_.vehicles, name); }
-  int point_mass_index(const std::string& name) const {  ///< see vehicle_index
+  /// \brief The index of the point mass called `name`, or −1.
+  /// \param name The point mass's name (PointMassParameters::name).
+  /// \return Its index in FleetParameters::point_masses, or −1.
+  int point_mass_index(const std::string& name) const {
     return find(parameters_.point_masses, name);
   }
-  int tether_index(const std::string& name) const {  ///< see vehicle_index
-    return find(parameters_.tethers, name);
-  }
+  /// \brief The index of the tether called `name`, or −1.
+  /// \param name The tether's name (FleetTether::name).
+  /// \return Its index in FleetParameters::tethers, or −1.
+  int tether_index(const std::string& name) const { return find(parameters_.tethers, name); }
 
  private:
   template <typename V>
@@ -351,6 +407,7 @@ struct FleetState {
   std::vector<tether::TetherState<Scalar>> tethers;  ///< per tether, with integrator history
 
   /// \brief Sets every clock to `t` [s].
+  /// \param t Time [s]: the fleet's, each vehicle's and each tether's (its time carry reset).
   void set_time(double t) {
     time = t;
     for (auto& v : vehicles) v.time = t;
@@ -377,8 +434,11 @@ struct FleetInputs {
   /// Per tether: its winch's commanded payout rate [m/s] (0 without a winch).
   std::vector<Scalar> winch_payout_rates;
 
+  /// \brief No parts (sized for an empty fleet).
   FleetInputs() = default;
   /// \brief All zero, sized for `model`.
+  /// \param model The fleet: one entry per vehicle in `vehicles` and `commands` (commands empty,
+  /// i.e. all 0) and one payout rate per tether.
   explicit FleetInputs(const FleetModel<Scalar>& model)
       : vehicles(std::size_t(model.vehicle_count())),
         commands(std::size_t(model.vehicle_count())),
@@ -392,6 +452,7 @@ struct FleetEnergy {
   std::vector<Scalar> point_masses;  ///< ½ (m + φ C_a ρ V) |v|² + weight and buoyancy potential
   std::vector<Scalar> tethers;       ///< kinetic + elastic + weight and buoyancy (tether_energy)
   /// \brief The sum of the parts.
+  /// \return Σ vehicles + Σ point_masses + Σ tethers [J].
   Scalar total() const {
     Scalar s(0);
     for (const auto* v : {&vehicles, &point_masses, &tethers})
@@ -419,8 +480,10 @@ struct FleetReport {
   FleetEnergy<Scalar> energy;  ///< after the step, when asked for (SystemStepOptions)
   int tether_fallbacks = 0;    ///< tether steps redone explicitly
 
+  /// \brief An empty report (no parts).
   FleetReport() = default;
   /// \brief Sized for `model`.
+  /// \param model The fleet: one entry per vehicle or tether in each per-part vector, all zero.
   explicit FleetReport(const FleetModel<Scalar>& model) {
     const auto n = std::size_t(model.vehicle_count()), m = std::size_t(model.tether_count());
     tethers.resize(m);
@@ -441,7 +504,9 @@ struct FleetTetherWorkspace {
   tether::TetherWorkspace<Scalar> tether;  ///< the line's buffers (the current node count's)
   tether::StateBackup<Scalar> backup;      ///< the state at the start of a step
   std::optional<tether::WinchWorkspace<Scalar>> winch;  ///< with a winch: every count's buffers
-  /// The backup of the state's node count.
+  /// \brief The backup of the state's node count.
+  /// \param line The line model of the state's node count (FleetModel::tether_of).
+  /// \return `backup` without a winch, else the winch's backup of that count.
   tether::StateBackup<Scalar>& backup_of(const tether::TetherModel<Scalar>& line) {
     return winch ? winch->backup[winch->slot(line.segments())] : backup;
   }
@@ -455,18 +520,26 @@ struct FleetWorkspace {
   FleetReport<Scalar> report;                               ///< the last step's report
   // The step's scratch: inputs after propulsion, a failed step's restore copies, the tether
   // forces on each vehicle and point mass.
+  /// Per vehicle: the step's inputs, the propulsion's mean wrench added to τ [N, N m] (body).
   std::vector<vehicle::VehicleInputs<Scalar>> inputs;
+  /// Per vehicle: a copy of its propulsion state advanced over the step, committed to the state
+  /// only when the whole step succeeds.
   std::vector<vehicle::PropulsionState<Scalar>> propulsion;
+  /// Per vehicle: its state at the start of the step (restored after a throw).
   std::vector<vehicle::VehicleState<Scalar>> vehicles_before;
-  std::vector<Vector6<Scalar>> nu_dot_before;
-  std::vector<PointMassState<Scalar>> masses_before;
+  std::vector<Vector6<Scalar>> nu_dot_before;  ///< per vehicle: ν̇ at the start of the step
+  std::vector<PointMassState<Scalar>> masses_before;  ///< per point mass: state at the start
+  /// Per point mass: its acceleration at the start of the step [m/s²].
   std::vector<Vector3<Scalar>> mass_acceleration_before;
-  std::vector<tether::TetherBoundary<Scalar>> ends;
+  std::vector<tether::TetherBoundary<Scalar>> ends;  ///< per tether: its ends' predicted motion
   std::vector<std::vector<detail::PointLoad<Scalar>>>
       loads;                                 ///< per vehicle, one per tether end on it
   std::vector<Vector3<Scalar>> mass_forces;  ///< per point mass, NED [N]
 
+  /// \brief Empty buffers (for an empty fleet; assign a sized workspace before stepping).
   FleetWorkspace() = default;
+  /// \brief Buffers for `model` (allocates; a step then allocates nothing).
+  /// \param model The fleet (its winches' buffers for every node count are built too).
   explicit FleetWorkspace(const FleetModel<Scalar>& model) : report(model) {
     const auto n = std::size_t(model.vehicle_count()), m = std::size_t(model.tether_count());
     const auto pm = std::size_t(model.point_mass_count());
@@ -489,6 +562,9 @@ struct FleetWorkspace {
     mass_forces.resize(pm);
   }
   /// \brief Whether the buffers were built for `model`.
+  /// \param model A fleet.
+  /// \return True when the counts of vehicles, tethers, point masses, ends per vehicle and
+  /// winches match.
   bool fits(const FleetModel<Scalar>& model) const {
     if (vehicles.size() != std::size_t(model.vehicle_count()) ||
         tethers.size() != std::size_t(model.tether_count()) ||
@@ -508,6 +584,10 @@ struct FleetWorkspace {
 /// allocate (once).
 /// \throws kelp::invalid_argument when the workspace or the state is not sized for the fleet
 /// or a tether's node count is outside its winch's range.
+/// \tparam Scalar double or float.
+/// \param model The fleet.
+/// \param[in,out] ws Its workspace.
+/// \param state The state to be stepped next.
 template <typename Scalar>
 void fit_workspace(const FleetModel<Scalar>& model, FleetWorkspace<Scalar>& ws,
                    const FleetState<Scalar>& state) {
@@ -665,6 +745,10 @@ bool actual_end(const TetherEnd<Scalar>& e, const FleetState<Scalar>& s, Vector3
 /// \brief The energy of `state`, part by part (allocation-free into `e`, sized for the model:
 /// FleetReport's). Hydrostatic potentials relative to the environment's free surface.
 /// \throws kelp::invalid_argument when `e` or `state` does not have the fleet's parts.
+/// \tparam Scalar double or float.
+/// \param model The fleet (its environment gives ρ, g and the free surface).
+/// \param state The state whose energy is wanted.
+/// \param[out] e Energy per part [J], sized for the fleet (e.g. FleetReport::energy).
 template <typename Scalar>
 void energy(const FleetModel<Scalar>& model, const FleetState<Scalar>& state,
             FleetEnergy<Scalar>& e) {
@@ -893,6 +977,14 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
 /// 1e-4 × each line's weight in air.
 /// \throws kelp::invalid_argument for states of the wrong count or bad; kelp::numerical_error
 /// when a tether's static solve does not converge (naming the tether).
+/// \tparam Scalar double or float.
+/// \param model The fleet.
+/// \param ws Its workspace (the static solves' buffers).
+/// \param vehicles One state per vehicle (pose, body velocity), copied as given.
+/// \param point_masses One NED position per point mass [m] (default: none).
+/// \param t Start time [s] (default 0).
+/// \param options The tethers' static solve (tolerance, iterations).
+/// \return The state: propulsion at its initial state, coupling memory zero, every clock at t.
 template <typename Scalar>
 FleetState<Scalar> initial_state(const FleetModel<Scalar>& model, FleetWorkspace<Scalar>& ws,
                                  const std::vector<vehicle::VehicleState<Scalar>>& vehicles,

@@ -45,9 +45,16 @@ enum class TetherKind {
 };
 
 /// \brief The paper's sea states.
-enum class Sea { calm, moderate, rough };
+enum class Sea {
+  calm,      ///< environment::presets::calm()
+  moderate,  ///< environment::presets::moderate()
+  rough      ///< environment::presets::rough()
+};
 
 /// \brief The sea state of `sea` (environment::presets).
+/// \param sea One of the paper's sea states.
+/// \return Its waves, wind and current.
+/// \throws kelp::invalid_argument when `sea` is not a Sea value.
 inline environment::SeaState sea_state(Sea sea) {
   switch (sea) {
     case Sea::calm:
@@ -62,6 +69,11 @@ inline environment::SeaState sea_state(Sea sea) {
 
 /// \brief The environment of `sea`: JONSWAP waves with the default number of components, wind
 /// with gusts and current, in seawater (environment::make_environment).
+/// \tparam Scalar double or float.
+/// \param sea One of the paper's sea states.
+/// \param options How the sea state becomes an environment (components, seeds, ...).
+/// \return The environment.
+/// \throws kelp::invalid_argument when `sea` is not a Sea value or `options` is invalid.
 template <typename Scalar>
 environment::Environment<Scalar> environment(Sea sea,
                                              const environment::SeaStateOptions& options = {}) {
@@ -69,12 +81,16 @@ environment::Environment<Scalar> environment(Sea sea,
 }
 
 /// \brief BlueBoat tether point, body axes [m] (see the file comment).
+/// \tparam Scalar double or float.
+/// \return (−0.5, 0, 0.08) m from the CO, body axes.
 template <typename Scalar>
 Vector3<Scalar> blueboat_attachment() {
   return Vector3<Scalar>(Scalar(-0.5), Scalar(0), Scalar(0.08));
 }
 
 /// \brief BlueROV2 Heavy tether point, body axes [m] (see the file comment).
+/// \tparam Scalar double or float.
+/// \return (−0.2, 0, −0.05) m from the CO, body axes.
 template <typename Scalar>
 Vector3<Scalar> bluerov2_attachment() {
   return Vector3<Scalar>(Scalar(-0.2), Scalar(0), Scalar(-0.05));
@@ -83,6 +99,11 @@ Vector3<Scalar> bluerov2_attachment() {
 /// \brief The propulsion of a vehicle preset: its thrusters (positions, directions, facing; the
 /// ESC command scale of its PWM mapping) on `battery`, with the T200 lag of `time_constant` [s]
 /// (0: none).
+/// \tparam Scalar double or float.
+/// \param preset The vehicle preset (vehicle::blueboat, vehicle::bluerov2_heavy, ...).
+/// \param battery The battery the thrusters draw from.
+/// \param time_constant First-order thrust lag [s] (default vehicle::t200_time_constant).
+/// \return Propulsion parameters (not validated here; the propulsion model checks them).
 template <typename Scalar>
 vehicle::PropulsionParameters<Scalar> propulsion_of(
     const vehicle::VehiclePreset<Scalar>& preset, const vehicle::BatteryParameters& battery,
@@ -110,7 +131,11 @@ vehicle::PropulsionParameters<Scalar> propulsion_of(
 /// split in halves, throws with the state unchanged. Both vehicles have their propulsion (see the
 /// file comment): T200s with a 20 ms lag on the BlueBoat's two packs in parallel and the
 /// BlueROV2's one (vehicle::battery_presets).
-/// \throws kelp::invalid_argument for a non-positive length.
+/// \tparam Scalar double or float.
+/// \param tether_length Unstretched tether length L [m] (> 0; default 10 m).
+/// \param kind Which line: the ROV tether (0.5 m segments) or the bead chain.
+/// \return The system's parameters.
+/// \throws kelp::invalid_argument for a non-positive length or a `kind` that is not a TetherKind.
 template <typename Scalar>
 SystemParameters<Scalar> paper_system(Scalar tether_length = Scalar(10),
                                       TetherKind kind = TetherKind::rov_tether) {
@@ -140,12 +165,18 @@ SystemParameters<Scalar> paper_system(Scalar tether_length = Scalar(10),
 /// \brief Where the paper's vehicles start: the boat at the origin heading north, the ROV
 /// straight astern of it at 5 m depth (0.6 L for tethers shorter than 8.3 m), at a distance
 /// between the tether points of 80 % of the tether length, both at rest.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct StartPoses {
-  vehicle::VehicleState<Scalar> asv, auv;  ///< the vehicles' states
+  vehicle::VehicleState<Scalar> asv,  ///< the boat's state: at the origin, level, heading north
+      auv;                            ///< the ROV's state: astern of the boat, level, at rest
 };
 
 /// \brief The start poses of `paper_system(tether_length)` (see StartPoses).
+/// \tparam Scalar double or float.
+/// \param tether_length Unstretched tether length L [m] (> 0; default 10 m).
+/// \return Both vehicles' start states.
+/// \throws kelp::invalid_argument for a non-positive length.
 template <typename Scalar>
 StartPoses<Scalar> paper_start(Scalar tether_length = Scalar(10)) {
   using std::sqrt;
@@ -163,12 +194,20 @@ StartPoses<Scalar> paper_start(Scalar tether_length = Scalar(10)) {
 }
 
 /// \brief The paper's system built in the sea `sea`, its workspace and its start state.
+/// \tparam Scalar double or float.
 template <typename Scalar>
 struct PaperWorld {
   SystemModel<Scalar> model;          ///< the system
   SystemWorkspace<Scalar> workspace;  ///< its buffers
   SystemState<Scalar> state;          ///< the start state (paper_start, static tether)
 
+  /// \brief Builds the system, its workspace and the start state (the tether's static shape).
+  /// \param tether_length Unstretched tether length L [m] (> 0).
+  /// \param sea One of the paper's sea states.
+  /// \param kind Which line joins the vehicles.
+  /// \param options How the sea state becomes an environment.
+  /// \throws kelp::invalid_argument for bad arguments (see paper_system and environment);
+  /// kelp::numerical_error when the tether's static solve does not converge (see initial_state).
   PaperWorld(Scalar tether_length, Sea sea, TetherKind kind = TetherKind::rov_tether,
              const environment::SeaStateOptions& options = {})
       : model(paper_system(tether_length, kind), environment<Scalar>(sea, options)),

@@ -51,6 +51,8 @@ struct SolverStats {
   Scalar worst_rejected_residual = Scalar(0);
 
   /// \brief Adds the work of one system step.
+  /// \param r The report of one `system::step` call.
+  /// \return *this.
   SolverStats& operator+=(const SystemReport<Scalar>& r) {
     ++steps;
     tether_steps += r.tether.substeps;
@@ -66,6 +68,8 @@ struct SolverStats {
 
   /// \brief Adds another run's (or part of a run's) statistics: counts add up, maxima are the
   /// worst.
+  /// \param o The statistics to add.
+  /// \return *this.
   SolverStats& operator+=(const SolverStats& o) {
     steps += o.steps;
     tether_steps += o.tether_steps;
@@ -80,10 +84,12 @@ struct SolverStats {
   }
 
   /// \brief Mean Newton corrections per system step (0 before the first step).
+  /// \return newton_iterations / steps.
   double mean_step_newton_iterations() const {
     return steps > 0 ? static_cast<double>(newton_iterations) / static_cast<double>(steps) : 0.0;
   }
   /// \brief Mean Newton corrections per committed tether step (0 before the first step).
+  /// \return newton_iterations / tether_steps (failed attempts' corrections included).
   double mean_tether_step_newton_iterations() const {
     return tether_steps > 0
                ? static_cast<double>(newton_iterations) / static_cast<double>(tether_steps)

@@ -325,6 +325,10 @@ struct SystemEnergy {
 /// \brief The energy of `state` (the hydrostatic potentials relative to the environment's free
 /// surface at the vehicles and the nodes). Allocation-free; costs about one tether force
 /// evaluation plus a surface query per node.
+/// \tparam Scalar double or float.
+/// \param model The system (its environment gives ρ, g and the free surface).
+/// \param state The state whose energy is wanted (its time places the free surface).
+/// \return The energy of each part [J].
 template <typename Scalar>
 SystemEnergy<Scalar> energy(const SystemModel<Scalar>& model, const SystemState<Scalar>& state) {
   const auto& env = model.environment();

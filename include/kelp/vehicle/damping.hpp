@@ -39,6 +39,7 @@ struct DampingParameters {
 /// \brief Throws kelp::invalid_argument naming `linear_damping` or `quadratic_damping` unless
 /// the coefficients are finite, the quadratic ones ≥ 0 and ½(D_L + D_Lᵀ) is positive
 /// semi-definite.
+/// \param d Linear D_L [N s/m, N m s/rad] and quadratic d coefficients, body axes.
 template <typename Scalar>
 void validate(const DampingParameters<Scalar>& d) {
   const Matrix6<Scalar> sym = Scalar(0.5) * (d.linear + d.linear.transpose());

@@ -69,6 +69,9 @@ StateDerivative<Scalar> state_derivative_unchecked(const VehicleModel<Scalar>& m
 /// \brief Full state derivative: kinematics (pose_rate()) and kinetics (forward_dynamics()).
 /// \param[in] model vehicle. \param[in,out] ws buffers. \param[in] state current state.
 /// \param[in] tau_total τ + τ_ext [N, N m], body axes. \param[in] current_ned v_c^n [m/s], NED.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \tparam DT, DC Eigen vector expressions (6 and 3 entries).
+/// \return ṗ (NED), q̇ and ν̇ (body) at `state`.
 /// \throws as forward_dynamics(): kelp::invalid_argument for a wrench or current of the wrong
 /// size or a non-finite value in them or in the state.
 template <typename Scalar, typename DT, typename DC>
@@ -224,6 +227,11 @@ void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& 
 }
 
 /// \brief step_rk4_with() in still water.
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] wrench callable `(stage_state, stage_time_offset)` → τ + τ_ext [N, N m], body.
+/// \param[in] dt step [s], > 0.
+/// \throws as the overload with a current.
 template <typename Scalar, typename WrenchFn>
 void step_rk4_with(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                    VehicleState<Scalar>& state, WrenchFn&& wrench, identity_t<Scalar> dt) {
@@ -253,6 +261,10 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 }
 
 /// \brief One RK4 step in still water (no current).
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] inputs τ and τ_ext [N, N m], body. \param[in] dt step [s], > 0.
+/// \throws as the overload with a current.
 template <typename Scalar>
 void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
               VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
@@ -272,6 +284,12 @@ void step_rk4(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
 /// (`hull_height` about the CB, Hydrostatics::submerged_free_surface) pierces the surface,
 /// halfway between the surface and the bottom of the box. One more environment sample when that
 /// applies.
+/// \tparam Env `kelp::environment::Environment` or a type with the same queries (see the
+/// overload without a model).
+/// \param[in] model vehicle (its hydrostatics, draft and wind areas decide what is sampled).
+/// \param[in] env environment \param[in] x vehicle state \param[in] t time [s]
+/// \return The surroundings: water velocity and material acceleration (NED), free surface and
+/// wind.
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const VehicleModel<Scalar>& model, const Env& env,
                                   const VehicleState<Scalar>& x, double t) {
@@ -361,6 +379,10 @@ void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<S
 }
 
 /// \brief One semi-implicit (symplectic) Euler step in still water (no current).
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] inputs τ and τ_ext [N, N m], body. \param[in] dt step [s], > 0.
+/// \throws as the overload with a current.
 template <typename Scalar>
 void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                            VehicleState<Scalar>& state, const VehicleInputs<Scalar>& inputs,
@@ -371,6 +393,10 @@ void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<S
 /// \brief One semi-implicit (symplectic) Euler step in an environment: ν̇ from the surroundings
 /// sampled at the start of the step (at state.time), then the update of the current-only
 /// overload. \throws as step_rk4() in an environment.
+/// \param[in] model vehicle. \param[in,out] ws buffers.
+/// \param[in] env environment (as for step_rk4() in an environment).
+/// \param[in,out] state advanced by dt (its clock too) on success, unchanged on failure.
+/// \param[in] inputs τ and τ_ext [N, N m], body. \param[in] dt step [s], > 0.
 template <typename Scalar, typename Env>
 void step_symplectic_euler(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
                            const Env& env, VehicleState<Scalar>& state,

@@ -96,8 +96,10 @@ struct VehicleParameters {
   environment::ConstantWindCoefficients wind_coefficients;
 
   /// \brief W = m g [N].
+  /// \return m g [N].
   Scalar weight() const { return mass * gravity; }
   /// \brief B = ρ g ∇ [N].
+  /// \return ρ g ∇ [N].
   Scalar buoyancy() const { return density * gravity * displaced_volume; }
 
   /// \brief The same parameters in another scalar type (e.g. double → ceres::Jet).
@@ -147,6 +149,8 @@ void check_water(const Scalar& density, const Scalar& gravity) {
 /// \throws kelp::invalid_argument as above; besides finiteness and signs, `density` must be at
 /// most 1e5 kg/m³ and `gravity` at most 1000 m/s² (see `environment::limits`; the message gives
 /// the value), and the weight m g and buoyancy ρ g ∇ must be finite.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param p The parameters to check.
 template <typename Scalar>
 void validate(const VehicleParameters<Scalar>& p) {
   check_positive(p.mass, "mass");
@@ -187,31 +191,41 @@ template <typename Scalar>
 class VehicleModel {
  public:
   /// \brief Validates `parameters` and factors the mass matrix.
+  /// \param parameters The vehicle's parameters (copied).
   /// \throws kelp::invalid_argument naming the offending field, or when a derived quantity
   /// (M_RB, M, M⁻¹, the surface vessel's stiffnesses ρ g A_wp and ρ g ∇ GM) is not finite, e.g.
   /// for a mass or inertia near the largest double.
   explicit VehicleModel(const VehicleParameters<Scalar>& parameters);
 
   /// \brief The validated parameters.
+  /// \return The parameters, as given.
   const VehicleParameters<Scalar>& parameters() const { return parameters_; }
   /// \brief M_RB about the CO [kg, kg m, kg m²].
+  /// \return The 6×6 rigid-body mass matrix, body axes.
   const Matrix6<Scalar>& rigid_body_mass() const { return rigid_body_mass_; }
   /// \brief M_A (symmetric part of the given matrix).
+  /// \return ½ (M_A + M_Aᵀ) [kg, kg m, kg m²], body axes.
   const Matrix6<Scalar>& added_mass() const { return added_mass_; }
   /// \brief M = M_RB + M_A (fully submerged; a `submerged_free_surface` vehicle at the surface has
   /// M_RB + φ M_A, see forward_dynamics()).
+  /// \return M [kg, kg m, kg m²], symmetric positive definite.
   const Matrix6<Scalar>& mass_matrix() const { return mass_; }
   /// \brief LDLT factorisation of M, computed once.
+  /// \return The factorisation of mass_matrix().
   const Eigen::LDLT<Matrix6<Scalar>>& mass_ldlt() const { return ldlt_; }
   /// \brief M⁻¹, obtained once from the LDLT factorisation at construction.
+  /// \return M⁻¹.
   const Matrix6<Scalar>& mass_inverse() const { return mass_inverse_; }
   /// \brief W = m g [N].
+  /// \return W [N].
   const Scalar& weight() const { return weight_; }
   /// \brief B = ρ g ∇ [N] (submerged model).
+  /// \return B [N] (fully submerged; the free-surface models scale it).
   const Scalar& buoyancy() const { return buoyancy_; }
 
   /// \brief Restoring vector g(η) [N, N m], body axes, in calm water (flat surface at z = 0).
   /// \param[in] state vehicle state. \param[in] R its rotation matrix body → NED.
+  /// \return g(η) [N, N m], body axes.
   template <typename DerivedR>
   Vector6<Scalar> restoring(const VehicleState<Scalar>& state,
                             const Eigen::MatrixBase<DerivedR>& R) const {
@@ -225,6 +239,7 @@ class VehicleModel {
   /// \param[in] zeta surface elevation ζ at the CO's (x, y) [m], up
   /// \param[in] slope (∂ζ/∂x, ∂ζ/∂y) [-] (read by `surface` only)
   /// \param[out] fraction submerged fraction φ (`submerged_free_surface`; 1 otherwise), if not null
+  /// \return g [N, N m], body axes.
   template <typename DerivedR, typename DerivedS>
   Vector6<Scalar> restoring(const VehicleState<Scalar>& state, const Eigen::MatrixBase<DerivedR>& R,
                             const Scalar& zeta, const Eigen::MatrixBase<DerivedS>& slope,
@@ -249,6 +264,9 @@ class VehicleModel {
   /// (`submerged_free_surface`: submerged_fraction() of the box hull about the CB; 1 for the other
   /// models). Every fluid term of a `submerged_free_surface` vehicle scales with it (see
   /// forward_dynamics()).
+  /// \param state Vehicle state (its CO depth and attitude place the CB).
+  /// \param zeta Surface elevation ζ at the vehicle [m], up.
+  /// \return φ [-].
   Scalar submerged_fraction(const VehicleState<Scalar>& state, const Scalar& zeta) const {
     if (parameters_.hydrostatics != Hydrostatics::submerged_free_surface) return Scalar(1);
     const Scalar z_cb =
@@ -259,6 +277,10 @@ class VehicleModel {
   /// \brief Hydrostatic potential energy U [J] of which restoring() is the gradient for a fixed
   /// surface (ζ, slope): see restoring_potential_free_surface() and
   /// restoring_potential_surface_following(); −W z_CG + B z_CB for `submerged`.
+  /// \param state Vehicle state.
+  /// \param zeta Surface elevation ζ at the CO's (x, y) [m], up.
+  /// \param slope (∂ζ/∂x, ∂ζ/∂y) [-] (read by `surface` only).
+  /// \return U [J].
   template <typename DerivedS>
   Scalar restoring_potential(const VehicleState<Scalar>& state, const Scalar& zeta,
                              const Eigen::MatrixBase<DerivedS>& slope) const {
@@ -494,7 +516,6 @@ void check_dynamics_input(const VehicleState<Scalar>& state, const Eigen::Matrix
 /// surface, wind), allocation-free:
 /// \f[ \dot\nu = M^{-1}\big(\tau + \tau_{ext} - C_{RB}(\nu)\nu - C_A(\nu_r)\nu_r - D(\nu_r)\nu_r
 ///     - g(\eta, \zeta, \nabla\zeta) + M_A\dot\nu_w + \tau_{FK} + \tau_{wind}\big). \f]
-///
 /// Water motion (Fossen 2021, §10.3, extended to a non-uniform, unsteady flow as in Faltinsen
 /// 1990, ch. 3, for a body small against the wavelength): ν_w = (Rᵀ v_w, 0) with v_w the water
 /// velocity at the CO (current + wave orbital velocity), ν_r = ν − ν_w, and the body-frame rate
@@ -568,6 +589,11 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
 }
 
 /// \brief Forward dynamics without current: ν̇ = M⁻¹(τ + τ_ext − C_RB ν − C_A ν − D ν − g).
+/// \param[in] model the vehicle. \param[in,out] ws buffers, filled with the terms.
+/// \param[in] state pose (NED, unit quaternion) and ν (body).
+/// \param[in] tau control wrench [N, N m], body axes about the CO.
+/// \param[in] tau_ext other external wrench [N, N m], body axes about the CO.
+/// \return ν̇ [m/s², rad/s²], body axes.
 /// \throws as the overload with a current.
 template <typename Scalar, typename DT, typename DE>
 Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorkspace<Scalar>& ws,
@@ -585,6 +611,11 @@ Vector6<Scalar> forward_dynamics(const VehicleModel<Scalar>& model, VehicleWorks
 /// U = −W z_CG + B h Φ(s) with Φ the integral of the submerged fraction (see
 /// restoring_potential_free_surface()). The added-mass kinetic energy uses the velocity over
 /// ground (the fluid at rest).
+/// \param model The vehicle.
+/// \param state Its state.
+/// \param s Surroundings at the vehicle (only the surface elevation and slope are read; default:
+/// flat calm surface at z = 0).
+/// \return Kinetic + hydrostatic potential energy [J].
 template <typename Scalar>
 Scalar energy(const VehicleModel<Scalar>& model, const VehicleState<Scalar>& state,
               const Surroundings<Scalar>& s = Surroundings<Scalar>()) {

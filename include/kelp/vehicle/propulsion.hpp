@@ -98,6 +98,7 @@ struct ThrustCurve {
   /// Current [A] drawn from the battery at each point, finite and >= 0; empty: none drawn.
   CurveVector current;
   /// \brief True without points: the thruster is a T200.
+  /// \return command.size() == 0.
   bool empty() const { return command.size() == 0; }
 };
 
@@ -124,6 +125,10 @@ Scalar clamp_command(Scalar u) {
 
 /// \brief Thrust [N] of a thruster's curve at command u (clamped to [−1, 1]), linear between its
 /// points. \throws kelp::invalid_argument for an empty curve (the T200: t200_thrust).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param c The thruster's curve (validated: commands ascending from −1 to 1).
+/// \param command Command u [-].
+/// \return Thrust [N] along the thruster's direction.
 template <typename Scalar>
 Scalar curve_thrust(const ThrustCurve& c, const Scalar& command) {
   KELP_CHECK(c.command.size() >= 2 && c.thrust.size() == c.command.size(),
@@ -134,6 +139,10 @@ Scalar curve_thrust(const ThrustCurve& c, const Scalar& command) {
 /// \brief Current [A] a thruster on its curve draws at command u (clamped to [−1, 1]), linear
 /// between its points; 0 for a curve without currents. \throws kelp::invalid_argument for an
 /// empty curve (the T200: t200_current).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param c The thruster's curve (validated).
+/// \param command Command u [-].
+/// \return Current [A] (≥ 0 for a valid curve).
 template <typename Scalar>
 Scalar curve_current(const ThrustCurve& c, const Scalar& command) {
   KELP_CHECK(c.command.size() >= 2,
@@ -177,6 +186,10 @@ struct PropulsionParameters {
 /// and no currents, or 2 to max_curve_points commands strictly ascending from −1 to 1, one finite
 /// thrust per command, no currents or one finite non-negative current per command; facing +1),
 /// a finite non-negative time constant, the battery's fields.
+/// Also: ESC scales finite > 0. The directions are checked when the model is built
+/// (allocation_matrix()).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param p The parameters to check.
 template <typename Scalar>
 void validate(const PropulsionParameters<Scalar>& p) {
   KELP_CHECK(p.positions.cols() >= 1 && p.positions.cols() <= max_thrusters,
@@ -220,9 +233,12 @@ void validate(const PropulsionParameters<Scalar>& p) {
 }
 
 /// \brief A propulsion built once: the parameters and the allocation B (6×n).
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 class PropulsionModel {
  public:
+  /// \brief Validates `p` and builds the allocation (directions normalised).
+  /// \param p The propulsion's parameters (copied).
   /// \throws kelp::invalid_argument (validate(), allocation_matrix()).
   explicit PropulsionModel(const PropulsionParameters<Scalar>& p)
       : parameters_((validate(p), p)), allocation_(p.positions, p.directions) {
@@ -230,12 +246,16 @@ class PropulsionModel {
     if (p.facing.size() > 0) facing_ = p.facing;
   }
   /// \brief The parameters.
+  /// \return The parameters, as given.
   const PropulsionParameters<Scalar>& parameters() const { return parameters_; }
   /// \brief The allocation (B = allocation().matrix()).
+  /// \return The thruster allocation, body axes about the CO.
   const ThrusterAllocation<Scalar>& allocation() const { return allocation_; }
   /// \brief Number of thrusters.
+  /// \return n, 1 ≤ n ≤ max_thrusters.
   Eigen::Index size() const { return allocation_.size(); }
   /// \brief ±1 per thruster.
+  /// \return n entries (all +1 when the parameters' facing was empty).
   const ThrusterVector<int>& facing() const { return facing_; }
 
  private:
@@ -245,6 +265,7 @@ class PropulsionModel {
 };
 
 /// \brief Everything of a propulsion that determines its next step (part of the system state).
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 struct PropulsionState {
   /// Each thruster's thrust along its direction now [N] (the lag's state).
@@ -256,6 +277,9 @@ struct PropulsionState {
 };
 
 /// \brief The state of `m` at rest with a fresh battery (at its initial_soc): zero thrust.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m The propulsion.
+/// \return n zero thrusts and currents, a default BatteryState.
 template <typename Scalar>
 PropulsionState<Scalar> initial_state(const PropulsionModel<Scalar>& m) {
   PropulsionState<Scalar> s;
@@ -264,8 +288,12 @@ PropulsionState<Scalar> initial_state(const PropulsionModel<Scalar>& m) {
   return s;
 }
 
-/// \brief Throws kelp::invalid_argument naming `field` unless `s` fits `m` (one entry per
-/// thruster, finite thrust, finite non-negative counters).
+/// \brief Throws kelp::invalid_argument naming `field` unless `s` fits `m` (one thrust and one
+/// current per thruster, finite thrusts, finite battery counters).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m The propulsion.
+/// \param s The state to check.
+/// \param field Name of the state in the message (e.g. "propulsion state").
 template <typename Scalar>
 void check_state(const PropulsionModel<Scalar>& m, const PropulsionState<Scalar>& s,
                  const char* field) {
@@ -279,6 +307,7 @@ void check_state(const PropulsionModel<Scalar>& m, const PropulsionState<Scalar>
 }
 
 /// \brief What one propulsion step delivered.
+/// \tparam Scalar double, float or ceres::Jet.
 template <typename Scalar>
 struct PropulsionStep {
   /// Body wrench of the thrust's mean over the step, B f̄ [N, N m].
@@ -293,7 +322,11 @@ struct PropulsionStep {
 /// empty: all 0) held over the step (see the file comment): solves the terminal voltage,
 /// integrates the lag exactly towards each thruster's static thrust (T200 or its curve), drains
 /// the battery. Allocation-free.
+/// \tparam Derived Any Eigen vector expression (n entries, or 0).
+/// \param[in] m the propulsion.
 /// \param[in,out] s advanced by dt (only once every check has passed).
+/// \param[in] commands u per thruster [-], clamped to [−1, 1] after the ESC scale; empty: all 0.
+/// \param[in] dt step [s], > 0.
 /// \returns the mean thrust's wrench and the step's voltage and current.
 /// \throws kelp::invalid_argument for a bad dt, a command vector of the wrong size or with a
 /// non-finite entry, or a state that does not fit the model (`s` unchanged).

@@ -118,6 +118,11 @@ Vector6<Scalar> restoring_force_free_surface(const Scalar& weight, const Scalar&
 /// s²/2 for 0 ≤ s ≤ 1, s − ½ for s > 1). Fully submerged it is −W z_CG + B (z_CB + ζ) − B h/2, the
 /// usual −W z_CG + B z_CB up to a constant. For a fixed surface (ζ constant) the work of g equals
 /// −ΔU, so an undamped, unforced vehicle conserves ½ νᵀ M ν + U.
+/// \param[in] weight W [N] \param[in] buoyancy B = ρ g ∇ fully submerged [N]
+/// \param[in] r_g CG [m], body \param[in] r_b CB [m], body \param[in] hull_height h [m], > 0
+/// \param[in] z NED z of the CO [m] \param[in] zeta surface elevation ζ [m], up
+/// \param[in] R rotation body → NED
+/// \return U [J].
 template <typename Scalar, typename DG, typename DB, typename DR>
 Scalar restoring_potential_free_surface(const Scalar& weight, const Scalar& buoyancy,
                                         const Eigen::MatrixBase<DG>& r_g,
@@ -199,6 +204,12 @@ Vector6<Scalar> restoring_force_surface_following(
 /// \brief Potential energy [J] whose gradient is restoring_force_surface_following() for a fixed
 /// surface: U = ρ g A_wp P(z + ζ) + ½ ρ g ∇ (GM_T d_y² + GM_L d_x²), with P(e) = ∫₀ᵉ clamp(ε, −T,
 /// D − T) dε (e²/2 inside the bounds, continued linearly outside; no bound when D = 0).
+/// \param[in] density ρ [kg/m³] \param[in] gravity g [m/s²] \param[in] displaced_volume ∇ [m³]
+/// \param[in] waterplane_area A_wp [m²] \param[in] gm_transverse GM_T [m]
+/// \param[in] gm_longitudinal GM_L [m] \param[in] hull_depth D [m] (0: no bound)
+/// \param[in] z NED z of the CO [m] \param[in] zeta local elevation ζ [m], up
+/// \param[in] slope (∂ζ/∂x, ∂ζ/∂y) [-] \param[in] R rotation body → NED
+/// \return U [J] (0 at calm equilibrium: e = 0, level).
 template <typename Scalar, typename DS, typename DR>
 Scalar restoring_potential_surface_following(
     const Scalar& density, const Scalar& gravity, const Scalar& displaced_volume,

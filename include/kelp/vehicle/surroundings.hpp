@@ -132,6 +132,8 @@ Surroundings<Scalar> sample_surroundings(const Env& env, const VehicleState<Scal
 /// surroundings, which forward_dynamics() refuses and a step reports as numerical_error.
 /// \param[in] env environment \param[in] x vehicle state (its CO position is used)
 /// \param[in] t time [s]
+/// \return Water velocity and material acceleration (NED), surface elevation and slope, wind
+/// and air density at the CO.
 template <typename Scalar, typename Env>
 Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x, double t) {
   return detail::sample_surroundings(env, x, t, true, true);
@@ -139,6 +141,9 @@ Surroundings<Scalar> surroundings(const Env& env, const VehicleState<Scalar>& x,
 
 /// \brief Replaces the water velocity and acceleration of `s` by those at depth `z` [m, NED]
 /// under the vehicle's CO (x, y), keeping the surface and the wind.
+/// \param[in] env environment \param[in] x vehicle state (its CO's north and east are used)
+/// \param[in] t time [s] \param[in] z NED depth of the sample [m]
+/// \param[in,out] s surroundings whose water velocity and acceleration are replaced
 template <typename Scalar, typename Env>
 void resample_water(const Env& env, const VehicleState<Scalar>& x, double t, const Scalar& z,
                     Surroundings<Scalar>& s) {

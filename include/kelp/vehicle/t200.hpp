@@ -157,6 +157,9 @@ bool t200_point(const Scalar& command, const Scalar& voltage, const T200Branch*&
 /// 20 V; fitted with the curves: the data read zero within ±24 to ±28 µs at 16–20 V and ±40 µs at
 /// 10 V, where rotation stays under the 300 rpm the data cut to zero); the 10 V value below
 /// 10 V.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param voltage Supply voltage at the ESC [V], in [0, 20].
+/// \return u₀(V) [-] (0.07 at 16 V).
 /// \throws kelp::invalid_argument for a voltage not finite or outside [0, 20] V.
 template <typename Scalar>
 Scalar t200_dead_band(const Scalar& voltage) {
@@ -170,6 +173,7 @@ Scalar t200_dead_band(const Scalar& voltage) {
 /// \tparam Scalar double, float or ceres::Jet.
 /// \param[in] command normalised command u (clamped to [−1, 1]; ±1 = 1900 / 1100 µs).
 /// \param[in] voltage supply voltage at the ESC [V], in [0, 20] (see the file's notes).
+/// \return Thrust [N] (51.6 N at u = 1 and 16 V).
 /// \throws kelp::invalid_argument when a value is not finite or the voltage is outside [0, 20] V.
 template <typename Scalar>
 Scalar t200_thrust(const Scalar& command, const Scalar& voltage) {
@@ -181,6 +185,9 @@ Scalar t200_thrust(const Scalar& command, const Scalar& voltage) {
 }
 
 /// \brief dF/du of t200_thrust() [N] (≥ 0; 0 in the dead band and for |u| > 1).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param[in] command normalised command u [-]. \param[in] voltage [V], in [0, 20].
+/// \return dF/du [N per unit command].
 /// \throws kelp::invalid_argument as t200_thrust().
 template <typename Scalar>
 Scalar t200_thrust_slope(const Scalar& command, const Scalar& voltage) {
@@ -198,6 +205,8 @@ Scalar t200_thrust_slope(const Scalar& command, const Scalar& voltage) {
 /// \brief Supply current drawn by one T200 and its ESC [A] (≥ 0; 0 in the dead band).
 /// Fit error over the data: ≤ 9.6 % of the reading, or ≤ 0.096 A below 1 A.
 /// \param[in] command u (clamped to [−1, 1]). \param[in] voltage [V], in [0, 20].
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return Current [A], ≥ 0.
 /// \throws kelp::invalid_argument as t200_thrust().
 template <typename Scalar>
 Scalar t200_current(const Scalar& command, const Scalar& voltage) {
@@ -210,6 +219,9 @@ Scalar t200_current(const Scalar& command, const Scalar& voltage) {
 }
 
 /// \brief Largest forward thrust [N] at a supply voltage: t200_thrust(1, V) (51.6 N at 16 V).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param voltage Supply voltage [V], in [0, 20].
+/// \return The thrust [N], ≥ 0.
 /// \throws kelp::invalid_argument for a voltage outside [0, 20] V or not finite.
 template <typename Scalar>
 Scalar t200_max_thrust(const Scalar& voltage) {
@@ -217,6 +229,9 @@ Scalar t200_max_thrust(const Scalar& voltage) {
 }
 
 /// \brief Largest reverse thrust [N], as a positive magnitude: −t200_thrust(−1, V).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param voltage Supply voltage [V], in [0, 20].
+/// \return The magnitude [N], ≥ 0.
 /// \throws kelp::invalid_argument for a voltage outside [0, 20] V or not finite.
 template <typename Scalar>
 Scalar t200_max_reverse_thrust(const Scalar& voltage) {
@@ -230,6 +245,8 @@ Scalar t200_max_reverse_thrust(const Scalar& voltage) {
 /// ceres::Jet derivatives follow the implicit-function theorem (∂u/∂F = 1/F_u, ∂u/∂V = −F_V/F_u).
 /// \param[in] force desired thrust [N] along the thruster's forward axis (negative: reverse).
 /// \param[in] voltage supply voltage [V], in [0, 20].
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return u ∈ [−1, 1] (outside the dead band unless the force is 0).
 /// \throws kelp::invalid_argument when a value is not finite or the voltage is out of range.
 template <typename Scalar>
 Scalar t200_command(const Scalar& force, const Scalar& voltage) {

@@ -23,6 +23,8 @@ namespace kelp::vehicle {
 /// \param[in] directions d_i, 3×n, body axes; normalised here (thrust of a positive command).
 /// \throws kelp::invalid_argument naming `thruster_positions` or `thruster_directions` (wrong
 /// shape, not finite, a zero direction), or when a moment r_i × d_i overflows.
+/// \tparam DP, DD Eigen matrix expressions (3×n) of the same scalar.
+/// \return B, 6×n [-, m]: forces in its top three rows, moments about the CO in the bottom three.
 template <typename DP, typename DD>
 Eigen::Matrix<typename DP::Scalar, 6, Eigen::Dynamic> allocation_matrix(
     const Eigen::MatrixBase<DP>& positions, const Eigen::MatrixBase<DD>& directions) {
@@ -85,19 +87,28 @@ class ThrusterAllocation {
   }
 
   /// \brief Number of thrusters n.
+  /// \return n ≥ 1.
   Eigen::Index size() const { return matrix_.cols(); }
   /// \brief Rank of B (6 for a fully actuated vehicle).
+  /// \return The numerical rank of B, 0 … min(6, n).
   Eigen::Index rank() const { return rank_; }
   /// \brief r_i [m], 3×n, body.
+  /// \return The positions, as given.
   const Matrix3X<Scalar>& positions() const { return positions_; }
   /// \brief Unit d_i, 3×n, body.
+  /// \return The normalised directions.
   const Matrix3X<Scalar>& directions() const { return directions_; }
   /// \brief B, 6×n.
+  /// \return The allocation matrix (see allocation_matrix()).
   const Eigen::Matrix<Scalar, 6, Eigen::Dynamic>& matrix() const { return matrix_; }
   /// \brief B⁺, n×6.
+  /// \return The Moore–Penrose pseudo-inverse of B.
   const Eigen::Matrix<Scalar, Eigen::Dynamic, 6>& pseudo_inverse() const { return pseudo_inverse_; }
 
   /// \brief Body wrench τ = B f [N, N m] of the thruster forces f [N] (n-vector).
+  /// \tparam Derived Any Eigen vector expression with n entries.
+  /// \param forces Thrust of each thruster along its direction d_i [N].
+  /// \return τ [N, N m], body axes about the CO.
   /// \throws kelp::invalid_argument when `forces` has not one entry per thruster or an entry
   /// is not finite.
   template <typename Derived>
@@ -113,6 +124,9 @@ class ThrusterAllocation {
   /// (least-squares when τ is not reachable). `forces` must already have n rows.
   /// \throws kelp::invalid_argument when `tau` has not 6 entries or an entry is not finite, or
   /// `forces` has not one entry per thruster (`forces` is left unchanged).
+  /// \tparam DW, DF Eigen vector expressions (6 and n entries).
+  /// \param tau Desired wrench [N, N m], body axes about the CO.
+  /// \param[out] forces Thrust per thruster along d_i [N] (n entries, not resized).
   template <typename DW, typename DF>
   void distribute(const Eigen::MatrixBase<DW>& tau, Eigen::MatrixBase<DF>& forces) const {
     KELP_CHECK(forces.size() == size(), "forces must have one entry per thruster");
@@ -198,6 +212,11 @@ void thrust_polynomial(const ThrusterModel& m, const Scalar& u, Scalar& f, Scala
 /// the thruster's forward axis).
 /// \throws kelp::invalid_argument naming the command when u is not finite, or (datasheet) the
 /// voltage when it is not finite or outside [0, 20] V.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m Thruster model.
+/// \param u_in Normalised command u [-].
+/// \param voltage Supply voltage [V] (default t200_nominal_voltage, 16 V).
+/// \return F(u) [N].
 template <typename Scalar>
 Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
               const Scalar& voltage = Scalar(t200_nominal_voltage)) {
@@ -214,6 +233,11 @@ Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
 }
 
 /// \brief dF/du [N] of thrust() (same clamping: 0 outside [−1, 1]).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m Thruster model.
+/// \param u Normalised command u [-].
+/// \param voltage Supply voltage [V] (datasheet curve only; default 16 V).
+/// \return dF/du [N per unit command].
 /// \throws kelp::invalid_argument as thrust().
 template <typename Scalar>
 Scalar thrust_slope(const ThrusterModel& m, const Scalar& u,
@@ -228,6 +252,10 @@ Scalar thrust_slope(const ThrusterModel& m, const Scalar& u,
 
 /// \brief Largest thrust [N] along the thruster's forward axis that model `m` delivers at a
 /// voltage [V] (datasheet: t200_max_thrust(); polynomial: max_thrust).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m Thruster model.
+/// \param voltage Supply voltage [V] (datasheet curve only; default 16 V).
+/// \return The thrust [N].
 /// \throws kelp::invalid_argument (datasheet) for a voltage outside [0, 20] V.
 template <typename Scalar>
 Scalar max_forward_thrust(const ThrusterModel& m,
@@ -238,6 +266,10 @@ Scalar max_forward_thrust(const ThrusterModel& m,
 
 /// \brief Largest reverse thrust [N] (a positive magnitude) of model `m` at a voltage [V]
 /// (datasheet: t200_max_reverse_thrust(); polynomial: max_thrust, the curve being odd).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m Thruster model.
+/// \param voltage Supply voltage [V] (datasheet curve only; default 16 V).
+/// \return The magnitude [N].
 /// \throws kelp::invalid_argument (datasheet) for a voltage outside [0, 20] V.
 template <typename Scalar>
 Scalar max_reverse_thrust(const ThrusterModel& m,
@@ -255,6 +287,8 @@ Scalar max_reverse_thrust(const ThrusterModel& m,
 /// ceres::Jet derivatives follow the implicit-function theorem (du/dF = 1/F'(u)).
 /// \param[in] m thruster model \param[in] force desired thrust [N] along the forward axis.
 /// \param[in] voltage supply voltage [V] (datasheet only).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return u [-] (|u| ≤ u_peak for the polynomial, ≤ 1 for the datasheet curve).
 /// \throws kelp::invalid_argument naming the force when it is not finite, or (datasheet) the
 /// voltage.
 template <typename Scalar>
@@ -288,6 +322,8 @@ Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force,
 /// \brief T200 thrust [N] at the nominal supply voltage (t200_nominal_voltage, 16 V):
 /// t200_thrust(u, 16 V).
 /// \param[in] u normalised command (clamped to [−1, 1]).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return Thrust [N] at 16 V.
 /// \throws kelp::invalid_argument naming the command when u is not finite.
 template <typename Scalar>
 Scalar t200_thrust(const Scalar& u) {
@@ -296,6 +332,9 @@ Scalar t200_thrust(const Scalar& u) {
 
 /// \brief dF/du of t200_thrust(u) [N] at the nominal voltage (0 outside [−1, 1] and in the
 /// dead band).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param u Normalised command u [-].
+/// \return dF/du [N per unit command] at 16 V.
 /// \throws kelp::invalid_argument naming the command when u is not finite.
 template <typename Scalar>
 Scalar t200_thrust_slope(const Scalar& u) {
@@ -304,6 +343,8 @@ Scalar t200_thrust_slope(const Scalar& u) {
 
 /// \brief Inverse of t200_thrust(u) at the nominal voltage: t200_command(force, 16 V).
 /// \param[in] force desired thrust [N] along the thruster's forward axis.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return u ∈ [−1, 1] [-].
 /// \throws kelp::invalid_argument naming the force when it is not finite.
 template <typename Scalar>
 Scalar t200_command(const Scalar& force) {
@@ -330,6 +371,7 @@ struct PwmMapping {
 
 /// \brief Throws kelp::invalid_argument naming the field unless min < neutral < max and
 /// 0 ≤ deadband < min(max − neutral, neutral − min).
+/// \param m PWM mapping [µs] (all values finite).
 template <typename Scalar>
 void validate(const PwmMapping<Scalar>& m) {
   check_finite(m.min_us, "min_us");
@@ -348,6 +390,10 @@ void validate(const PwmMapping<Scalar>& m) {
 /// clamped (as ArduPilot's SITL submarine does: no rescaling of the dead band).
 /// \throws kelp::invalid_argument when the pulse width is not finite or `m` is invalid (see
 /// `validate(const PwmMapping&)`).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param pwm_us Pulse width [µs].
+/// \param m PWM mapping (default 1100–1500–1900 µs, ±25 µs dead band).
+/// \return u ∈ [−1, 1] [-].
 template <typename Scalar>
 Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
   check_finite(pwm_us, "pwm");
@@ -367,6 +413,10 @@ Scalar command_from_pwm(const Scalar& pwm_us, const PwmMapping<Scalar>& m = PwmM
 /// band is not skipped.
 /// \throws kelp::invalid_argument when u is not finite or `m` is invalid (see
 /// `validate(const PwmMapping&)`).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param u_in Normalised command u [-].
+/// \param m PWM mapping (default 1100–1500–1900 µs).
+/// \return Pulse width [µs], in [min_us, max_us].
 template <typename Scalar>
 Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMapping<Scalar>()) {
   check_finite(u_in, "thruster command u");
@@ -380,7 +430,11 @@ Scalar pwm_from_command(const Scalar& u_in, const PwmMapping<Scalar>& m = PwmMap
 
 /// \brief Thrust [N] of a pulse width [µs] through the chain's first two links: the command
 /// u = command_from_pwm(pwm, pwm_map) (dead band, clamped) and the curve thrust(m, u, V).
+/// \param[in] m thruster model \param[in] pwm_us pulse width [µs]
+/// \param[in] pwm_map the ESC's PWM mapping
 /// \param[out] command u, if not null. \param[in] voltage supply voltage [V] (datasheet curve).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return Thrust [N] along the thruster's forward axis.
 /// \throws kelp::invalid_argument when the pulse width is not finite, `pwm_map` is invalid or
 /// the voltage is out of range.
 template <typename Scalar>
@@ -407,6 +461,7 @@ Scalar thrust_from_pwm(const ThrusterModel& m, const Scalar& pwm_us,
 template <typename Scalar>
 class ThrusterChain {
  public:
+  /// \brief Builds the chain (copies its parts) and sets the voltage.
   /// \param[in] allocation the thruster set \param[in] model the thrusters' curve (all alike)
   /// \param[in] pwm the ESCs' PWM mapping
   /// \param[in] facing ±1 per thruster (see the class); empty: all +1.
@@ -446,14 +501,19 @@ class ThrusterChain {
   }
 
   /// \brief Number of thrusters.
+  /// \return n.
   Eigen::Index size() const { return allocation_.size(); }
   /// \brief The allocation.
+  /// \return The thruster set (a copy held by the chain).
   const ThrusterAllocation<Scalar>& allocation() const { return allocation_; }
   /// \brief The thruster model.
+  /// \return The curve every thruster uses.
   const ThrusterModel& model() const { return model_; }
   /// \brief The PWM mapping.
+  /// \return The ESCs' mapping.
   const PwmMapping<Scalar>& pwm() const { return pwm_; }
   /// \brief ±1 per thruster (see the class).
+  /// \return n entries, each +1 or −1.
   const Eigen::VectorXd& facing() const { return facing_; }
 
   /// \brief Sets the supply voltage [V] at the ESCs that every thrust and command of the chain
@@ -461,6 +521,7 @@ class ThrusterChain {
   /// t200_nominal_voltage (16 V).
   /// \throws kelp::invalid_argument when it is not finite or outside [0, 20] V (the chain is
   /// left unchanged).
+  /// \param volts Supply voltage [V], in [0, 20].
   void set_voltage(double volts) {
     detail::t200_check_voltage(volts);
     voltage_ = volts;
@@ -469,18 +530,26 @@ class ThrusterChain {
     max_reverse_ = value_of(max_reverse_thrust(model_, v));
   }
   /// \brief The supply voltage [V].
+  /// \return The voltage set last [V].
   double voltage() const { return voltage_; }
 
   /// \brief Largest thrust [N] thruster i delivers along +d_i at the current voltage.
+  /// \param i Thruster index in [0, n) (not checked).
+  /// \return The thrust [N] (forward or reverse maximum, by its facing).
   double max_positive_thrust(Eigen::Index i) const {
     return facing_(i) > 0 ? max_forward_ : max_reverse_;
   }
   /// \brief Largest thrust [N] (a magnitude) thruster i delivers along −d_i.
+  /// \param i Thruster index in [0, n) (not checked).
+  /// \return The magnitude [N].
   double max_negative_thrust(Eigen::Index i) const {
     return facing_(i) > 0 ? max_reverse_ : max_forward_;
   }
 
   /// \brief Normalised command of a pulse width [µs] (command_from_pwm()).
+  /// \param pwm_us Pulse width [µs].
+  /// \return u ∈ [−1, 1] [-] of this chain's PWM mapping.
+  /// \throws kelp::invalid_argument when the pulse width is not finite.
   Scalar command_from_pwm(const Scalar& pwm_us) const {
     return vehicle::command_from_pwm(pwm_us, pwm_);
   }
@@ -488,12 +557,19 @@ class ThrusterChain {
   /// mapping): facing · thrust(facing · u_esc, V). For the datasheet curve u_esc is the ESC's
   /// command, u scaled to the ESC's 1100–1900 µs and clamped (e.g. the BlueBoat's 1000–2000 µs
   /// mapping: u_esc = 1.25 u, full thrust from 1900 µs on); for a polynomial u_esc = u.
+  /// \param i Thruster index in [0, n) (not checked).
+  /// \param u Normalised command [-].
+  /// \return Thrust along d_i [N].
+  /// \throws kelp::invalid_argument when u is not finite.
   Scalar thrust_of_command(Eigen::Index i, const Scalar& u) const {
     const Scalar s(facing_(i));
     return s * thrust(model_, Scalar(s * esc_command(u)), Scalar(voltage_));
   }
   /// \brief Thrust [N] of thruster i along d_i for a pulse width [µs].
+  /// \param[in] i thruster index in [0, n) (not checked) \param[in] pwm_us pulse width [µs]
   /// \param[out] command the normalised command, if not null.
+  /// \return Thrust along d_i [N].
+  /// \throws kelp::invalid_argument when the pulse width is not finite.
   Scalar thrust_of_pwm(Eigen::Index i, const Scalar& pwm_us, Scalar* command = nullptr) const {
     const Scalar u = command_from_pwm(pwm_us);
     if (command != nullptr) *command = u;
@@ -502,6 +578,10 @@ class ThrusterChain {
   /// \brief Command of thruster i for a desired thrust [N] along d_i: the inverse of
   /// thrust_of_command(), facing · command_for_thrust(facing · force, V) taken back from the
   /// ESC's command to the chain's (saturates at the largest thrust that way, |u| ≤ 1).
+  /// \param i Thruster index in [0, n) (not checked).
+  /// \param force Desired thrust along d_i [N].
+  /// \return u ∈ [−1, 1] [-].
+  /// \throws kelp::invalid_argument when the force is not finite.
   Scalar command_for(Eigen::Index i, const Scalar& force) const {
     const Scalar s(facing_(i));
     const Scalar ue = s * command_for_thrust(model_, Scalar(s * force), Scalar(voltage_));
@@ -514,6 +594,8 @@ class ThrusterChain {
   /// \brief For desired per-thruster forces [N]: the commands and the thrust they deliver
   /// (saturated on the curve's monotone branch). All three have one entry per thruster.
   /// \throws kelp::invalid_argument for a wrong size or a non-finite force.
+  /// \param[in] forces desired thrust per thruster along d_i [N]
+  /// \param[out] commands u per thruster [-] \param[out] delivered thrust per thruster [N]
   template <typename DF, typename DC, typename DT>
   void commands_for(const Eigen::MatrixBase<DF>& forces, Eigen::MatrixBase<DC>& commands,
                     Eigen::MatrixBase<DT>& delivered) const {
@@ -527,6 +609,8 @@ class ThrusterChain {
 
   /// \brief Body wrench [N, N m] of normalised commands: B F(u); `thrusts` receives F(u) [N].
   /// \throws kelp::invalid_argument for a wrong size or a non-finite command.
+  /// \param[in] commands u per thruster [-] \param[out] thrusts F(u) per thruster [N]
+  /// \return B F(u) [N, N m], body axes about the CO.
   template <typename DC, typename DT>
   Vector6<Scalar> wrench_from_commands(const Eigen::MatrixBase<DC>& commands,
                                        Eigen::MatrixBase<DT>& thrusts) const {
@@ -539,6 +623,9 @@ class ThrusterChain {
   /// \brief Body wrench [N, N m] of pulse widths [µs]: B F(u(pwm)); `commands` and `thrusts`
   /// receive u and F(u).
   /// \throws kelp::invalid_argument for a wrong size or a non-finite pulse width.
+  /// \param[in] pwm_us pulse width per thruster [µs] \param[out] commands u per thruster [-]
+  /// \param[out] thrusts F(u) per thruster [N]
+  /// \return B F(u) [N, N m], body axes about the CO.
   template <typename DP, typename DC, typename DT>
   Vector6<Scalar> wrench_from_pwm(const Eigen::MatrixBase<DP>& pwm_us,
                                   Eigen::MatrixBase<DC>& commands,
@@ -550,6 +637,9 @@ class ThrusterChain {
   }
 
   /// \brief Body wrench [N, N m] of thrusts [N] (the allocation's wrench()).
+  /// \param thrusts Thrust per thruster along d_i [N].
+  /// \return B f [N, N m], body axes about the CO.
+  /// \throws kelp::invalid_argument as ThrusterAllocation::wrench().
   template <typename DT>
   Vector6<Scalar> wrench(const Eigen::MatrixBase<DT>& thrusts) const {
     return allocation_.wrench(thrusts);
