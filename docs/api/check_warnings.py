@@ -1,22 +1,13 @@
 #!/usr/bin/env python3
 """Doxygen's warnings over include/kelp, counted per header (the `docs` target runs it).
 
-Usage: check_warnings.py LOG INCLUDE_DIR BASELINE [--update]
+Usage: check_warnings.py LOG INCLUDE_DIR
 
 LOG is Doxygen's WARN_LOGFILE. Each warning (a first line "file:line: warning: ...", then its
 continuation lines) is attributed to its header, relative to INCLUDE_DIR (kelp/tether/winch.hpp);
 a warning Doxygen gives without a file ("<name>:1: ...", a member documented apart from its
-declaration) is attributed to "<name>".
-
-BASELINE lists, one "count header" a line, the warnings each header still had when the check was
-introduced: the API reference is being completed header by header, and the goal is an empty
-file. The check fails when any header has more warnings than its baseline (a header not listed
-has a baseline of 0: a new header must be fully documented), printing every warning of those
-headers; it reports the headers now below their baseline, and --update rewrites BASELINE with
-today's counts (run it after documenting a header, so that its count cannot rise again).
-
-Always prints a per-header table of today's counts (the first column), so that one run says
-what remains.
+declaration) is attributed to the header that declares the member. Any warning fails the check:
+every public type, function and parameter is documented. The warnings are printed per header.
 """
 import collections
 import os
@@ -95,64 +86,25 @@ def read_warnings(log, include_dir):
     return warnings
 
 
-def read_baseline(path):
-    base = {}
-    if os.path.exists(path):
-        with open(path, encoding="utf-8") as f:
-            for line in f:
-                line = line.strip()
-                if line and not line.startswith("#"):
-                    count, name = line.split(None, 1)
-                    base[name] = int(count)
-    return base
-
-
-def write_baseline(path, counts):
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("# Doxygen warnings per public header still to be fixed (docs/api/check_warnings.py):\n"
-                "# a header may not have more; the goal is an empty file. Lower it with\n"
-                "# `cmake --build <build> --target docs_update_baseline`.\n")
-        for name in sorted(counts):
-            if counts[name]:
-                f.write("%d %s\n" % (counts[name], name))
-
-
 def main():
-    args = [a for a in sys.argv[1:] if a != "--update"]
-    update = "--update" in sys.argv[1:]
-    if len(args) != 3:
-        sys.exit("usage: check_warnings.py LOG INCLUDE_DIR BASELINE [--update]")
-    log, include_dir, baseline_path = args
+    if len(sys.argv) != 3:
+        sys.exit("usage: check_warnings.py LOG INCLUDE_DIR")
+    log, include_dir = sys.argv[1:]
     warnings = read_warnings(log, include_dir)
-    counts = {k: len(v) for k, v in warnings.items()}
-    total = sum(counts.values())
-    if update:
-        write_baseline(baseline_path, counts)
-        print("check_warnings: %s rewritten: %d warnings in %d headers"
-              % (baseline_path, total, len(counts)))
+    total = sum(len(v) for v in warnings.values())
+    if not total:
+        print("check_warnings: no Doxygen warning")
         return 0
-    base = read_baseline(baseline_path)
-    worse = sorted(k for k in counts if counts[k] > base.get(k, 0))
-    better = sorted(k for k in base if counts.get(k, 0) < base[k])
-    print("check_warnings: Doxygen warnings per header (today / baseline):")
-    for k in sorted(set(counts) | set(base)):
-        flag = " <- MORE THAN ITS BASELINE" if k in worse else (" (below its baseline)" if k in better else "")
-        print("  %4d / %4d  %s%s" % (counts.get(k, 0), base.get(k, 0), k, flag))
-    print("check_warnings: %d warnings in %d headers (baseline %d)"
-          % (total, len(counts), sum(base.values())))
-    for k in worse:
-        print("\ncheck_warnings: %s: %d warnings, baseline %d:" % (k, counts[k], base.get(k, 0)))
+    print("check_warnings: Doxygen warnings per header:")
+    for k in sorted(warnings):
+        print("  %4d  %s" % (len(warnings[k]), k))
+    for k in sorted(warnings):
+        print("\ncheck_warnings: %s:" % k)
         for w in warnings[k]:
             print("  " + "\n    ".join(w))
-    if better:
-        print("\ncheck_warnings: below their baseline (lower it: the docs_update_baseline target): "
-              + ", ".join(better))
-    if worse:
-        print("\ncheck_warnings: FAILED: %d headers have more Doxygen warnings than their baseline "
-              "(document every public type, function and parameter: units, frames, what it throws)"
-              % len(worse))
-        return 1
-    return 0
+    print("\ncheck_warnings: FAILED: %d Doxygen warnings in %d headers (document every public type, "
+          "function and parameter: units, frames, what it throws)" % (total, len(warnings)))
+    return 1
 
 
 if __name__ == "__main__":
