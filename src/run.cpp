@@ -21,7 +21,11 @@ namespace kelp {
 namespace sim {
 
 Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o) {
-  KELP_CHECK(!std::isnan(o.duration), "ScenarioOverrides::duration must not be NaN");
+  // The scenario file's range for "duration" (scenario.cpp), so that an override cannot pass
+  // what a file may not: an infinite or huge duration has no step count.
+  KELP_CHECK(
+      !std::isnan(o.duration) && (o.duration <= 0 || (o.duration >= 1e-3 && o.duration <= 1e7)),
+      "ScenarioOverrides::duration must be in [0.001, 1e7] s (or <= 0: the scenario's)");
   KELP_CHECK(
       !o.deterministic || o.kernel.empty() || o.kernel == "portable",
       "ScenarioOverrides: deterministic pins the kernel \"portable\", not \"" + o.kernel + "\"");

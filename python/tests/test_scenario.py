@@ -106,6 +106,8 @@ def test_bad_scenarios_are_named():
         kelp.run_scenario(duration=-1)
     with pytest.raises(kelp.InvalidArgument, match="duration"):
         kelp.run_scenario(duration=math.nan)
+    with pytest.raises(kelp.InvalidArgument, match="duration"):
+        kelp.run_scenario(duration=1e300)  # beyond the scenario file's range (no step count)
     with pytest.raises(kelp.InvalidArgument, match="seed"):
         kelp.run_scenario(duration=1, seed=-2)
     with pytest.raises(kelp.InvalidArgument, match="deterministic"):

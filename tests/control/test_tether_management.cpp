@@ -57,5 +57,8 @@ TEST_CASE("strategy names and bad settings", "[control][winch][bad_input]") {
   s = {};
   s.slack = std::nan("");
   CHECK_THROWS_AS(kc::validate(s), kelp::invalid_argument);
+  s = {};
+  s.strategy = static_cast<kc::WinchStrategy>(17);  // e.g. an integer cast from a file
+  CHECK_THROWS_AS(kc::validate(s), kelp::invalid_argument);
   CHECK_NOTHROW(kc::validate(kc::TetherManagementSettings{}));
 }

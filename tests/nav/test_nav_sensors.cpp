@@ -287,6 +287,20 @@ TEST_CASE(
   turned.sample(V3(10, 0, 5), V3::Zero(), V3(1, 1, 0), kelp::pi / 2, 0.0);
   REQUIRE(turned.poll(0.0, f));
   CHECK(f.position.isApprox(V3(1, 11, 5)));
+  // Never polled: the queue keeps its newest usbl_queue_capacity fixes, in order.
+  kn::Usbl unread(p, 8, 7);
+  const int n = kn::usbl_queue_capacity + 10;
+  for (int k = 0; k < n; ++k) REQUIRE(unread.sample(V3(0, 0, 10), V3::Zero(), V3::Zero(), 0.0, k));
+  int kept = 0;
+  double first = -1, last = -1;
+  while (unread.poll(1e9, f)) {
+    if (kept++ == 0) first = f.measured_at;
+    CHECK(f.measured_at > last);
+    last = f.measured_at;
+  }
+  CHECK(kept == kn::usbl_queue_capacity);
+  CHECK(first == n - kn::usbl_queue_capacity);
+  CHECK(last == n - 1);
 }
 
 TEST_CASE("sensors: the same seed gives the same numbers, another seed others", "[nav]") {

@@ -271,6 +271,11 @@ void check_scene(const Config& c, unsigned seed) {
     CHECK(r.worst <= 1.0);
     CHECK(r.checked >= 3 * nodes - 6);
   }
+  // Outside the band or the nodes: a zero block, never a read beyond the store.
+  for (const auto& [i, j] : {std::make_pair(-1, 0), std::make_pair(-2, -1),
+                             std::make_pair(nodes, nodes), std::make_pair(0, 3)})
+    CHECK(jac.dF_dx(i, j).isZero(0.0));
+  CHECK_FALSE(jac.dF_dx(1, 0).isZero(0.0));
 }
 
 }  // namespace

@@ -83,8 +83,8 @@ struct TetherManagementSettings {
 };
 
 /// \brief Checks the settings.
-/// \param s the settings: every magnitude finite and ≥ 0, tension_high > tension_low (the
-/// strategy itself is not checked).
+/// \param s the settings: a known strategy, every magnitude finite and ≥ 0, tension_high >
+/// tension_low.
 /// \throws kelp::invalid_argument naming the field.
 inline void validate(const TetherManagementSettings& s) {
   const auto finite_nonneg = [](double x, const char* name) {
@@ -101,7 +101,8 @@ inline void validate(const TetherManagementSettings& s) {
   finite_nonneg(s.length_per_depth, "length_per_depth");
   finite_nonneg(s.length_per_offset, "length_per_offset");
   finite_nonneg(s.length_gain, "length_gain");
-  winch_strategy_name(s.strategy);
+  KELP_CHECK(std::string(winch_strategy_name(s.strategy)) != "unknown",
+             "tether management: unknown strategy " + std::to_string(static_cast<int>(s.strategy)));
 }
 
 /// \brief What the strategies see.

@@ -599,7 +599,9 @@ struct UsblFix {
 ///
 /// Each due ping is lost with probability `dropout` (or beyond `max_range`); otherwise the fix,
 /// boat position estimate + Rz(heading error) (p_rov − p_boat) + noise(σ = floor + fraction·range
-/// per NED axis), is delivered `latency` later. Fixes wait in a fixed queue (no allocation).
+/// per NED axis), is delivered `latency` later. Fixes wait in a fixed queue (no allocation) of
+/// usbl_queue_capacity, which validate() keeps above latency × rate when poll() is called as
+/// often as sample(); a queue never polled keeps its newest fixes.
 class Usbl {
  public:
   /// \brief A USBL with its own noise stream and an empty queue.
@@ -633,6 +635,10 @@ class Usbl {
     f.sigma = p_.noise_floor + p_.noise_fraction * range;
     for (int i = 0; i < 3; ++i)
       f.position(i) = boat_estimate(i) + turned(i) + f.sigma * rng_.normal();
+    if (size_ == usbl_queue_capacity) {  // never polled: the oldest fix is dropped
+      head_ = (head_ + 1) % usbl_queue_capacity;
+      --size_;
+    }
     queue_[(head_ + size_) % usbl_queue_capacity] = f;
     ++size_;
     return true;

@@ -392,17 +392,17 @@ struct ForceJacobian {
     for (auto* m : {&dfdx, &dfdv, &dmdx}) m->setZero(9, 5 * Eigen::Index(model.nodes()));
   }
   /// \brief ∂F_i/∂x_j (zero beyond |i − j| ≤ 2).
-  /// \param i the node whose force, 0 ≤ i ≤ N (not checked below 0).
+  /// \param i the node whose force, 0 ≤ i ≤ N (a zero block outside).
   /// \param j the node whose position.
   /// \return the 3×3 block [N/m], NED.
   Matrix3<Scalar> dF_dx(int i, int j) const { return block(dfdx, i, j); }
   /// \brief ∂F_i/∂v_j (zero beyond |i − j| ≤ 2).
-  /// \param i the node whose force, 0 ≤ i ≤ N (not checked below 0).
+  /// \param i the node whose force, 0 ≤ i ≤ N (a zero block outside).
   /// \param j the node whose velocity.
   /// \return the 3×3 block [N s/m], NED.
   Matrix3<Scalar> dF_dv(int i, int j) const { return block(dfdv, i, j); }
   /// \brief ∂(M_i d_i)/∂x_j (zero beyond |i − j| ≤ 1).
-  /// \param i the node whose mass matrix, 0 ≤ i ≤ N (not checked below 0).
+  /// \param i the node whose mass matrix, 0 ≤ i ≤ N (a zero block outside).
   /// \param j the node whose position.
   /// \return the 3×3 block [kg/s], NED.
   Matrix3<Scalar> dMd_dx(int i, int j) const { return block(dmdx, i, j); }
@@ -441,7 +441,8 @@ struct ForceJacobian {
 
  private:
   static Matrix3<Scalar> block(const Eigen::Matrix<Scalar, 9, Eigen::Dynamic>& s, int i, int j) {
-    if (j < i - 2 || j > i + 2 || j < 0 || 5 * i + 4 >= s.cols()) return Matrix3<Scalar>::Zero();
+    if (i < 0 || j < i - 2 || j > i + 2 || j < 0 || 5 * i + 4 >= s.cols())
+      return Matrix3<Scalar>::Zero();
     return Eigen::Map<const Matrix3<Scalar>>(s.col(detail::band_block_index(i, j)).data());
   }
   static void add(Eigen::Matrix<Scalar, 9, Eigen::Dynamic>& s, int i, int j,
