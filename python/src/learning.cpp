@@ -14,8 +14,8 @@ namespace kelp_python {
 
 void bind_learning(py::module_& m) {
   namespace ks = kelp::sim;
-  using Env = ks::TetheredPairEnv;
-  py::class_<Env>(m, "PairEnvCore", R"(The C++ core of kelp.TetheredPairEnv (use that instead).
+  using PairEnv = ks::TetheredPairEnv;
+  py::class_<PairEnv>(m, "PairEnvCore", R"(The C++ core of kelp.TetheredPairEnv (use that instead).
 
 A scenario's world whose ROV (and optionally boat) is flown by an action through the ROV
 controller's thrust allocation, with a 20-entry observation and the reward
@@ -29,17 +29,17 @@ controller's thrust allocation, with a 20-entry observation and the reward
              o.max_path_error = max_path_error;
              o.path_weight = path_weight;
              o.energy_weight = energy_weight;
-             return std::make_unique<Env>(ks::parse_scenario(text, name), o);
+             return std::make_unique<PairEnv>(ks::parse_scenario(text, name), o);
            }),
            py::arg("scenario_json"), py::arg("scenario_name"), py::arg("control_period") = 0.1,
            py::arg("asv_action") = false, py::arg("max_path_error") = 20.0,
            py::arg("path_weight") = 1.0, py::arg("energy_weight") = 0.01,
            "An environment over the scenario in JSON text (its name is used in errors).")
-      .def("reset", &Env::reset, py::arg("seed"),
+      .def("reset", &PairEnv::reset, py::arg("seed"),
            "New episode: the scenario's world with `seed` as its sea's seed.")
       .def(
           "step",
-          [](Env& e, py::array_t<double, py::array::c_style | py::array::forcecast> action) {
+          [](PairEnv& e, py::array_t<double, py::array::c_style | py::array::forcecast> action) {
             if (action.ndim() != 1 || action.shape(0) != e.action_size())
               throw kelp::invalid_argument("TetheredPairEnv.step: the action must have shape (" +
                                            std::to_string(e.action_size()) + ",), got ndim " +
@@ -52,48 +52,49 @@ controller's thrust allocation, with a 20-entry observation and the reward
           "Applies the action for one control period; returns (reward, terminated, truncated).")
       .def(
           "observation",
-          [](const Env& e) {
-            py::array_t<double> o(Env::observation_size);
+          [](const PairEnv& e) {
+            py::array_t<double> o(PairEnv::observation_size);
             std::copy(e.observation().begin(), e.observation().end(), o.mutable_data());
             return o;
           },
           "A copy of the current observation (20 floats).")
-      .def_property_readonly("action_size", &Env::action_size, "Entries of an action.")
+      .def_property_readonly("action_size", &PairEnv::action_size, "Entries of an action.")
       .def_property_readonly_static(
-          "observation_size", [](py::object) { return Env::observation_size; },
+          "observation_size", [](py::object) { return PairEnv::observation_size; },
           "Entries of an observation.")
       .def_property_readonly_static(
           "action_scale",
           [](py::object) {
-            py::tuple t(Env::action_scale.size());
-            for (std::size_t i = 0; i < Env::action_scale.size(); ++i) t[i] = Env::action_scale[i];
+            py::tuple t(PairEnv::action_scale.size());
+            for (std::size_t i = 0; i < PairEnv::action_scale.size(); ++i)
+              t[i] = PairEnv::action_scale[i];
             return t;
           },
           "The ROV wrench an action entry of 1 asks for [N, N m] (X, Y, Z, K, M, N).")
-      .def_property_readonly("substeps", &Env::substeps, "System steps (10 ms) per step.")
+      .def_property_readonly("substeps", &PairEnv::substeps, "System steps (10 ms) per step.")
       .def_property_readonly(
-          "time", [](const Env& e) { return e.loop().time(); }, "Simulation time [s].")
+          "time", [](const PairEnv& e) { return e.loop().time(); }, "Simulation time [s].")
       .def_property_readonly(
-          "path_error", [](const Env& e) { return e.observation()[19]; },
+          "path_error", [](const PairEnv& e) { return e.observation()[19]; },
           "The ROV's distance from its survey leg [m].")
-      .def_property_readonly("energy_drawn", &Env::energy_drawn,
+      .def_property_readonly("energy_drawn", &PairEnv::energy_drawn,
                              "Energy the ROV's battery delivered since reset [J].")
       .def_property_readonly(
-          "saturated", [](const Env& e) { return e.auv_command().saturated; },
+          "saturated", [](const PairEnv& e) { return e.auv_command().saturated; },
           "The ROV's action asked for more than its thrusters give.")
-      .def_property_readonly("terminated", &Env::terminated, "The episode terminated.")
-      .def_property_readonly("truncated", &Env::truncated, "The episode was truncated.")
-      .def_property_readonly("error", &Env::error, "Why a step failed ('' otherwise).")
+      .def_property_readonly("terminated", &PairEnv::terminated, "The episode terminated.")
+      .def_property_readonly("truncated", &PairEnv::truncated, "The episode was truncated.")
+      .def_property_readonly("error", &PairEnv::error, "Why a step failed ('' otherwise).")
       .def_property_readonly(
           "auv_position",
-          [](const Env& e) {
+          [](const PairEnv& e) {
             const auto& p = e.loop().state().auv.position;
             return py::make_tuple(p.x(), p.y(), p.z());
           },
           "The ROV's position, NED [m].")
       .def(
           "summary",
-          [](const Env& e) {
+          [](const PairEnv& e) {
             return py::module_::import("json").attr("loads")(
                 kelp::sim::summary_json(e.loop().summary()));
           },
