@@ -28,7 +28,7 @@ class BagRecorder;
 /// \brief What a run may change in its scenario (kelp-tethered-pair's `--duration`, `--seed`,
 /// `--kernel`, `--deterministic`); an unset field keeps the scenario's value.
 struct ScenarioOverrides {
-  double duration = -1;    ///< simulated time [s]; > 0 overrides
+  double duration = -1;    ///< simulated time [s]; > 0 overrides (0.001 to 1e7)
   std::int64_t seed = -1;  ///< seed of the waves and gusts; >= 0 overrides
   std::string
       kernel;  ///< wave kernel path ("auto", "portable", "avx2", "avx512"); non-empty overrides
@@ -39,8 +39,8 @@ struct ScenarioOverrides {
 /// \brief The scenario with the overrides applied.
 /// \param sc the scenario (a copy, returned changed) \param o the overrides
 /// \return the scenario with every set override applied
-/// \throws kelp::invalid_argument for a NaN duration, an unknown kernel name, or
-/// `deterministic` with a kernel other than "portable".
+/// \throws kelp::invalid_argument for a NaN duration or one > 0 outside [0.001, 1e7] s, an unknown
+/// kernel name, or `deterministic` with a kernel other than "portable".
 KELP_SIM_API Scenario apply_overrides(Scenario sc, const ScenarioOverrides& o);
 
 /// \brief Options of run_scenario().
