@@ -48,6 +48,7 @@
 #include "kelp/tether/initial_state.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "line_input.hpp"
 
 namespace kt = kelp::tether;
 using kelp::Vector3;
@@ -404,61 +405,17 @@ MdRun run_moordyn(const mc::Case& c, const std::string& dir) {
   std::system(("mkdir -p " + sub).c_str());
   const std::string path = sub + "/line.txt";
   const double dt = c.dt();
-  {
-    std::ofstream o(path);
-    char num[256];
-    o << "--------------------- MoorDyn Input File ------------------------------------\n"
-         "kelp validation case "
-      << c.name
-      << "\n"
-         "----------------------- LINE TYPES ------------------------------------------\n"
-         "TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    "
-         "CaAx\n"
-         "(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     "
-         "(-)\n";
-    std::snprintf(num, sizeof num,
-                  "tether     0.008   0.07       1.0e5      %.17g   0.0   1.2    "
-                  "1.0    0.008   0.0\n",
-                  c.internal_damping);
-    o << num
-      << "---------------------- POINT PROPERTIES --------------------------------\n"
-         "ID    Type      X       Y       Z       Mass   Volume  CdA    Ca\n"
-         "(#)   (-)       (m)     (m)     (m)     (kg)   (mˆ3)   (m^2)  (-)\n";
-    std::snprintf(num, sizeof num, "1     Fixed     %.17g %.17g %.17g 0 0 0 0\n", c.start[0],
-                  c.start[1], -c.start[2]);
-    o << num;
-    std::snprintf(num, sizeof num, "2     Coupled   %.17g %.17g %.17g 0 0 0 0\n", c.end[0],
-                  c.end[1], -c.end[2]);
-    o << num
-      << "---------------------- LINES ----------------------------------------\n"
-         "ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs\n"
-         "(#)   (name)     (#)      (#)       (m)       (-)     (-)\n"
-         "1     tether     1        2         20.0      "
-      << n << "      -\n"
-      << "---------------------- OPTIONS -----------------------------------------\n"
-         "0             writeLog\n"
-         "RK4           tScheme\n";
-    std::snprintf(num, sizeof num, "%.17g  dtM\n", dt);
-    o << num
-      << "1025.0        WtrDnsty\n"
-         "9.80665       g\n"
-         "1000.0        WtrDpth\n"
-         "3.0e6         kBot\n"
-         "3.0e5         cBot\n"
-         "0.5 dtIC\n300.0 TmaxIC\n1e-9 threshIC\n1.0 CdScaleIC\n"
-      << (c.current != 0 ? "1             Currents\n" : "")
-      << "1             disableOutput\n"
-         "1             disableOutTime\n"
-         "------------------------- need this line --------------------------------------\n";
+  kelp_bench::LineInput input;
+  input.title = std::string("kelp validation case ") + c.name;
+  input.internal_damping = c.internal_damping;
+  for (int i = 0; i < 3; ++i) {
+    input.start[i] = c.start[i];
+    input.end[i] = c.end[i];
   }
-  if (c.current != 0) {
-    // A uniform current (MoorDyn's steady current profile: Currents = 1).
-    std::ofstream o(sub + "/current_profile.txt");
-    o << "--------------------- MoorDyn steady currents File ------------------------------\n"
-         "uniform current\n"
-         "z (m), ux (m/s), uy (m/s), uz (m/s)\n";
-    o << "-1000.0 " << c.current << " 0 0\n0.0 " << c.current << " 0 0\n";
-  }
+  input.segments = n;
+  input.dt = dt;
+  input.current = c.current;
+  kelp_bench::write_moordyn_line(input, sub, path);
   std::fflush(stdout);
   const int saved = dup(1), devnull = open("/dev/null", O_WRONLY);
   dup2(devnull, 1);

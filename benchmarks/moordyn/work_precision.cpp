@@ -50,6 +50,7 @@
 #include "kelp/environment/environment.hpp"
 #include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
+#include "line_input.hpp"
 
 namespace kt = kelp::tether;
 using kelp::Vector3;
@@ -125,56 +126,17 @@ std::string write_input(const Case& c, const std::string& dir, const char* schem
   char name[96];
   std::snprintf(name, sizeof name, "/line_%s_%.9g.txt", scheme, dt);
   const std::string path = sub + name;
-  std::ofstream o(path);
-  char num[128];
-  o << "--------------------- MoorDyn Input File ------------------------------------\n"
-       "kelp work-precision case "
-    << c.name
-    << "\n"
-       "----------------------- LINE TYPES ------------------------------------------\n"
-       "TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    "
-       "CaAx\n"
-       "(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     "
-       "(-)\n"
-       "tether     0.008   0.07       1.0e5      0.0         0.0        1.2    1.0    0.008   "
-       "0.0\n"
-       "---------------------- POINT PROPERTIES --------------------------------\n"
-       "ID    Type      X       Y       Z       Mass   Volume  CdA    Ca\n"
-       "(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)\n";
-  std::snprintf(num, sizeof num, "1     Fixed     %g  %g  %g  0  0  0  0\n", c.start()(0),
-                c.start()(1), -c.start()(2));
-  o << num;
-  std::snprintf(num, sizeof num, "2     Coupled   %g  %g  %g  0  0  0  0\n", c.end0()(0),
-                c.end0()(1), -c.end0()(2));
-  o << num;
-  o << "---------------------- LINES ----------------------------------------\n"
-       "ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs\n"
-       "(#)   (name)     (#)      (#)       (m)       (-)     (-)\n"
-       "1     tether     1        2         20.0      "
-    << kSegments
-    << "      -\n"
-       "---------------------- OPTIONS -----------------------------------------\n"
-       "0             writeLog\n"
-    << scheme << "           tScheme\n";
-  std::snprintf(num, sizeof num, "%.17g  dtM\n", dt);
-  o << num
-    << "1025.0        WtrDnsty\n"
-       "9.80665       g\n"
-       "1000.0        WtrDpth\n"
-       "3.0e6         kBot\n"
-       "3.0e5         cBot\n"
-       "0.5 dtIC\n300.0 TmaxIC\n1e-9 threshIC\n1.0 CdScaleIC\n"
-    << (c.current != 0 ? "1             Currents\n" : "")
-    << "1             disableOutput\n"
-       "1             disableOutTime\n"
-       "------------------------- need this line --------------------------------------\n";
-  if (c.current != 0) {
-    std::ofstream cp(sub + "/current_profile.txt");
-    cp << "--------------------- MoorDyn steady currents File ------------------------------\n"
-          "uniform current\n"
-          "z (m), ux (m/s), uy (m/s), uz (m/s)\n";
-    cp << "-1000.0 " << c.current << " 0 0\n0.0 " << c.current << " 0 0\n";
+  kelp_bench::LineInput input;
+  input.title = std::string("kelp work-precision case ") + c.name;
+  for (int i = 0; i < 3; ++i) {
+    input.start[i] = c.start()(i);
+    input.end[i] = c.end0()(i);
   }
+  input.segments = kSegments;
+  input.scheme = scheme;
+  input.dt = dt;
+  input.current = c.current;
+  kelp_bench::write_moordyn_line(input, sub, path);
   return path;
 }
 
