@@ -1,9 +1,10 @@
-// Controllers: the PID's saturation and anti-windup; the AUV controller holds depth, heading and
-// position and flies a square of waypoints on the BlueROV2 Heavy preset; the ASV controller keeps
-// station and follows the AUV on the BlueBoat preset; the disturbance feedforward lowers the
-// error in a current.
+// Controllers: the PID's saturation and anti-windup, its integral set back within its limit; the
+// AUV controller holds depth, heading and position and flies a square of waypoints on the
+// BlueROV2 Heavy preset; the ASV controller keeps station and follows the AUV on the BlueBoat
+// preset; the disturbance feedforward lowers the error in a current.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "kelp/control/controllers.hpp"
@@ -39,6 +40,25 @@ TEST_CASE("PID: proportional, integral, derivative on measurement, saturation wi
   CHECK_THROWS_AS(kc::Pid({1.0, 0, 0, 0.0}), kelp::invalid_argument);
   CHECK_THROWS_AS(p.update(std::nan(""), 0.1), kelp::invalid_argument);
   CHECK_THROWS_AS(p.update(1.0, 0.0), kelp::invalid_argument);
+}
+
+TEST_CASE("PID: set_integral refuses a non-finite value and clamps into the integral limit",
+          "[control][pid]") {
+  kc::Pid p({1.0, 0.5, 0.0, 10.0, 2.0});
+  p.set_integral(1.5);
+  CHECK(p.integral() == 1.5);  // a value within the limit is kept exactly
+  p.set_integral(5.0);
+  CHECK(p.integral() == 2.0);
+  p.set_integral(-5.0);
+  CHECK(p.integral() == -2.0);
+  p.set_integral(0.25);
+  CHECK_THROWS_AS(p.set_integral(std::nan("")), kelp::invalid_argument);
+  CHECK_THROWS_AS(p.set_integral(std::numeric_limits<double>::infinity()), kelp::invalid_argument);
+  CHECK(p.integral() == 0.25);  // the refused values changed nothing
+  // Without a limit any finite value is kept.
+  kc::Pid q({1.0, 0.5, 0.0});
+  q.set_integral(-1e6);
+  CHECK(q.integral() == -1e6);
 }
 
 namespace {
