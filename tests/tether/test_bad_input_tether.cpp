@@ -548,6 +548,28 @@ TEST_CASE("The ROV tether preset refuses segments shorter than a tether model ta
   CHECK_NOTHROW(kt::validate(fine));
 }
 
+TEST_CASE("A tether state's winch length and payout rate must be finite", "[tether][bad_input]") {
+  Line line;
+  kt::check_state(line.model, line.state);
+  for (const double bad : {nan_, inf_, -inf_}) {
+    INFO("value " << bad);
+    kt::TetherStated s = line.state;
+    s.winch_length = bad;
+    REQUIRE_THROWS_WITH(kt::check_state(line.model, s), Catch::Contains("state.winch_length"));
+    REQUIRE_THROWS_AS(kt::tether_energy(line.model, line.water, s), kelp::invalid_argument);
+    require_refused("static solve, winch_length", s, [&] {
+      (void)kt::solve_static_equilibrium(line.model, line.ws, line.water, s, line.boundary);
+    });
+    s = line.state;
+    s.payout_rate = bad;
+    REQUIRE_THROWS_WITH(kt::check_state(line.model, s), Catch::Contains("state.payout_rate"));
+    REQUIRE_THROWS_AS(kt::tether_energy(line.model, line.water, s), kelp::invalid_argument);
+    require_refused("static solve, payout_rate", s, [&] {
+      (void)kt::solve_static_equilibrium(line.model, line.ws, line.water, s, line.boundary);
+    });
+  }
+}
+
 TEST_CASE("Workspace resize refuses node counts no tether has, naming the count",
           "[tether][bad_input]") {
   // resize(0) and resize(-5) used to reach Eigen with a negative segment count and throw
