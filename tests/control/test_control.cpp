@@ -1,7 +1,8 @@
 // Controllers: the PID's saturation and anti-windup, its integral set back within its limit; the
 // AUV controller holds depth, heading and position and flies a square of waypoints on the
 // BlueROV2 Heavy preset; the ASV controller keeps station and follows the AUV on the BlueBoat
-// preset; the disturbance feedforward lowers the error in a current.
+// preset, holding the heading it arrived with; the disturbance feedforward lowers the error in a
+// current.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -278,6 +279,34 @@ TEST_CASE("ASV controller: station keeping and following with the paper's gains"
   CHECK(off <= radius + coast(follow_inside_speed));
   CHECK(b.x.nu.head<2>().norm() < 1e-6);
   CHECK(off <= radius);
+}
+
+TEST_CASE("ASV controller (pursuit): following, it holds the heading it arrived with",
+          "[control][asv]") {
+  Boat b;
+  kc::AsvController c(b.model, b.thrusters);
+  c.follow_auv();
+  const Vector3<double> auv(10, 0, 5);
+  kc::Navigation nav;
+  const auto at = [&](double north, double psi) {
+    nav.position = Vector3<double>(north, 0, 0);
+    nav.attitude = kelp::quaternion_from_euler(0.0, 0.0, psi);
+  };
+  at(0.0, 0.0);  // 10 m off: pursuit
+  c.update(nav, auv, 0.0);
+  at(9.5, 0.2);  // arrives (0.5 m off, inside arrive_radius) heading 0.2 rad
+  CHECK(c.update(nav, auv, 0.1).heading_error == Approx(0.0).margin(1e-12));
+  at(9.5, 0.5);  // yawed 0.3 rad further (a wave): it turns back to 0.2 rad
+  const kc::AsvCommand& cmd = c.update(nav, auv, 0.2);
+  CHECK(cmd.heading_error == Approx(-0.3));
+  CHECK(cmd.left < cmd.right);  // more thrust to starboard: the bow turns to port
+  // Out of the circle and in again: it holds the heading of the new arrival.
+  at(0.0, 0.5);
+  c.update(nav, auv, 0.3);
+  at(9.5, 1.0);
+  c.update(nav, auv, 0.4);
+  at(9.5, 1.1);
+  CHECK(c.update(nav, auv, 0.5).heading_error == Approx(-0.1));
 }
 
 TEST_CASE("Controllers in float: the float instantiations follow the double ones",
