@@ -44,12 +44,20 @@ const ros2::Messages& Ros2Sampler::messages(const LogRow& r) {
   return m_;
 }
 
+namespace {
+// The bag's path, once the marker rate is known to be finite and > 0: BagRecorder checks it here,
+// in its bag's initialiser, so that a bad rate is refused before the file is created.
+const std::filesystem::path& checked_bag_path(const std::filesystem::path& path,
+                                              double marker_rate) {
+  KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
+             "BagRecorder: the marker rate must be finite and > 0");
+  return path;
+}
+}  // namespace
+
 BagRecorder::BagRecorder(const std::filesystem::path& path, double marker_rate,
                          const ros2::McapOptions& options)
-    : bag_(path, options), marker_period_(1.0 / marker_rate) {
-  KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
-             "BagRecorder: the marker rate must be > 0");
-}
+    : bag_(checked_bag_path(path, marker_rate), options), marker_period_(1.0 / marker_rate) {}
 
 void BagRecorder::record(const LogRow& r) {
   const ros2::Messages& m = sampler_.messages(r);

@@ -74,6 +74,22 @@ int write_all(int fd, const char* p, std::size_t n) {
   }
   return 0;
 }
+
+// Appends `field` to `s` as one CSV field (RFC 4180): as it is, or, when it holds a comma, a
+// double quote or a line break (which would split the row), enclosed in double quotes with each
+// double quote in it doubled.
+void append_csv_field(std::string& s, const std::string& field) {
+  if (field.find_first_of(",\"\r\n") == std::string::npos) {
+    s += field;
+    return;
+  }
+  s += '"';
+  for (const char c : field) {
+    if (c == '"') s += '"';
+    s += c;
+  }
+  s += '"';
+}
 }  // namespace
 
 LineFile::~LineFile() {
@@ -210,7 +226,7 @@ void RunLog::entanglement(double t, const char* event, const kelp::Vector3<doubl
     s += num(v);
   }
   s += ',';
-  s += obstacle;
+  append_csv_field(s, obstacle);
   s += ',';
   s += num(winding);
   events_.end_line();

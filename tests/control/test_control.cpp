@@ -1,9 +1,11 @@
-// Controllers: the PID's saturation and anti-windup; the AUV controller holds depth, heading and
-// position and flies a square of waypoints on the BlueROV2 Heavy preset; the ASV controller keeps
-// station and follows the AUV on the BlueBoat preset; the disturbance feedforward lowers the
-// error in a current.
+// Controllers: the PID's saturation and anti-windup, its integral set back within its limit; the
+// AUV controller holds depth, heading and position and flies a square of waypoints on the
+// BlueROV2 Heavy preset; the ASV controller keeps station and follows the AUV on the BlueBoat
+// preset, holding the heading it arrived with; the disturbance feedforward lowers the error in a
+// current.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "kelp/control/controllers.hpp"
@@ -39,6 +41,25 @@ TEST_CASE("PID: proportional, integral, derivative on measurement, saturation wi
   CHECK_THROWS_AS(kc::Pid({1.0, 0, 0, 0.0}), kelp::invalid_argument);
   CHECK_THROWS_AS(p.update(std::nan(""), 0.1), kelp::invalid_argument);
   CHECK_THROWS_AS(p.update(1.0, 0.0), kelp::invalid_argument);
+}
+
+TEST_CASE("PID: set_integral refuses a non-finite value and clamps into the integral limit",
+          "[control][pid]") {
+  kc::Pid p({1.0, 0.5, 0.0, 10.0, 2.0});
+  p.set_integral(1.5);
+  CHECK(p.integral() == 1.5);  // a value within the limit is kept exactly
+  p.set_integral(5.0);
+  CHECK(p.integral() == 2.0);
+  p.set_integral(-5.0);
+  CHECK(p.integral() == -2.0);
+  p.set_integral(0.25);
+  CHECK_THROWS_AS(p.set_integral(std::nan("")), kelp::invalid_argument);
+  CHECK_THROWS_AS(p.set_integral(std::numeric_limits<double>::infinity()), kelp::invalid_argument);
+  CHECK(p.integral() == 0.25);  // the refused values changed nothing
+  // Without a limit any finite value is kept.
+  kc::Pid q({1.0, 0.5, 0.0});
+  q.set_integral(-1e6);
+  CHECK(q.integral() == -1e6);
 }
 
 namespace {
@@ -258,6 +279,34 @@ TEST_CASE("ASV controller: station keeping and following with the paper's gains"
   CHECK(off <= radius + coast(follow_inside_speed));
   CHECK(b.x.nu.head<2>().norm() < 1e-6);
   CHECK(off <= radius);
+}
+
+TEST_CASE("ASV controller (pursuit): following, it holds the heading it arrived with",
+          "[control][asv]") {
+  Boat b;
+  kc::AsvController c(b.model, b.thrusters);
+  c.follow_auv();
+  const Vector3<double> auv(10, 0, 5);
+  kc::Navigation nav;
+  const auto at = [&](double north, double psi) {
+    nav.position = Vector3<double>(north, 0, 0);
+    nav.attitude = kelp::quaternion_from_euler(0.0, 0.0, psi);
+  };
+  at(0.0, 0.0);  // 10 m off: pursuit
+  c.update(nav, auv, 0.0);
+  at(9.5, 0.2);  // arrives (0.5 m off, inside arrive_radius) heading 0.2 rad
+  CHECK(c.update(nav, auv, 0.1).heading_error == Approx(0.0).margin(1e-12));
+  at(9.5, 0.5);  // yawed 0.3 rad further (a wave): it turns back to 0.2 rad
+  const kc::AsvCommand& cmd = c.update(nav, auv, 0.2);
+  CHECK(cmd.heading_error == Approx(-0.3));
+  CHECK(cmd.left < cmd.right);  // more thrust to starboard: the bow turns to port
+  // Out of the circle and in again: it holds the heading of the new arrival.
+  at(0.0, 0.5);
+  c.update(nav, auv, 0.3);
+  at(9.5, 1.0);
+  c.update(nav, auv, 0.4);
+  at(9.5, 1.1);
+  CHECK(c.update(nav, auv, 0.5).heading_error == Approx(-0.1));
 }
 
 TEST_CASE("Controllers in float: the float instantiations follow the double ones",

@@ -1,8 +1,10 @@
 // kelp::nav's filter on a known trajectory (a level circle at constant speed and depth): from
 // wrong initial position, velocity and heading it converges with the aiding sensors, late
-// position fixes included, and stays bounded; its settings are checked.
+// position fixes included, and stays bounded; its settings are checked; updates before
+// initialize() are ignored and a non-finite measurement is refused, the filter unchanged.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 
 #include "kelp/nav/filter.hpp"
 #include "kelp/nav/sensors.hpp"
@@ -191,4 +193,64 @@ TEST_CASE("Navigation filter in float follows the double one on the same samples
   CHECK((ff.navigation().position.cast<double>() - c.at(30.0).position).norm() < 1.0);
   CHECK(ff.covariance().diagonal().minCoeff() >= 0.0f);
   CHECK(std::abs(kelp::wrap_angle(kelp::heading_of(ff.navigation().attitude) - 3.0)) < 0.05);
+}
+
+TEST_CASE("before initialize() every update is ignored, the heading's too", "[nav][filter]") {
+  kn::NavigationFilter f(kn::ImuParameters{});
+  f.update_heading(1.0, 1.0);
+  f.update_depth(3.0, 0.1);
+  f.update_position(V3(1.0, 2.0, 3.0), V3::Constant(0.1), 0.0);
+  CHECK_FALSE(f.initialized());
+  CHECK(f.gyro_bias() == V3::Zero());
+  CHECK(f.navigation().attitude.coeffs() == kelp::Quaternion<double>::Identity().coeffs());
+  CHECK(f.state() == kn::NavigationFilter::StateVector::Zero());
+}
+
+TEST_CASE("every update refuses a non-finite measurement, σ or time and changes nothing",
+          "[nav][filter][errors]") {
+  kn::FilterSettings fs;
+  fs.estimate_current = true;  // so that update_water_velocity acts
+  kn::NavigationFilter f(kn::ImuParameters{}, fs);
+  kn::ImuSample s;
+  s.accel = V3(0, 0, -kelp::standard_gravity);
+  f.initialize(V3(1.0, 2.0, 3.0), V3(0.5, 0.0, 0.0), 0.3, s);
+  s.t = 0.01;
+  f.predict(s);
+  const kn::NavigationFilter::StateVector x = f.state();
+  const kn::NavigationFilter::Covariance P = f.covariance();
+  const kelp::Quaternion<double> q = f.navigation().attitude;
+  const V3 bias = f.gyro_bias();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d ne(1.0, 2.0);
+  CHECK_THROWS_AS(f.update_depth(nan, 0.1), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_depth(3.0, nan), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_depth(3.0, -0.1), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_body_velocity(V3(nan, 0, 0), 0.1), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_body_velocity(V3::Zero(), inf), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_water_velocity(V3(0, inf, 0), 0.1), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_water_velocity(V3::Zero(), nan), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_heading(nan, 0.1), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_heading(0.1, nan), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_heading(0.1, inf), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_heading(0.1, -0.1), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_horizontal_position(Eigen::Vector2d(nan, 2.0), 0.1, 0.0),
+                  kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_horizontal_position(ne, nan, 0.0), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_horizontal_position(ne, 0.1, nan), kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_position(V3(1.0, nan, 3.0), V3::Constant(0.1), 0.0),
+                  kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_position(V3(1.0, 2.0, 3.0), V3(0.1, 0.1, nan), 0.0),
+                  kelp::invalid_argument);
+  CHECK_THROWS_AS(f.update_position(V3(1.0, 2.0, 3.0), V3::Constant(0.1), nan),
+                  kelp::invalid_argument);
+  CHECK_THROWS_WITH(f.update_heading(nan, 0.1), Catch::Contains("update_heading: psi"));
+  // Nothing moved: bit for bit.
+  CHECK(f.state() == x);
+  CHECK(f.covariance() == P);
+  CHECK(f.navigation().attitude.coeffs() == q.coeffs());
+  CHECK(f.gyro_bias() == bias);
+  // The same updates with finite values act.
+  f.update_depth(3.5, 0.1);
+  CHECK(f.state() != x);
 }

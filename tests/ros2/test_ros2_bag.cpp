@@ -1,11 +1,14 @@
 // A run's ROS 2 bag through kelp::sim::run_scenario: run.mcap beside the CSV log, and
 // reference.csv, the same samples in kelp's own frames (NED/FRD) at full precision (%.17g), for
 // the independent check of the bag (tests/ros2/node/check_bags.mjs, with @mcap/core and
-// @foxglove/rosmsg2-serialization) which converts them to ROS's frames itself.
+// @foxglove/rosmsg2-serialization) which converts them to ROS's frames itself; a bad marker rate
+// refused before any file is created.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "../sim/sim_test_support.hpp"
 #include "kelp/sim/ros2.hpp"
@@ -93,5 +96,17 @@ TEST_CASE("run_scenario writes run.mcap beside the log; reference.csv for the np
     // The scenario key round-trips through JSON; on (the default) it is left out.
     CHECK(kelp::sim::parse_scenario(kelp_test::json_of(q).dump(), "q").mcap == false);
     CHECK_FALSE(kelp_test::json_of(sc).at("output").contains("mcap"));
+  }
+}
+
+TEST_CASE("BagRecorder refuses a marker rate that is not > 0 before it creates its file",
+          "[ros2][sim]") {
+  const std::filesystem::path dir = "ros2_bag_bad_rate", file = dir / "run.mcap";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  for (const double rate : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    INFO("marker rate " << rate);
+    CHECK_THROWS_AS(kelp::sim::BagRecorder(file, rate), kelp::invalid_argument);
+    CHECK_FALSE(std::filesystem::exists(file));
   }
 }

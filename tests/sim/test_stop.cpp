@@ -2,7 +2,8 @@
 // the stop request and the programs' signal handlers (the second signal's default action back,
 // an ignored signal left ignored), simulate() stopped mid-run (the summary of the time reached,
 // the log whole), the log on the file in whole lines at least once a simulated second while the
-// run goes on, no allocation in a logged step, and files written atomically.
+// run goes on, no allocation in a logged step, events.csv's obstacle names quoted as CSV, and
+// files written atomically.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <csignal>
@@ -153,6 +154,31 @@ TEST_CASE("a logged closed-loop step allocates nothing, the log's writes include
   const long before = kelp_test::heap_allocations();
   loop.run_for(3.0);  // three seconds: rows, snapshots and three writes of each file
   CHECK(kelp_test::heap_allocations() == before);
+}
+
+TEST_CASE("events.csv quotes an obstacle name that holds a comma, a quote or a line break",
+          "[sim][stop]") {
+  const fs::path dir = fs::current_path() / "test_stop_log_quoting";
+  fs::remove_all(dir);
+  {
+    ks::RunLog log(dir);
+    const kelp::Vector3<double> at(1, 2, 3);
+    log.entanglement(1.0, "entangled", at, ks::LogRow::none, "pile", 6.5);
+    log.entanglement(2.0, "entangled", at, ks::LogRow::none, "pile, north", 6.5);
+    log.entanglement(3.0, "pinned", at, 4.0, "the \"big\" one", 7.0);
+    log.entanglement(4.0, "entangled", at, ks::LogRow::none, "two\nlines", 6.5);
+    log.entanglement(5.0, "entangled", at, ks::LogRow::none, "cr\r", 6.5);
+    log.close();
+  }
+  // RFC 4180: a field with a comma, a double quote or a line break is enclosed in double quotes,
+  // a double quote in it doubled; any other field is written as it is.
+  CHECK(slurp(dir / "events.csv") ==
+        "t,event,segment,x,y,z,tension,obstacle,winding\n"
+        "1,entangled,nan,1,2,3,nan,pile,6.5\n"
+        "2,entangled,nan,1,2,3,nan,\"pile, north\",6.5\n"
+        "3,pinned,nan,1,2,3,4,\"the \"\"big\"\" one\",7\n"
+        "4,entangled,nan,1,2,3,nan,\"two\nlines\",6.5\n"
+        "5,entangled,nan,1,2,3,nan,\"cr\r\",6.5\n");
 }
 
 TEST_CASE("write_file_atomically replaces a file whole and leaves no temporary", "[sim][stop]") {

@@ -1,11 +1,15 @@
 // Any tethered fleet (kelp/system/fleet.hpp): the pair as a fleet is the pair bit for bit; a
 // vehicle – tether – point mass – tether – vehicle chain keeps its momentum and, undamped, its
 // energy; a TMS hanging on its umbilical with its tether below it settles where the elastic
-// hanging line puts it; bad fleets are refused naming the part; a failed step changes nothing.
+// hanging line puts it; bad fleets are refused naming the part, bad states and inputs naming
+// their index; a failed step changes nothing.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "kelp/environment/environment.hpp"
 #include "kelp/system/fleet.hpp"
@@ -323,6 +327,64 @@ TEST_CASE("a fleet refuses parts that do not fit together, naming the part",
   auto fresh = env;
   fresh.set_water_density(1000.0);
   CHECK_THROWS_WITH(ks::FleetModeld(chain(), fresh), Catch::Contains("rov1"));
+}
+
+TEST_CASE("a fleet's bad state or input is named with its index", "[system][fleet][bad_input]") {
+  ks::FleetParametersd p = chain();
+  ks::PointMassParametersd buoy = p.point_masses[0];
+  buoy.name = "buoy";  // a second point mass, on no tether
+  p.point_masses.push_back(buoy);
+  const ks::FleetModeld model(p, kelp::environment::Environmentd{});
+  ks::FleetWorkspaced ws(model);
+  std::vector<kv::VehicleStated> v(2);
+  v[0].position = Vector3<double>(0, 0, 10);
+  v[1].position = Vector3<double>(12, 0, 10);
+  const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+  const Vector3<double> clump(6, 0, 11);
+  CHECK_THROWS_WITH(ks::initial_state(model, ws, v, {clump, Vector3<double>(3, nan, 5)}),
+                    Catch::Contains("point_masses[1] must be finite"));
+  const ks::FleetStated good = ks::initial_state(model, ws, v, {clump, Vector3<double>(3, 3, 5)});
+  const ks::FleetInputsd no_input(model);
+  // Each bad part of the state or the inputs in turn, the rest as given.
+  const auto refused = [&](const ks::FleetStated& s, const ks::FleetInputsd& in) {
+    ks::FleetStated x = s;
+    try {
+      ks::step(model, ws, x, in, 0.01);
+    } catch (const kelp::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  ks::FleetStated s = good;
+  s.point_masses[1].position.z() = nan;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.point_masses[1].position"));
+  s = good;
+  s.point_masses[1].velocity.x() = inf;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.point_masses[1].velocity"));
+  s = good;
+  s.point_mass_acceleration[1].y() = nan;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.point_mass_acceleration[1]"));
+  s = good;
+  s.vehicle_nu_dot[1](3) = nan;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.vehicle_nu_dot[1]"));
+  s = good;
+  s.vehicles[1].time += 1.0;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.vehicles[1].time"));
+  s = good;
+  s.tethers[1].time += 1.0;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].time"));
+  ks::FleetInputsd in = no_input;
+  in.vehicles[1].tau(0) = nan;
+  CHECK_THAT(refused(good, in), Catch::Contains("inputs.vehicles[1].tau must"));
+  in = no_input;
+  in.vehicles[1].tau_ext(5) = inf;
+  CHECK_THAT(refused(good, in), Catch::Contains("inputs.vehicles[1].tau_ext"));
+  in = no_input;
+  in.winch_payout_rates[1] = nan;
+  CHECK_THAT(refused(good, in), Catch::Contains("inputs.winch_payout_rates[1] must be finite"));
+  in.winch_payout_rates[1] = 0.1;
+  CHECK_THAT(refused(good, in), Catch::Contains("inputs.winch_payout_rates[1] must be 0"));
+  CHECK(refused(good, no_input) == "(accepted)");
 }
 
 TEST_CASE("a failed fleet step throws and leaves every part of the state bit-identical",

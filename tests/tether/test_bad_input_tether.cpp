@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kelp/tether/initial_state.hpp"
@@ -528,6 +529,45 @@ TEST_CASE("Tether presets refuse lengths they cannot cut into segments", "[tethe
   CHECK(kt::presets::rov_tether(100.0, 1e-3).segments == 100000);
   CHECK_THROWS_AS(kt::presets::rov_tether(100.0, 0.9e-3), kelp::invalid_argument);
   CHECK(kt::presets::bead_chain(30.0).segments == 60);
+}
+
+TEST_CASE("The ROV tether preset refuses segments shorter than a tether model takes",
+          "[tether][bad_input]") {
+  // 0.1 mm cut into 10 nm segments (10000 of them: a count the model takes), and 0.1 µm in one
+  // segment: each shorter than limits::min_segment_length (1 µm), which TetherModel refuses.
+  for (const auto& [length, segment] : {std::pair{1e-4, 1e-8}, std::pair{1e-7, 0.25}}) {
+    INFO(length << " m in segments of at most " << segment << " m");
+    REQUIRE_THROWS_AS(kt::presets::rov_tether(length, segment), kelp::invalid_argument);
+    REQUIRE_THROWS_WITH(kt::presets::rov_tether(length, segment),
+                        Catch::Contains("segment length"));
+  }
+  REQUIRE_THROWS_AS(kt::presets::rov_tether(1e-4f, 1e-8f), kelp::invalid_argument);
+  // What the preset gives, the model takes: 5 cm in 2 µm segments.
+  const kt::TetherParametersd fine = kt::presets::rov_tether(0.05, 2e-6);
+  CHECK(fine.segments == 25000);
+  CHECK_NOTHROW(kt::validate(fine));
+}
+
+TEST_CASE("A tether state's winch length and payout rate must be finite", "[tether][bad_input]") {
+  Line line;
+  kt::check_state(line.model, line.state);
+  for (const double bad : {nan_, inf_, -inf_}) {
+    INFO("value " << bad);
+    kt::TetherStated s = line.state;
+    s.winch_length = bad;
+    REQUIRE_THROWS_WITH(kt::check_state(line.model, s), Catch::Contains("state.winch_length"));
+    REQUIRE_THROWS_AS(kt::tether_energy(line.model, line.water, s), kelp::invalid_argument);
+    require_refused("static solve, winch_length", s, [&] {
+      (void)kt::solve_static_equilibrium(line.model, line.ws, line.water, s, line.boundary);
+    });
+    s = line.state;
+    s.payout_rate = bad;
+    REQUIRE_THROWS_WITH(kt::check_state(line.model, s), Catch::Contains("state.payout_rate"));
+    REQUIRE_THROWS_AS(kt::tether_energy(line.model, line.water, s), kelp::invalid_argument);
+    require_refused("static solve, payout_rate", s, [&] {
+      (void)kt::solve_static_equilibrium(line.model, line.ws, line.water, s, line.boundary);
+    });
+  }
 }
 
 TEST_CASE("Workspace resize refuses node counts no tether has, naming the count",

@@ -1,5 +1,6 @@
 // The winch at the start end of the lumped-mass tether (kelp/tether/winch.hpp): re-meshing
-// conserves mass and momentum, a slow reel-in ends at the static solution and the catenary.
+// conserves mass and momentum (and refuses a start end that is not kinematic), a slow reel-in
+// ends at the static solution and the catenary.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
@@ -109,6 +110,40 @@ TEST_CASE("a re-mesh carries the parted flags with their segments", "[tether][wi
   kt::remove_winch_node(wm.line(10), s, shrunk, r);
   CHECK(shrunk.parted(0) == 1);
   CHECK(shrunk.parted_segments() == 1);
+}
+
+TEST_CASE("removing a node at the winch needs the kinematic start end the winch sits on",
+          "[tether][winch][remesh]") {
+  auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
+  p.length = 10;
+  auto shorter = p;
+  shorter.segments = 9;
+  shorter.length = 9;
+  for (const kt::EndMode start : {kt::EndMode::free, kt::EndMode::kinematic}) {
+    p.start_mode = shorter.start_mode = start;
+    const kt::TetherModel<double> line(p), after(shorter);
+    kt::TetherState<double> s(line);
+    for (int i = 0; i <= 10; ++i) {
+      s.position.col(i) = V3(i, 0, 0.5 * i);
+      s.velocity.col(i) = V3(0.1 * i, 0, 0);
+    }
+    s.winch_length = 0.4;
+    kt::TetherState<double> out(after);
+    const kt::TetherState<double> out_before = out;
+    kt::RemeshReport<double> r;
+    if (start == kt::EndMode::free) {
+      // Node 0's share of node 1's momentum would go to a body that is not there.
+      REQUIRE_THROWS_AS(kt::remove_winch_node(line, s, out, r), kelp::invalid_argument);
+      REQUIRE_THROWS_WITH(kt::remove_winch_node(line, s, out, r), Catch::Contains("kinematic"));
+      CHECK(r.removed == 0);
+      CHECK(out.position == out_before.position);
+      CHECK(out.velocity == out_before.velocity);
+    } else {
+      kt::remove_winch_node(line, s, out, r);
+      CHECK(r.removed == 1);
+      CHECK(out.winch_length == Approx(1.4));
+    }
+  }
 }
 
 TEST_CASE("winch limits: speed, acceleration, pull and length", "[tether][winch]") {

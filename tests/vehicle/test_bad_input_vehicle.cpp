@@ -1,9 +1,9 @@
 // Bad input at the vehicle layer's public boundary: absurd but finite parameters whose derived
 // quantities overflow, NaN / Inf currents and times and mis-sized wrenches given to the steps,
-// thruster allocation
-// with a NaN wrench or mismatched sizes. Each bad input must throw kelp::invalid_argument; the
-// valid inputs next to them must keep working, and a step that blows up from valid input must
-// still end as kelp::numerical_error with the state unchanged.
+// thruster allocation with a NaN wrench or mismatched sizes, thruster models with non-finite or
+// non-physical curves. Each bad input must throw kelp::invalid_argument; the valid inputs next to
+// them must keep working, and a step that blows up from valid input must still end as
+// kelp::numerical_error with the state unchanged.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -204,6 +204,40 @@ TEST_CASE("bad input: thruster allocation with NaN wrenches and mismatched sizes
   REQUIRE_THROWS_AS(kv::pwm_from_command(0.5, m), kelp::invalid_argument);
   CHECK(kv::command_from_pwm(1900.0) == 1.0);
   CHECK(kv::pwm_from_command(-1.0) == 1100.0);
+}
+
+TEST_CASE("bad input: a thruster model is checked wherever it enters", "[vehicle][bad_input]") {
+  const kv::ThrusterModel good = kv::von_benzon_t200_model;
+  kv::ThrusterModel nan_coefficient = good, no_thrust = good, nan_thrust = good, no_peak = good,
+                    past_full = good, no_curve = good;
+  nan_coefficient.odd_coefficients[2] = kNan;
+  no_thrust.max_thrust = 0.0;
+  nan_thrust.max_thrust = kNan;
+  no_peak.peak_command = 0.0;
+  past_full.peak_command = 1.5;
+  no_curve.curve = static_cast<kv::ThrusterCurve>(7);
+  const kv::PwmMapping<double> pwm;
+  for (const kv::ThrusterModel& m :
+       {nan_coefficient, no_thrust, nan_thrust, no_peak, past_full, no_curve}) {
+    REQUIRE_THROWS_AS(kv::validate(m), kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kv::thrust(m, 0.5), kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kv::thrust_slope(m, 0.5), kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kv::command_for_thrust(m, 5.0), kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kv::max_forward_thrust(m, 16.0), kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kv::max_reverse_thrust(m, 16.0), kelp::invalid_argument);
+    REQUIRE_THROWS_AS(kv::thrust_from_pwm(m, 1700.0, pwm), kelp::invalid_argument);
+  }
+  REQUIRE_THROWS_WITH(kv::thrust(nan_coefficient, 0.5), Catch::Contains("odd_coefficients"));
+  REQUIRE_THROWS_WITH(kv::thrust(no_thrust, 0.5), Catch::Contains("max_thrust"));
+  REQUIRE_THROWS_WITH(kv::thrust(past_full, 0.5), Catch::Contains("peak_command"));
+  REQUIRE_THROWS_WITH(kv::thrust(no_curve, 0.5), Catch::Contains("curve"));
+  // The valid models pass; the datasheet curve ignores the polynomial's fields.
+  kv::validate(good);
+  kv::validate(kv::t200_model);
+  kv::ThrusterModel datasheet = kv::t200_model;
+  datasheet.odd_coefficients[0] = kNan;
+  CHECK(kv::thrust(datasheet, 0.5) == kv::thrust(kv::t200_model, 0.5));
+  CHECK(kv::thrust(good, 1.0) == Approx(30.4).epsilon(1e-6));
 }
 
 TEST_CASE("bad input: added mass, restoring and hull parameters", "[vehicle][bad_input]") {

@@ -511,7 +511,9 @@ using AuvController = AuvControllerT<double>;
 enum class AsvLaw {
   /// The paper's pursuit (Buchholz et al. 2025): a PID on the distance pushes forward as far as the
   /// bow points at the target, a PID on the bearing turns it; inside `arrive_radius` only the
-  /// heading is held (so a current carries the boat off until it turns back).
+  /// heading is held (so a current carries the boat off until it turns back): keeping station,
+  /// the station's heading; following, the heading the boat had when it arrived inside the
+  /// radius.
   pursuit,
   /// Velocity tracking (kelp's default): the boat is commanded the target's velocity over ground
   /// (estimated from its successive positions, e.g. USBL fixes of the AUV, low-passed over
@@ -535,7 +537,9 @@ struct AsvControllerSettings {
   PidGains yaw{2.0, 0.0, 0.5, 15.0};             ///< heading error [rad] → differential [N]
   double period = 0.1;                           ///< update period [s] (10 Hz)
   double thrust_clip = 15.0;                     ///< per thruster [N]
-  double arrive_radius = 1.0;  ///< within this distance the boat only holds its heading [m]
+  /// Within this distance the boat only holds its heading (AsvLaw::pursuit: the station's, or,
+  /// following, the one it arrived with) [m].
+  double arrive_radius = 1.0;
   /// Follow offset: the boat's target is the AUV's horizontal position plus this NED offset [m].
   Vector3<double> follow_offset = Vector3<double>::Zero();
   bool compensate = false;              ///< feed the estimated disturbance forward
@@ -629,11 +633,17 @@ class AsvControllerT {
     check_all_finite(point, "station point");
     check_finite(heading, "station heading");
     follow_ = false;
+    arrived_ = false;
     target_ = point;
     heading_ = heading;
   }
-  /// \brief Follow the AUV (its position given to each update) at `follow_offset`.
-  void follow_auv() { follow_ = true; }
+  /// \brief Follow the AUV (its position given to each update) at `follow_offset`. Within
+  /// arrive_radius the pursuit law holds the heading the boat had when it arrived there (taken
+  /// anew at each arrival).
+  void follow_auv() {
+    follow_ = true;
+    arrived_ = false;
+  }
 
   /// \brief The command at time t [s] from the boat's navigation and the AUV's position (USBL).
   /// Recomputed every `period`, held in between.
@@ -649,10 +659,7 @@ class AsvControllerT {
     double dt = 0.0;
     if (!clock_.due(t, settings_.period, dt)) return command_;
     if (settings_.compensate) observer_.update(nav, command_.wrench, dt);
-    if (follow_) {
-      target_ = auv_position + settings_.follow_offset.template cast<Scalar>();
-      heading_ = heading_of(nav.attitude);  // hold whatever heading it arrives with
-    }
+    if (follow_) target_ = auv_position + settings_.follow_offset.template cast<Scalar>();
     const double psi = heading_of(nav.attitude);
     Vector3<Scalar> e = target_ - nav.position;
     e.z() = Scalar(0);
@@ -668,7 +675,12 @@ class AsvControllerT {
       common = linear_.update(distance, dt) * std::max(0.0, std::cos(bearing));
       differential = angular_.update(bearing, dt, -nav.nu(5));
       yaw_.reset();
+      arrived_ = false;
     } else {
+      // Following, the heading held is the one the boat arrives with (keeping station, the
+      // station's).
+      if (follow_ && !arrived_) heading_ = psi;
+      arrived_ = true;
       const double e_psi = wrap_angle(heading_ - psi);
       command_.heading_error = e_psi;
       differential = yaw_.update(e_psi, dt, -nav.nu(5));
@@ -724,7 +736,8 @@ class AsvControllerT {
   template <class Self, class V>
   static void memory(Self& s, V& v) {
     v(s.linear_, s.angular_, s.yaw_, s.speed_, s.heading_pid_, s.last_target_, s.target_velocity_,
-      s.course_, s.has_last_target_, s.has_course_, s.observer_, s.target_, s.heading_, s.follow_);
+      s.course_, s.has_last_target_, s.has_course_, s.observer_, s.target_, s.heading_, s.follow_,
+      s.arrived_);
     v(s.command_.left, s.command_.right, s.command_.command, s.command_.wrench,
       s.command_.position_error, s.command_.heading_error, s.clock_);
     double volts = s.thrusters_.voltage();
@@ -773,6 +786,9 @@ class AsvControllerT {
   Vector3<Scalar> target_ = Vector3<Scalar>::Zero();
   double heading_ = 0.0, half_track_ = 0.0;
   bool follow_ = false;
+  // Inside arrive_radius at the last update (pursuit): following, heading_ is then the heading
+  // the boat arrived with.
+  bool arrived_ = false;
   AsvCommandT<Scalar> command_;
   SampleClock clock_;
 };

@@ -86,11 +86,16 @@ class Pid {
     return output_;
   }
   /// \brief Sets the integral back (e.g. to its value before an update whose output an actuator
-  /// downstream could not deliver: anti-windup for saturation after allocation).
-  /// \param value the new ∫e dt [unit of e × s]; not checked against integral_limit.
-  void set_integral(double value) { integral_ = value; }
+  /// downstream could not deliver: anti-windup for saturation after allocation). A value within
+  /// ±integral_limit is kept exactly; one beyond it is clamped to the limit, as update() clamps.
+  /// \param value the new ∫e dt [unit of e × s], finite.
+  /// \throws kelp::invalid_argument when `value` is not finite (the integral is then unchanged).
+  void set_integral(double value) {
+    check_finite(value, "pid integral");
+    integral_ = std::clamp(value, -gains_.integral_limit, gains_.integral_limit);
+  }
   /// \brief The integral ∫e dt.
-  /// \return ∫e dt [unit of e × s], within ±integral_limit unless set_integral() put it outside.
+  /// \return ∫e dt [unit of e × s], within ±integral_limit.
   double integral() const { return integral_; }
   /// \brief The last output.
   /// \return the value update() last returned (0 before the first update and after reset()).

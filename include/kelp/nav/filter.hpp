@@ -44,6 +44,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/memory.hpp"
 #include "kelp/core/rotation.hpp"
+#include "kelp/core/scalar.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/nav/estimate.hpp"
 #include "kelp/nav/sensors.hpp"
@@ -200,10 +201,14 @@ class NavigationFilterT {
   }
 
   /// \brief A depth fix z [m] of noise σ [m].
-  /// \param z Depth, NED z [m] (positive down).
-  /// \param sigma Its standard deviation [m] (at least 1e-4 m is assumed).
+  /// \param z Depth, NED z [m] (positive down), finite.
+  /// \param sigma Its standard deviation [m], finite and ≥ 0 (at least 1e-4 m is assumed).
   /// Ignored before initialize().
+  /// \throws kelp::invalid_argument when z is not finite or σ is not finite and ≥ 0 (the
+  /// filter is then unchanged).
   void update_depth(double z, double sigma) {
+    check_finite(z, "NavigationFilter::update_depth: z");
+    check_non_negative(sigma, "NavigationFilter::update_depth: sigma");
     Eigen::Matrix<Scalar, 1, n> H = Eigen::Matrix<Scalar, 1, n>::Zero();
     H(0, 2) = Scalar(1);
     Eigen::Matrix<Scalar, 1, 1> y, R;
@@ -213,10 +218,15 @@ class NavigationFilterT {
   }
 
   /// \brief A bottom-lock velocity (body axes, over ground) [m/s] of noise σ [m/s] per axis.
-  /// \param v Velocity over ground in body axes [m/s].
-  /// \param sigma Its standard deviation per axis [m/s] (at least 1e-4 m/s is assumed).
+  /// \param v Velocity over ground in body axes [m/s], finite.
+  /// \param sigma Its standard deviation per axis [m/s], finite and ≥ 0 (at least 1e-4 m/s is
+  /// assumed).
   /// Ignored before initialize().
+  /// \throws kelp::invalid_argument when v is not finite or σ is not finite and ≥ 0 (the
+  /// filter is then unchanged).
   void update_body_velocity(const Vector3<Scalar>& v, double sigma) {
+    check_all_finite(v, "NavigationFilter::update_body_velocity: v");
+    check_non_negative(sigma, "NavigationFilter::update_body_velocity: sigma");
     const Matrix3<Scalar> Rt = q_.toRotationMatrix().transpose();
     Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
     H.template block<3, 3>(0, 3) = Rt;
@@ -226,10 +236,14 @@ class NavigationFilterT {
 
   /// \brief A water-track velocity (body axes, relative to the water) [m/s] of noise σ [m/s]
   /// (the filter adds its `water_track_noise`). Used only when the filter estimates the current.
-  /// \param v Velocity relative to the water in body axes [m/s].
-  /// \param sigma The DVL's standard deviation per axis [m/s].
+  /// \param v Velocity relative to the water in body axes [m/s], finite.
+  /// \param sigma The DVL's standard deviation per axis [m/s], finite and ≥ 0.
   /// Ignored before initialize().
+  /// \throws kelp::invalid_argument when v is not finite or σ is not finite and ≥ 0, whether
+  /// the filter estimates the current or not (the filter is then unchanged).
   void update_water_velocity(const Vector3<Scalar>& v, double sigma) {
+    check_all_finite(v, "NavigationFilter::update_water_velocity: v");
+    check_non_negative(sigma, "NavigationFilter::update_water_velocity: sigma");
     if (!s_.estimate_current) return;
     const Matrix3<Scalar> Rt = q_.toRotationMatrix().transpose();
     Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
@@ -243,9 +257,16 @@ class NavigationFilterT {
 
   /// \brief A compass heading ψ [rad]; `dt` [s] is the time since the last one (the correction
   /// is a rate).
-  /// \param psi Measured heading ψ [rad] (any value; the error is wrapped to (−π, π]).
-  /// \param dt Time since the last heading update [s]; the correction is heading_gain·e·dt.
+  /// \param psi Measured heading ψ [rad] (any finite value; the error is wrapped to (−π, π]).
+  /// \param dt Time since the last heading update [s], finite and ≥ 0; the correction is
+  /// heading_gain·e·dt.
+  /// Ignored before initialize(), as the other updates.
+  /// \throws kelp::invalid_argument when ψ is not finite or dt is not finite and ≥ 0 (the
+  /// filter is then unchanged).
   void update_heading(double psi, double dt) {
+    check_finite(psi, "NavigationFilter::update_heading: psi");
+    check_non_negative(dt, "NavigationFilter::update_heading: dt");
+    if (!initialized_) return;
     const double e = kelp::wrap_angle(psi - kelp::heading_of(q_));
     const Vector3<Scalar> axis = q_.conjugate() * Vector3<Scalar>::UnitZ();  // NED z in body
     rotate(Scalar(s_.heading_gain * e * dt) * axis);
@@ -255,12 +276,18 @@ class NavigationFilterT {
 
   /// \brief A horizontal position fix (north, east) [m] of noise σ per axis [m] (e.g. a GPS fix,
   /// whose altitude is much worse than its horizontal position).
-  /// \param p North, east [m].
-  /// \param sigma Standard deviation per axis [m] (at least 1e-4 m is assumed).
-  /// \param measured_at Time of the measurement [s] (see update_position).
+  /// \param p North, east [m], finite.
+  /// \param sigma Standard deviation per axis [m], finite and ≥ 0 (at least 1e-4 m is
+  /// assumed).
+  /// \param measured_at Time of the measurement [s], finite (see update_position).
   /// Ignored before initialize().
+  /// \throws kelp::invalid_argument when p or the time is not finite or σ is not finite and ≥ 0
+  /// (the filter is then unchanged).
   void update_horizontal_position(const Eigen::Matrix<Scalar, 2, 1>& p, double sigma,
                                   double measured_at) {
+    check_all_finite(p, "NavigationFilter::update_horizontal_position: p");
+    check_non_negative(sigma, "NavigationFilter::update_horizontal_position: sigma");
+    check_finite(measured_at, "NavigationFilter::update_horizontal_position: measured_at");
     Eigen::Matrix<Scalar, 2, n> H = Eigen::Matrix<Scalar, 2, n>::Zero();
     H.template block<2, 2>(0, 0).setIdentity();
     const Eigen::Matrix<Scalar, 2, 1> y = p - position_at(measured_at).template head<2>();
@@ -269,12 +296,19 @@ class NavigationFilterT {
 
   /// \brief A position fix (NED) [m] of noise σ per axis [m], measured at time `measured_at`
   /// [s] (earlier than now for a late fix; compared with the estimate of then).
-  /// \param p NED position [m].
-  /// \param sigma Standard deviation per axis [m] (each at least 1e-4 m is assumed).
-  /// \param measured_at Time of the measurement [s]; times older than the kept history use its
-  /// oldest estimate.
+  /// \param p NED position [m], finite.
+  /// \param sigma Standard deviation per axis [m], each finite and ≥ 0 (each at least 1e-4 m is
+  /// assumed).
+  /// \param measured_at Time of the measurement [s], finite; times older than the kept history
+  /// use its oldest estimate.
   /// Ignored before initialize().
+  /// \throws kelp::invalid_argument when p or the time is not finite or a σ is not finite and
+  /// ≥ 0 (the filter is then unchanged).
   void update_position(const Vector3<Scalar>& p, const Vector3<Scalar>& sigma, double measured_at) {
+    check_all_finite(p, "NavigationFilter::update_position: p");
+    for (int i = 0; i < 3; ++i)
+      check_non_negative(sigma(i), "NavigationFilter::update_position: sigma");
+    check_finite(measured_at, "NavigationFilter::update_position: measured_at");
     Eigen::Matrix<Scalar, 3, n> H = Eigen::Matrix<Scalar, 3, n>::Zero();
     H.template block<3, 3>(0, 0).setIdentity();
     const Vector3<Scalar> y = p - position_at(measured_at);

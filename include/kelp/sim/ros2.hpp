@@ -53,7 +53,7 @@ class KELP_SIM_API BagRecorder {
   /// \brief Creates the bag at `path`; markers at most `marker_rate` times a second (> 0);
   /// `options` of the MCAP file (chunk size).
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument for a rate
-  /// that is not > 0.
+  /// that is not finite and > 0 (checked before the file is created: none is left behind).
   /// \param path the bag's file \param marker_rate markers per second [Hz], > 0
   /// \param options the MCAP options
   BagRecorder(const std::filesystem::path& path, double marker_rate,

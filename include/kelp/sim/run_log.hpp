@@ -247,7 +247,9 @@ class KELP_SIM_API RunLog {
   /// \param t time [s] \param event the event's name (`entangled` or `pinned`)
   /// \param position the contact's position, NED [m]
   /// \param tension the tension difference [N] (`pinned`), or NaN
-  /// \param obstacle the obstacle's name (written as is: no commas)
+  /// \param obstacle the obstacle's name, written as one CSV field (RFC 4180): enclosed in
+  /// double quotes, each double quote in it doubled, when it holds a comma, a double quote or a
+  /// line break; as it is otherwise
   /// \param winding the winding about it [rad]
   /// \throws kelp::error when the file cannot be written.
   void entanglement(double t, const char* event, const kelp::Vector3<double>& position,

@@ -529,6 +529,14 @@ bool actual_end(const TetherEnd<Scalar>& e, const FleetState<Scalar>& s, Vector3
   return false;
 }
 
+/// The name of element `index` of the array named `array`, followed by `rest`, e.g.
+/// element("state.point_masses", 2, ".position must be finite") is
+/// "state.point_masses[2].position must be finite": an error message, built only when a check
+/// fails (so that a step's checks allocate nothing).
+inline std::string element(const char* array, std::size_t index, const char* rest) {
+  return std::string(array) + "[" + std::to_string(index) + "]" + rest;
+}
+
 }  // namespace detail
 
 /// \brief The energy of `state`, part by part (allocation-free into `e`, sized for the model:
@@ -579,7 +587,8 @@ void energy(const FleetModel<Scalar>& model, const FleetState<Scalar>& state,
 /// \param[in] dt step [s], > 0. \param[in] options SystemStepOptions::with_energy.
 /// \returns `ws.report`, refilled.
 /// \throws kelp::invalid_argument for bad input (dt, inputs or states of the wrong size or
-/// non-finite, clocks that differ from state.time, a workspace built for another model);
+/// non-finite, clocks that differ from state.time, a workspace built for another model), naming
+/// the element (e.g. `state.point_masses[2].position`);
 /// kelp::numerical_error when a part cannot be advanced. After any throw every part of `state`
 /// is bit-identical to what it was.
 template <typename Scalar>
@@ -599,31 +608,44 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
                  state.propulsion.size() == n && state.point_masses.size() == pm &&
                  state.point_mass_acceleration.size() == pm && state.tethers.size() == m,
              "state must be sized for the fleet (initial_state(model, ...))");
+  // The messages name the element (e.g. "state.point_masses[2].position"), built only when a
+  // check fails.
   for (std::size_t i = 0; i < n; ++i) {
-    check_all_finite(inputs.vehicles[i].tau, "inputs.vehicles[i].tau");
-    check_all_finite(inputs.vehicles[i].tau_ext, "inputs.vehicles[i].tau_ext");
+    KELP_CHECK(all_finite(inputs.vehicles[i].tau),
+               detail::element("inputs.vehicles", i, ".tau must be finite"));
+    KELP_CHECK(all_finite(inputs.vehicles[i].tau_ext),
+               detail::element("inputs.vehicles", i, ".tau_ext must be finite"));
     KELP_CHECK(state.vehicles[i].time == state.time,
-               "state.vehicles[i].time must equal state.time (use FleetState::set_time)");
+               detail::element("state.vehicles", i,
+                               ".time must equal state.time (use FleetState::set_time)"));
     vehicle::detail::check_state(state.vehicles[i]);
-    check_all_finite(state.vehicle_nu_dot[i], "state.vehicle_nu_dot[i]");
+    KELP_CHECK(all_finite(state.vehicle_nu_dot[i]),
+               detail::element("state.vehicle_nu_dot", i, " must be finite"));
   }
   for (std::size_t j = 0; j < pm; ++j) {
-    check_all_finite(state.point_masses[j].position, "state.point_masses[j].position");
-    check_all_finite(state.point_masses[j].velocity, "state.point_masses[j].velocity");
-    check_all_finite(state.point_mass_acceleration[j], "state.point_mass_acceleration[j]");
+    KELP_CHECK(all_finite(state.point_masses[j].position),
+               detail::element("state.point_masses", j, ".position must be finite"));
+    KELP_CHECK(all_finite(state.point_masses[j].velocity),
+               detail::element("state.point_masses", j, ".velocity must be finite"));
+    KELP_CHECK(all_finite(state.point_mass_acceleration[j]),
+               detail::element("state.point_mass_acceleration", j, " must be finite"));
   }
   for (std::size_t k = 0; k < m; ++k) {
-    check_finite(inputs.winch_payout_rates[k], "inputs.winch_payout_rates[k]");
-    KELP_CHECK(model.winch(int(k)) != nullptr || inputs.winch_payout_rates[k] == Scalar(0),
-               "inputs.winch_payout_rates[k] must be 0 for a tether without a winch");
+    KELP_CHECK(is_finite(inputs.winch_payout_rates[k]),
+               detail::element("inputs.winch_payout_rates", k, " must be finite"));
+    KELP_CHECK(
+        model.winch(int(k)) != nullptr || inputs.winch_payout_rates[k] == Scalar(0),
+        detail::element("inputs.winch_payout_rates", k, " must be 0 for a tether without a winch"));
     KELP_CHECK(state.tethers[k].time == state.time,
-               "state.tethers[k].time must equal state.time (use FleetState::set_time)");
+               detail::element("state.tethers", k,
+                               ".time must equal state.time (use FleetState::set_time)"));
     KELP_CHECK(ws.tethers[k].tether.fits(model.tether_of(int(k), state.tethers[k]).nodes()),
                ws.tethers[k].winch
-                   ? "workspace holds tether k's buffers of another node count than the "
-                     "state's: call system::fit_workspace(model, ws, state) first (a state "
-                     "loaded or restored at another count)"
-                   : "workspace was built for a different fleet");
+                   ? detail::element("workspace holds the buffers of tethers", k,
+                                     " at another node count than the state's: call "
+                                     "system::fit_workspace(model, ws, state) first (a state "
+                                     "loaded or restored at another count)")
+                   : std::string("workspace was built for a different fleet"));
   }
   FleetReport<Scalar>& report = ws.report;
   report.tether = {};
@@ -764,7 +786,8 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
 /// its ends' positions (a free end: the line hanging from its other end, solved with its end
 /// mass), at rest, at time `t` [s]. The static solve's tolerance is, unless `options` gives one,
 /// 1e-4 × each line's weight in air.
-/// \throws kelp::invalid_argument for states of the wrong count or bad; kelp::numerical_error
+/// \throws kelp::invalid_argument for states of the wrong count or bad (a point mass's position
+/// named with its index, e.g. `point_masses[2]`); kelp::numerical_error
 /// when a tether's static solve does not converge (naming the tether).
 /// \tparam Scalar double or float.
 /// \param model The fleet.
@@ -794,7 +817,7 @@ FleetState<Scalar> initial_state(const FleetModel<Scalar>& model, FleetWorkspace
       s.propulsion[i] = vehicle::initial_state(*model.propulsion(int(i)));
   s.point_masses.resize(pm);
   for (std::size_t j = 0; j < pm; ++j) {
-    check_all_finite(point_masses[j], "point_masses[j]");
+    KELP_CHECK(all_finite(point_masses[j]), detail::element("point_masses", j, " must be finite"));
     s.point_masses[j].position = point_masses[j];
   }
   s.point_mass_acceleration.assign(pm, Vector3<Scalar>::Zero());

@@ -35,10 +35,12 @@ namespace kelp::tether::presets {
 /// 0.25 m segments and 8.7 at 1 m: the axial mode is far above critical damping at any
 /// practical segment length.
 /// \throws kelp::invalid_argument for a length not finite in (0, 1e5] m, a segment length not
-/// finite and > 0, or more than 100000 segments.
+/// finite and > 0, more than 100000 segments, or segments L / N shorter than
+/// limits::min_segment_length (1 µm): the counts and lengths TetherModel refuses.
 /// \tparam Scalar double or float.
 /// \param length the unstretched length L [m], in (0, 1e5].
-/// \param max_segment_length the longest segment [m] (default 0.25 m): N = ⌈L / it⌉, at least 1.
+/// \param max_segment_length the longest segment [m] (default 0.25 m): N = ⌈L / it⌉, at least 1;
+/// L / N must be at least 1 µm.
 /// \return the parameters (not yet validated: TetherModel does that).
 template <typename Scalar>
 TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = Scalar(0.25)) {
@@ -53,6 +55,10 @@ TetherParameters<Scalar> rov_tether(Scalar length, Scalar max_segment_length = S
   p.length = length;
   p.segments = static_cast<int>(count);
   if (p.segments < 1) p.segments = 1;
+  // TetherModel's rule (validate(const TetherParameters&)), so that the preset never gives a
+  // line the model refuses.
+  check_at_least(p.length / Scalar(p.segments), limits::min_segment_length,
+                 "rov_tether: length / segments (the segment length)");
   p.diameter = Scalar(d);
   p.mass_per_length = Scalar(1000.0 * area);
   p.axial_stiffness = Scalar(6.437e7 * area);

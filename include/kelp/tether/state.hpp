@@ -696,11 +696,13 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 
 /// \brief Checks that a state fits the model and is finite (its history too, when it has one).
 /// \throws kelp::invalid_argument naming `state.position` / `state.velocity` / `state.time` /
-/// `state.previous_position` / `state.previous_velocity` / `state.previous_dt` (or the
-/// sizes: segments + 1 columns, `state.parted` empty or one flag per segment).
+/// `state.winch_length` / `state.payout_rate` / `state.previous_position` /
+/// `state.previous_velocity` / `state.previous_dt` (or the sizes: segments + 1 columns,
+/// `state.parted` empty or one flag per segment).
 /// \tparam Scalar double or float.
 /// \param model the tether the state must fit.
-/// \param state the state checked (TetherState::winch_length and payout_rate are not).
+/// \param state the state checked (its winch fields, TetherState::winch_length and payout_rate,
+/// finite; their ranges are the winch's and the steps' to check).
 template <typename Scalar>
 void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& state) {
   KELP_CHECK(state.position.rows() == 3 && state.velocity.rows() == 3 &&
@@ -709,6 +711,8 @@ void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& st
   check_all_finite(state.position, "state.position");
   check_all_finite(state.velocity, "state.velocity");
   check_finite(state.time, "state.time");
+  check_finite(state.winch_length, "state.winch_length");
+  check_finite(state.payout_rate, "state.payout_rate");
   check_non_negative(state.previous_dt, "state.previous_dt");
   KELP_CHECK(state.parted.size() == 0 || state.parted.size() == model.segments(),
              "state.parted must be empty or have one flag per segment");

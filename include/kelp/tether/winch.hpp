@@ -228,7 +228,8 @@ void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
 /// the share of a kinematic node (node 0 always, node 2 when it is a kinematic far end), whose
 /// velocity is prescribed, goes to the body that carries it (report.impulse_on_start / _end).
 /// Mass and momentum (line plus those impulses) are conserved exactly. The history restarts.
-/// Node 0 is taken as kinematic (a winch sits on a body).
+/// The start end must be kinematic (a winch sits on a body; WinchModel requires it): the share
+/// of a free node 0 would be handed to a body that is not there.
 /// \tparam Scalar double or float.
 /// \param from the model of N ≥ 2 segments that fits `in`.
 /// \param in the state before.
@@ -236,11 +237,14 @@ void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
 /// insert_winch_node().
 /// \param[in,out] report counts the removal, adds the kinetic energy lost [J] and the impulses
 /// handed to the ends, NED [N s].
-/// \throws kelp::invalid_argument when N < 2 or `out` has the wrong size (nothing written then).
+/// \throws kelp::invalid_argument when the start end is not kinematic, N < 2 or `out` has the
+/// wrong size (nothing written then).
 template <typename Scalar>
 void remove_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar>& in,
                        TetherState<Scalar>& out, RemeshReport<Scalar>& report) {
   const int n = from.segments();
+  KELP_CHECK(from.parameters().start_mode == EndMode::kinematic,
+             "remove_winch_node: the start end must be kinematic (the winch sits on a body)");
   KELP_CHECK(n >= 2, "remove_winch_node: the line must have at least two segments");
   KELP_CHECK(out.position.cols() == n && out.velocity.cols() == n,
              "remove_winch_node: out must have N columns");

@@ -190,6 +190,24 @@ inline constexpr double von_benzon_t200_peak_command = von_benzon_t200_model.pea
 /// \brief Largest thrust of the von Benzon curve [N] (`von_benzon_t200_model.max_thrust`).
 inline constexpr double von_benzon_t200_max_thrust = von_benzon_t200_model.max_thrust;
 
+/// \brief Checks a thruster model: its curve is a ThrusterCurve value and, for the odd polynomial
+/// (the datasheet curve does not read the polynomial's fields), peak_command in (0, 1],
+/// max_thrust finite and > 0 and every coefficient finite. The free functions that take a model
+/// (thrust(), thrust_slope(), max_forward_thrust(), max_reverse_thrust(),
+/// command_for_thrust(), thrust_from_pwm()) call it; ThrusterChain calls it once, when built.
+/// \param m the model.
+/// \throws kelp::invalid_argument naming the field.
+inline void validate(const ThrusterModel& m) {
+  KELP_CHECK(m.curve == ThrusterCurve::t200_datasheet || m.curve == ThrusterCurve::odd_polynomial,
+             "ThrusterModel: curve must be ThrusterCurve::t200_datasheet or "
+             "ThrusterCurve::odd_polynomial");
+  if (m.curve != ThrusterCurve::odd_polynomial) return;
+  KELP_CHECK(m.peak_command > 0.0 && m.peak_command <= 1.0,
+             "ThrusterModel: peak_command must be in (0, 1]");
+  check_positive(m.max_thrust, "ThrusterModel: max_thrust");
+  for (double c : m.odd_coefficients) check_finite(c, "ThrusterModel: odd_coefficients");
+}
+
 namespace detail {
 /// F(u) and dF/du of an odd polynomial, u unclamped: with P(x) = Σ cₖ xᵏ and x = u², F = u P(x)
 /// and F' = P(x) + 2x P'(x); P and P' by one Horner pass (the coefficients are written once).
@@ -205,21 +223,10 @@ void thrust_polynomial(const ThrusterModel& m, const Scalar& u, Scalar& f, Scala
   f = u * p;
   if (slope != nullptr) *slope = p + Scalar(2) * x * dp;
 }
-}  // namespace detail
 
-/// \brief Static thrust F(u) [N] of thruster model `m` for a normalised command u (clamped to
-/// [−1, 1]) at a supply voltage [V] (used by the datasheet curve only; positive: thrust along
-/// the thruster's forward axis).
-/// \throws kelp::invalid_argument naming the command when u is not finite, or (datasheet) the
-/// voltage when it is not finite or outside [0, 20] V.
-/// \tparam Scalar double, float or ceres::Jet.
-/// \param m Thruster model.
-/// \param u_in Normalised command u [-].
-/// \param voltage Supply voltage [V] (default t200_nominal_voltage, 16 V).
-/// \return F(u) [N].
+/// thrust() of a model already validated (ThrusterChain's, checked once when it was built).
 template <typename Scalar>
-Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
-              const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+Scalar model_thrust(const ThrusterModel& m, const Scalar& u_in, const Scalar& voltage) {
   if (m.curve == ThrusterCurve::t200_datasheet) return t200_thrust(u_in, voltage);
   check_finite(u_in, "thruster command u");
   Scalar u = u_in;
@@ -232,6 +239,36 @@ Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
   return u * p;
 }
 
+/// thrust_slope() of a model already validated.
+template <typename Scalar>
+Scalar model_thrust_slope(const ThrusterModel& m, const Scalar& u, const Scalar& voltage) {
+  if (m.curve == ThrusterCurve::t200_datasheet) return t200_thrust_slope(u, voltage);
+  check_finite(u, "thruster command u");
+  if (value_of(u) > 1.0 || value_of(u) < -1.0) return Scalar(0);
+  Scalar f, d;
+  thrust_polynomial<Scalar>(m, u, f, &d);
+  return d;
+}
+}  // namespace detail
+
+/// \brief Static thrust F(u) [N] of thruster model `m` for a normalised command u (clamped to
+/// [−1, 1]) at a supply voltage [V] (used by the datasheet curve only; positive: thrust along
+/// the thruster's forward axis).
+/// \throws kelp::invalid_argument when `m` is invalid (`validate(const ThrusterModel&)`), naming
+/// the command when u is not finite, or (datasheet) the voltage when it is not finite or outside
+/// [0, 20] V.
+/// \tparam Scalar double, float or ceres::Jet.
+/// \param m Thruster model.
+/// \param u_in Normalised command u [-].
+/// \param voltage Supply voltage [V] (default t200_nominal_voltage, 16 V).
+/// \return F(u) [N].
+template <typename Scalar>
+Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
+              const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  validate(m);
+  return detail::model_thrust(m, u_in, voltage);
+}
+
 /// \brief dF/du [N] of thrust() (same clamping: 0 outside [−1, 1]).
 /// \tparam Scalar double, float or ceres::Jet.
 /// \param m Thruster model.
@@ -242,12 +279,8 @@ Scalar thrust(const ThrusterModel& m, const Scalar& u_in,
 template <typename Scalar>
 Scalar thrust_slope(const ThrusterModel& m, const Scalar& u,
                     const Scalar& voltage = Scalar(t200_nominal_voltage)) {
-  if (m.curve == ThrusterCurve::t200_datasheet) return t200_thrust_slope(u, voltage);
-  check_finite(u, "thruster command u");
-  if (value_of(u) > 1.0 || value_of(u) < -1.0) return Scalar(0);
-  Scalar f, d;
-  detail::thrust_polynomial<Scalar>(m, u, f, &d);
-  return d;
+  validate(m);
+  return detail::model_thrust_slope(m, u, voltage);
 }
 
 /// \brief Largest thrust [N] along the thruster's forward axis that model `m` delivers at a
@@ -256,10 +289,12 @@ Scalar thrust_slope(const ThrusterModel& m, const Scalar& u,
 /// \param m Thruster model.
 /// \param voltage Supply voltage [V] (datasheet curve only; default 16 V).
 /// \return The thrust [N].
-/// \throws kelp::invalid_argument (datasheet) for a voltage outside [0, 20] V.
+/// \throws kelp::invalid_argument when `m` is invalid (`validate(const ThrusterModel&)`), or
+/// (datasheet) for a voltage outside [0, 20] V.
 template <typename Scalar>
 Scalar max_forward_thrust(const ThrusterModel& m,
                           const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  validate(m);
   if (m.curve == ThrusterCurve::t200_datasheet) return t200_max_thrust(voltage);
   return Scalar(m.max_thrust);
 }
@@ -270,30 +305,20 @@ Scalar max_forward_thrust(const ThrusterModel& m,
 /// \param m Thruster model.
 /// \param voltage Supply voltage [V] (datasheet curve only; default 16 V).
 /// \return The magnitude [N].
-/// \throws kelp::invalid_argument (datasheet) for a voltage outside [0, 20] V.
+/// \throws kelp::invalid_argument when `m` is invalid (`validate(const ThrusterModel&)`), or
+/// (datasheet) for a voltage outside [0, 20] V.
 template <typename Scalar>
 Scalar max_reverse_thrust(const ThrusterModel& m,
                           const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  validate(m);
   if (m.curve == ThrusterCurve::t200_datasheet) return t200_max_reverse_thrust(voltage);
   return Scalar(m.max_thrust);
 }
 
-/// \brief Inverse of the curve on its monotone branch: the command u with
-/// thrust(m, u, V) = force. Datasheet: t200_command() (saturates at u = ±1 beyond the largest
-/// forward / reverse thrust at that voltage). Polynomial: u ∈ [−u_peak, u_peak], forces beyond
-/// ±max_thrust saturate at ±u_peak; Newton's method safeguarded by bisection on the value (the
-/// bracket shrinks at every step; a Newton step that leaves it is replaced by the midpoint; 5–8
-/// iterations instead of 60 bisections), then one Newton correction in Scalar so that
-/// ceres::Jet derivatives follow the implicit-function theorem (du/dF = 1/F'(u)).
-/// \param[in] m thruster model \param[in] force desired thrust [N] along the forward axis.
-/// \param[in] voltage supply voltage [V] (datasheet only).
-/// \tparam Scalar double, float or ceres::Jet.
-/// \return u [-] (|u| ≤ u_peak for the polynomial, ≤ 1 for the datasheet curve).
-/// \throws kelp::invalid_argument naming the force when it is not finite, or (datasheet) the
-/// voltage.
+namespace detail {
+/// command_for_thrust() of a model already validated (ThrusterChain's).
 template <typename Scalar>
-Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force,
-                          const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+Scalar model_command(const ThrusterModel& m, const Scalar& force, const Scalar& voltage) {
   if (m.curve == ThrusterCurve::t200_datasheet) return t200_command(force, voltage);
   check_finite(force, "thruster force");
   const double f = value_of(force);
@@ -316,7 +341,29 @@ Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force,
   }
   const double u0 = f < 0 ? -x : x;  // x stays inside the bracket
   const Scalar u(u0);
-  return u + (force - thrust(m, u)) / thrust_slope(m, u);
+  const Scalar v(t200_nominal_voltage);  // unused by the polynomial
+  return u + (force - model_thrust(m, u, v)) / model_thrust_slope(m, u, v);
+}
+}  // namespace detail
+
+/// \brief Inverse of the curve on its monotone branch: the command u with
+/// thrust(m, u, V) = force. Datasheet: t200_command() (saturates at u = ±1 beyond the largest
+/// forward / reverse thrust at that voltage). Polynomial: u ∈ [−u_peak, u_peak], forces beyond
+/// ±max_thrust saturate at ±u_peak; Newton's method safeguarded by bisection on the value (the
+/// bracket shrinks at every step; a Newton step that leaves it is replaced by the midpoint; 5–8
+/// iterations instead of 60 bisections), then one Newton correction in Scalar so that
+/// ceres::Jet derivatives follow the implicit-function theorem (du/dF = 1/F'(u)).
+/// \param[in] m thruster model \param[in] force desired thrust [N] along the forward axis.
+/// \param[in] voltage supply voltage [V] (datasheet only).
+/// \tparam Scalar double, float or ceres::Jet.
+/// \return u [-] (|u| ≤ u_peak for the polynomial, ≤ 1 for the datasheet curve).
+/// \throws kelp::invalid_argument when `m` is invalid (`validate(const ThrusterModel&)`), naming
+/// the force when it is not finite, or (datasheet) the voltage.
+template <typename Scalar>
+Scalar command_for_thrust(const ThrusterModel& m, const Scalar& force,
+                          const Scalar& voltage = Scalar(t200_nominal_voltage)) {
+  validate(m);
+  return detail::model_command(m, force, voltage);
 }
 
 /// \brief T200 thrust [N] at the nominal supply voltage (t200_nominal_voltage, 16 V):
@@ -467,8 +514,9 @@ class ThrusterChain {
   /// \param[in] facing ±1 per thruster (see the class); empty: all +1.
   /// \param[in] voltage supply voltage [V] (set_voltage()).
   /// \throws kelp::invalid_argument when `pwm` is invalid (see `validate(const PwmMapping&)`),
-  /// the polynomial model's peak command is not in (0, 1] or its max thrust not > 0, `facing`
-  /// has a wrong size or an entry other than ±1, or the voltage is invalid.
+  /// `model` is invalid (see `validate(const ThrusterModel&)`: the chain's thrusts and commands
+  /// then need no further check of it), `facing` has a wrong size or an entry other than ±1, or
+  /// the voltage is invalid.
   explicit ThrusterChain(const ThrusterAllocation<Scalar>& allocation,
                          const ThrusterModel& model = t200_model,
                          const PwmMapping<Scalar>& pwm = PwmMapping<Scalar>(),
@@ -476,12 +524,7 @@ class ThrusterChain {
                          double voltage = t200_nominal_voltage)
       : allocation_(allocation), model_(model), pwm_(pwm) {
     validate(pwm_);
-    if (model.curve == ThrusterCurve::odd_polynomial) {
-      KELP_CHECK(model.peak_command > 0.0 && model.peak_command <= 1.0,
-                 "ThrusterModel: peak_command must be in (0, 1]");
-      check_positive(model.max_thrust, "ThrusterModel: max_thrust");
-      for (double c : model.odd_coefficients) check_finite(c, "ThrusterModel: odd_coefficients");
-    }
+    validate(model);
     if (facing.size() == 0) {
       facing_ = Eigen::VectorXd::Ones(allocation_.size());
     } else {
@@ -563,7 +606,7 @@ class ThrusterChain {
   /// \throws kelp::invalid_argument when u is not finite.
   Scalar thrust_of_command(Eigen::Index i, const Scalar& u) const {
     const Scalar s(facing_(i));
-    return s * thrust(model_, Scalar(s * esc_command(u)), Scalar(voltage_));
+    return s * detail::model_thrust(model_, Scalar(s * esc_command(u)), Scalar(voltage_));
   }
   /// \brief Thrust [N] of thruster i along d_i for a pulse width [µs].
   /// \param[in] i thruster index in [0, n) (not checked) \param[in] pwm_us pulse width [µs]
@@ -584,7 +627,7 @@ class ThrusterChain {
   /// \throws kelp::invalid_argument when the force is not finite.
   Scalar command_for(Eigen::Index i, const Scalar& force) const {
     const Scalar s(facing_(i));
-    const Scalar ue = s * command_for_thrust(model_, Scalar(s * force), Scalar(voltage_));
+    const Scalar ue = s * detail::model_command(model_, Scalar(s * force), Scalar(voltage_));
     Scalar u = value_of(ue) > 0.0 ? Scalar(ue / Scalar(esc_up_)) : Scalar(ue / Scalar(esc_down_));
     if (value_of(u) > 1.0) u = Scalar(1);
     if (value_of(u) < -1.0) u = Scalar(-1);
