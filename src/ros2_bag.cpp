@@ -45,12 +45,16 @@ const ros2::Messages& Ros2Sampler::messages(const LogRow& r) {
 }
 
 namespace {
+void check_marker_rate(double marker_rate) {
+  KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
+             "BagRecorder: the marker rate must be finite and > 0");
+}
+
 // The bag's path, once the marker rate is known to be finite and > 0: BagRecorder checks it here,
 // in its bag's initialiser, so that a bad rate is refused before the file is created.
 const std::filesystem::path& checked_bag_path(const std::filesystem::path& path,
                                               double marker_rate) {
-  KELP_CHECK(marker_rate > 0 && std::isfinite(marker_rate),
-             "BagRecorder: the marker rate must be finite and > 0");
+  check_marker_rate(marker_rate);
   return path;
 }
 }  // namespace
@@ -73,6 +77,11 @@ RunBag::~RunBag() = default;
 
 void RunBag::record(const LogRow& r) {
   if (!bag_) {
+    // What BagRecorder would refuse, checked before the directory is created, so that a refused
+    // first record leaves nothing on disk: the marker rate, and the row, by turning it into
+    // messages as the recorder will (once per bag).
+    check_marker_rate(marker_rate_);
+    Ros2Sampler().messages(r);
     if (file_.has_parent_path()) std::filesystem::create_directories(file_.parent_path());
     bag_ = std::make_unique<BagRecorder>(file_, marker_rate_);
   }

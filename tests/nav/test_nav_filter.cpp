@@ -1,7 +1,8 @@
 // kelp::nav's filter on a known trajectory (a level circle at constant speed and depth): from
 // wrong initial position, velocity and heading it converges with the aiding sensors, late
 // position fixes included, and stays bounded; its settings are checked; updates before
-// initialize() are ignored and a non-finite measurement is refused, the filter unchanged.
+// initialize() are ignored and a non-finite measurement or IMU sample is refused, the filter
+// unchanged.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -253,4 +254,79 @@ TEST_CASE("every update refuses a non-finite measurement, σ or time and changes
   // The same updates with finite values act.
   f.update_depth(3.5, 0.1);
   CHECK(f.state() != x);
+}
+
+TEST_CASE("predict and initialize refuse a non-finite IMU sample or time and change nothing",
+          "[nav][filter][errors]") {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  kn::ImuSample s;
+  s.accel = V3(0.3, -0.2, -kelp::standard_gravity);
+  s.gyro = V3(0.01, -0.02, 0.05);
+  // `f` is offered the bad samples; `twin` gets only the good ones.
+  kn::NavigationFilter f(kn::ImuParameters{}), twin(kn::ImuParameters{});
+  f.initialize(V3(1.0, 2.0, 3.0), V3(0.5, 0.0, 0.0), 0.3, s);
+  twin.initialize(V3(1.0, 2.0, 3.0), V3(0.5, 0.0, 0.0), 0.3, s);
+  s.t = 0.01;
+  f.predict(s);
+  twin.predict(s);
+  const kn::NavigationFilter::StateVector x = f.state();
+  const kn::NavigationFilter::Covariance P = f.covariance();
+  const kelp::Quaternion<double> q = f.navigation().attitude;
+  const kelp::Vector6<double> nu = f.navigation().nu;
+  const V3 bias = f.gyro_bias();
+  // A bad time, later than the last sample or not, and bad components with a good time, a
+  // time of the last sample's (dt = 0: it would only set the body rate) included.
+  for (const double t : {nan, inf, -inf}) {
+    kn::ImuSample m = s;
+    m.t = t;
+    INFO("t " << t);
+    CHECK_THROWS_AS(f.predict(m), kelp::invalid_argument);
+  }
+  for (const double t : {0.01, 0.02}) {
+    for (int i = 0; i < 3; ++i) {
+      INFO("t " << t << ", component " << i);
+      kn::ImuSample m = s;
+      m.t = t;
+      m.gyro(i) = nan;
+      CHECK_THROWS_AS(f.predict(m), kelp::invalid_argument);
+      m = s;
+      m.t = t;
+      m.accel(i) = i == 1 ? -inf : nan;
+      CHECK_THROWS_AS(f.predict(m), kelp::invalid_argument);
+    }
+  }
+  kn::ImuSample bad = s;
+  bad.t = nan;
+  CHECK_THROWS_WITH(f.predict(bad), Catch::Contains("predict: m.t"));
+  bad = s;
+  bad.gyro.x() = nan;
+  CHECK_THROWS_WITH(f.predict(bad), Catch::Contains("predict: m.gyro"));
+  // initialize() takes its clock and attitude from an IMU sample too: a bad one is refused the
+  // same way, the running filter kept.
+  bad = s;
+  bad.t = nan;
+  CHECK_THROWS_AS(f.initialize(V3::Zero(), V3::Zero(), 0.0, bad), kelp::invalid_argument);
+  bad = s;
+  bad.accel.z() = inf;
+  CHECK_THROWS_AS(f.initialize(V3::Zero(), V3::Zero(), 0.0, bad), kelp::invalid_argument);
+  bad = s;
+  bad.gyro.y() = nan;
+  CHECK_THROWS_AS(f.initialize(V3::Zero(), V3::Zero(), 0.0, bad), kelp::invalid_argument);
+  // Nothing moved: bit for bit.
+  CHECK(f.state() == x);
+  CHECK(f.covariance() == P);
+  CHECK(f.navigation().attitude.coeffs() == q.coeffs());
+  CHECK(f.navigation().nu == nu);
+  CHECK(f.gyro_bias() == bias);
+  // The clock and body rate too: the next good sample gives what it gives the twin.
+  s.t = 0.02;
+  f.predict(s);
+  twin.predict(s);
+  CHECK(f.state() != x);
+  CHECK(f.state() == twin.state());
+  CHECK(f.covariance() == twin.covariance());
+  CHECK(f.navigation().attitude.coeffs() == twin.navigation().attitude.coeffs());
+  CHECK(f.navigation().nu == twin.navigation().nu);
+  CHECK(f.position_at(0.015) == twin.position_at(0.015));
 }

@@ -2,7 +2,8 @@
 // reference.csv, the same samples in kelp's own frames (NED/FRD) at full precision (%.17g), for
 // the independent check of the bag (tests/ros2/node/check_bags.mjs, with @mcap/core and
 // @foxglove/rosmsg2-serialization) which converts them to ROS's frames itself; a bad marker rate
-// refused before any file is created.
+// (or, for a run's bag, a row that lacks what the messages need) refused before any file or
+// directory is created.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,9 @@
 #include "../sim/sim_test_support.hpp"
 #include "kelp/sim/ros2.hpp"
 #include "kelp/sim/run.hpp"
+#include "kelp/tether/model.hpp"
+#include "kelp/tether/state.hpp"
+#include "kelp/vehicle/state.hpp"
 
 namespace {
 void put(std::FILE* f, double v) { std::fprintf(f, ",%.17g", v); }
@@ -109,4 +113,51 @@ TEST_CASE("BagRecorder refuses a marker rate that is not > 0 before it creates i
     CHECK_THROWS_AS(kelp::sim::BagRecorder(file, rate), kelp::invalid_argument);
     CHECK_FALSE(std::filesystem::exists(file));
   }
+}
+
+TEST_CASE("RunBag refuses a bad marker rate or row before it creates its directory",
+          "[ros2][sim]") {
+  const std::filesystem::path top = "ros2_run_bag_refused", file = top / "out" / "run.mcap";
+  std::filesystem::remove_all(top);
+  // A row with what the messages need: both vehicles and a straight 4-segment tether at rest.
+  kelp::tether::TetherParametersd p;
+  p.length = 4;
+  p.segments = 4;
+  const kelp::tether::TetherModeld line(p);
+  kelp::tether::TetherStated x(line);
+  for (int i = 0; i <= 4; ++i) x.position.col(i) = kelp::Vector3<double>(i, 0, 1);
+  kelp::vehicle::VehicleStated asv, auv;
+  auv.position = kelp::Vector3<double>(4, 0, 1);
+  kelp::sim::LogRow row;
+  row.asv = &asv;
+  row.auv = &auv;
+  row.tether_model = &line;
+  row.tether = &x;
+  row.force_on_asv.setZero();
+  row.force_on_auv.setZero();
+  for (const double rate : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    INFO("marker rate " << rate);
+    std::filesystem::remove_all(top);
+    kelp::sim::RunBag bag(file, rate);
+    CHECK_THROWS_AS(bag.record(row), kelp::invalid_argument);
+    CHECK_FALSE(std::filesystem::exists(top));
+  }
+  // A good rate, but a row the messages refuse: no tether, a time that is not a ROS time.
+  kelp::sim::LogRow no_tether = row, no_time = row;
+  no_tether.tether = nullptr;
+  no_time.t = std::nan("");
+  for (const kelp::sim::LogRow* bad : {&no_tether, &no_time}) {
+    INFO((bad == &no_tether ? "no tether" : "a NaN time"));
+    std::filesystem::remove_all(top);
+    kelp::sim::RunBag refused(file, 2.0);
+    CHECK_THROWS_AS(refused.record(*bad), kelp::invalid_argument);
+    CHECK_FALSE(std::filesystem::exists(top));
+  }
+  // A bag whose first row was refused records the next good one: its directory and file are
+  // created then.
+  kelp::sim::RunBag bag(file, 2.0);
+  CHECK_THROWS_AS(bag.record(no_tether), kelp::invalid_argument);
+  bag.record(row);
+  bag.close();
+  CHECK(std::filesystem::exists(file));
 }

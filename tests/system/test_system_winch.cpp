@@ -1,8 +1,11 @@
 // The boat's winch in system::step (SystemParameters::winch, SystemInputs::winch_payout_rate):
 // the line pays out and reels back in during a coupled run with nodes inserted and removed,
-// without allocating, and a failed step leaves the state (node count included) as it was.
+// without allocating, and a failed step leaves the state (node count included) as it was, a
+// non-finite payout rate in the state included.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
+#include <limits>
 
 #include "kelp/system/system.hpp"
 #include "kelp/tether/presets.hpp"
@@ -104,4 +107,32 @@ TEST_CASE("a failed winch step leaves the state as it was, node count included",
   ks::SystemInputsd fin;
   fin.winch_payout_rate = 0.1;
   CHECK_THROWS_WITH(ks::step(fixed, fws, fs, fin, 0.01), Catch::Contains("no winch"));
+}
+
+TEST_CASE("system::step refuses a non-finite payout rate in the state and changes nothing",
+          "[system][winch][bad_input]") {
+  kelp::environment::Environmentd env;
+  const ks::SystemModeld model(winch_system(), env);
+  ks::SystemWorkspaced ws(model);
+  ks::SystemStated s = start(model, ws);
+  ks::SystemInputsd in;
+  in.winch_payout_rate = 0.5;
+  ks::step(model, ws, s, in, 0.01);
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    INFO("payout rate " << bad);
+    ks::SystemStated x = s;
+    x.tether.payout_rate = bad;
+    const ks::SystemStated before = x;
+    CHECK_THROWS_WITH(ks::step(model, ws, x, in, 0.01), Catch::Contains("state.payout_rate"));
+    CHECK(x.time == before.time);
+    CHECK(x.tether.time == before.tether.time);
+    CHECK(x.tether.position == before.tether.position);
+    CHECK(x.tether.velocity == before.tether.velocity);
+    CHECK(x.tether.winch_length == before.tether.winch_length);
+    CHECK(std::memcmp(&x.tether.payout_rate, &before.tether.payout_rate, sizeof(double)) == 0);
+    CHECK(x.asv.position == before.asv.position);
+    CHECK(x.auv.nu == before.auv.nu);
+  }
+  // The state as it was steps on.
+  CHECK_NOTHROW(ks::step(model, ws, s, in, 0.01));
 }

@@ -1,8 +1,10 @@
 // The winch at the start end of the lumped-mass tether (kelp/tether/winch.hpp): re-meshing
-// conserves mass and momentum (and refuses a start end that is not kinematic), a slow reel-in
-// ends at the static solution and the catenary.
+// conserves mass and momentum (and refuses a start end that is not kinematic), a non-finite
+// winch length or payout rate is refused with the state unchanged, a slow reel-in ends at the
+// static solution and the catenary.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "kelp/environment/environment.hpp"
@@ -169,6 +171,56 @@ TEST_CASE("winch limits: speed, acceleration, pull and length", "[tether][winch]
   CHECK_THROWS_AS(kt::WinchModel<double>(p, bad), kelp::invalid_argument);
   p.start_mode = kt::EndMode::free;
   CHECK_THROWS_AS(kt::WinchModel<double>(p, w), kelp::invalid_argument);
+}
+
+TEST_CASE("the winch refuses a non-finite winch length or payout rate and changes nothing",
+          "[tether][winch][bad_input]") {
+  auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
+  p.length = 10;
+  kt::WinchParameters<double> w;
+  w.min_length = 2;
+  w.max_length = 20;
+  const kt::WinchModel<double> wm(p, w);
+  kt::WinchWorkspace<double> wws(wm);
+  kt::TetherWorkspace<double> ws(wm.line(10));
+  // A straight line at rest, segment 0 1.4 m long: a payout of 0.5 m/s over 0.5 s inserts a node.
+  kt::TetherState<double> good(wm.line(10));
+  for (int i = 1; i <= 10; ++i) good.position.col(i) = V3(0.4 + i, 0, 0);
+  good.winch_length = 1.4;
+  good.payout_rate = 0.4;
+  const auto ends = kt::TetherBoundaryd::fixed(good.position.col(0), good.position.col(10));
+  const kelp::environment::Environmentd env;
+  const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+  const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+  for (const double bad : {nan, inf, -inf}) {
+    for (const bool length : {true, false}) {
+      INFO((length ? "winch_length " : "payout_rate ") << bad);
+      kt::TetherState<double> s = good;
+      (length ? s.winch_length : s.payout_rate) = bad;
+      const kt::TetherState<double> before = s;
+      CHECK_THROWS_WITH(kt::advance_winch(wm, wws, s, ws, 0.5, 0.5),
+                        Catch::Contains(length ? "state.winch_length" : "state.payout_rate"));
+      CHECK_THROWS_AS(kt::advance_winch(wm, wws, s, ws, 0.5, 0.5), kelp::invalid_argument);
+      REQUIRE(s.position.cols() == 11);  // no node inserted
+      CHECK(s.position == before.position);
+      CHECK(s.velocity == before.velocity);
+      CHECK(same(s.winch_length, before.winch_length));
+      CHECK(same(s.payout_rate, before.payout_rate));
+      CHECK(ws.fits(11));
+      // The line's step, which system::step and a fleet's take before the winch's, refuses them
+      // too, so that a coupled step is refused before it changes anything.
+      CHECK_THROWS_AS(kt::advance(wm.line_of(s), ws, env, s, ends, 0.01), kelp::invalid_argument);
+      CHECK(s.time == before.time);
+      CHECK(s.position == before.position);
+      CHECK(same(s.payout_rate, before.payout_rate));
+    }
+  }
+  // The finite state pays out and inserts its node.
+  kt::TetherState<double> s = good;
+  const kt::RemeshReport<double> r = kt::advance_winch(wm, wws, s, ws, 0.5, 0.5);
+  CHECK(r.inserted == 1);
+  CHECK(s.position.cols() == 12);
+  CHECK(s.payout_rate == Approx(0.5));
 }
 
 TEST_CASE(

@@ -118,14 +118,19 @@ class NavigationFilterT {
   /// \param position NED position [m].
   /// \param velocity NED velocity over ground [m/s].
   /// \param heading Yaw ψ [rad].
-  /// \param imu An IMU sample: its specific force gives roll and pitch, its time the filter's
-  /// clock, its angular rate the first body rate.
-  /// \throws kelp::invalid_argument when position, velocity or heading is not finite.
+  /// \param imu An IMU sample, its time, angular rate and specific force finite: its specific
+  /// force gives roll and pitch, its time the filter's clock, its angular rate the first body
+  /// rate.
+  /// \throws kelp::invalid_argument when position, velocity, heading or the IMU sample's time,
+  /// angular rate or specific force is not finite (the filter is then unchanged).
   void initialize(const Vector3<Scalar>& position, const Vector3<Scalar>& velocity, double heading,
                   const ImuSample& imu) {
     check_all_finite(position, "initialize: position");
     check_all_finite(velocity, "initialize: velocity");
     check_finite(heading, "initialize: heading");
+    check_finite(imu.t, "initialize: imu.t");
+    check_all_finite(imu.gyro, "initialize: imu.gyro");
+    check_all_finite(imu.accel, "initialize: imu.accel");
     const Vector3<double>& f = imu.accel;
     const double roll = std::atan2(-f.y(), -f.z());
     const double pitch = std::atan2(f.x(), std::hypot(f.y(), f.z()));
@@ -155,11 +160,18 @@ class NavigationFilterT {
 
   /// \brief Integrates an IMU sample (attitude, then position and velocity over the time since
   /// the last one).
-  /// \param m The sample; one not later than the last (dt ≤ 0) only updates the body rate.
-  /// \throws kelp::invalid_argument when the filter was not initialized.
+  /// \param m The sample: its time, angular rate and specific force finite. One not later than
+  /// the last (dt ≤ 0) integrates nothing: it only sets the body rate and the clock.
+  /// \throws kelp::invalid_argument when the filter was not initialized, or when the sample's
+  /// time, angular rate or specific force is not finite, or its time is so far from the last
+  /// one that dt is not finite (the filter is then unchanged).
   void predict(const ImuSample& m) {
     KELP_CHECK(initialized_, "NavigationFilter::predict: call initialize() first");
+    check_finite(m.t, "NavigationFilter::predict: m.t");
+    check_all_finite(m.gyro, "NavigationFilter::predict: m.gyro");
+    check_all_finite(m.accel, "NavigationFilter::predict: m.accel");
     const double dt = m.t - t_;
+    check_finite(dt, "NavigationFilter::predict: dt (m.t less the last sample's time)");
     t_ = m.t;
     omega_ = m.gyro.template cast<Scalar>();
     if (!(dt > 0)) return;

@@ -85,8 +85,9 @@ class KELP_SIM_API RunBag {
   /// \brief Records sample `r`, opening the bag first if it is not open yet.
   /// \param r the sample (with both vehicles, the tether and its end forces: Ros2Sampler)
   /// \throws kelp::error when the file cannot be written; kelp::invalid_argument as
-  /// BagRecorder (a rate that is not > 0, a row that lacks what the messages need);
-  /// std::filesystem::filesystem_error when the directory cannot be created.
+  /// BagRecorder (a rate that is not finite and > 0, a row that lacks what the messages need),
+  /// checked before the bag's directory and file are created: a refused first record creates
+  /// neither; std::filesystem::filesystem_error when the directory cannot be created.
   void record(const LogRow& r);
   /// \brief Finishes the bag if it was opened.
   void close();

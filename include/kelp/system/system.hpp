@@ -709,7 +709,8 @@ SystemReport<Scalar> step(const SystemModel<Scalar>& model, SystemWorkspace<Scal
     backup.restore(state.tether);
     throw;
   }
-  // The winch, between this step and the next (it cannot fail: its inputs were checked).
+  // The winch, between this step and the next (it cannot fail: its inputs were checked, the
+  // state's winch length and payout rate by the tether's step).
   if (model.winch())
     report.remesh = tether::advance_winch(*model.winch(), *ws.winch, state.tether, ws.tether,
                                           inputs.winch_payout_rate, dt);

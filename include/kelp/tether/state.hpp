@@ -125,7 +125,8 @@ struct TetherState {
   /// because it changes during a run and determines the next step.
   Scalar winch_length = Scalar(0);
   /// Rate at which the winch pays line out [m/s] (negative: reeling in); the winch's own state
-  /// (its speed is limited in acceleration), 0 without a winch.
+  /// (its speed is limited in acceleration), 0 without a winch. Finite: the steps, the winch
+  /// and check_state refuse a state whose rate is not.
   Scalar payout_rate = Scalar(0);
 
   TetherState() = default;

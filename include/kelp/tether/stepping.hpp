@@ -319,6 +319,10 @@ void check_step_inputs(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
          state.winch_length <= limits::max_length)))
     ::kelp::detail::throw_invalid_argument(
         "state.winch_length must be 0 (no winch) or in [0.01 l, limits::max_length]");
+  // The winch's payout rate, which advance_winch() reads after this step in system::step and a
+  // fleet's: finite (as check_state requires), so that a coupled step refuses a bad one before
+  // it changes anything.
+  check_finite(state.payout_rate, "state.payout_rate");
   ws.winch_length = state.winch_length;
   KELP_CHECK(state.position.cols() == model.nodes() && state.velocity.cols() == model.nodes(),
              "state.position and state.velocity must have segments + 1 columns");

@@ -506,13 +506,15 @@ void winch_switch(WinchWorkspace<Scalar>& w, TetherState<Scalar>& state,
 /// `w`'s slots, nothing allocated). Segment 0's length is constant over the line's step that
 /// follows (the payout is explicit in time: the new line enters the step at rest relative to
 /// nodes 0 and 1, whose masses grow or shrink with it).
-/// \throws kelp::invalid_argument for a non-finite command or dt ≤ 0, or when the state does
-/// not fit the winch (nothing changed then).
+/// \throws kelp::invalid_argument for a non-finite command, dt ≤ 0, a state whose winch_length
+/// or payout_rate is not finite, or when the state does not fit the winch (nothing changed
+/// then).
 /// \tparam Scalar double or float.
 /// \param model the winch line.
 /// \param[in,out] w the winch's buffers (built for `model`).
 /// \param[in,out] state the line's state, of a count in the model's range; its winch_length
-/// (0 is read as l) and payout_rate are updated, and its buffers swapped on a re-mesh.
+/// (finite; 0 is read as l) and payout_rate (finite) are updated, and its buffers swapped on a
+/// re-mesh.
 /// \param[in,out] ws the line's workspace, sized for the state's count; swapped with it.
 /// \param command the commanded payout rate [m/s] (positive: pay out).
 /// \param dt the line's coming step [s], > 0.
@@ -523,6 +525,10 @@ RemeshReport<Scalar> advance_winch(const WinchModel<Scalar>& model, WinchWorkspa
                                    Scalar command, double dt) {
   check_finite(command, "winch command (payout rate)");
   check_positive(dt, "dt");
+  // The line's steps check these too, but the winch may be advanced on a state no step has
+  // seen: a NaN length would be read as l below, a NaN rate lose the acceleration limit.
+  check_finite(state.winch_length, "state.winch_length");
+  check_finite(state.payout_rate, "state.payout_rate");
   const int n0 = int(state.position.cols()) - 1;
   const TetherModel<Scalar>& line0 = model.line(n0);
   KELP_CHECK(ws.fits(line0.nodes()), "advance_winch: workspace and state of different lines");
