@@ -117,3 +117,20 @@ template <typename Scalar, typename Env>
 }
 
 }  // namespace kelp::tether
+
+/// \brief The double-precision static solves in kelp's Environment (solve_static_equilibrium and
+/// static_initial_state), for a compiled layer that instantiates them once, as
+/// KELP_TETHER_INSTANCES does the step (kelp/tether/driver.hpp): kelp::sim declares them extern in
+/// kelp/sim/instantiation.hpp. The expansion needs kelp/environment/environment.hpp.
+#define KELP_TETHER_STATICS_INSTANCES(prefix)                                                   \
+  prefix kelp::tether::StaticResult<double>                                                     \
+  kelp::tether::solve_static_equilibrium<double, kelp::environment::Environment<double>>(       \
+      const kelp::tether::TetherModel<double>&, kelp::tether::TetherWorkspace<double>&,         \
+      const kelp::environment::Environment<double>&, kelp::tether::TetherState<double>&,        \
+      const kelp::tether::TetherBoundary<double>&, const kelp::tether::StaticOptions<double>&); \
+  prefix kelp::tether::StaticResult<double>                                                     \
+  kelp::tether::static_initial_state<double, kelp::environment::Environment<double>>(           \
+      const kelp::tether::TetherModel<double>&, kelp::tether::TetherWorkspace<double>&,         \
+      const kelp::environment::Environment<double>&, const kelp::Vector3<double>&,              \
+      const kelp::Vector3<double>&, kelp::tether::TetherState<double>&,                         \
+      const kelp::tether::StaticOptions<double>&);
