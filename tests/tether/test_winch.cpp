@@ -173,7 +173,7 @@ TEST_CASE("winch limits: speed, acceleration, pull and length", "[tether][winch]
   CHECK_THROWS_AS(kt::WinchModel<double>(p, w), kelp::invalid_argument);
 }
 
-TEST_CASE("the winch refuses a non-finite winch length or payout rate and changes nothing",
+TEST_CASE("the winch refuses a non-finite or negative winch length, a non-finite payout rate",
           "[tether][winch][bad_input]") {
   auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
   p.length = 10;
@@ -214,6 +214,20 @@ TEST_CASE("the winch refuses a non-finite winch length or payout rate and change
       CHECK(s.position == before.position);
       CHECK(same(s.payout_rate, before.payout_rate));
     }
+  }
+  {
+    // A finite negative length is no length either (0 is read as l, a negative one was read as
+    // l too): refused, nothing changed, as the line's step refuses it.
+    kt::TetherState<double> s = good;
+    s.winch_length = -0.5;
+    const kt::TetherState<double> before = s;
+    CHECK_THROWS_WITH(kt::advance_winch(wm, wws, s, ws, 0.5, 0.5),
+                      Catch::Contains("state.winch_length"));
+    CHECK_THROWS_AS(kt::advance_winch(wm, wws, s, ws, 0.5, 0.5), kelp::invalid_argument);
+    CHECK(s.position == before.position);
+    CHECK(s.winch_length == before.winch_length);
+    CHECK(s.payout_rate == before.payout_rate);
+    CHECK_THROWS_AS(kt::advance(wm.line_of(s), ws, env, s, ends, 0.01), kelp::invalid_argument);
   }
   // The finite state pays out and inserts its node.
   kt::TetherState<double> s = good;

@@ -507,13 +507,13 @@ void winch_switch(WinchWorkspace<Scalar>& w, TetherState<Scalar>& state,
 /// follows (the payout is explicit in time: the new line enters the step at rest relative to
 /// nodes 0 and 1, whose masses grow or shrink with it).
 /// \throws kelp::invalid_argument for a non-finite command, dt ≤ 0, a state whose winch_length
-/// or payout_rate is not finite, or when the state does not fit the winch (nothing changed
-/// then).
+/// is negative or not finite or whose payout_rate is not finite, or when the state does not fit
+/// the winch (nothing changed then).
 /// \tparam Scalar double or float.
 /// \param model the winch line.
 /// \param[in,out] w the winch's buffers (built for `model`).
 /// \param[in,out] state the line's state, of a count in the model's range; its winch_length
-/// (finite; 0 is read as l) and payout_rate (finite) are updated, and its buffers swapped on a
+/// (finite, ≥ 0; 0 is read as l) and payout_rate (finite) are updated, and its buffers swapped on a
 /// re-mesh.
 /// \param[in,out] ws the line's workspace, sized for the state's count; swapped with it.
 /// \param command the commanded payout rate [m/s] (positive: pay out).
@@ -529,6 +529,9 @@ RemeshReport<Scalar> advance_winch(const WinchModel<Scalar>& model, WinchWorkspa
   // seen: a NaN length would be read as l below, a NaN rate lose the acceleration limit.
   check_finite(state.winch_length, "state.winch_length");
   check_finite(state.payout_rate, "state.payout_rate");
+  // 0 means l (no winch segment yet); a negative length is none (the line's step refuses it).
+  if (state.winch_length < Scalar(0))
+    ::kelp::detail::throw_invalid_argument("advance_winch: state.winch_length must be >= 0");
   const int n0 = int(state.position.cols()) - 1;
   const TetherModel<Scalar>& line0 = model.line(n0);
   KELP_CHECK(ws.fits(line0.nodes()), "advance_winch: workspace and state of different lines");
