@@ -373,6 +373,12 @@ TEST_CASE("a fleet's bad state or input is named with its index", "[system][flee
   s = good;
   s.tethers[1].time += 1.0;
   CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].time"));
+  s = good;
+  s.tethers[1].payout_rate = nan;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].payout_rate must be finite"));
+  s = good;
+  s.tethers[1].winch_length = -inf;
+  CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].winch_length must be finite"));
   ks::FleetInputsd in = no_input;
   in.vehicles[1].tau(0) = nan;
   CHECK_THAT(refused(good, in), Catch::Contains("inputs.vehicles[1].tau must"));

@@ -636,6 +636,11 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
     KELP_CHECK(
         model.winch(int(k)) != nullptr || inputs.winch_payout_rates[k] == Scalar(0),
         detail::element("inputs.winch_payout_rates", k, " must be 0 for a tether without a winch"));
+    // The tether's step checks these too, but names no tether.
+    KELP_CHECK(is_finite(state.tethers[k].payout_rate),
+               detail::element("state.tethers", k, ".payout_rate must be finite"));
+    KELP_CHECK(is_finite(state.tethers[k].winch_length),
+               detail::element("state.tethers", k, ".winch_length must be finite"));
     KELP_CHECK(state.tethers[k].time == state.time,
                detail::element("state.tethers", k,
                                ".time must equal state.time (use FleetState::set_time)"));
