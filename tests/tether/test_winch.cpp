@@ -1,7 +1,7 @@
 // The winch at the start end of the lumped-mass tether (kelp/tether/winch.hpp): re-meshing
-// conserves mass and momentum (and refuses a start end that is not kinematic), a non-finite
-// winch length or payout rate is refused with the state unchanged, a slow reel-in ends at the
-// static solution and the catenary.
+// conserves mass and momentum (and refuses a start end that is not kinematic), a non-finite or
+// negative winch length and a non-finite payout rate are refused with the state unchanged, a slow
+// reel-in ends at the static solution and the catenary.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -17,6 +17,18 @@
 
 namespace kt = kelp::tether;
 using V3 = kelp::Vector3<double>;
+
+namespace {
+// The benchmark line of 10 segments of 1 m on a winch that holds 2 to 20 m of it.
+kt::WinchModel<double> ten_segment_winch() {
+  auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
+  p.length = 10;
+  kt::WinchParameters<double> w;
+  w.min_length = 2;
+  w.max_length = 20;
+  return kt::WinchModel<double>(p, w);
+}
+}  // namespace
 
 TEST_CASE("1000 node insertions and removals at the winch conserve mass and momentum",
           "[tether][winch][remesh]") {
@@ -82,12 +94,7 @@ TEST_CASE("1000 node insertions and removals at the winch conserve mass and mome
 }
 
 TEST_CASE("a re-mesh carries the parted flags with their segments", "[tether][winch][remesh]") {
-  auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
-  p.length = 10;
-  kt::WinchParameters<double> w;
-  w.min_length = 2;
-  w.max_length = 20;
-  const kt::WinchModel<double> wm(p, w);
+  const kt::WinchModel<double> wm = ten_segment_winch();
   kt::TetherState<double> s(wm.line(10));
   for (int i = 0; i <= 10; ++i) s.position.col(i) = V3(i, 0, 0.5 * i);
   s.parted(6) = 1;  // the line has parted between nodes 6 and 7
@@ -175,12 +182,7 @@ TEST_CASE("winch limits: speed, acceleration, pull and length", "[tether][winch]
 
 TEST_CASE("the winch refuses a non-finite or negative winch length, a non-finite payout rate",
           "[tether][winch][bad_input]") {
-  auto p = kelp_test::benchmark_line<double>(10);  // l = 1 m
-  p.length = 10;
-  kt::WinchParameters<double> w;
-  w.min_length = 2;
-  w.max_length = 20;
-  const kt::WinchModel<double> wm(p, w);
+  const kt::WinchModel<double> wm = ten_segment_winch();
   kt::WinchWorkspace<double> wws(wm);
   kt::TetherWorkspace<double> ws(wm.line(10));
   // A straight line at rest, segment 0 1.4 m long: a payout of 0.5 m/s over 0.5 s inserts a node.
