@@ -33,12 +33,13 @@ int main(int argc, char** argv) {
       "Exit status: 0 written, 1 not a run directory or a file error, 2 no page template, 130 / "
       "143 stopped by SIGINT / SIGTERM before the page was written (nothing written). The page "
       "(or the data) is written to a temporary file beside it and renamed: never half a page.");
+  // SIGINT or SIGTERM: the page is not written (kelp/sim/stop.hpp); a second signal stops at once.
+  // Installed before anything else, so that a signal in the first milliseconds is a clean stop.
+  kelp::sim::install_stop_handlers();
   CLI11_PARSE(app, argc, argv);
   kelp::sim::ReplayOptions o;
   o.title = title;
   o.source = source;
-  // SIGINT or SIGTERM: the page is not written (kelp/sim/stop.hpp); a second signal stops at once.
-  kelp::sim::install_stop_handlers();
   const auto stopped = [] {
     if (!kelp::sim::stop_requested()) return false;
     std::fprintf(stderr, "kelp-replay: stopped by %s; nothing written\n",

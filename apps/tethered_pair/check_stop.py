@@ -18,8 +18,9 @@ failure can be replayed with KELP_STOP_TEST_SEED):
    kelp/sim/run_log.hpp).
 3. With --fleet: a fleet run (kelp/sim/fleet_run.hpp) stopped by SIGINT: exit status 130, its CSV
    files whole, summary.json "completed": false.
-4. With --replay: kelp-replay on the stopped run's directory, SIGTERM'd at once: exit status 143
-   and no page (or, had it finished first, status 0 and a whole page).
+4. With --replay: kelp-replay on the stopped run's directory, SIGTERM'd at once (0-50 ms after its
+   handler is installed, seen in /proc/PID/status): exit status 143 and no page (or, had it
+   finished first, status 0 and a whole page).
 
 Every run is stopped once its run.mcap holds a few chunks (a simulated minute or two, a fraction
 of a second of one core). On the code before the clean stop, 1 fails (killed by the signal,
@@ -54,6 +55,23 @@ def wait_for_size(path, size, proc, timeout=60.0):
             pass
         time.sleep(0.005)
     return False
+
+
+def wait_for_handler(proc, signum, timeout=60.0):
+    """Waits until `proc` catches `signum` (its handler is installed: the SigCgt mask of
+    /proc/PID/status) or has ended. A signal sent before that, while the loader and the static
+    initialisers run, takes its default action: the process ends by it with nothing written, which
+    no program can prevent."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            with open("/proc/%d/status" % proc.pid) as f:
+                caught = next(int(line.split()[1], 16) for line in f if line.startswith("SigCgt:"))
+            if caught >> (signum - 1) & 1:
+                return
+        except (OSError, StopIteration):
+            pass
+        time.sleep(0.0005)
 
 
 def default_signals():
@@ -179,12 +197,15 @@ def main():
         print("fleet, SIGINT: status %s, %d rows to t = %s s" % (p.returncode, rows,
                                                                summary.get("simulated_s")))
 
-    # 4. kelp-replay, SIGTERM'd at once: nothing written, or a whole page.
+    # 4. kelp-replay, SIGTERM'd at once: nothing written, or a whole page. Once its handler is
+    # installed: a signal in the program's first milliseconds (seed 1055009337: 2 ms) killed it
+    # before main() ran, status -15.
     if "--replay" in opts:
         d = os.path.join(work, "sigterm")
         page = os.path.join(work, "replay_stopped.html")
         p = subprocess.Popen([opts["--replay"], d, "--out", page], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True, preexec_fn=default_signals)
+        wait_for_handler(p, signal.SIGTERM)
         time.sleep(rng.uniform(0.0, 0.05))
         p.send_signal(signal.SIGTERM)
         out, err = p.communicate(timeout=60)
