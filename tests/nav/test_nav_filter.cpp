@@ -256,8 +256,10 @@ TEST_CASE("every update refuses a non-finite measurement, σ or time and changes
   CHECK(f.state() != x);
 }
 
-TEST_CASE("predict and initialize refuse a non-finite IMU sample or time and change nothing",
-          "[nav][filter][errors]") {
+TEST_CASE(
+    "predict and initialize refuse a non-finite IMU sample or time, predict one earlier "
+    "than the last, and change nothing",
+    "[nav][filter][errors]") {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   kn::ImuSample s;
@@ -296,7 +298,17 @@ TEST_CASE("predict and initialize refuse a non-finite IMU sample or time and cha
       CHECK_THROWS_AS(f.predict(m), kelp::invalid_argument);
     }
   }
+  // A sample earlier than the last (good in every component): it would set the clock back and
+  // the next sample would integrate the span between them twice.
+  for (const double t : {0.0099, 0.0, -1.0}) {
+    kn::ImuSample m = s;
+    m.t = t;
+    INFO("t " << t);
+    CHECK_THROWS_AS(f.predict(m), kelp::invalid_argument);
+  }
   kn::ImuSample bad = s;
+  bad.t = 0.005;
+  CHECK_THROWS_WITH(f.predict(bad), Catch::Contains("earlier than the last sample"));
   bad.t = nan;
   CHECK_THROWS_WITH(f.predict(bad), Catch::Contains("predict: m.t"));
   bad = s;

@@ -175,6 +175,18 @@ TEST_CASE("the pair as a fleet is the pair, bit for bit", "[system][fleet]") {
     CHECK(compared == 200);
     CHECK(remeshes > 0);  // the winch did re-mesh the line
   }
+  // A bad propulsion state is refused naming the vehicle's index in the fleet's state (it named
+  // the literal "state.propulsion[i]"), the state unchanged.
+  ks::FleetWorkspaced fws(fm);
+  const auto start = ks::presets::paper_start(10.0);
+  ks::FleetStated fs = ks::initial_state(fm, fws, {start.asv, start.auv});
+  fs.propulsion[1].thrust(3) = std::nan("");
+  const ks::FleetStated before = fs;
+  CHECK_THROWS_WITH(ks::step(fm, fws, fs, ks::FleetInputsd(fm), 0.01),
+                    Catch::StartsWith("state.propulsion[1]") && !Catch::Contains("[i]"));
+  CHECK(fs.time == before.time);
+  CHECK(same(fs.vehicles[1], before.vehicles[1]));
+  CHECK(same(fs.tethers[0], before.tethers[0]));
 }
 
 TEST_CASE("a vehicle - tether - point mass - tether - vehicle chain keeps its momentum",
@@ -379,6 +391,14 @@ TEST_CASE("a fleet's bad state or input is named with its index", "[system][flee
   s = good;
   s.tethers[1].winch_length = -inf;
   CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].winch_length must be finite"));
+  // A finite one the tether's step refuses (negative, or under 1 % of a segment): refused there,
+  // with the tether named (its message named no tether).
+  for (const double w : {-1.0, 1e-6}) {
+    INFO("winch_length " << w);
+    s.tethers[1].winch_length = w;
+    CHECK_THAT(refused(s, no_input), Catch::StartsWith("state.tethers[1]: state.winch_length must "
+                                                       "be 0 (no winch) or in [0.01 l"));
+  }
   ks::FleetInputsd in = no_input;
   in.vehicles[1].tau(0) = nan;
   CHECK_THAT(refused(good, in), Catch::Contains("inputs.vehicles[1].tau must"));

@@ -160,11 +160,13 @@ class NavigationFilterT {
 
   /// \brief Integrates an IMU sample (attitude, then position and velocity over the time since
   /// the last one).
-  /// \param m The sample: its time, angular rate and specific force finite. One not later than
-  /// the last (dt ≤ 0) integrates nothing: it only sets the body rate and the clock.
+  /// \param m The sample: its time, angular rate and specific force finite, its time not earlier
+  /// than the last sample's. One at the last sample's time (dt = 0) integrates nothing: it only
+  /// sets the body rate.
   /// \throws kelp::invalid_argument when the filter was not initialized, or when the sample's
-  /// time, angular rate or specific force is not finite, or its time is so far from the last
-  /// one that dt is not finite (the filter is then unchanged).
+  /// time, angular rate or specific force is not finite, or its time is earlier than the last
+  /// sample's (samples come in time order: one taken back would integrate the span between
+  /// them twice) or so far from it that dt is not finite (the filter is then unchanged).
   void predict(const ImuSample& m) {
     KELP_CHECK(initialized_, "NavigationFilter::predict: call initialize() first");
     check_finite(m.t, "NavigationFilter::predict: m.t");
@@ -172,6 +174,9 @@ class NavigationFilterT {
     check_all_finite(m.accel, "NavigationFilter::predict: m.accel");
     const double dt = m.t - t_;
     check_finite(dt, "NavigationFilter::predict: dt (m.t less the last sample's time)");
+    KELP_CHECK(dt >= 0,
+               "NavigationFilter::predict: m.t is earlier than the last sample's time "
+               "(IMU samples must come in time order)");
     t_ = m.t;
     omega_ = m.gyro.template cast<Scalar>();
     if (!(dt > 0)) return;

@@ -43,6 +43,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -660,8 +661,11 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
     ws.inputs[i] = inputs.vehicles[i];
     ws.propulsion[i] = state.propulsion[i];
     report.propulsion[i] = {};
+    // The state's name in a refusal's message, on the stack (no allocation in a step).
+    char state_name[40];
+    std::snprintf(state_name, sizeof state_name, "state.propulsion[%zu]", i);
     detail::propel(model.propulsion(int(i)), ws.propulsion[i], inputs.commands[i], ws.inputs[i],
-                   report.propulsion[i], dt, p.vehicles[i].name, "state.propulsion[i]");
+                   report.propulsion[i], dt, p.vehicles[i].name, state_name);
   }
   const auto& env = model.environment();
   const double t = state.time;
@@ -696,9 +700,14 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
     for (int pass = 0;; ++pass) {
       for (std::size_t k = 0; k < m; ++k) {
         const auto& line = model.tether_of(int(k), state.tethers[k]);
-        report.tethers[k] = detail::advance_tether(
-            line, model.winch(int(k)), ws.tethers[k].tether, env, state.tethers[k], ws.ends[k], dt,
-            tether_options, p.explicit_fallback, report.tether_fallbacks);
+        try {
+          report.tethers[k] = detail::advance_tether(
+              line, model.winch(int(k)), ws.tethers[k].tether, env, state.tethers[k], ws.ends[k],
+              dt, tether_options, p.explicit_fallback, report.tether_fallbacks);
+        } catch (const kelp::invalid_argument& e) {
+          // The tether's step names its own fields ("state.winch_length ..."): say which tether.
+          throw kelp::invalid_argument(detail::element("state.tethers", k, ": ") + e.what());
+        }
         report.tether += report.tethers[k];
         const auto& impulse = ws.tethers[k].tether.end_impulse;
         report.force_at_start[k] = p.tethers[k].start.kind == EndKind::free
