@@ -28,6 +28,7 @@
 #include "kelp/system/fleet.hpp"
 #include "kelp/system/presets.hpp"
 #include "kelp/system/system.hpp"
+#include "ship_tms_rov.hpp"
 
 namespace ks = kelp::system;
 namespace kt = kelp::tether;
@@ -147,37 +148,13 @@ void BM_FleetPairStep(benchmark::State& st, ks::presets::Sea sea) {
 }
 
 void BM_ShipTmsRovStep(benchmark::State& st) {
-  ks::FleetParametersd p;
-  p.vehicles.push_back({"rov", kv::bluerov2_heavy<double>().parameters, {}, {}});
-  ks::PointMassParametersd tms;
-  tms.name = "tms";
-  tms.mass = 400;
-  tms.volume = 0.2;
-  tms.drag_area = 1.0;
-  p.point_masses.push_back(tms);
-  kt::TetherParametersd umbilical = kt::presets::rov_tether(60.0, 1.0);
-  umbilical.diameter = 0.025;
-  umbilical.mass_per_length = 1.2;
-  umbilical.axial_stiffness = 3e6;
-  umbilical.internal_damping = 0;
-  umbilical.internal_damping_ratio = 0.5;
-  umbilical.breaking_strength = 0;
-  kt::WinchParametersd winch;
-  winch.min_length = 5;
-  winch.max_length = 60;
-  p.tethers.push_back({"umbilical",
-                       umbilical,
-                       ks::TetherEnd<double>::at_anchor({0, 0, 0}),
-                       ks::TetherEnd<double>::on_point_mass(0),
-                       {}});
-  p.tethers.push_back(
-      {"tether", kt::presets::rov_tether(30.0, 0.5), ks::TetherEnd<double>::on_point_mass(0),
-       ks::TetherEnd<double>::on_vehicle(0, ks::presets::bluerov2_attachment<double>()), winch});
-  const ks::FleetModeld model(p, ks::presets::environment<double>(ks::presets::Sea::rough));
+  const ks::FleetModeld model(kelp_bench::ship_tms_rov_parameters(),
+                              ks::presets::environment<double>(ks::presets::Sea::rough));
   ks::FleetWorkspaced ws(model);
   std::vector<kv::VehicleStated> rov(1);
-  rov[0].position = Vector3<double>(20, 0, 60);
-  const ks::FleetStated s = ks::initial_state(model, ws, rov, {Vector3<double>(8, 0, 50)});
+  rov[0].position = kelp_bench::ship_tms_rov_rov_start();
+  const ks::FleetStated s =
+      ks::initial_state(model, ws, rov, {kelp_bench::ship_tms_rov_tms_start()});
   ks::FleetInputsd in(model);
   in.vehicles[0].tau << 10, 0, 0, 0, 0, 0;
   run_fleet(st, model, s, in);
