@@ -387,17 +387,23 @@ TEST_CASE("a fleet's bad state or input is named with its index", "[system][flee
   CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].time"));
   s = good;
   s.tethers[1].payout_rate = nan;
-  CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].payout_rate must be finite"));
+  CHECK_THAT(refused(s, no_input),
+             Catch::StartsWith("state.tethers[1]: state.payout_rate must be finite"));
+  // A winch length the tether's step refuses (not finite, negative, or under 1 % of a segment):
+  // refused there, with the tether named (its message named no tether). Tether 0 was stepped
+  // before tether 1 refused: the whole state is restored.
   s = good;
-  s.tethers[1].winch_length = -inf;
-  CHECK_THAT(refused(s, no_input), Catch::Contains("state.tethers[1].winch_length must be finite"));
-  // A finite one the tether's step refuses (negative, or under 1 % of a segment): refused there,
-  // with the tether named (its message named no tether).
-  for (const double w : {-1.0, 1e-6}) {
+  for (const double w : {-inf, nan, -1.0, 1e-6}) {
     INFO("winch_length " << w);
     s.tethers[1].winch_length = w;
     CHECK_THAT(refused(s, no_input), Catch::StartsWith("state.tethers[1]: state.winch_length must "
                                                        "be 0 (no winch) or in [0.01 l"));
+    ks::FleetStated x = s;
+    CHECK_THROWS_AS(ks::step(model, ws, x, no_input, 0.01), kelp::invalid_argument);
+    CHECK(x.time == s.time);
+    CHECK(same(x.tethers[0], s.tethers[0]));
+    CHECK(same(x.vehicles[0], s.vehicles[0]));
+    CHECK(same(x.point_masses[0].position, s.point_masses[0].position));
   }
   ks::FleetInputsd in = no_input;
   in.vehicles[1].tau(0) = nan;

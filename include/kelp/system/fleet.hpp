@@ -637,11 +637,6 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
     KELP_CHECK(
         model.winch(int(k)) != nullptr || inputs.winch_payout_rates[k] == Scalar(0),
         detail::element("inputs.winch_payout_rates", k, " must be 0 for a tether without a winch"));
-    // The tether's step checks these too, but names no tether.
-    KELP_CHECK(is_finite(state.tethers[k].payout_rate),
-               detail::element("state.tethers", k, ".payout_rate must be finite"));
-    KELP_CHECK(is_finite(state.tethers[k].winch_length),
-               detail::element("state.tethers", k, ".winch_length must be finite"));
     KELP_CHECK(state.tethers[k].time == state.time,
                detail::element("state.tethers", k,
                                ".time must equal state.time (use FleetState::set_time)"));
@@ -705,7 +700,8 @@ const FleetReport<Scalar>& step(const FleetModel<Scalar>& model, FleetWorkspace<
               line, model.winch(int(k)), ws.tethers[k].tether, env, state.tethers[k], ws.ends[k],
               dt, tether_options, p.explicit_fallback, report.tether_fallbacks);
         } catch (const kelp::invalid_argument& e) {
-          // The tether's step names its own fields ("state.winch_length ..."): say which tether.
+          // The tether's step checks its state (winch_length, payout_rate, ...) and names its own
+          // fields ("state.winch_length ..."): say which tether. The state is restored below.
           throw kelp::invalid_argument(detail::element("state.tethers", k, ": ") + e.what());
         }
         report.tether += report.tethers[k];
