@@ -2,12 +2,17 @@
 // (reference_forces.hpp): every workspace output, with and without the Jacobian terms, on lines
 // that exercise every branch (surface band, in air, seabed with friction, slack and clamped
 // segments, coincident nodes, bending, free ends, water current and acceleration, inputs given
-// as expressions), in double to 1e-12 of each field's magnitude and in float to 1e-5.
+// as expressions), in double to 1e-12 of each field's magnitude and in float to 1e-5; and the
+// passes' AVX2 build against the baseline build, bit for bit.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 
+#include "kelp/environment/environment.hpp"
+#include "kelp/tether/initial_state.hpp"
+#include "kelp/tether/integrators.hpp"
 #include "kelp/tether/lumped_mass.hpp"
 #include "reference_forces.hpp"
 #include "tether_test_support.hpp"
@@ -206,4 +211,119 @@ TEST_CASE("the equivalence check can fail: a changed drag coefficient is seen",
   const double scale = std::max(
       {1.0, double(b.force.cwiseAbs().maxCoeff()), double(b.tension.cwiseAbs().maxCoeff())});
   CHECK(double((a.force - b.force).cwiseAbs().maxCoeff()) / scale > 1e-12);
+}
+
+namespace {
+
+template <typename M>
+bool same_bits(const M& a, const M& b) {
+  using S = typename M::Scalar;
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(S) * std::size_t(a.size())) == 0;
+}
+
+// Every field compute_forces writes, bit for bit.
+bool same_outputs(const kt::TetherWorkspace<double>& a, const kt::TetherWorkspace<double>& b) {
+  return same_bits(a.force, b.force) && same_bits(a.tangent, b.tangent) &&
+         same_bits(a.mass_iso, b.mass_iso) && same_bits(a.mass_tan, b.mass_tan) &&
+         same_bits(a.mass_iso_inv, b.mass_iso_inv) &&
+         same_bits(a.mass_tan_ratio, b.mass_tan_ratio) && same_bits(a.submerged, b.submerged) &&
+         same_bits(a.seabed_force, b.seabed_force) && same_bits(a.direction, b.direction) &&
+         same_bits(a.tension, b.tension) && same_bits(a.stretched_length, b.stretched_length) &&
+         same_bits(a.bending, b.bending) && same_bits(a.seg_k_uu, b.seg_k_uu) &&
+         same_bits(a.seg_k_perp, b.seg_k_perp) && same_bits(a.seg_c_uu, b.seg_c_uu) &&
+         same_bits(a.seg_rate, b.seg_rate) && same_bits(a.node_dv, b.node_dv) &&
+         same_bits(a.node_kz, b.node_kz);
+}
+
+// Sets kelp::tether::detail::wide_force_passes for a scope.
+struct WidePasses {
+  explicit WidePasses(bool on) { kt::detail::wide_force_passes() = on; }
+  ~WidePasses() { kt::detail::wide_force_passes() = true; }
+};
+
+// A few steps of `step` from `s0`, with the AVX2 build allowed or not.
+template <typename Step>
+kt::TetherStated run_steps(const kt::TetherModeld& model, const kt::TetherStated& s0, bool wide,
+                           int steps, Step&& step) {
+  const WidePasses scope(wide);
+  CHECK(kt::detail::force_passes_take_avx2() == wide);
+  kt::TetherWorkspaced ws(model);
+  kt::TetherStated s = s0;
+  for (int k = 0; k < steps; ++k) step(ws, s);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("the force passes' AVX2 build gives the baseline build's bits",
+          "[tether][forces][simd]") {
+#if defined(KELP_X86_DISPATCH)
+  if (!__builtin_cpu_supports("avx2")) {
+    WARN("this CPU has no AVX2: the baseline build is the only one");
+    CHECK_FALSE(kt::detail::force_passes_take_avx2());
+    return;
+  }
+  REQUIRE(kt::detail::force_passes_take_avx2());
+  int compared = 0;
+  for (const auto& c : cases<double>())
+    for (int variant = 0; variant < 3; ++variant)
+      for (bool jacobian : {false, true}) {
+        // 0 as built, 1 a winch segment at the start (its own rest length), 2 a parted line.
+        const kt::TetherModeld model(c.params);
+        kt::TetherWorkspaced a(model), b(model);
+        if (variant == 1) a.winch_length = b.winch_length = 0.4 * model.segment_length();
+        if (variant == 2) {
+          if (model.segments() < 3) continue;
+          a.parted.setZero();
+          a.parted(model.segments() / 2) = 1;
+          a.any_parted = true;
+          b.parted = a.parted;
+          b.any_parted = true;
+        }
+        for (bool wide : {true, false}) {
+          const WidePasses scope(wide);
+          CHECK(kt::detail::force_passes_take_avx2() == wide);
+          if (jacobian)
+            kt::compute_forces<true>(model, wide ? a : b, c.water, 1.0, c.x, c.v);
+          else
+            kt::compute_forces(model, wide ? a : b, c.water, 1.0, c.x, c.v);
+        }
+        INFO(c.name << ", variant " << variant << (jacobian ? ", with Jacobian" : ""));
+        CHECK(same_outputs(a, b));
+        ++compared;
+      }
+  CHECK(compared > 60);
+
+  // Whole steps: RK4 (the passes' accelerations) and BDF2 (forces and Jacobian terms) on a line
+  // swinging through the surface band from a boundary in air.
+  auto p = kelp_test::benchmark_line<double>(37);
+  p.internal_damping = 30.0;
+  const kt::TetherModeld model(p);
+  const kelp::environment::Environmentd water;
+  const Vector3<double> a(0, 0, -0.3), b(10, 0, 5);
+  kt::TetherStated s0 = kt::catenary_initial_state(model, water, a, b);
+  for (int i = 0; i < model.nodes(); ++i) s0.velocity.col(i) = Vector3<double>(0.3, 0.2, -0.8);
+  const auto bnd = kt::TetherBoundaryd::fixed(a, b);
+  const double dt = kt::estimate_stable_dt(model, kt::Integrator::rk4, water.water_density(), 0.5);
+  const auto rk4 = [&](kt::TetherWorkspaced& ws, kt::TetherStated& s) {
+    kt::step_rk4(model, ws, water, s, bnd, dt);
+  };
+  const auto bdf2 = [&](kt::TetherWorkspaced& ws, kt::TetherStated& s) {
+    kt::step_bdf2(model, ws, water, s, bnd, 0.01);
+  };
+  const kt::TetherStated r_wide = run_steps(model, s0, true, 200, rk4);
+  const kt::TetherStated r_base = run_steps(model, s0, false, 200, rk4);
+  CHECK(same_bits(r_wide.position, r_base.position));
+  CHECK(same_bits(r_wide.velocity, r_base.velocity));
+  CHECK_FALSE(same_bits(r_wide.position, s0.position));
+  const kt::TetherStated i_wide = run_steps(model, s0, true, 100, bdf2);
+  const kt::TetherStated i_base = run_steps(model, s0, false, 100, bdf2);
+  CHECK(same_bits(i_wide.position, i_base.position));
+  CHECK(same_bits(i_wide.velocity, i_base.velocity));
+  CHECK_FALSE(same_bits(i_wide.position, s0.position));
+#else
+  WARN("this build does not dispatch at run time: one build of the force passes only");
+  CHECK_FALSE(kt::detail::force_passes_take_avx2());
+#endif
 }

@@ -1,16 +1,18 @@
 /// \file
-/// \brief The CPU-specific (SIMD) part of the lumped-mass tether's force evaluation: the
-/// constants one evaluation shares (`detail::ForcePass`), their broadcast to SIMD packets, and the
-/// packet kernels of the segment pass, of the interior wet nodes and of the final pass (written
-/// once over kelp/core/simd.hpp's `simd::Pack`, run on as many lanes as the compiler flags give).
-/// The scalar passes and the public entry points are in kelp/tether/forces.hpp.
+/// \brief What the SIMD passes of the lumped-mass tether's force evaluation share: the constants
+/// of one evaluation (`detail::ForcePass`), the node kinds, the pass buffer's columns, and the
+/// switch between the passes' builds (`detail::wide_force_passes`). The packet kernels are in
+/// kelp/tether/force_pass_body.hpp (built for the compiler flags' packets and, on x86-64, for
+/// AVX2 as well, chosen at run time), the scalar passes and the public entry points in
+/// kelp/tether/forces.hpp.
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 
-#include "kelp/core/simd.hpp"
+#include "kelp/core/kernel_path.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/environment/obstacles.hpp"
 #include "kelp/tether/model.hpp"
@@ -77,259 +79,25 @@ struct ForcePass {
 /// Columns of TetherWorkspace::pass_buffer.
 enum PassColumn : int { kSegmentForce = 0, kNodeForce = 3, kMassRate = 6 };
 
-/// ForcePass constants broadcast to every lane once per evaluation (the kernels run in loops
-/// that would otherwise broadcast them block after block).
-template <typename Scalar, bool Wide>
-struct PackedConstants {
-  using P = simd::Pack<Scalar, Wide>;
-  P zero, one, two, three, l, l2, inv_l, ea, ea_l, ba, ba_l, inv_fade, bed, half_d, wet_weight, kn,
-      kt, rho_vol, one_plus_can, cat_minus_can, mass_iso_wet, mass_tan_wet, mass_iso_inv,
-      mass_tan_ratio;
-  explicit PackedConstants(const ForcePass<Scalar>& c) {
-    const NodeConstants<Scalar>& nc = c.kinds[1];
-    zero = P::all(Scalar(0));
-    one = P::all(Scalar(1));
-    two = P::all(Scalar(2));
-    three = P::all(Scalar(3));
-    l = P::all(c.l);
-    l2 = P::all(c.l2);
-    inv_l = P::all(c.inv_l);
-    ea = P::all(c.ea);
-    ea_l = P::all(c.ea_l);
-    ba = P::all(c.ba);
-    ba_l = P::all(c.ba_l);
-    inv_fade = P::all(c.inv_fade);
-    bed = P::all(c.bed);
-    half_d = P::all(c.half_d);
-    wet_weight = P::all(nc.wet_weight);
-    kn = P::all(nc.kn);
-    kt = P::all(nc.kt);
-    rho_vol = P::all(nc.rho_vol);
-    one_plus_can = P::all(Scalar(1) + c.can);
-    cat_minus_can = P::all(c.cat - c.can);
-    mass_iso_wet = P::all(nc.mass_iso_wet);
-    mass_tan_wet = P::all(nc.mass_tan_wet);
-    mass_iso_inv = P::all(Scalar(1) / nc.mass_iso_wet);
-    mass_tan_ratio = P::all(nc.mass_tan_wet / (nc.mass_iso_wet + nc.mass_tan_wet));
-  }
-};
-
-/// Segments s … s + lanes − 1 (see compute_forces): length, direction, axial force T_s (elastic
-/// EA·ε when stretched plus the dashpot BA·ε̇ at any length, clamped at zero unless
-/// compressive_damping), T_s u_s into the pass buffer, and the Jacobian terms.
-template <bool WithJacobian, bool Wide, typename Scalar>
-EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
-                                       const PackedConstants<Scalar, Wide>& pc,
-                                       TetherWorkspace<Scalar>& ws, int s) {
-  using P = simd::Pack<Scalar, Wide>;
-  const P zero = pc.zero;
-  const Scalar* a = c.x + s * c.xs;
-  const P d0 = P::gather(a + c.xs, c.xs) - P::gather(a, c.xs);
-  const P d1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a + 1, c.xs);
-  const P d2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a + 2, c.xs);
-  const P ls2 = (d0 * d0 + d1 * d1) + d2 * d2;
-  const P ls = sqrt(ls2);
-  const auto positive = simd::greater(ls, zero);
-  const P inv_ls = simd::select(positive, pc.one / ls, zero);
-  const P u0 = d0 * inv_ls, u1 = d1 * inv_ls, u2 = d2 * inv_ls;
-  const auto stretched = simd::greater(ls2, pc.l2);
-  P tension = simd::select(stretched, (pc.ea * (ls - pc.l)) * pc.inv_l, zero);
-  P k_axial = simd::select(stretched, pc.ea_l, zero);
-  P c_axial = pc.ba_l;
-  P rate = zero;
-  if (c.damping) {
-    const Scalar* b = c.v + s * c.vs;
-    const P e0 = P::gather(b + c.vs, c.vs) - P::gather(b, c.vs);
-    const P e1 = P::gather(b + c.vs + 1, c.vs) - P::gather(b + 1, c.vs);
-    const P e2 = P::gather(b + c.vs + 2, c.vs) - P::gather(b + 2, c.vs);
-    rate = (u0 * e0 + u1 * e1) + u2 * e2;
-    P damping = (pc.ba * rate) * pc.inv_l;
-    if (c.fade) {
-      // kelp's line: the dashpot fades out below l_f (TetherModel::dashpot_fade), σ = ρ²(3 − 2ρ)
-      // with ρ = min(l_s/l_f, 1); σ = 1 exactly above l_f. Its slope σ' BA/l ε̇ joins the axial
-      // stiffness where it is positive (the symmetric matrix stays positive semi-definite).
-      const P r0 = ls * pc.inv_fade;
-      const P r = simd::select(simd::greater(r0, pc.one), pc.one, r0);
-      const P sigma = (r * r) * (pc.three - pc.two * r);
-      const P k_fade = ((pc.two * pc.three) * r * (pc.one - r) * pc.inv_fade) * (pc.ba_l * rate);
-      damping = damping * sigma;
-      c_axial = c_axial * sigma;
-      k_axial = k_axial + simd::select(simd::greater(k_fade, zero), k_fade, zero);
-    }
-    tension += damping;
-    if (c.clamp) {
-      // A zero-length segment keeps its dashpot slope (its force is zero either way).
-      const auto keep = simd::greater(tension, zero);
-      tension = simd::select(keep, tension, zero);
-      k_axial = simd::select(keep, k_axial, zero);
-      c_axial = simd::select(keep || simd::greater_equal(zero, ls), c_axial, zero);
-    }
-  }
-  ls.store(&ws.stretched_length(s));
-  tension.store(&ws.tension(s));
-  Scalar* dir = ws.direction.data() + 3 * s;
-  u0.scatter(dir, 3);
-  u1.scatter(dir + 1, 3);
-  u2.scatter(dir + 2, 3);
-  (tension * u0).store(&ws.pass_buffer(s, kSegmentForce));
-  (tension * u1).store(&ws.pass_buffer(s, kSegmentForce + 1));
-  (tension * u2).store(&ws.pass_buffer(s, kSegmentForce + 2));
-  if constexpr (WithJacobian) {
-    // ∂(T u)/∂x_{s+1} = k_axial u uᵀ + (T/l_s)(I − u uᵀ); the geometric term is kept only for
-    // T > 0 so that the Jacobian stays positive semi-definite.
-    const P k_perp = simd::select(simd::greater(tension, zero), tension * inv_ls, zero);
-    (k_axial - k_perp).store(&ws.seg_k_uu(s));
-    k_perp.store(&ws.seg_k_perp(s));
-    c_axial.store(&ws.seg_c_uu(s));
-    rate.store(&ws.seg_rate(s));
-  }
+/// Whether a double evaluation may take the force passes' AVX2 build on a CPU with AVX2 (where
+/// kelp dispatches at run time, KELP_X86_DISPATCH; true unless set otherwise). Both builds give
+/// the same bits: the switch is there for the tests that compare them and the benchmarks that
+/// measure the baseline, process-wide.
+inline std::atomic<bool>& wide_force_passes() {
+  static std::atomic<bool> allowed{true};
+  return allowed;
 }
 
-/// Interior nodes i … i + lanes − 1 (1 ≤ i, i + lanes ≤ N) when all of them and their neighbours
-/// are below the surface band (at least half a diameter deep: their half segments are wholly wet)
-/// and they are off the seabed (returns false, writing nothing, otherwise): tangent, node force
-/// without the added-mass coupling to the neighbours, that coupling term w_i, masses and the
-/// Jacobian terms. The same arithmetic as node_general for such nodes.
-template <bool WithJacobian, bool Wide, typename Scalar>
-EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
-                                        const PackedConstants<Scalar, Wide>& pc,
-                                        TetherWorkspace<Scalar>& ws, int i) {
-  using P = simd::Pack<Scalar, Wide>;
-  const P zero = pc.zero;
-  const Scalar* a = c.x + i * c.xs;
-  const P z = P::gather(a + 2, c.xs);
-  // Wholly wet (the node and its neighbours at least half a diameter under the surface: φ = 1)
-  // and off the seabed.
-  const P z_lo = P::gather(a - c.xs + 2, c.xs), z_hi = P::gather(a + c.xs + 2, c.xs);
-  P d = z, d_lo = z_lo, d_hi = z_hi;
-  if (!c.still) {
-    const Scalar* zeta = &ws.surface_elevation(i);
-    d += P::load(zeta);
-    d_lo += P::load(zeta - 1);
-    d_hi += P::load(zeta + 1);
-  }
-  if (simd::any(simd::less(d, pc.half_d) || simd::less(d_lo, pc.half_d) ||
-                simd::less(d_hi, pc.half_d) || simd::greater(z - pc.bed, zero)))
-    return false;
-  const P c0 = P::gather(a + c.xs, c.xs) - P::gather(a - c.xs, c.xs);
-  const P c1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a - c.xs + 1, c.xs);
-  const P c2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a - c.xs + 2, c.xs);
-  const P cc = (c0 * c0 + c1 * c1) + c2 * c2;
-  const P inv_c2 = simd::select(simd::greater(cc, zero), pc.one / cc, zero);
-  const P inv_c = sqrt(inv_c2);
-  const P q0 = c0 * inv_c, q1 = c1 * inv_c, q2 = c2 * inv_c;
-  Scalar* tan = ws.tangent.data() + 3 * i;
-  q0.scatter(tan, 3);
-  q1.scatter(tan + 1, 3);
-  q2.scatter(tan + 2, 3);
-  const Scalar* tu = &ws.pass_buffer(i, kSegmentForce);
-  const Eigen::Index col = ws.pass_buffer.rows();
-  P f0 = P::load(tu) - P::load(tu - 1);
-  P f1 = P::load(tu + col) - P::load(tu + col - 1);
-  P f2 = P::load(tu + 2 * col) - P::load(tu + 2 * col - 1);
-  f2 += pc.wet_weight;
-  // Morison drag on the relative velocity, split along the chord.
-  const Scalar* vi = c.v + i * c.vs;
-  const Scalar* wi = ws.water_velocity.data() + 3 * i;
-  const P vr0 = P::gather(wi, 3) - P::gather(vi, c.vs);
-  const P vr1 = P::gather(wi + 1, 3) - P::gather(vi + 1, c.vs);
-  const P vr2 = P::gather(wi + 2, 3) - P::gather(vi + 2, c.vs);
-  const P vc = (vr0 * c0 + vr1 * c1) + vr2 * c2;
-  const P sc = vc * inv_c2;
-  const P vn0 = vr0 - sc * c0, vn1 = vr1 - sc * c1, vn2 = vr2 - sc * c2;
-  const P vn_abs = sqrt((vn0 * vn0 + vn1 * vn1) + vn2 * vn2);
-  const P vq = vc * inv_c;
-  const P kn = pc.kn, kt = pc.kt;
-  const P dn = kn * vn_abs, dt = (kt * abs(vq)) * vq;
-  f0 += dn * vn0 + dt * q0;
-  f1 += dn * vn1 + dt * q1;
-  f2 += dn * vn2 + dt * q2;
-  if (!c.still) {
-    // Froude–Krylov plus added-mass forcing (zero where the water does not accelerate).
-    const Scalar* ai = ws.water_acceleration.data() + 3 * i;
-    const P aw0 = P::gather(ai, 3), aw1 = P::gather(ai + 1, 3), aw2 = P::gather(ai + 2, 3);
-    const P qa = pc.cat_minus_can * ((q0 * aw0 + q1 * aw1) + q2 * aw2);
-    const P rv = pc.rho_vol, ca = pc.one_plus_can;
-    f0 += rv * (ca * aw0 + qa * q0);
-    f1 += rv * (ca * aw1 + qa * q1);
-    f2 += rv * (ca * aw2 + qa * q2);
-  }
-  pc.mass_iso_wet.store(&ws.mass_iso(i));
-  pc.mass_tan_wet.store(&ws.mass_tan(i));
-  pc.mass_iso_inv.store(&ws.mass_iso_inv(i));
-  pc.mass_tan_ratio.store(&ws.mass_tan_ratio(i));
-  if (c.mass_turns) {
-    // Added-mass rate terms (see compute_forces; zero for a zero chord, where 1/|c| = 0).
-    const P k = pc.mass_tan_wet * inv_c, ks = k * vq;
-    const P dc0 = P::gather(vi + c.vs, c.vs) - P::gather(vi - c.vs, c.vs);
-    const P dc1 = P::gather(vi + c.vs + 1, c.vs) - P::gather(vi - c.vs + 1, c.vs);
-    const P dc2 = P::gather(vi + c.vs + 2, c.vs) - P::gather(vi - c.vs + 2, c.vs);
-    const P m = k * ((dc0 * vn0 + dc1 * vn1) + dc2 * vn2) - ks * ((q0 * dc0 + q1 * dc1) + q2 * dc2);
-    f0 += ks * dc0 + m * q0;
-    f1 += ks * dc1 + m * q1;
-    f2 += ks * dc2 + m * q2;
-    (ks * vn0).store(&ws.pass_buffer(i, kMassRate));
-    (ks * vn1).store(&ws.pass_buffer(i, kMassRate + 1));
-    (ks * vn2).store(&ws.pass_buffer(i, kMassRate + 2));
-  }
-  f0.store(&ws.pass_buffer(i, kNodeForce));
-  f1.store(&ws.pass_buffer(i, kNodeForce + 1));
-  f2.store(&ws.pass_buffer(i, kNodeForce + 2));
-  pc.one.store(&ws.submerged(i));
-  zero.store(&ws.seabed_force(i));
-  if constexpr (WithJacobian) {
-    // −∂F/∂v of the drag (q held fixed) = c1 I + (c3 − c1) q qᵀ + cn v_n v_nᵀ.
-    const P cn = simd::select(simd::greater(vn_abs, zero), kn / vn_abs, zero);
-    const P c31 = (pc.two * kt) * abs(vq) - dn;
-    Scalar* dv = ws.node_dv.data() + 6 * i;
-    (dn + c31 * q0 * q0 + cn * vn0 * vn0).scatter(dv, 6);
-    (c31 * q1 * q0 + cn * vn1 * vn0).scatter(dv + 1, 6);
-    (c31 * q2 * q0 + cn * vn2 * vn0).scatter(dv + 2, 6);
-    (dn + c31 * q1 * q1 + cn * vn1 * vn1).scatter(dv + 3, 6);
-    (c31 * q2 * q1 + cn * vn2 * vn1).scatter(dv + 4, 6);
-    (dn + c31 * q2 * q2 + cn * vn2 * vn2).scatter(dv + 5, 6);
-    zero.store(&ws.node_kz(i));
-  }
-  return true;
-}
-
-/// Node forces i … i + lanes − 1 into ws.force: the node pass's force plus the added-mass
-/// coupling of the neighbours (+w_{i−1} − w_{i+1}; at node 0 the node's own −w_0, at node N its
-/// own +w_N, as its chord is its own segment) and bending.
-template <bool Wide, typename Scalar>
-EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws,
-                                      int i) {
-  using P = simd::Pack<Scalar, Wide>;
-  P f[3];
-  for (int k = 0; k < 3; ++k) {
-    f[k] = P::load(&ws.pass_buffer(i, kNodeForce + k));
-    if (c.mass_turns) {
-      const Scalar* w = &ws.pass_buffer(0, kMassRate + k);
-      if constexpr (P::lanes == 1) {
-        // At an end of the line or of a parted piece the node's own w stands for its neighbour's
-        // (its chord is its own segment: detail::chord_nodes).
-        const bool cut_before = i == 0 || (c.parted && c.parted[i - 1]);
-        const bool cut_after = i == c.n || (c.parted && c.parted[i]);
-        const Scalar prev = cut_before ? -w[i] : w[i - 1], next = cut_after ? -w[i] : w[i + 1];
-        f[k] = f[k] + (P::all(prev) - P::all(next));
-      } else {
-        f[k] = f[k] + (P::load(w + i - 1) - P::load(w + i + 1));
-      }
-    }
-    if (c.bending) f[k] += P::gather(ws.bending.data() + 3 * i + k, 3);
-    f[k].scatter(ws.force.data() + 3 * i + k, 3);
-  }
-  if (c.acc) {
-    // a = M⁻¹F = (F − (b/(a+b)) q (q·F)) / a (see accelerations_from_forces).
-    const Scalar* tq = ws.tangent.data() + 3 * i;
-    const P q0 = P::gather(tq, 3), q1 = P::gather(tq + 1, 3), q2 = P::gather(tq + 2, 3);
-    const P rq = P::load(&ws.mass_tan_ratio(i)) * ((q0 * f[0] + q1 * f[1]) + q2 * f[2]);
-    const P ia = P::load(&ws.mass_iso_inv(i));
-    Scalar* a = c.acc + 3 * i;
-    ((f[0] - rq * q0) * ia).scatter(a, 3);
-    ((f[1] - rq * q1) * ia).scatter(a + 1, 3);
-    ((f[2] - rq * q2) * ia).scatter(a + 2, 3);
-  }
+/// Whether a double evaluation takes the force passes' AVX2 build now: a dispatching build on a
+/// CPU with AVX2 (checked once; GCC's and clang's check includes the OS's support), with
+/// wide_force_passes() set.
+inline bool force_passes_take_avx2() {
+#if defined(KELP_X86_DISPATCH)
+  static const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
+  return cpu_has_avx2 && wide_force_passes().load(std::memory_order_relaxed);
+#else
+  return false;
+#endif
 }
 
 }  // namespace detail

@@ -16,6 +16,7 @@
 #include "kelp/core/error.hpp"
 #include "kelp/core/scalar.hpp"
 #include "kelp/core/simd.hpp"
+#include "kelp/core/simd_avx2.hpp"
 #include "kelp/core/types.hpp"
 #include "kelp/tether/contact.hpp"
 #include "kelp/tether/force_kernels.hpp"
@@ -555,65 +556,40 @@ void bind_columns(const Eigen::MatrixBase<D>& m, Matrix3X<Scalar>& copy, const S
   stride = 3;
 }
 
-/// The passes of compute_forces on positions and velocities stored column-major with the given
-/// column strides.
+// The packet kernels and force_passes (kelp/tether/force_pass_body.hpp): once for the build's own
+// packets, and where kelp dispatches at run time once more for AVX2 (same bits; chosen by
+// run_force_passes below).
+namespace baseline {
+namespace vec = ::kelp::simd;
+#define KELP_FORCE_PASS_BODY 1
+#include "kelp/tether/force_pass_body.hpp"  // IWYU pragma: keep
+#undef KELP_FORCE_PASS_BODY
+}  // namespace baseline
+
+#if defined(KELP_X86_DISPATCH)
+KELP_AVX2_BEGIN
+namespace avx2 {
+namespace vec = ::kelp::simd::detail::avx2;
+#define KELP_FORCE_PASS_BODY 1
+#include "kelp/tether/force_pass_body.hpp"  // IWYU pragma: keep
+#undef KELP_FORCE_PASS_BODY
+}  // namespace avx2
+KELP_AVX2_END
+#endif
+
+/// force_passes on the widest build this CPU runs: AVX2 for doubles when
+/// force_passes_take_avx2(), the build's own packets otherwise. Both give the same bits.
 template <bool WithJacobian, typename Scalar>
-void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
-  constexpr bool wide = simd::vectorized<Scalar>;
-  constexpr int lanes = simd::Pack<Scalar, wide>::lanes;
-  const int n = c.n;
-  const PackedConstants<Scalar, wide> packed(c);
-  const PackedConstants<Scalar, false> single(c);
-  int s = 0;
-  if (c.winch) {
-    // Segment 0 at a winch: its own rest length l_w (TetherWorkspace::winch_length), the same
-    // arithmetic with l, EA/l, BA/l and the fade length taken for l_w.
-    ForcePass<Scalar> cw = c;
-    const Scalar lw = ws.winch_length;
-    cw.l = lw;
-    cw.l2 = lw * lw;
-    cw.inv_l = Scalar(1) / lw;
-    cw.ea_l = c.ea * cw.inv_l;
-    cw.ba_l = c.ba * cw.inv_l;
-    cw.inv_fade = c.inv_fade * (c.l * cw.inv_l);
-    segment_block<WithJacobian, false>(cw, PackedConstants<Scalar, false>(cw), ws, 0);
-    s = 1;
+void run_force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>) {
+    if (force_passes_take_avx2()) {
+      avx2::force_passes<WithJacobian>(c, ws);
+      return;
+    }
   }
-  if constexpr (wide)
-    for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, packed, ws, s);
-  for (; s < n; ++s) segment_block<WithJacobian, false>(c, single, ws, s);
-  if (c.parted) {
-    // A parted line (TetherState::parted) takes the general path: its parted segments carry no
-    // axial force, and the nodes beside them are ends of their pieces (chord_nodes).
-    parted_segments<WithJacobian>(c, ws);
-    if (c.bending) bending_forces(c, ws);
-    for (int i = 0; i <= n; ++i) node_general<WithJacobian>(c, ws, i);
-    if (c.obstacles) contact_pass<WithJacobian>(c, ws);
-    for (int i = 0; i <= n; ++i) finish_block<false>(c, ws, i);
-    return;
-  }
-  if (c.bending) bending_forces(c, ws);
-  node_general<WithJacobian>(c, ws, 0);
-  int i = 1;
-  // Node 1 next to a winch segment has its own constants (kinds[3]).
-  if (c.winch && n > 1) node_general<WithJacobian>(c, ws, i++);
-  if constexpr (wide)
-    for (; i + lanes <= n; i += lanes)
-      if (!interior_block<WithJacobian, true>(c, packed, ws, i))
-        for (int j = i; j < i + lanes; ++j)
-          if (!interior_block<WithJacobian, false>(c, single, ws, j))
-            node_general<WithJacobian>(c, ws, j);
-  for (; i < n; ++i)
-    if (!interior_block<WithJacobian, false>(c, single, ws, i))
-      node_general<WithJacobian>(c, ws, i);
-  if (n > 0) node_general<WithJacobian>(c, ws, n);
-  // Obstacles (kelp/tether/contact.hpp): none in most environments, and then no pass at all.
-  if (c.obstacles) contact_pass<WithJacobian>(c, ws);
-  finish_block<false>(c, ws, 0);
-  i = 1;
-  if constexpr (wide)
-    for (; i + lanes <= n; i += lanes) finish_block<true>(c, ws, i);
-  for (; i <= n; ++i) finish_block<false>(c, ws, i);
+#endif
+  baseline::force_passes<WithJacobian>(c, ws);
 }
 
 /// compute_forces, and when `acc` is not null the node accelerations M⁻¹F of every node into
@@ -716,7 +692,7 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   bind_columns(x, ws.x_eval, c.x, c.xs);
   bind_columns(v, ws.v_eval, c.v, c.vs);
   c.acc = acc;
-  force_passes<WithJacobian>(c, ws);
+  run_force_passes<WithJacobian>(c, ws);
 }
 
 }  // namespace detail
