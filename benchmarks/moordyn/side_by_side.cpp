@@ -24,7 +24,9 @@
 // MoorDyn RK4 (one MoorDyn_Step per ~10 ms coupling interval, K internal dtM steps), kelp RK4
 // at dt, kelp bare compute_forces (without and with the Jacobian terms), kelp BDF2 at 10 ms (to
 // tolerance with the default simplified Newton / W-method, to tolerance with Newton's method,
-// then one unchecked correction per step). Each measurement runs >= min_time of wall
+// then one unchecked correction per step), and kelp's force evaluation and BDF2 step again on the
+// force passes' baseline build (kelp::tether::detail::wide_force_passes off: SSE2 where the AVX2
+// build is dispatched). Each measurement runs >= min_time of wall
 // clock (steady_clock); thread CPU time is recorded as well.
 #include <fcntl.h>
 #include <moordyn/MoorDyn2.h>
@@ -623,7 +625,7 @@ int main(int argc, char** argv) {
   struct Sum {
     int n;
     double dt, dt_kelp;
-    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf2x, kbdf21, krk4own;
+    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf2x, kbdf21, krk4own, kforce_base, kbdf2_base;
   };
   std::vector<Sum> sums;
   for (int n : sizes) {
@@ -635,7 +637,7 @@ int main(int argc, char** argv) {
     S.dt = dt;
     Md md(n, dt, dir);
     Md mdc(n, dt, dir);
-    Kelp krk(n), kf(n), kbd(n), kbdx(n), kbd1(n), kown(n);
+    Kelp krk(n), kf(n), kbd(n), kbdx(n), kbd1(n), kown(n), kbd_base(n);
     const kt::ImplicitOptionsd once = one_newton(), exact = exact_newton();
     S.dt_kelp = kt::estimate_stable_dt(kown.model, kt::Integrator::rk4, kown.env.water_density());
     const double nodes = n + 1;
@@ -690,6 +692,22 @@ int main(int argc, char** argv) {
       record("kelp_bdf2_one_newton_10ms", S.kbdf21, r, t, 1, 0.01, 0.01);
       t = run_for(min_time, 64, [&] { kown.step(S.dt_kelp, kt::Integrator::rk4); });
       record("kelp_rk4_own_dt", S.krk4own, r, t, 4, S.dt_kelp, S.dt_kelp);
+      // The same force evaluation and BDF2 step on the force passes' baseline build (the build's
+      // own packets: SSE2 on x86-64) where kelp dispatches them to AVX2 (same bits).
+      kt::detail::wide_force_passes() = false;
+      t = run_for(min_time, 256, [&] {
+        kt::compute_forces(kf.model, kf.ws, kf.env, 0.0, kf.state.position, kf.state.velocity);
+        asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
+      });
+      record("kelp_forces_baseline", S.kforce_base, r, t, 1, 0, 0);
+      evb = 0;
+      t = run_for(min_time, 16, [&] {
+        evb += kt::step(kbd_base.model, kbd_base.ws, kbd_base.env, kbd_base.state,
+                        kbd_base.boundary(kbd_base.state.time), 0.01, {kt::Integrator::bdf2})
+                   .force_evaluations;
+      });
+      record("kelp_bdf2_10ms_baseline", S.kbdf2_base, r, t, double(evb) / t.iters, 0.01, 0.01);
+      kt::detail::wide_force_passes() = true;
     }
     sums.push_back(S);
   }
@@ -729,6 +747,17 @@ int main(int argc, char** argv) {
                 rtf(S.kbdf21).c_str());
     std::printf("  kelp RK4 (own dt)           ns/node/eval %s  RTF %s\n", ns(S.krk4own).c_str(),
                 rtf(S.krk4own).c_str());
+    std::printf("  kelp compute_forces, baseline build ns/node %s\n", ns(S.kforce_base).c_str());
+    std::printf("  kelp BDF2 10 ms, baseline build ns/node/eval %s  RTF %s\n",
+                ns(S.kbdf2_base).c_str(), rtf(S.kbdf2_base).c_str());
+    std::printf(
+        "  force passes' build taken: %s; baseline / it: force evaluation %.2f (min) %.2f "
+        "(median), BDF2 real-time factor %.2f (max) %.2f (median)\n",
+        kt::detail::force_passes_take_avx2() ? "AVX2" : "baseline",
+        minv(S.kforce_base.ns_w) / minv(S.kforce.ns_w),
+        median(S.kforce_base.ns_w) / median(S.kforce.ns_w),
+        maxv(S.kbdf2.rtf_w) / maxv(S.kbdf2_base.rtf_w),
+        median(S.kbdf2.rtf_w) / median(S.kbdf2_base.rtf_w));
     // Ratios of the minima (wall clock) and of the medians, measured in this run.
     std::printf(
         "  ratios MoorDyn/kelp: force evaluation %.2f (min) %.2f (median); RK4 real-time factor "

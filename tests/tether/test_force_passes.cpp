@@ -146,6 +146,22 @@ void compare(const Case<Scalar>& c, double tol, bool frozen_friction, bool as_ex
   else
     kt::compute_forces<WithJacobian>(model, a, c.water, 1.0, c.x, c.v);
   kelp_test::reference_compute_forces<WithJacobian>(model, b, c.water, 1.0, c.x, c.v);
+  // Positions and velocities read in place from the rows of a 6 × (N+1) matrix (column stride
+  // 6): the same bits as from their own 3 × (N+1) storage.
+  {
+    Eigen::Matrix<Scalar, 6, Eigen::Dynamic> xv(6, c.x.cols());
+    xv.template topRows<3>() = c.x;
+    xv.template bottomRows<3>() = c.v;
+    kt::TetherWorkspace<Scalar> d(model), e(model);
+    d.frozen_friction = e.frozen_friction = a.frozen_friction;
+    d.friction_normal = e.friction_normal = a.friction_normal;
+    kt::compute_forces<WithJacobian>(model, d, c.water, 1.0, xv.template topRows<3>(),
+                                     xv.template bottomRows<3>());
+    kt::compute_forces<WithJacobian>(model, e, c.water, 1.0, c.x, c.v);
+    INFO(c.name << ": inputs with column stride 6");
+    CHECK((d.force.array() == e.force.array()).all());
+    CHECK((d.tension.array() == e.tension.array()).all());
+  }
   INFO(c.name << (WithJacobian ? " with Jacobian" : "")
               << (frozen_friction ? ", frozen friction" : "")
               << (as_expression ? ", expression inputs" : ""));

@@ -77,7 +77,13 @@ struct ForcePass {
 };
 
 /// Columns of TetherWorkspace::pass_buffer.
-enum PassColumn : int { kSegmentForce = 0, kNodeForce = 3, kMassRate = 6 };
+enum PassColumn : int {
+  kSegmentForce = 0,
+  kNodeForce = 3,
+  kMassRate = 6,
+  kPosition = 9,
+  kVelocity = 12
+};
 
 /// Whether a double evaluation may take the force passes' AVX2 build on a CPU with AVX2 (where
 /// kelp dispatches at run time, KELP_X86_DISPATCH; true unless set otherwise). Both builds give

@@ -55,10 +55,12 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
                                        TetherWorkspace<Scalar>& ws, int s) {
   using P = vec::Pack<Scalar, Wide>;
   const P zero = pc.zero;
-  const Scalar* a = c.x + s * c.xs;
-  const P d0 = P::gather(a + c.xs, c.xs) - P::gather(a, c.xs);
-  const P d1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a + 1, c.xs);
-  const P d2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a + 2, c.xs);
+  // Positions and velocities one column per component (soa_inputs): whole loads, no gathers.
+  const Eigen::Index col = ws.pass_buffer.rows();
+  const Scalar* a = &ws.pass_buffer(s, kPosition);
+  const P d0 = P::load(a + 1) - P::load(a);
+  const P d1 = P::load(a + col + 1) - P::load(a + col);
+  const P d2 = P::load(a + 2 * col + 1) - P::load(a + 2 * col);
   const P ls2 = (d0 * d0 + d1 * d1) + d2 * d2;
   const P ls = sqrt(ls2);
   const auto positive = vec::greater(ls, zero);
@@ -70,10 +72,10 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
   P c_axial = pc.ba_l;
   P rate = zero;
   if (c.damping) {
-    const Scalar* b = c.v + s * c.vs;
-    const P e0 = P::gather(b + c.vs, c.vs) - P::gather(b, c.vs);
-    const P e1 = P::gather(b + c.vs + 1, c.vs) - P::gather(b + 1, c.vs);
-    const P e2 = P::gather(b + c.vs + 2, c.vs) - P::gather(b + 2, c.vs);
+    const Scalar* b = &ws.pass_buffer(s, kVelocity);
+    const P e0 = P::load(b + 1) - P::load(b);
+    const P e1 = P::load(b + col + 1) - P::load(b + col);
+    const P e2 = P::load(b + 2 * col + 1) - P::load(b + 2 * col);
     rate = (u0 * e0 + u1 * e1) + u2 * e2;
     P damping = (pc.ba * rate) * pc.inv_l;
     if (c.fade) {
@@ -128,11 +130,13 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
                                         TetherWorkspace<Scalar>& ws, int i) {
   using P = vec::Pack<Scalar, Wide>;
   const P zero = pc.zero;
-  const Scalar* a = c.x + i * c.xs;
-  const P z = P::gather(a + 2, c.xs);
+  const Eigen::Index col = ws.pass_buffer.rows();
+  const Scalar* a = &ws.pass_buffer(i, kPosition);  // soa_inputs' columns
+  const Scalar* az = a + 2 * col;
+  const P z = P::load(az);
   // Wholly wet (the node and its neighbours at least half a diameter under the surface: φ = 1)
   // and off the seabed.
-  const P z_lo = P::gather(a - c.xs + 2, c.xs), z_hi = P::gather(a + c.xs + 2, c.xs);
+  const P z_lo = P::load(az - 1), z_hi = P::load(az + 1);
   P d = z, d_lo = z_lo, d_hi = z_hi;
   if (!c.still) {
     const Scalar* zeta = &ws.surface_elevation(i);
@@ -143,9 +147,9 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   if (vec::any(vec::less(d, pc.half_d) || vec::less(d_lo, pc.half_d) ||
                vec::less(d_hi, pc.half_d) || vec::greater(z - pc.bed, zero)))
     return false;
-  const P c0 = P::gather(a + c.xs, c.xs) - P::gather(a - c.xs, c.xs);
-  const P c1 = P::gather(a + c.xs + 1, c.xs) - P::gather(a - c.xs + 1, c.xs);
-  const P c2 = P::gather(a + c.xs + 2, c.xs) - P::gather(a - c.xs + 2, c.xs);
+  const P c0 = P::load(a + 1) - P::load(a - 1);
+  const P c1 = P::load(a + col + 1) - P::load(a + col - 1);
+  const P c2 = z_hi - z_lo;
   const P cc = (c0 * c0 + c1 * c1) + c2 * c2;
   const P inv_c2 = vec::select(vec::greater(cc, zero), pc.one / cc, zero);
   const P inv_c = sqrt(inv_c2);
@@ -155,17 +159,19 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   q1.scatter(tan + 1, 3);
   q2.scatter(tan + 2, 3);
   const Scalar* tu = &ws.pass_buffer(i, kSegmentForce);
-  const Eigen::Index col = ws.pass_buffer.rows();
   P f0 = P::load(tu) - P::load(tu - 1);
   P f1 = P::load(tu + col) - P::load(tu + col - 1);
   P f2 = P::load(tu + 2 * col) - P::load(tu + 2 * col - 1);
   f2 += pc.wet_weight;
   // Morison drag on the relative velocity, split along the chord.
-  const Scalar* vi = c.v + i * c.vs;
+  const Scalar* vi = &ws.pass_buffer(i, kVelocity);
+  // Still water: the water velocity buffer holds +0 (evaluate_forces), which zero is.
   const Scalar* wi = ws.water_velocity.data() + 3 * i;
-  const P vr0 = P::gather(wi, 3) - P::gather(vi, c.vs);
-  const P vr1 = P::gather(wi + 1, 3) - P::gather(vi + 1, c.vs);
-  const P vr2 = P::gather(wi + 2, 3) - P::gather(vi + 2, c.vs);
+  const P w0 = c.still ? zero : P::gather(wi, 3), w1 = c.still ? zero : P::gather(wi + 1, 3),
+          w2 = c.still ? zero : P::gather(wi + 2, 3);
+  const P vr0 = w0 - P::load(vi);
+  const P vr1 = w1 - P::load(vi + col);
+  const P vr2 = w2 - P::load(vi + 2 * col);
   const P vc = (vr0 * c0 + vr1 * c1) + vr2 * c2;
   const P sc = vc * inv_c2;
   const P vn0 = vr0 - sc * c0, vn1 = vr1 - sc * c1, vn2 = vr2 - sc * c2;
@@ -193,9 +199,9 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   if (c.mass_turns) {
     // Added-mass rate terms (see compute_forces; zero for a zero chord, where 1/|c| = 0).
     const P k = pc.mass_tan_wet * inv_c, ks = k * vq;
-    const P dc0 = P::gather(vi + c.vs, c.vs) - P::gather(vi - c.vs, c.vs);
-    const P dc1 = P::gather(vi + c.vs + 1, c.vs) - P::gather(vi - c.vs + 1, c.vs);
-    const P dc2 = P::gather(vi + c.vs + 2, c.vs) - P::gather(vi - c.vs + 2, c.vs);
+    const P dc0 = P::load(vi + 1) - P::load(vi - 1);
+    const P dc1 = P::load(vi + col + 1) - P::load(vi + col - 1);
+    const P dc2 = P::load(vi + 2 * col + 1) - P::load(vi + 2 * col - 1);
     const P m = k * ((dc0 * vn0 + dc1 * vn1) + dc2 * vn2) - ks * ((q0 * dc0 + q1 * dc1) + q2 * dc2);
     f0 += ks * dc0 + m * q0;
     f1 += ks * dc1 + m * q1;
@@ -264,6 +270,31 @@ EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspac
   }
 }
 
+/// Positions and velocities into TetherWorkspace::pass_buffer, one column per component
+/// (kPosition, kVelocity): the segment and interior kernels then load 4 neighbouring nodes' x with
+/// one instruction, where gathering them from 3-strided columns took five and their addresses
+/// (each coordinate is read by 2–3 kernels, so it is gathered once here instead of at each use).
+template <typename Scalar>
+EIGEN_ALWAYS_INLINE void soa_inputs(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  using W = vec::Pack<Scalar, vec::vectorized<Scalar>>;
+  const Eigen::Index col = ws.pass_buffer.rows();
+  Scalar* px = &ws.pass_buffer(0, kPosition);
+  Scalar* pv = &ws.pass_buffer(0, kVelocity);
+  const int nodes = c.n + 1;
+  int i = 0;
+  if (c.xs == 3 && c.vs == 3)
+    for (; i + W::lanes <= nodes; i += W::lanes)
+      for (int k = 0; k < 3; ++k) {
+        W::gather(c.x + 3 * i + k, 3).store(px + k * col + i);
+        W::gather(c.v + 3 * i + k, 3).store(pv + k * col + i);
+      }
+  for (; i < nodes; ++i)
+    for (int k = 0; k < 3; ++k) {
+      px[k * col + i] = c.X(k, i);
+      pv[k * col + i] = c.V(k, i);
+    }
+}
+
 /// The passes of compute_forces on positions and velocities stored column-major with the given
 /// column strides.
 template <bool WithJacobian, typename Scalar>
@@ -271,6 +302,7 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   constexpr bool wide = vec::vectorized<Scalar>;
   constexpr int lanes = vec::Pack<Scalar, wide>::lanes;
   const int n = c.n;
+  soa_inputs(c, ws);
   const PackedConstants<Scalar, wide> packed(c);
   const PackedConstants<Scalar, false> single(c);
   int s = 0;

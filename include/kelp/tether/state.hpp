@@ -426,8 +426,8 @@ struct TetherWorkspace {
   ///@}
   /// compute_forces' scratch, one contiguous column per component: T_s u_s of each segment
   /// (columns 0–2), each node's force before the added-mass coupling to its neighbours (3–5),
-  /// and that coupling term (6–8)
-  Eigen::Matrix<Scalar, Eigen::Dynamic, 9> pass_buffer;
+  /// that coupling term (6–8), and the positions (9–11) and velocities (12–14) evaluated
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 15> pass_buffer;
   /// \brief Copies of positions and velocities given to compute_forces as expressions rather
   /// than as column-major storage.
   ///@{
@@ -564,7 +564,7 @@ struct TetherWorkspace {
     f(w.node_kc, 6, n);
     f(w.segment_contact, s, 1);
     f(w.segment_obstacle, s, 1);
-    f(w.pass_buffer, n, 9);
+    f(w.pass_buffer, n, 15);
     f(w.block_inv, 17, n);
     f(w.newton_lu, 9, 5 * n);
     f(w.newton_factor, detail::newton_factor_size(nodes), 1);
