@@ -99,7 +99,9 @@ inline std::atomic<bool>& wide_force_passes() {
 /// wide_force_passes() set.
 inline bool force_passes_take_avx2() {
 #if defined(KELP_X86_DISPATCH)
-  static const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
+  // __builtin_cpu_init first: the check may run before libgcc's constructor that fills the CPU
+  // model (a static object's constructor that evaluates forces).
+  static const bool cpu_has_avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
   return cpu_has_avx2 && wide_force_passes().load(std::memory_order_relaxed);
 #else
   return false;
