@@ -558,7 +558,8 @@ void bind_columns(const Eigen::MatrixBase<D>& m, Matrix3X<Scalar>& copy, const S
 
 // The packet kernels and force_passes (kelp/tether/force_pass_body.hpp): once for the build's own
 // packets, and where kelp dispatches at run time once more for AVX2 (same bits; chosen by
-// run_force_passes below).
+// run_force_passes below). Doxygen does not read them (their namespaces are details).
+#if !defined(KELP_DOXYGEN)
 namespace baseline {
 namespace vec = ::kelp::simd;
 #define KELP_FORCE_PASS_BODY 1
@@ -576,6 +577,7 @@ namespace vec = ::kelp::simd::detail::avx2;
 }  // namespace avx2
 KELP_AVX2_END
 #endif
+#endif  // KELP_DOXYGEN
 
 /// force_passes on the widest build this CPU runs: AVX2 for doubles when
 /// force_passes_take_avx2(), the build's own packets otherwise. Both give the same bits.
