@@ -20,7 +20,6 @@
 #include "kelp/core/simd.hpp"
 
 #if defined(KELP_X86_DISPATCH)
-#include <immintrin.h>
 
 #if defined(__clang__)
 #define KELP_AVX2_BEGIN \
@@ -34,61 +33,75 @@
 KELP_AVX2_BEGIN
 namespace kelp::simd::detail::avx2 {
 
+// GCC's and clang's vector extensions and the builtins their <immintrin.h> is written with, not
+// <immintrin.h> itself: that header costs every unit that includes kelp/tether/forces.hpp ~0.8 CPU
+// s and ~95 MB (GCC 12), for the dozen operations used here.
+typedef double V4d __attribute__((vector_size(32)));
+typedef unsigned long long V4i __attribute__((vector_size(32)));
+typedef double V4du __attribute__((vector_size(32), aligned(8), may_alias));  // unaligned
+inline constexpr int kCmpLtOs = 0x01;  // _CMP_LT_OS: cmpltpd's predicate
+inline constexpr int kCmpLeOs = 0x02;  // _CMP_LE_OS: cmplepd's predicate
+
 /// 4 doubles in an AVX register: kelp::simd::Pack's interface (the operations the force
 /// kernels use), each the instruction Eigen's SSE2 packet uses, on 4 lanes.
 struct Pack4d {
-  using Raw = __m256d;
+  using Raw = V4d;
   static constexpr int lanes = 4;
-  __m256d r;
+  V4d r;
 
   Pack4d() = default;
-  explicit Pack4d(__m256d raw) : r(raw) {}
-  static Pack4d all(double s) { return Pack4d(_mm256_set1_pd(s)); }
+  explicit Pack4d(V4d raw) : r(raw) {}
+  static Pack4d all(double s) { return Pack4d(V4d{s, s, s, s}); }
   static Pack4d gather(const double* p, Eigen::Index stride) {
-    return Pack4d(_mm256_set_pd(p[3 * stride], p[2 * stride], p[stride], p[0]));
+    return Pack4d(V4d{p[0], p[stride], p[2 * stride], p[3 * stride]});
   }
-  static Pack4d load(const double* p) { return Pack4d(_mm256_loadu_pd(p)); }
+  static Pack4d load(const double* p) { return Pack4d(*reinterpret_cast<const V4du*>(p)); }
   void scatter(double* p, Eigen::Index stride) const {
-    const __m128d lo = _mm256_castpd256_pd128(r), hi = _mm256_extractf128_pd(r, 1);
-    _mm_storel_pd(p, lo);
-    _mm_storeh_pd(p + stride, lo);
-    _mm_storel_pd(p + 2 * stride, hi);
-    _mm_storeh_pd(p + 3 * stride, hi);
+    p[0] = r[0];
+    p[stride] = r[1];
+    p[2 * stride] = r[2];
+    p[3 * stride] = r[3];
   }
-  void store(double* p) const { _mm256_storeu_pd(p, r); }
+  void store(double* p) const { *reinterpret_cast<V4du*>(p) = r; }
   Pack4d& operator+=(Pack4d b) {
-    r = _mm256_add_pd(r, b.r);
+    r += b.r;
     return *this;
   }
   Pack4d& operator-=(Pack4d b) {
-    r = _mm256_sub_pd(r, b.r);
+    r -= b.r;
     return *this;
   }
 };
 
 // Free functions, not friends defined in the class: GCC does not give those the region's target.
-inline Pack4d operator+(Pack4d a, Pack4d b) { return Pack4d(_mm256_add_pd(a.r, b.r)); }
-inline Pack4d operator-(Pack4d a, Pack4d b) { return Pack4d(_mm256_sub_pd(a.r, b.r)); }
-inline Pack4d operator*(Pack4d a, Pack4d b) { return Pack4d(_mm256_mul_pd(a.r, b.r)); }
-inline Pack4d operator/(Pack4d a, Pack4d b) { return Pack4d(_mm256_div_pd(a.r, b.r)); }
-inline Pack4d operator-(Pack4d a) { return Pack4d(_mm256_xor_pd(a.r, _mm256_set1_pd(-0.0))); }
-inline Pack4d sqrt(Pack4d a) { return Pack4d(_mm256_sqrt_pd(a.r)); }
-inline Pack4d abs(Pack4d a) { return Pack4d(_mm256_andnot_pd(_mm256_set1_pd(-0.0), a.r)); }
+inline Pack4d operator+(Pack4d a, Pack4d b) { return Pack4d(a.r + b.r); }
+inline Pack4d operator-(Pack4d a, Pack4d b) { return Pack4d(a.r - b.r); }
+inline Pack4d operator*(Pack4d a, Pack4d b) { return Pack4d(a.r * b.r); }
+inline Pack4d operator/(Pack4d a, Pack4d b) { return Pack4d(a.r / b.r); }
+inline V4i sign_bits() {
+  constexpr unsigned long long sign = 0x8000000000000000ull;
+  return V4i{sign, sign, sign, sign};
+}
+inline Pack4d operator-(Pack4d a) { return Pack4d(V4d(V4i(a.r) ^ sign_bits())); }
+inline Pack4d sqrt(Pack4d a) { return Pack4d(__builtin_ia32_sqrtpd256(a.r)); }
+inline Pack4d abs(Pack4d a) { return Pack4d(V4d(V4i(a.r) & ~sign_bits())); }
 
 /// Lane-wise comparison result of Pack4d (all bits set in the true lanes).
 struct Mask4d {
-  __m256d m;
+  V4d m;
 };
 // The predicates of SSE2's cmpltpd / cmplepd (ordered, signalling), so that the flags raised match.
-inline Mask4d greater(Pack4d a, Pack4d b) { return {_mm256_cmp_pd(b.r, a.r, _CMP_LT_OS)}; }
-inline Mask4d greater_equal(Pack4d a, Pack4d b) { return {_mm256_cmp_pd(b.r, a.r, _CMP_LE_OS)}; }
-inline Mask4d less(Pack4d a, Pack4d b) { return greater(b, a); }
-inline Mask4d operator&&(Mask4d a, Mask4d b) { return {_mm256_and_pd(a.m, b.m)}; }
-inline Mask4d operator||(Mask4d a, Mask4d b) { return {_mm256_or_pd(a.m, b.m)}; }
-inline Pack4d select(Mask4d k, Pack4d a, Pack4d b) {
-  return Pack4d(_mm256_blendv_pd(b.r, a.r, k.m));
+inline Mask4d greater(Pack4d a, Pack4d b) { return {__builtin_ia32_cmppd256(b.r, a.r, kCmpLtOs)}; }
+inline Mask4d greater_equal(Pack4d a, Pack4d b) {
+  return {__builtin_ia32_cmppd256(b.r, a.r, kCmpLeOs)};
 }
-inline bool any(Mask4d k) { return _mm256_movemask_pd(k.m) != 0; }
+inline Mask4d less(Pack4d a, Pack4d b) { return greater(b, a); }
+inline Mask4d operator&&(Mask4d a, Mask4d b) { return {V4d(V4i(a.m) & V4i(b.m))}; }
+inline Mask4d operator||(Mask4d a, Mask4d b) { return {V4d(V4i(a.m) | V4i(b.m))}; }
+inline Pack4d select(Mask4d k, Pack4d a, Pack4d b) {
+  return Pack4d(__builtin_ia32_blendvpd256(b.r, a.r, k.m));
+}
+inline bool any(Mask4d k) { return __builtin_ia32_movmskpd256(k.m) != 0; }
 
 /// The pack of this namespace for a lane type and width: Pack4d for wide doubles; otherwise
 /// kelp::simd's (one lane, or a lane type this namespace has no pack for).
