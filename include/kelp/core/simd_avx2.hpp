@@ -1,6 +1,6 @@
 /// \file
 /// \brief Packs of 4 doubles in AVX registers for kelp's run-time dispatched tether force passes
-/// (kelp/tether/force_kernels.hpp), with the interface of kelp/core/simd.hpp's `Pack`; and the
+/// (kelp/tether/force_pass_body.hpp), with the interface of kelp/core/simd.hpp's `Pack`; and the
 /// `KELP_AVX2_BEGIN` / `KELP_AVX2_END` pair that compiles the functions defined between them for
 /// AVX2 (without FMA).
 ///
