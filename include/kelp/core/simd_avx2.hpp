@@ -82,7 +82,6 @@ inline V4i sign_bits() {
   constexpr unsigned long long sign = 0x8000000000000000ull;
   return V4i{sign, sign, sign, sign};
 }
-inline Pack4d operator-(Pack4d a) { return Pack4d(V4d(V4i(a.r) ^ sign_bits())); }
 inline Pack4d sqrt(Pack4d a) { return Pack4d(__builtin_ia32_sqrtpd256(a.r)); }
 inline Pack4d abs(Pack4d a) { return Pack4d(V4d(V4i(a.r) & ~sign_bits())); }
 
