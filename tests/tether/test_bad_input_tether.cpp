@@ -26,10 +26,7 @@ namespace {
 const double nan_ = std::numeric_limits<double>::quiet_NaN();
 const double inf_ = std::numeric_limits<double>::infinity();
 
-bool same_bits(const Matrix3X<double>& a, const Matrix3X<double>& b) {
-  return a.rows() == b.rows() && a.cols() == b.cols() &&
-         (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0);
-}
+using kelp_test::same_bits;
 
 bool same_state(const kt::TetherStated& a, const kt::TetherStated& b) {
   return same_bits(a.position, b.position) && same_bits(a.velocity, b.velocity) &&

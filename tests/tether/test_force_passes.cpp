@@ -6,7 +6,6 @@
 // passes' AVX2 build against the baseline build, bit for bit.
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <cstring>
 #include <random>
 #include <string>
 
@@ -231,12 +230,7 @@ TEST_CASE("the equivalence check can fail: a changed drag coefficient is seen",
 
 namespace {
 
-template <typename M>
-bool same_bits(const M& a, const M& b) {
-  using S = typename M::Scalar;
-  return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.data(), b.data(), sizeof(S) * std::size_t(a.size())) == 0;
-}
+using kelp_test::same_bits;
 
 // Every field compute_forces writes, bit for bit.
 bool same_outputs(const kt::TetherWorkspace<double>& a, const kt::TetherWorkspace<double>& b) {
@@ -252,10 +246,11 @@ bool same_outputs(const kt::TetherWorkspace<double>& a, const kt::TetherWorkspac
          same_bits(a.node_kz, b.node_kz);
 }
 
-// Sets kelp::tether::detail::wide_force_passes for a scope.
+// Sets kelp::tether::detail::wide_force_passes for a scope, then restores it.
 struct WidePasses {
-  explicit WidePasses(bool on) { kt::detail::wide_force_passes() = on; }
-  ~WidePasses() { kt::detail::wide_force_passes() = true; }
+  explicit WidePasses(bool on) : before(kt::detail::wide_force_passes().exchange(on)) {}
+  ~WidePasses() { kt::detail::wide_force_passes() = before; }
+  bool before;
 };
 
 // A few steps of `step` from `s0`, with the AVX2 build allowed or not.

@@ -32,13 +32,9 @@ kt::TetherStated swinging(const kt::TetherModeld& model) {
   return s;
 }
 
-bool bitwise_equal(const kelp::Matrix3X<double>& a, const kelp::Matrix3X<double>& b) {
-  return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.data(), b.data(), sizeof(double) * std::size_t(a.size())) == 0;
-}
-
 bool bitwise_equal(const kt::TetherStated& a, const kt::TetherStated& b) {
-  return bitwise_equal(a.position, b.position) && bitwise_equal(a.velocity, b.velocity) &&
+  return kelp_test::same_bits(a.position, b.position) &&
+         kelp_test::same_bits(a.velocity, b.velocity) &&
          std::memcmp(&a.time, &b.time, sizeof(double)) == 0;
 }
 
@@ -249,8 +245,7 @@ TEST_CASE("end forces: every integrator reports them at the end of the step",
       if (k > 0) sub = sub.after(2e-4);
       separate += kt::step(model, ws_s, env, ss, sub, 2e-4, {integ}).force_evaluations;
     }
-    CHECK(std::memcmp(sa.position.data(), ss.position.data(),
-                      sizeof(double) * std::size_t(sa.position.size())) == 0);
+    CHECK(kelp_test::same_bits(sa.position, ss.position));
     CHECK(ws_a.end_forces.on_start == ws_s.end_forces.on_start);
     CHECK(ws_a.end_forces.on_end == ws_s.end_forces.on_end);
     const int stages = integ == kt::Integrator::rk4 ? 4 : (integ == kt::Integrator::rk2 ? 2 : 1);
@@ -505,7 +500,7 @@ TEST_CASE("the integrator history lives in the state: save, step, restore, step 
     for (int k = 0; k < 3; ++k) {
       kt::step(model, other, env, s, bnd, dt, {integ});
       CHECK(bitwise_equal(s, first[std::size_t(k)]));
-      CHECK(bitwise_equal(s.previous_position, first[std::size_t(k)].previous_position));
+      CHECK(kelp_test::same_bits(s.previous_position, first[std::size_t(k)].previous_position));
     }
   }
 }

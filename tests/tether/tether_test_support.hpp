@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstring>
 #include <limits>
 
 #include "kelp/core/constants.hpp"
@@ -10,6 +11,15 @@
 #include "kelp/tether/lumped_mass.hpp"
 
 namespace kelp_test {
+
+/// True when two matrices have the same shape and the same bits (NaN equal to itself, -0 not
+/// equal to +0): the check for results that must be reproduced exactly.
+template <typename M>
+bool same_bits(const M& a, const M& b) {
+  using S = typename M::Scalar;
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(S) * std::size_t(a.size())) == 0);
+}
 
 /// A fluid-free world (vacuum) with gravity g: no buoyancy, drag or added mass. Water density 0
 /// is something kelp::environment::Environment refuses, hence this test type.
