@@ -42,6 +42,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "../../tests/tether/moordyn_cases.hpp"
@@ -655,6 +656,23 @@ int main(int argc, char** argv) {
                   t.wall, t.cpu, nsw, nsc, rw, rc);
       std::fflush(stdout);
     };
+    // kf's force evaluation (with the Jacobian terms when WithJacobian) and BDF2 steps of 10 ms of
+    // line k (counting the force evaluations into `evals`), each timed by run_for.
+    const auto time_forces = [&](auto with_jacobian) {
+      return run_for(min_time, 256, [&] {
+        kt::compute_forces<decltype(with_jacobian)::value>(kf.model, kf.ws, kf.env, 0.0,
+                                                           kf.state.position, kf.state.velocity);
+        asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
+      });
+    };
+    const auto time_bdf2 = [&](Kelp& k, const kt::ImplicitOptionsd& options, long& evals) {
+      evals = 0;
+      return run_for(min_time, 16, [&] {
+        evals += kt::step(k.model, k.ws, k.env, k.state, k.boundary(k.state.time), 0.01,
+                          {kt::Integrator::bdf2, options})
+                     .force_evaluations;
+      });
+    };
     for (int r = 0; r < rounds; ++r) {
       // MoorDyn first, then kelp
       Timing t = run_for(min_time, 64, [&] { md.step(dt); });
@@ -663,30 +681,14 @@ int main(int argc, char** argv) {
       record("moordyn_rk4_10ms_coupling", S.mdc, r, t, 4.0 * K, hc, dt);
       t = run_for(min_time, 64, [&] { krk.step(dt, kt::Integrator::rk4); });
       record("kelp_rk4", S.krk4, r, t, 4, dt, dt);
-      t = run_for(min_time, 256, [&] {
-        kt::compute_forces(kf.model, kf.ws, kf.env, 0.0, kf.state.position, kf.state.velocity);
-        asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
-      });
+      t = time_forces(std::false_type{});
       record("kelp_forces", S.kforce, r, t, 1, 0, 0);
-      t = run_for(min_time, 256, [&] {
-        kt::compute_forces<true>(kf.model, kf.ws, kf.env, 0.0, kf.state.position,
-                                 kf.state.velocity);
-        asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
-      });
+      t = time_forces(std::true_type{});
       record("kelp_forces_jacobian", S.kforcej, r, t, 1, 0, 0);
       long evb = 0;
-      t = run_for(min_time, 16, [&] {
-        evb += kt::step(kbd.model, kbd.ws, kbd.env, kbd.state, kbd.boundary(kbd.state.time), 0.01,
-                        {kt::Integrator::bdf2})
-                   .force_evaluations;
-      });
+      t = time_bdf2(kbd, {}, evb);
       record("kelp_bdf2_10ms", S.kbdf2, r, t, double(evb) / t.iters, 0.01, 0.01);
-      evb = 0;
-      t = run_for(min_time, 16, [&] {
-        evb += kt::step(kbdx.model, kbdx.ws, kbdx.env, kbdx.state, kbdx.boundary(kbdx.state.time),
-                        0.01, {kt::Integrator::bdf2, exact})
-                   .force_evaluations;
-      });
+      t = time_bdf2(kbdx, exact, evb);
       record("kelp_bdf2_exact_10ms", S.kbdf2x, r, t, double(evb) / t.iters, 0.01, 0.01);
       t = run_for(min_time, 16, [&] { kbd1.step(0.01, kt::Integrator::bdf2, once); });
       record("kelp_bdf2_one_newton_10ms", S.kbdf21, r, t, 1, 0.01, 0.01);
@@ -695,17 +697,9 @@ int main(int argc, char** argv) {
       // The same force evaluation and BDF2 step on the force passes' baseline build (the build's
       // own packets: SSE2 on x86-64) where kelp dispatches them to AVX2 (same bits).
       kt::detail::wide_force_passes() = false;
-      t = run_for(min_time, 256, [&] {
-        kt::compute_forces(kf.model, kf.ws, kf.env, 0.0, kf.state.position, kf.state.velocity);
-        asm volatile("" : : "r"(kf.ws.force.data()) : "memory");
-      });
+      t = time_forces(std::false_type{});
       record("kelp_forces_baseline", S.kforce_base, r, t, 1, 0, 0);
-      evb = 0;
-      t = run_for(min_time, 16, [&] {
-        evb += kt::step(kbd_base.model, kbd_base.ws, kbd_base.env, kbd_base.state,
-                        kbd_base.boundary(kbd_base.state.time), 0.01, {kt::Integrator::bdf2})
-                   .force_evaluations;
-      });
+      t = time_bdf2(kbd_base, {}, evb);
       record("kelp_bdf2_10ms_baseline", S.kbdf2_base, r, t, double(evb) / t.iters, 0.01, 0.01);
       kt::detail::wide_force_passes() = true;
     }
