@@ -4,8 +4,10 @@
 // segments, coincident nodes, bending, free ends, water current and acceleration, inputs given
 // as expressions), in double to 1e-12 of each field's magnitude and in float to 1e-5; and the
 // passes' AVX2 build against the baseline build, bit for bit.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -337,4 +339,69 @@ TEST_CASE("the force passes' AVX2 build gives the baseline build's bits",
   WARN("this build does not dispatch at run time: one build of the force passes only");
   CHECK_FALSE(kt::detail::force_passes_take_avx2());
 #endif
+}
+
+TEST_CASE("the force passes form the implicit step's residual γh F − M (v − v̂) on the free nodes",
+          "[tether][forces][implicit]") {
+  // Against the residual computed here from the evaluation's own forces, masses and tangents,
+  // in the order of operations the implicit step documents: bit for bit on every free node of
+  // every case (as built, at a winch, parted), with both builds of the passes; the kinematic
+  // ends' columns are left alone, and a non-finite velocity makes the sum non-finite.
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  const double gh = 2.0 / 3.0 * 0.01;
+  int compared = 0;
+  for (const auto& c : cases<double>())
+    for (int variant = 0; variant < 3; ++variant)
+      for (bool wide : {true, false}) {
+        const kt::TetherModeld model(c.params);
+        kt::TetherWorkspaced ws(model);
+        if (variant == 1) ws.winch_length = 0.4 * model.segment_length();
+        if (variant == 2) {
+          if (model.segments() < 3) continue;
+          ws.parted.setZero();
+          ws.parted(model.segments() / 2) = 1;
+          ws.any_parted = true;
+        }
+        Matrix3X<double> v_hat = c.v;
+        for (int i = 0; i < model.nodes(); ++i)
+          for (int k = 0; k < 3; ++k) v_hat(k, i) += u(rng);
+        const int f0 = model.first_free_node(), f1 = model.last_free_node();
+        Matrix3X<double> rhs = Matrix3X<double>::Constant(3, model.nodes(), 12345.0);
+        kt::detail::ImplicitResidual<double> res{v_hat.data(), gh, f0, f1, rhs.data()};
+        const WidePasses scope(wide);
+        kt::detail::evaluate_forces<false>(model, ws, c.water, 1.0, c.x, c.v,
+                                           static_cast<double*>(nullptr), &res);
+        Matrix3X<double> expected = rhs;
+        double r_max = 0.0;
+        for (int i = f0; i <= f1; ++i) {
+          const Vector3<double> d = c.v.col(i) - v_hat.col(i), q = ws.tangent.col(i);
+          const double a = ws.mass_iso(i);
+          const double bqd = ws.mass_tan(i) * ((q(0) * d(0) + q(1) * d(1)) + q(2) * d(2));
+          for (int k = 0; k < 3; ++k) {
+            expected(k, i) = gh * ws.force(k, i) - (a * d(k) + bqd * q(k));
+            r_max = std::max(r_max, std::abs(expected(k, i)) * ws.mass_iso_inv(i));
+          }
+        }
+        INFO(c.name << ", variant " << variant << (wide ? ", AVX2 build" : ", baseline build"));
+        CHECK(same_bits(rhs, expected));
+        CHECK(res.r_max == r_max);
+        CHECK((r_max > 0.0) == (f1 >= f0));  // N = 1 with both ends kinematic: none free
+        CHECK(std::isfinite(res.sum));
+        ++compared;
+      }
+  CHECK(compared > 60);
+
+  // A NaN velocity at a free node reaches the sum.
+  const auto c = cases<double>()[7];
+  REQUIRE(c.params.segments == 20);
+  const kt::TetherModeld model(c.params);
+  kt::TetherWorkspaced ws(model);
+  Matrix3X<double> v = c.v, rhs(3, model.nodes());
+  v(1, model.nodes() / 2) = std::numeric_limits<double>::quiet_NaN();
+  kt::detail::ImplicitResidual<double> res{c.v.data(), gh, model.first_free_node(),
+                                           model.last_free_node(), rhs.data()};
+  kt::detail::evaluate_forces<false>(model, ws, c.water, 1.0, c.x, v, static_cast<double*>(nullptr),
+                                     &res);
+  CHECK_FALSE(std::isfinite(res.sum));
 }

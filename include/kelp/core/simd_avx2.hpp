@@ -83,6 +83,8 @@ inline V4i sign_bits() {
   return V4i{sign, sign, sign, sign};
 }
 inline Pack4d sqrt(Pack4d a) { return Pack4d(__builtin_ia32_sqrtpd256(a.r)); }
+// Lane-wise maximum: maxpd's operand order as Eigen's SSE2 pmax (the same lane for NaN).
+inline Pack4d max(Pack4d a, Pack4d b) { return Pack4d(__builtin_ia32_maxpd256(b.r, a.r)); }
 inline Pack4d abs(Pack4d a) { return Pack4d(V4d(V4i(a.r) & ~sign_bits())); }
 
 /// Lane-wise comparison result of Pack4d (all bits set in the true lanes).

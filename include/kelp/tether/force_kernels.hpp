@@ -40,6 +40,22 @@ struct NodeConstants {
   }
 };
 
+/// The implicit step's momentum residual, which the force passes form in their last loop
+/// (finish_block) while the node forces are in registers, instead of a pass of their own that
+/// gathered the forces back: on the free nodes f0 … f1, with M_i = a_i I + b_i q_i q_iᵀ,
+///   rhs_i = −R_i = γh F_i − M_i (v_i − v̂_i),
+/// `r_max` = max_i max_k |R_ik| / a_i and `sum` = Σ_i Σ_k R_ik, finite only when every R_ik is
+/// (detail::implicit_attempt's convergence test and finiteness check).
+template <typename Scalar>
+struct ImplicitResidual {
+  const Scalar* v_hat;  ///< v̂ of the step, 3 × (N+1), column-major
+  Scalar gh;            ///< γh [s]
+  int f0, f1;           ///< the free nodes
+  Scalar* rhs;          ///< out: −R, 3 × (N+1), column-major (free columns only)
+  Scalar r_max{};       ///< out: the scaled max-norm
+  Scalar sum{};         ///< out: the sum of the residual's entries
+};
+
 /// Everything compute_forces' passes share: the environment's and the model's constants of one
 /// evaluation, the node kinds (0 start, 1 interior, 2 end), and where the positions and
 /// velocities are (column-major 3 × (N+1) with the given column strides).
@@ -64,6 +80,8 @@ struct ForcePass {
   Eigen::Index vs;
   /// When set: M⁻¹F of every node is written here as well (3 × (N+1), column-major).
   Scalar* acc = nullptr;
+  /// When set: the implicit step's residual is formed as well (ImplicitResidual).
+  ImplicitResidual<Scalar>* residual = nullptr;
   /// One flag per segment when the line has parted (TetherWorkspace::parted), else null.
   const std::uint8_t* parted = nullptr;
   /// The environment's obstacles (environment::ObstacleSet), or null: no contact pass at all.

@@ -231,12 +231,61 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   return true;
 }
 
+/// The running maximum of |R_ik| / a_i and sum of R_ik of the implicit step's residual, lane by
+/// lane (residual_block).
+template <typename P>
+struct ResidualLanes {
+  P max_scaled, sum;
+};
+
+/// The implicit step's residual at nodes i … i + lanes − 1 (ImplicitResidual) from their forces
+/// `f`: the arithmetic of the pass it replaces, operation for operation, so that it gives the
+/// same bits. A single node outside f0 … f1 (a kinematic end) has none; the packets cover
+/// interior nodes only, which are free.
+template <typename P, typename Scalar>
+EIGEN_ALWAYS_INLINE void residual_block(const ImplicitResidual<Scalar>& res,
+                                        const TetherWorkspace<Scalar>& ws, int i, const P (&f)[3],
+                                        ResidualLanes<P>& lanes) {
+  if constexpr (P::lanes == 1)
+    if (i < res.f0 || i > res.f1) return;
+  const Scalar *vh = res.v_hat + 3 * i, *tq = ws.tangent.data() + 3 * i;
+  const P d0 = P::load(&ws.pass_buffer(i, kVelocity)) - P::gather(vh, 3);
+  const P d1 = P::load(&ws.pass_buffer(i, kVelocity + 1)) - P::gather(vh + 1, 3);
+  const P d2 = P::load(&ws.pass_buffer(i, kVelocity + 2)) - P::gather(vh + 2, 3);
+  const P q0 = P::gather(tq, 3), q1 = P::gather(tq + 1, 3), q2 = P::gather(tq + 2, 3);
+  const P a = P::load(&ws.mass_iso(i));
+  const P bqd = P::load(&ws.mass_tan(i)) * ((q0 * d0 + q1 * d1) + q2 * d2);
+  const P g = P::all(res.gh);
+  const P r0 = g * f[0] - (a * d0 + bqd * q0);
+  const P r1 = g * f[1] - (a * d1 + bqd * q1);
+  const P r2 = g * f[2] - (a * d2 + bqd * q2);
+  Scalar* out = res.rhs + 3 * i;
+  r0.scatter(out, 3);
+  r1.scatter(out + 1, 3);
+  r2.scatter(out + 2, 3);
+  lanes.max_scaled =
+      max(lanes.max_scaled, max(max(abs(r0), abs(r1)), abs(r2)) * P::load(&ws.mass_iso_inv(i)));
+  lanes.sum += (r0 + r1) + r2;
+}
+
+/// The residual's lanes (residual_block) reduced into `res`.
+template <typename P, typename Scalar>
+void reduce_residual(const ResidualLanes<P>& lanes, ImplicitResidual<Scalar>& res) {
+  Scalar m[P::lanes], t[P::lanes];
+  lanes.max_scaled.store(m);
+  lanes.sum.store(t);
+  for (int k = 0; k < P::lanes; ++k) {
+    res.r_max = std::max(res.r_max, m[k]);
+    res.sum += t[k];
+  }
+}
+
 /// Node forces i … i + lanes − 1 into ws.force: the node pass's force plus the added-mass
 /// coupling of the neighbours (+w_{i−1} − w_{i+1}; at node 0 the node's own −w_0, at node N its
 /// own +w_N, as its chord is its own segment) and bending.
 template <bool Wide, typename Scalar>
 EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws,
-                                      int i) {
+                                      int i, ResidualLanes<vec::Pack<Scalar, Wide>>& lanes) {
   using P = vec::Pack<Scalar, Wide>;
   P f[3];
   for (int k = 0; k < 3; ++k) {
@@ -257,6 +306,7 @@ EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspac
     if (c.bending) f[k] += P::gather(ws.bending.data() + 3 * i + k, 3);
     f[k].scatter(ws.force.data() + 3 * i + k, 3);
   }
+  if (c.residual) residual_block(*c.residual, ws, i, f, lanes);
   if (c.acc) {
     // a = M⁻¹F = (F − (b/(a+b)) q (q·F)) / a (see accelerations_from_forces).
     const Scalar* tq = ws.tangent.data() + 3 * i;
@@ -305,6 +355,10 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   soa_inputs(c, ws);
   const PackedConstants<Scalar, wide> packed(c);
   const PackedConstants<Scalar, false> single(c);
+  using PW = vec::Pack<Scalar, wide>;
+  using P1 = vec::Pack<Scalar, false>;
+  ResidualLanes<PW> res_wide{PW::all(Scalar(0)), PW::all(Scalar(0))};
+  ResidualLanes<P1> res_one{P1::all(Scalar(0)), P1::all(Scalar(0))};
   int s = 0;
   if (c.winch) {
     // Segment 0 at a winch: its own rest length l_w (TetherWorkspace::winch_length), the same
@@ -330,7 +384,8 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
     if (c.bending) bending_forces(c, ws);
     for (int i = 0; i <= n; ++i) node_general<WithJacobian>(c, ws, i);
     if (c.obstacles) contact_pass<WithJacobian>(c, ws);
-    for (int i = 0; i <= n; ++i) finish_block<false>(c, ws, i);
+    for (int i = 0; i <= n; ++i) finish_block<false>(c, ws, i, res_one);
+    if (c.residual) reduce_residual(res_one, *c.residual);
     return;
   }
   if (c.bending) bending_forces(c, ws);
@@ -350,11 +405,15 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   if (n > 0) node_general<WithJacobian>(c, ws, n);
   // Obstacles (kelp/tether/contact.hpp): none in most environments, and then no pass at all.
   if (c.obstacles) contact_pass<WithJacobian>(c, ws);
-  finish_block<false>(c, ws, 0);
+  finish_block<false>(c, ws, 0, res_one);
   i = 1;
   if constexpr (wide)
-    for (; i + lanes <= n; i += lanes) finish_block<true>(c, ws, i);
-  for (; i <= n; ++i) finish_block<false>(c, ws, i);
+    for (; i + lanes <= n; i += lanes) finish_block<true>(c, ws, i, res_wide);
+  for (; i <= n; ++i) finish_block<false>(c, ws, i, res_one);
+  if (c.residual) {
+    reduce_residual(res_wide, *c.residual);
+    reduce_residual(res_one, *c.residual);
+  }
 }
 
 #endif  // KELP_FORCE_PASS_BODY

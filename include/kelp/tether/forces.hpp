@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
@@ -596,11 +597,12 @@ void run_force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
 
 /// compute_forces, and when `acc` is not null the node accelerations M⁻¹F of every node into
 /// `acc` (3 × (N+1), column-major; the kinematic ends' entries are M⁻¹F too, not their
-/// prescribed accelerations).
+/// prescribed accelerations); when `residual` is not null, the implicit step's residual
+/// (ImplicitResidual).
 template <bool WithJacobian, typename Scalar, typename Env, typename DX, typename DV>
 void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                      double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v,
-                     Scalar* acc) {
+                     Scalar* acc, ImplicitResidual<Scalar>* residual = nullptr) {
   const TetherParameters<Scalar>& p = model.parameters();
   const int n = model.segments();
   // Any evaluation overwrites what an explicit step kept from its end (TetherWorkspace::
@@ -694,6 +696,7 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
   bind_columns(x, ws.x_eval, c.x, c.xs);
   bind_columns(v, ws.v_eval, c.v, c.vs);
   c.acc = acc;
+  c.residual = residual;
   run_force_passes<WithJacobian>(c, ws);
 }
 

@@ -52,21 +52,23 @@ template <typename Scalar>
 bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar>& ws,
                   const VectorX<Scalar>& branch, Scalar band) {
   const bool clamp = !model.parameters().compressive_damping;
-  bool same = true;
-  for (int s = 0; s < model.segments(); ++s) {
-    // The segment's rest length (segment 0's own at a winch).
-    const Scalar l = segment_springs(model, ws, s).l;
+  const int n = model.segments();
+  // The segments' rest length (segment 0's own at a winch).
+  const Scalar l_rest = model.segment_length();
+  for (int s = 0; s < n; ++s) {
+    const Scalar l = s == 0 ? segment_springs(model, ws, 0).l : l_rest;
     const Scalar taut_from = band > Scalar(0) ? (Scalar(1) - band) * l : l;
     const Scalar ls = ws.stretched_length(s);
-    const bool taut = !ws.is_parted(s) && (band > Scalar(0) ? ls >= taut_from : ls > l);
-    const Scalar b = ws.is_parted(s)            ? Scalar(0)
+    const bool parted = ws.is_parted(s);
+    const bool taut = !parted && (band > Scalar(0) ? ls >= taut_from : ls > l);
+    const Scalar b = parted                     ? Scalar(0)
                      : taut && band > Scalar(0) ? Scalar(2)
                                                 : (clamp && !(ws.tension(s) > Scalar(0))
                                                        ? Scalar(0)
                                                        : (ls > l ? Scalar(2) : Scalar(1)));
-    same = same && b == branch(s);
+    if (b != branch(s)) return false;
   }
-  return same;
+  return true;
 }
 
 /// The implicit step's predictor over the flat 3 × (N+1) arrays from index j on, in packets of P
@@ -219,51 +221,22 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     ++report.substeps;
   };
   // Evaluates F at (x, v), writes rhs = −R = γh F − M (v − v̂) on the free nodes and sets `res`
-  // to the scaled max-norm max_i |R_i|/a_i.
+  // to the scaled max-norm max_i |R_i|/a_i: the force passes form the residual in their last
+  // loop (ImplicitResidual).
   const auto evaluate = [&](const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v, Scalar& r_max,
                             bool with_jacobian) {
     // The evaluation behind compute_forces, without its checks: the workspace and the state
     // were checked once for the step, and a non-finite iterate shows in the residual's sum
     // below (numerical_error: the step is retried).
+    ImplicitResidual<Scalar> residual{ws.v0.data(), gh, f0, f1, ws.rhs.data()};
     if (with_jacobian)
-      evaluate_forces<true>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr));
+      evaluate_forces<true>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr), &residual);
     else
-      evaluate_forces<false>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr));
+      evaluate_forces<false>(model, ws, env, t1, x, v, static_cast<Scalar*>(nullptr), &residual);
     ++report.force_evaluations;
-    // One vectorised pass over the free nodes: rhs = −R, its scaled max-norm and (for the
-    // finiteness test below) its sum.
-    const auto residual = [&](auto lanes, int i, auto& r_lanes, auto& sum_lanes) {
-      using P = decltype(lanes);
-      const Scalar *vi = v.data() + 3 * i, *v0 = ws.v0.data() + 3 * i;
-      const Scalar *qi = ws.tangent.data() + 3 * i, *fi = ws.force.data() + 3 * i;
-      const P d0 = P::gather(vi, 3) - P::gather(v0, 3);
-      const P d1 = P::gather(vi + 1, 3) - P::gather(v0 + 1, 3);
-      const P d2 = P::gather(vi + 2, 3) - P::gather(v0 + 2, 3);
-      const P q0 = P::gather(qi, 3), q1 = P::gather(qi + 1, 3), q2 = P::gather(qi + 2, 3);
-      const P a = P::load(&ws.mass_iso(i));
-      const P bqd = P::load(&ws.mass_tan(i)) * ((q0 * d0 + q1 * d1) + q2 * d2);
-      const P g = P::all(gh);
-      const P r0 = g * P::gather(fi, 3) - (a * d0 + bqd * q0);
-      const P r1 = g * P::gather(fi + 1, 3) - (a * d1 + bqd * q1);
-      const P r2 = g * P::gather(fi + 2, 3) - (a * d2 + bqd * q2);
-      Scalar* out = ws.rhs.data() + 3 * i;
-      r0.scatter(out, 3);
-      r1.scatter(out + 1, 3);
-      r2.scatter(out + 2, 3);
-      r_lanes = max(r_lanes, max(max(abs(r0), abs(r1)), abs(r2)) * P::load(&ws.mass_iso_inv(i)));
-      sum_lanes += (r0 + r1) + r2;
-    };
-    using Wide = simd::Pack<Scalar, true>;
-    using One = simd::Pack<Scalar, false>;
-    Wide r_wide = Wide::all(Scalar(0)), sum_wide = Wide::all(Scalar(0));
-    One r_one = One::all(Scalar(0)), sum_one = One::all(Scalar(0));
-    int i = f0;
-    for (; i + Wide::lanes <= f1 + 1; i += Wide::lanes) residual(Wide(), i, r_wide, sum_wide);
-    for (; i <= f1; ++i) residual(One(), i, r_one, sum_one);
-    r_max = std::max(r_wide.max_lane(), r_one.max_lane());
-    const Scalar sum = sum_wide.sum() + sum_one.sum();
-    // NaN fails every comparison and std::max keeps its first argument: test the sum instead.
-    if (!is_finite(sum))
+    r_max = residual.r_max;
+    // NaN fails every comparison and max keeps one of its arguments: test the sum instead.
+    if (!is_finite(residual.sum))
       ::kelp::detail::throw_numerical_error(
           "step_implicit: non-finite residual; the state is unchanged");
   };
