@@ -498,13 +498,25 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
                        Scalar band, int max_passes, Solve&& solve) {
   const int n = model.segments();
   const int f0 = model.first_free_node(), f1 = model.last_free_node();
-  // Each segment's rest length and constants (segment 0's are its own at a winch).
-  const auto springs = [&](int s) { return segment_springs(model, ws, s); };
+  // Each segment's rest length and constants (segment 0's are its own at a winch), read once.
+  const SegmentSprings<Scalar> first = segment_springs(model, ws, 0),
+                               rest = segment_springs(model, ws, 1);
+  const auto springs = [&](int s) -> const SegmentSprings<Scalar>& {
+    return s == 0 ? first : rest;
+  };
+  // segment_branch with the model's clamp read once.
+  const bool clamp = !model.parameters().compressive_damping;
+  const auto branch_of = [clamp](Scalar e, Scalar r, const SegmentSprings<Scalar>& k) {
+    const bool elastic = e > Scalar(0);
+    const Scalar force = (elastic ? k.ea_l * e : Scalar(0)) + k.ba_l * r;
+    if (clamp && !(force > Scalar(0))) return Scalar(0);
+    return elastic ? Scalar(2) : Scalar(1);
+  };
   // A parted segment (TetherState::parted) has no force on any branch.
   const auto true_branch = [&](int s) {
     if (ws.is_parted(s)) return Scalar(0);
-    const SegmentSprings<Scalar> k = springs(s);
-    return segment_branch(model, ws.stretched_length(s) - k.l, ws.seg_rate(s), k.ea_l, k.ba_l);
+    const SegmentSprings<Scalar>& k = springs(s);
+    return branch_of(ws.stretched_length(s) - k.l, ws.seg_rate(s), k);
   };
   // Updates the branches from the extension and rate predicted by ws.delta; true if any changed.
   const auto update = [&]() {
@@ -514,11 +526,10 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
       const auto u = ws.direction.col(s);
       if (s >= f0 && s <= f1) w -= u.dot(ws.delta.col(s));
       if (s + 1 >= f0 && s + 1 <= f1) w += u.dot(ws.delta.col(s + 1));
-      const SegmentSprings<Scalar> k = springs(s);
-      const Scalar now = ws.is_parted(s)
-                             ? Scalar(0)
-                             : segment_branch(model, ws.stretched_length(s) - k.l + gh * w,
-                                              ws.seg_rate(s) + w, k.ea_l, k.ba_l);
+      const SegmentSprings<Scalar>& k = springs(s);
+      const Scalar now =
+          ws.is_parted(s) ? Scalar(0)
+                          : branch_of(ws.stretched_length(s) - k.l + gh * w, ws.seg_rate(s) + w, k);
       if (now != ws.seg_branch(s)) {
         changed = true;
         ws.seg_branch(s) = now;
