@@ -334,42 +334,49 @@ void factor_solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWork
     const Sym3<V> l{lxx + lxx + bb * nm.xx,         uy * ex + ey * ux + bb * nm.yx,
                     uz * ex + ez * ux + bb * nm.zx, lyy + lyy + bb * nm.yy,
                     uz * ey + ez * uy + bb * nm.zy, lzz + lzz + bb * nm.zz};
-    // P = g N, C = A P = α u (P u)ᵀ + β P; the chain's rhs goes on as A z = C rhs' and the back
-    // substitution is δ_i = z_i + Cᵀ δ_k (z = P rhs'): one 3×3 product per step on each
-    // dependency chain (the form solve_factored_block_tridiagonal repeats).
-    const Sym3<V> p{g * nm.xx, g * nm.yx, g * nm.zx, g * nm.yy, g * nm.zy, g * nm.zz};
-    const V px = g * nx, py = g * ny, pz = g * nz;
-    const V ax = al * ux, ay = al * uy, az = al * uz;
-    const V c00 = ax * px + be * p.xx, c01 = ax * py + be * p.yx, c02 = ax * pz + be * p.zx;
-    const V c10 = ay * px + be * p.yx, c11 = ay * py + be * p.yy, c12 = ay * pz + be * p.zy;
-    const V c20 = az * px + be * p.zx, c21 = az * py + be * p.zy, c22 = az * pz + be * p.zz;
+    // The coupling to the chain's next node, A − A P A = A − g L (a_s and l are done with).
     cpl = {a_s.xx - g * l.xx, a_s.yx - g * l.yx, a_s.zx - g * l.zx,
            a_s.yy - g * l.yy, a_s.zy - g * l.zy, a_s.zz - g * l.zz};
+    // P = g N, C = A P = α u (P u)ᵀ + β P; the chain's rhs goes on as A z = C rhs' and the back
+    // substitution is δ_i = z_i + Cᵀ δ_k (z = P rhs'): one 3×3 product per step on each
+    // dependency chain (the form solve_factored_block_tridiagonal repeats). z goes to δ's
+    // columns until the back substitution; P and C to `kept`, step by step (both lanes side by
+    // side), each as soon as it is formed (fewer values live at once: the loop spilled).
+    S* const out = kept + kKeptStepSize * (k + (extra ? 1 : 0));
+    const Sym3<V> p{g * nm.xx, g * nm.yx, g * nm.zx, g * nm.yy, g * nm.zy, g * nm.zz};
+    keep(out, p.xx);
+    keep(out + 2, p.yx);
+    keep(out + 4, p.zx);
+    keep(out + 6, p.yy);
+    keep(out + 8, p.zy);
+    keep(out + 10, p.zz);
     put(ws.delta, 0, i0, i1, p.xx * r0 + p.yx * r1 + p.zx * r2);
     put(ws.delta, 1, i0, i1, p.yx * r0 + p.yy * r1 + p.zy * r2);
     put(ws.delta, 2, i0, i1, p.zx * r0 + p.zy * r1 + p.zz * r2);
-    cr0 = c00 * r0 + c01 * r1 + c02 * r2;
-    cr1 = c10 * r0 + c11 * r1 + c12 * r2;
-    cr2 = c20 * r0 + c21 * r1 + c22 * r2;
-    // z goes to δ's columns until the back substitution; P and C to `kept`, step by step (both
-    // lanes side by side).
+    const V px = g * nx, py = g * ny, pz = g * nz;
     {
-      S* const out = kept + kKeptStepSize * (k + (extra ? 1 : 0));
-      keep(out, p.xx);
-      keep(out + 2, p.yx);
-      keep(out + 4, p.zx);
-      keep(out + 6, p.yy);
-      keep(out + 8, p.zy);
-      keep(out + 10, p.zz);
+      const V ax = al * ux;
+      const V c00 = ax * px + be * p.xx, c01 = ax * py + be * p.yx, c02 = ax * pz + be * p.zx;
       keep(out + 12, c00);
       keep(out + 14, c01);
       keep(out + 16, c02);
+      cr0 = c00 * r0 + c01 * r1 + c02 * r2;
+    }
+    {
+      const V ay = al * uy;
+      const V c10 = ay * px + be * p.yx, c11 = ay * py + be * p.yy, c12 = ay * pz + be * p.zy;
       keep(out + 18, c10);
       keep(out + 20, c11);
       keep(out + 22, c12);
+      cr1 = c10 * r0 + c11 * r1 + c12 * r2;
+    }
+    {
+      const V az = al * uz;
+      const V c20 = az * px + be * p.zx, c21 = az * py + be * p.zy, c22 = az * pz + be * p.zz;
       keep(out + 24, c20);
       keep(out + 26, c21);
       keep(out + 28, c22);
+      cr2 = c20 * r0 + c21 * r1 + c22 * r2;
     }
     if (k < 0) {
       // Lane 1 starts the bottom chain.
