@@ -470,14 +470,21 @@ void solve_block_tridiagonal(const TetherModel<Scalar>& model, TetherWorkspace<S
 
 /// The branch compute_forces takes for a segment of extension e = l_s − l [m] and stretch rate r
 /// [m/s] (2 taut, 1 dashpot only, 0 clamped at zero or slack without a dashpot), with the
-/// segment's EA/l_s and BA/l_s (its own for segment 0 at a winch).
+/// segment's EA/l_s and BA/l_s (its own for segment 0 at a winch); `clamp` when the axial force
+/// is clamped at zero (no `compressive_damping`).
+template <typename Scalar>
+Scalar segment_branch(bool clamp, Scalar e, Scalar r, Scalar ea_l, Scalar ba_l) {
+  const bool elastic = e > Scalar(0);
+  const Scalar force = (elastic ? ea_l * e : Scalar(0)) + ba_l * r;
+  if (clamp && !(force > Scalar(0))) return Scalar(0);
+  return elastic ? Scalar(2) : Scalar(1);
+}
+
+/// segment_branch with the model's clamp.
 template <typename Scalar>
 Scalar segment_branch(const TetherModel<Scalar>& model, Scalar e, Scalar r, Scalar ea_l,
                       Scalar ba_l) {
-  const bool elastic = e > Scalar(0);
-  const Scalar force = (elastic ? ea_l * e : Scalar(0)) + ba_l * r;
-  if (!model.parameters().compressive_damping && !(force > Scalar(0))) return Scalar(0);
-  return elastic ? Scalar(2) : Scalar(1);
+  return segment_branch(!model.parameters().compressive_damping, e, r, ea_l, ba_l);
 }
 
 /// segment_branch with the model's uniform EA/l and BA/l.
@@ -514,10 +521,7 @@ int segment_active_set(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
   // segment_branch with the model's clamp read once.
   const bool clamp = !model.parameters().compressive_damping;
   const auto branch_of = [clamp](Scalar e, Scalar r, const SegmentSprings<Scalar>& k) {
-    const bool elastic = e > Scalar(0);
-    const Scalar force = (elastic ? k.ea_l * e : Scalar(0)) + k.ba_l * r;
-    if (clamp && !(force > Scalar(0))) return Scalar(0);
-    return elastic ? Scalar(2) : Scalar(1);
+    return segment_branch(clamp, e, r, k.ea_l, k.ba_l);
   };
   // A parted segment (TetherState::parted) has no force on any branch.
   const auto true_branch = [&](int s) {
