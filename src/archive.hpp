@@ -6,7 +6,7 @@
 // (written byte by byte, never as structs):
 //
 //   magic       8 bytes  89 'K' 'E' 'L' 'P' 0D 0A 1A
-//   format      u16      archive_format (1)
+//   format      u16      archive_format (2)
 //   kind        u16      what the payload holds (ArchiveKind)
 //   writer      u8 n, n bytes   the kelp version that wrote it (informative, ASCII, n <= 64)
 //   payload     u64 p    the payload's length in bytes, then p bytes of sections:
@@ -39,8 +39,9 @@ namespace archive {
 /// The magic bytes every archive starts with (PNG's pattern: a non-ASCII byte, the name, CR LF,
 /// ^Z, so that a text-mode transfer or a truncated header shows).
 inline constexpr std::array<std::uint8_t, 8> magic = {0x89, 'K', 'E', 'L', 'P', 0x0D, 0x0A, 0x1A};
-/// The archive format this code writes and reads.
-inline constexpr std::uint16_t archive_format = 1;
+/// The archive format this code writes and reads. Format 2 added a tether's accelerations
+/// (TetherState::acceleration) after its kept Newton matrix; format 1 files are refused.
+inline constexpr std::uint16_t archive_format = 2;
 /// Bytes before the writer's version string: magic, format, kind, the string's length.
 inline constexpr std::size_t fixed_header_bytes = 8 + 2 + 2 + 1;
 /// Longest writer version string.

@@ -115,6 +115,9 @@ void check_tether(const Where& w, const kt::TetherStated& t, double time) {
   if (t.has_history())
     w.check(all_finite(t.previous_position) && all_finite(t.previous_velocity),
             "its previous positions and velocities must be finite");
+  if (t.has_acceleration)
+    w.check(t.acceleration.cols() == nodes && all_finite(t.acceleration),
+            "its accelerations must have one finite column per node");
   w.check(t.parted.size() == 0 || t.parted.size() == nodes - 1,
           "its parted flags must be empty or one per segment");
   for (Eigen::Index s = 0; s < t.parted.size(); ++s)
@@ -300,6 +303,11 @@ void write_tether(Writer& a, const kt::TetherStated& t) {
   a.i32(t.newton.backoff);
   write_or_zeros(a, t.newton.factor, std::size_t(kt::detail::newton_factor_size(int(nodes))));
   write_or_zeros(a, t.newton.branch, nodes - 1);
+  a.u8(std::uint8_t((t.has_acceleration ? 1 : 0) | (t.predict_from_acceleration ? 2 : 0)));
+  if (t.has_acceleration)
+    a.f64s(t.acceleration.data(), 3 * nodes);
+  else
+    for (std::size_t i = 0; i < 3 * nodes; ++i) a.f64(0.0);
   a.end();
 }
 
@@ -372,7 +380,8 @@ void read_tether(Reader& r, kt::TetherStated& t) {
   // The rest of the section, exactly (nodes is bounded, so this does not overflow).
   const auto n = std::size_t(nodes);
   const auto factor = std::size_t(kt::detail::newton_factor_size(int(nodes)));
-  const std::size_t expected = 4 * 3 * n * 8 + (n - 1) + 8 + 3 * 4 + factor * 8 + (n - 1) * 8;
+  const std::size_t expected =
+      4 * 3 * n * 8 + (n - 1) + 8 + 3 * 4 + factor * 8 + (n - 1) * 8 + 1 + 3 * n * 8;
   if (s.left() != expected)
     s.fail(std::to_string(nodes) + " nodes need " + std::to_string(expected) +
            " more bytes, the section has " + std::to_string(s.left()));
@@ -394,6 +403,12 @@ void read_tether(Reader& r, kt::TetherStated& t) {
   t.newton.branch.resize(Eigen::Index(n - 1));
   s.f64s(t.newton.factor.data(), factor);
   s.f64s(t.newton.branch.data(), n - 1);
+  const std::uint8_t flags = s.u8();
+  if (flags > 3) s.fail("its acceleration flags are " + std::to_string(flags) + ", not 0 to 3");
+  t.has_acceleration = (flags & 1) != 0;
+  t.predict_from_acceleration = (flags & 2) != 0;
+  t.acceleration.resize(3, Eigen::Index(n));
+  s.f64s(t.acceleration.data(), 3 * n);
   s.end();
 }
 

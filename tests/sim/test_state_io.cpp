@@ -238,17 +238,22 @@ TEST_CASE("a pair's state saved and loaded steps on bit for bit (BDF2, winch, th
   CHECK(same_bytes(sim::save_state(s), sim::save_state(loaded)));
 }
 
-TEST_CASE("the integrator history and the kept Newton matrix change the next steps' bits",
-          "[sim][state_io]") {
+TEST_CASE(
+    "the integrator history, the accelerations and the kept Newton matrix change the next "
+    "steps' bits",
+    "[sim][state_io]") {
   // What the test above relies on: without them a loaded state would step differently.
   Pair a;
   const ks::SystemStated s = stepped_pair(a);
   const std::string bytes = sim::save_state(s);
-  for (int variant = 0; variant < 2; ++variant) {
+  REQUIRE(s.tether.has_acceleration);
+  for (int variant = 0; variant < 4; ++variant) {
     Pair b;
     ks::SystemStated x = sim::load_state(bytes, b.model), y = x;
     if (variant == 0) y.tether.newton.clear();
     if (variant == 1) y.tether.clear_history();
+    if (variant == 2) y.tether.has_acceleration = false;
+    if (variant == 3) y.tether.predict_from_acceleration = !y.tether.predict_from_acceleration;
     const auto in = b.inputs(0.5);
     for (ks::SystemStated* z : {&x, &y}) {
       ks::fit_workspace(b.model, b.ws, *z);
@@ -385,8 +390,11 @@ TEST_CASE("a state file of another magic, format, kind or system is refused, nam
   CHECK_THAT(load_error("{\"not\": \"a state\"}", p.model),
              Catch::Contains("not a kelp state file"));
   std::string b = bytes;
-  put_u(b, 8, 2, 2);
-  CHECK_THAT(load_error(resealed(b), p.model), Catch::Contains("archive format 2"));
+  put_u(b, 8, 1, 2);  // format 1: before the tethers' accelerations were saved
+  CHECK_THAT(load_error(resealed(b), p.model),
+             Catch::Contains("archive format 1, this kelp reads format 2 only"));
+  put_u(b, 8, 3, 2);
+  CHECK_THAT(load_error(resealed(b), p.model), Catch::Contains("archive format 3"));
   // A fleet's file for a pair, and the other way round.
   Fleet f;
   const std::string fleet_bytes = sim::save_state(f.start());

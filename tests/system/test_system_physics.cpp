@@ -605,6 +605,7 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
   ks::SystemInputsd in;
   double tension_max = 0, f_end_max = 0, residual_max = 0, depth_min = 1e9, depth_max = -1e9;
   double span_max = 0, boat_peak_time = 0, boat_peak_force = 0, boat_peak_height = 0;
+  double boat_pull_max = 0;  // the largest force the tether put on the boat [N]
   int unconverged = 0, nonfinite = 0;
   ks::SolverStatsd solver;
   bool threw = false;
@@ -641,6 +642,7 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
       track(rov, model.auv(), s.auv, 0.0);
       tension_max = std::max(tension_max, workspace.tether.tension.maxCoeff());
       f_end_max = std::max({f_end_max, r.force_on_asv.norm(), r.force_on_auv.norm()});
+      boat_pull_max = std::max(boat_pull_max, r.force_on_asv.norm());
       depth_min = std::min(depth_min, s.auv.position.z());
       depth_max = std::max(depth_max, s.auv.position.z());
       span_max = std::max(
@@ -687,8 +689,16 @@ TEST_CASE("long run: two hours in the paper's rough sea stay finite, converged a
   CHECK(boat.kinetic < boat.kinetic_bound);
   CHECK(rov.kinetic < rov.kinetic_bound);
   CHECK(rov.through_water < through_water_max);
-  // An unpowered boat does not move through the water faster than its engines could drive it.
-  CHECK(boat.through_water < through_water_max);
+  // The unpowered boat is driven through the water by the tether and the waves only: not faster
+  // than where its surge drag d_l u + d_q u² balances the largest pull the tether put on it, nor
+  // than its top speed at full thrust where that pull stays below its thrust. (A bound of 3 m/s
+  // alone was met by chance: with the Newton tolerance 0.1 % tighter or looser, this run reached
+  // 3.10 and 3.14 m/s with 150 N of pull, 2026-12-01, which balances 3.86 m/s.)
+  const double d_l = bp.damping.linear(0, 0), d_q = bp.damping.quadratic(0);
+  const double pulled = (-d_l + std::sqrt(d_l * d_l + 4 * d_q * boat_pull_max)) / (2 * d_q);
+  INFO("the boat's surge drag balances the tether's largest pull on it, "
+       << boat_pull_max << " N, at " << pulled << " m/s");
+  CHECK(boat.through_water < std::max(through_water_max, pulled));
   CHECK(tension_max < breaking);
   CHECK(f_end_max < breaking);
 }

@@ -32,6 +32,7 @@ bool same_state(const kt::TetherStated& a, const kt::TetherStated& b) {
   return same_bits(a.position, b.position) && same_bits(a.velocity, b.velocity) &&
          same_bits(a.previous_position, b.previous_position) &&
          same_bits(a.previous_velocity, b.previous_velocity) &&
+         same_bits(a.acceleration, b.acceleration) && a.has_acceleration == b.has_acceleration &&
          std::memcmp(&a.time, &b.time, sizeof a.time) == 0 &&
          std::memcmp(&a.time_carry, &b.time_carry, sizeof a.time_carry) == 0 &&
          std::memcmp(&a.previous_dt, &b.previous_dt, sizeof a.previous_dt) == 0;
@@ -273,13 +274,15 @@ TEST_CASE("Tether steps refuse bad input and leave the state unchanged", "[tethe
     (void)kt::step(line.model, line.ws, line.water, wrong, line.boundary, 0.01,
                    {kt::Integrator::rk4});
   });
-  for (int k = 0; k < 5; ++k) {
+  REQUIRE(state.has_acceleration);  // the accelerations of the step Line took
+  for (int k = 0; k < 6; ++k) {
     kt::TetherStated s = state;
     if (k == 0) s.position(0, 3) = nan_;
     if (k == 1) s.velocity(2, 5) = -inf_;
     if (k == 2) s.time = nan_;
     if (k == 3) s.previous_position(1, 1) = nan_;
     if (k == 4) s.previous_dt = -1;
+    if (k == 5) s.acceleration(2, 4) = nan_;
     for (const kt::Integrator integrator : all)
       require_refused("non-finite state", s, [&] {
         (void)kt::step(line.model, line.ws, line.water, s, line.boundary, 0.01, {integrator});
@@ -600,4 +603,33 @@ TEST_CASE("Workspace resize refuses node counts no tether has, naming the count"
   kt::TetherWorkspaced two;
   two.resize(2);
   CHECK(two.fits(2));
+}
+
+TEST_CASE("A tether state's accelerations are refused, by name, where the steps use them",
+          "[tether][bad_input]") {
+  Line line;
+  REQUIRE(line.state.has_acceleration);
+  kt::TetherStated s = line.state;
+  s.acceleration(1, 3) = nan_;
+  REQUIRE_THROWS_WITH(kt::check_state(line.model, s), Catch::Contains("state.acceleration"));
+  for (const kt::Integrator integrator : {kt::Integrator::bdf2, kt::Integrator::rk4}) {
+    kt::TetherStated t = s;
+    INFO("integrator " << int(integrator));
+    REQUIRE_THROWS_WITH(
+        kt::step(line.model, line.ws, line.water, t, line.boundary, 0.01, {integrator}),
+        Catch::Contains("state.acceleration"));
+    REQUIRE(same_state(s, t));
+  }
+  // Not kept: not read, and the step leaves its own.
+  s.has_acceleration = false;
+  kt::check_state(line.model, s);
+  (void)kt::step(line.model, line.ws, line.water, s, line.boundary, 0.01, {kt::Integrator::bdf2});
+  CHECK(s.has_acceleration);
+  CHECK(s.acceleration.allFinite());
+  // An explicit step drops them; clear_history() too.
+  (void)kt::step(line.model, line.ws, line.water, s, line.boundary, 0.001, {kt::Integrator::rk4});
+  CHECK_FALSE(s.has_acceleration);
+  s = line.state;
+  s.clear_history();
+  CHECK_FALSE(s.has_acceleration);
 }

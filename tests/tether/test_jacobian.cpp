@@ -531,9 +531,11 @@ TEST_CASE("BDF2 with the whole Jacobian: the same steps in fewer Newton iteratio
   CHECK((sym.state.position - whole.state.position).cwiseAbs().maxCoeff() < 1e-5);
   CHECK((sym.ws.end_forces.on_end - whole.ws.end_forces.on_end).norm() <
         1e-4 * (1.0 + sym.ws.end_forces.on_end.norm()));
-  // Measured: 1.76 and 1.005 Newton iterations per step over 120 s.
+  // Measured over these 10 s: 1.21 and 1.03 Newton iterations per step (1.84 and 1.04 before
+  // BDF2 predicted from the accelerations, TetherState::acceleration: a closer start saves the
+  // symmetric matrix more corrections than the whole one, which converges quadratically).
   INFO("Newton iterations: symmetric " << ns << ", whole " << nw);
-  CHECK(nw < 0.75 * ns);
+  CHECK(nw < 0.9 * ns);
 }
 
 TEST_CASE("BDF2 with the whole Jacobian: Newton converges quadratically",

@@ -83,14 +83,15 @@ Scalar segment_axial_force(const TetherModel<Scalar>& model, const TetherState<S
 
 /// \brief Parts the line at its most loaded segment when that segment's axial force
 /// (segment_axial_force) exceeds the breaking strength: sets its flag in `state.parted` (sizing
-/// the flags for an intact state that has none), drops the kept Newton matrix, and describes the
-/// event in `event`. Does nothing when the line cannot part (TetherModel::can_part) or no segment
-/// is over the strength. O(N), no heap allocation (unless `state.parted` is empty).
+/// the flags for an intact state that has none), drops the kept Newton matrix and the
+/// accelerations (TetherState::has_acceleration), and describes the event in `event`. Does
+/// nothing when the line cannot part (TetherModel::can_part) or no segment is over the strength.
+/// O(N), no heap allocation (unless `state.parted` is empty).
 /// \returns true when the line parted.
 /// \tparam Scalar double or float.
 /// \param model the tether (its breaking strength).
 /// \param[in,out] state the committed state: a flag is set in `parted`, the kept Newton matrix
-/// cleared, when the line parts.
+/// and the accelerations cleared, when the line parts.
 /// \param[out] event set only when the line parts: time [s], segment, axial force [N] and
 /// midpoint (NED [m]).
 template <typename Scalar>
@@ -112,6 +113,7 @@ bool part_if_overloaded(const TetherModel<Scalar>& model, TetherState<Scalar>& s
   if (state.parted.size() != n) state.parted.setZero(n);
   state.parted(worst) = 1;
   state.newton.clear();
+  state.has_acceleration = false;  // forces of the intact line
   event.time = state.time;
   event.segment = worst;
   event.tension = worst_t;

@@ -72,21 +72,23 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
 }
 
 /// The implicit step's predictor over the flat 3 × (N+1) arrays from index j on, in packets of P
-/// (every argument by value: no reloads after the stores); returns where it stopped. mode 2:
-/// BDF2 (x̂ = (4x_n − x_{n−1})/3, v̂ likewise, v = 2v_n − v_{n−1}); 1: backward Euler with the
-/// velocity extrapolated; 0: backward Euler from v_n. x = x̂ + γh v in every mode.
+/// (every argument by value: no reloads after the stores); returns where it stopped. mode 3:
+/// BDF2 (x̂ = (4x_n − x_{n−1})/3, v̂ likewise) from the accelerations a_n,
+/// v = v_{n−1} + 2h a_n (`two_h` = 2h); 2: BDF2 with v = 2v_n − v_{n−1}; 1: backward Euler with
+/// the velocity extrapolated; 0: backward Euler from v_n. x = x̂ + γh v in every mode.
 template <typename P, typename Scalar>
 Eigen::Index predict_pass(Eigen::Index j, Eigen::Index len, int mode, Scalar four_thirds,
-                          Scalar third, Scalar gh, const Scalar* xn, const Scalar* vn,
-                          const Scalar* xp, const Scalar* vp, Scalar* x0, Scalar* v0, Scalar* x1,
-                          Scalar* v1) {
-  const P c43 = P::all(four_thirds), c13 = P::all(third), two = P::all(Scalar(2)), g = P::all(gh);
+                          Scalar third, Scalar gh, Scalar two_h, const Scalar* xn, const Scalar* vn,
+                          const Scalar* xp, const Scalar* vp, const Scalar* an, Scalar* x0,
+                          Scalar* v0, Scalar* x1, Scalar* v1) {
+  const P c43 = P::all(four_thirds), c13 = P::all(third), two = P::all(Scalar(2)), g = P::all(gh),
+          h2 = P::all(two_h);
   for (; j + P::lanes <= len; j += P::lanes) {
     const P xnj = P::load(xn + j), vnj = P::load(vn + j);
-    if (mode == 2) {
+    if (mode >= 2) {
       const P vpj = P::load(vp + j);
       const P xh = c43 * xnj - c13 * P::load(xp + j);
-      const P vg = two * vnj - vpj;
+      const P vg = mode == 3 ? vpj + h2 * P::load(an + j) : two * vnj - vpj;
       xh.store(x0 + j);
       (c43 * vnj - c13 * vpj).store(v0 + j);
       vg.store(v1 + j);
@@ -97,6 +99,28 @@ Eigen::Index predict_pass(Eigen::Index j, Eigen::Index len, int mode, Scalar fou
       vnj.store(v0 + j);
       vg.store(v1 + j);
       (xnj + g * vg).store(x1 + j);
+    }
+  }
+  return j;
+}
+
+/// After a converged BDF2 step, over the flat 3 × (N+1) arrays from index j to len in packets of
+/// P: the new accelerations a = (v − v̂)·`inv_gh` into `a_new`, and, when `compare`, the squared
+/// distances of the solution v from the step's two predictors, 2v_n − v_{n−1} into `lin` and
+/// v_{n−1} + `two_h`·a_n into `leap` (lane-wise partial sums); returns where it stopped.
+template <typename P, typename Scalar>
+Eigen::Index acceleration_pass(Eigen::Index j, Eigen::Index len, bool compare, Scalar inv_gh,
+                               Scalar two_h, const Scalar* vn, const Scalar* vp, const Scalar* an,
+                               const Scalar* v0, const Scalar* v, Scalar* a_new, P& lin, P& leap) {
+  const P g = P::all(inv_gh), h2 = P::all(two_h), two = P::all(Scalar(2));
+  for (; j + P::lanes <= len; j += P::lanes) {
+    const P vj = P::load(v + j);
+    ((vj - P::load(v0 + j)) * g).store(a_new + j);
+    if (compare) {
+      const P vpj = P::load(vp + j);
+      const P dl = vj - (two * P::load(vn + j) - vpj), da = vj - (vpj + h2 * P::load(an + j));
+      lin += dl * dl;
+      leap += da * da;
     }
   }
   return j;
@@ -127,23 +151,32 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   const Scalar gamma = use_bdf2 ? Scalar(2) / Scalar(3) : Scalar(1);
   const Scalar gh = gamma * Scalar(dt);
   const Scalar tolerance = options.acceleration_tolerance * Scalar(dt);
-  // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or the BDF2 extrapolation).
+  // x̂ (ws.x0) and v̂ (ws.v0); initial guess v1 = v_n (or an extrapolation).
   // One vectorised pass over the flat 3 × (N+1) arrays for the history, the predictor and its
-  // positions. Predictor: linear extrapolation of the velocity when the last step had the same
-  // dt.
+  // positions. Predictor, when the last step had the same dt: BDF2, v_{n−1} + 2h a_n from the
+  // accelerations the last implicit step left (TetherState::acceleration; the leapfrog formula,
+  // exact for a velocity quadratic in time: error O(h³)), else the linear extrapolation
+  // 2v_n − v_{n−1} (error O(h²); what the leapfrog gives after a backward Euler step, whose
+  // a_n = (v_n − v_{n−1})/h), whichever came closer to the last BDF2 step's solution
+  // (TetherState::predict_from_acceleration; the accelerations' overshoots where stiff modes
+  // ring, ωh ≳ 1). A kept Newton matrix then serves many more steps (its first correction
+  // starts closer: on the benchmark line at N = 100, 28 steps per matrix instead of 3).
   const int cols = model.nodes();
   {
     // One pass (predict_pass), its constants and pointers passed by value.
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
     const Eigen::Index len = 3 * Eigen::Index(cols);
-    const int mode = use_bdf2 ? 2 : (history ? 1 : 0);
+    const int mode = use_bdf2 ? (state.has_acceleration && state.predict_from_acceleration ? 3 : 2)
+                              : (history ? 1 : 0);
+    const Scalar two_h = Scalar(2 * dt);
     const Scalar *xn = state.position.data(), *vn = state.velocity.data();
     const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
+    const Scalar* an = state.acceleration.data();
     Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
     const Eigen::Index j = predict_pass<simd::Pack<Scalar, true>>(
-        0, len, mode, four_thirds, third, gh, xn, vn, xp, vp, x0, v0, x1, v1);
-    predict_pass<simd::Pack<Scalar, false>>(j, len, mode, four_thirds, third, gh, xn, vn, xp, vp,
-                                            x0, v0, x1, v1);
+        0, len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0, x1, v1);
+    predict_pass<simd::Pack<Scalar, false>>(j, len, mode, four_thirds, third, gh, two_h, xn, vn, xp,
+                                            vp, an, x0, v0, x1, v1);
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton
@@ -197,7 +230,39 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     } else if (first_reused) {
       backoff = 0;
     }
+    // The accelerations at the new state, (v − v̂)/(γh), into ws.xs (scratch now: the trial
+    // iterates are done), handed to the state after the commit; and, after a BDF2 step that had
+    // both predictors and was not made by one correction with the kept matrix (the predictor
+    // served: nothing to choose), which of them came closer to its solution on the free nodes:
+    // the next steps start from that one (TetherState::predict_from_acceleration).
+    const bool served = first_reused && first_residual <= options.refresh_residual * tolerance;
+    const bool compare = use_bdf2 && state.has_acceleration && !served;
+    bool from_acceleration = state.predict_from_acceleration;
+    {
+      using PW = simd::Pack<Scalar, true>;
+      using P1 = simd::Pack<Scalar, false>;
+      PW lin_w = PW::all(Scalar(0)), leap_w = lin_w;
+      P1 lin_1 = P1::all(Scalar(0)), leap_1 = lin_1;
+      const Scalar inv_gh = Scalar(1) / gh, two_h = Scalar(2 * dt);
+      const Scalar *vn = state.velocity.data(), *vp = state.previous_velocity.data();
+      const Scalar *an = state.acceleration.data(), *v0 = ws.v0.data(), *v = ws.v1.data();
+      Scalar* a_new = ws.xs.data();
+      const Eigen::Index free0 = 3 * Eigen::Index(f0), free1 = 3 * Eigen::Index(f1 + 1);
+      // The kinematic ends (at most one column each side) without the comparison.
+      acceleration_pass<P1>(0, free0, false, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1,
+                            leap_1);
+      const Eigen::Index j = acceleration_pass<PW>(free0, free1, compare, inv_gh, two_h, vn, vp, an,
+                                                   v0, v, a_new, lin_w, leap_w);
+      acceleration_pass<P1>(j, free1, compare, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1,
+                            leap_1);
+      acceleration_pass<P1>(free1, 3 * Eigen::Index(cols), false, inv_gh, two_h, vn, vp, an, v0, v,
+                            a_new, lin_1, leap_1);
+      if (compare) from_acceleration = leap_w.sum() + leap_1.sum() < lin_w.sum() + lin_1.sum();
+    }
     commit(state, ws.x1, ws.v1, dt, "step_implicit");  // drops the kept matrix
+    state.acceleration.swap(ws.xs);
+    state.has_acceleration = true;
+    state.predict_from_acceleration = from_acceleration;
     if (simplified) {
       state.newton.pause = pause;
       state.newton.backoff = backoff;
@@ -532,7 +597,10 @@ bool implicit_halves(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// 1, 3, 7, … 31 steps form their own (a fast-moving line). A step that fails with a reused matrix
 /// is attempted again with a fresh matrix at every iteration (Newton's method) before it is split.
 /// Both methods stop on the same residual test, so their results agree to the tolerance. The
-/// initial guess extrapolates the velocity (2v_n − v_{n−1}) when the previous step had the same dt.
+/// initial guess extrapolates the velocity when the previous step had the same dt: BDF2 from the
+/// accelerations the last implicit step left (TetherState::acceleration), v_{n−1} + 2h a_n, or
+/// linearly, 2v_n − v_{n−1}, whichever came closer to the last BDF2 step's solution
+/// (TetherState::predict_from_acceleration); backward Euler linearly.
 /// At least one and up to `options.max_iterations` corrections, until max_i |R_i|/a_i ≤
 /// acceleration_tolerance · dt (the tolerance raised to the arithmetic's resolution where it is
 /// below it, see ImplicitOptions::acceleration_tolerance). A step that does not converge is not

@@ -84,8 +84,8 @@ struct KeptNewtonMatrix {
 
 /// \brief Everything that determines the tether's next step: positions and velocities of all
 /// N + 1 nodes (NED), the clock, and the integrator history (BDF2's previous step, also the
-/// implicit schemes' velocity predictor, and the Newton matrix the simplified Newton method
-/// keeps).
+/// implicit schemes' velocity predictor, with the accelerations the last implicit step left, and
+/// the Newton matrix the simplified Newton method keeps).
 ///
 /// Saving a copy of a state and restoring it later reproduces the following steps bit for bit;
 /// the workspace holds scratch only. The clock is a double for every Scalar, so a float tether
@@ -113,6 +113,18 @@ struct TetherState {
   double previous_dt = 0.0;
   /// The implicit steps' kept Newton matrix (see KeptNewtonMatrix; ImplicitOptions::newton).
   KeptNewtonMatrix<Scalar> newton;
+  /// Node accelerations at `time`, 3 × (N+1), NED [m/s²] (valid when has_acceleration): those of
+  /// the implicit step that led to this state, (v − v̂)/(γh) at its converged iterate, that is
+  /// M⁻¹F there to the step's tolerance (kinematic ends: the difference of their prescribed
+  /// velocities). The next BDF2 step's velocity predictor v_{n−1} + 2h·a_n (step_bdf2).
+  Matrix3X<Scalar> acceleration;
+  /// True when `acceleration` is this state's: set by the implicit steps, cleared by every
+  /// other step, clear_history(), a parting (kelp/tether/failure.hpp) and a winch re-mesh.
+  bool has_acceleration = false;
+  /// Which extrapolation the next BDF2 step starts its Newton iteration from: true, the
+  /// accelerations' v_{n−1} + 2h·a_n; false, the linear 2v_n − v_{n−1}. Each BDF2 step that had
+  /// both sets it to the one that came closer to its own solution (step_bdf2).
+  bool predict_from_acceleration = true;
   /// Per segment: 1 when the line has parted there (TetherParameters::breaking_strength, see
   /// kelp/tether/failure.hpp), else 0. A parted segment carries no axial force and no bending;
   /// its two nodes become the free ends of the two pieces. Empty or all zero: an intact line
@@ -139,6 +151,7 @@ struct TetherState {
         velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
         previous_position(Matrix3X<Scalar>::Zero(3, model.nodes())),
         previous_velocity(Matrix3X<Scalar>::Zero(3, model.nodes())),
+        acceleration(Matrix3X<Scalar>::Zero(3, model.nodes())),
         parted(SegmentFlags::Zero(model.segments())) {
     newton.resize(model.nodes());
   }
@@ -151,11 +164,13 @@ struct TetherState {
   /// \return whether previous_dt > 0.
   bool has_history() const { return previous_dt > 0.0; }
   /// \brief Forgets the integrator history: the next implicit step starts with backward Euler.
-  /// Call it after editing `position` or `velocity` by hand. The kept Newton matrix is dropped
-  /// too.
+  /// Call it after editing `position` or `velocity` by hand. The kept Newton matrix and the
+  /// accelerations are dropped too.
   void clear_history() {
     previous_dt = 0.0;
     newton.clear();
+    has_acceleration = false;
+    predict_from_acceleration = true;
   }
 };
 
@@ -256,11 +271,13 @@ inline void check_node_count(int nodes, const char* who) {
 /// \tparam Scalar double or float.
 template <typename Scalar>
 struct StateBackup {
-  /// \brief Saved TetherState::position, velocity, previous_position, previous_velocity
-  /// (3 × (N+1), NED [m], [m/s]).
+  /// \brief Saved TetherState::position, velocity, previous_position, previous_velocity,
+  /// acceleration (3 × (N+1), NED [m], [m/s], [m/s²]).
   ///@{
-  Matrix3X<Scalar> position, velocity, previous_position, previous_velocity;
+  Matrix3X<Scalar> position, velocity, previous_position, previous_velocity, acceleration;
   ///@}
+  bool has_acceleration = false;          ///< saved TetherState::has_acceleration
+  bool predict_from_acceleration = true;  ///< saved TetherState::predict_from_acceleration
   /// \brief Saved TetherState::time, time_carry, previous_dt [s].
   ///@{
   double time = 0.0, time_carry = 0.0, previous_dt = 0.0;
@@ -277,7 +294,8 @@ struct StateBackup {
   /// \throws kelp::invalid_argument naming `nodes` unless it is in [2, limits::max_segments + 1].
   void resize(int nodes) {
     detail::check_node_count(nodes, "StateBackup::resize");
-    for (Matrix3X<Scalar>* m : {&position, &velocity, &previous_position, &previous_velocity})
+    for (Matrix3X<Scalar>* m :
+         {&position, &velocity, &previous_position, &previous_velocity, &acceleration})
       m->setZero(3, nodes);
     newton.resize(nodes);
     parted.setZero(nodes - 1);
@@ -289,6 +307,9 @@ struct StateBackup {
     velocity = s.velocity;
     previous_position = s.previous_position;
     previous_velocity = s.previous_velocity;
+    acceleration = s.acceleration;
+    has_acceleration = s.has_acceleration;
+    predict_from_acceleration = s.predict_from_acceleration;
     time = s.time;
     time_carry = s.time_carry;
     previous_dt = s.previous_dt;
@@ -309,6 +330,9 @@ struct StateBackup {
     s.velocity = velocity;
     s.previous_position = previous_position;
     s.previous_velocity = previous_velocity;
+    s.acceleration = acceleration;
+    s.has_acceleration = has_acceleration;
+    s.predict_from_acceleration = predict_from_acceleration;
     s.time = time;
     s.time_carry = time_carry;
     s.previous_dt = previous_dt;
@@ -713,8 +737,8 @@ void apply_boundary(const TetherModel<Scalar>& model, const TetherBoundary<Scala
 /// \brief Checks that a state fits the model and is finite (its history too, when it has one).
 /// \throws kelp::invalid_argument naming `state.position` / `state.velocity` / `state.time` /
 /// `state.winch_length` / `state.payout_rate` / `state.previous_position` /
-/// `state.previous_velocity` / `state.previous_dt` (or the sizes: segments + 1 columns,
-/// `state.parted` empty or one flag per segment).
+/// `state.previous_velocity` / `state.previous_dt` / `state.acceleration` (or the sizes:
+/// segments + 1 columns, `state.parted` empty or one flag per segment).
 /// \tparam Scalar double or float.
 /// \param model the tether the state must fit.
 /// \param state the state checked (its winch fields, TetherState::winch_length and payout_rate,
@@ -739,6 +763,11 @@ void check_state(const TetherModel<Scalar>& model, const TetherState<Scalar>& st
                "columns when state.previous_dt > 0");
     check_all_finite(state.previous_position, "state.previous_position");
     check_all_finite(state.previous_velocity, "state.previous_velocity");
+  }
+  if (state.has_acceleration) {
+    KELP_CHECK(state.acceleration.cols() == model.nodes(),
+               "state.acceleration must have segments + 1 columns when state.has_acceleration");
+    check_all_finite(state.acceleration, "state.acceleration");
   }
 }
 

@@ -292,6 +292,7 @@ void commit(TetherState<Scalar>& state, Matrix3X<Scalar>& x, Matrix3X<Scalar>& v
   state.velocity.swap(v);
   state.previous_dt = dt;
   state.newton.clear();
+  state.has_acceleration = false;  // an implicit step sets its own after this
   // Kahan summation of the clock (TetherState::time_carry).
   const double step = dt + state.time_carry;
   const double next = state.time + step;
@@ -351,11 +352,17 @@ void check_step_inputs(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
   check_boundary(b);
   const bool history_fits = state.previous_position.cols() == model.nodes() &&
                             state.previous_velocity.cols() == model.nodes();
+  const bool acceleration_fits = state.acceleration.cols() == model.nodes();
+  // The accelerations count where a step can use them: with the history they extrapolate.
+  const bool acceleration_used =
+      acceleration_fits && state.has_acceleration && history_fits && state.has_history();
   // One pass over the state; the named checks run only to build the message.
   if (!(all_finite_fast(state.position, state.velocity) && std::isfinite(state.time) &&
         state.previous_dt >= 0.0 &&
         (!history_fits || !state.has_history() ||
-         all_finite_fast(state.previous_position, state.previous_velocity)))) {
+         all_finite_fast(state.previous_position, state.previous_velocity)) &&
+        (!acceleration_used || std::isfinite(value_of(flat_sum(state.acceleration.data(),
+                                                               state.acceleration.size())))))) {
     check_all_finite(state.position, "state.position");
     check_all_finite(state.velocity, "state.velocity");
     check_finite(state.time, "state.time");
@@ -364,12 +371,17 @@ void check_step_inputs(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
       check_all_finite(state.previous_position, "state.previous_position");
       check_all_finite(state.previous_velocity, "state.previous_velocity");
     }
+    if (acceleration_used) check_all_finite(state.acceleration, "state.acceleration");
     ::kelp::detail::throw_invalid_argument("state: the sum of its coordinates overflows");
   }
   if (!history_fits) {
     state.previous_position.setZero(3, model.nodes());
     state.previous_velocity.setZero(3, model.nodes());
     state.previous_dt = 0.0;
+  }
+  if (!acceleration_fits) {
+    state.acceleration.setZero(3, model.nodes());
+    state.has_acceleration = false;
   }
   KELP_CHECK(state.parted.size() == 0 || state.parted.size() == model.segments(),
              "state.parted must be empty or have one flag per segment");

@@ -171,8 +171,9 @@ Vector3<Scalar> line_momentum(const TetherModel<Scalar>& model, const TetherStat
 /// \param from the model of N segments that fits `in`.
 /// \param in the state before (its winch_length, or l when 0, must exceed l).
 /// \param[out] out the state after, already sized for N + 1 segments (N + 2 columns): positions,
-/// velocities, clock, winch fields and parted flags are written, the history and the kept Newton
-/// matrix cleared (previous_position and previous_velocity keep their old content).
+/// velocities, clock, winch fields and parted flags are written, the history, the kept Newton
+/// matrix and the accelerations cleared (previous_position, previous_velocity and acceleration
+/// keep their old content).
 /// \param[in,out] report counts the insertion and adds the kinetic energy lost [J].
 /// \throws kelp::invalid_argument when `out` has the wrong size or segment 0 is not longer
 /// than l (nothing written then).
@@ -212,6 +213,7 @@ void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
   out.winch_length = lw - l;
   out.previous_dt = 0.0;
   out.newton.clear();
+  out.has_acceleration = false;
   // The parted flags (TetherState::parted) follow their segments: old segment 0 is new segments
   // 0 and 1, and a parting in it stays on the winch's side (new segment 0).
   out.parted.setZero(n + 1);
@@ -277,6 +279,7 @@ void remove_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
   out.winch_length = lw + l;
   out.previous_dt = 0.0;
   out.newton.clear();
+  out.has_acceleration = false;
   // The parted flags follow their segments: old segments 0 and 1 are new segment 0.
   out.parted.setZero(n - 1);
   if (in.parted.size() == n) {
