@@ -122,8 +122,9 @@ struct TetherState {
   /// other step, clear_history(), a parting (kelp/tether/failure.hpp) and a winch re-mesh.
   bool has_acceleration = false;
   /// Which extrapolation the next BDF2 step starts its Newton iteration from: true, the
-  /// accelerations' v_{n−1} + 2h·a_n; false, the linear 2v_n − v_{n−1}. Each BDF2 step that had
-  /// both sets it to the one that came closer to its own solution (step_bdf2).
+  /// accelerations' v_{n−1} + 2h·a_n; false, the linear 2v_n − v_{n−1}. A BDF2 step that had
+  /// both and was not made by one correction with the kept Newton matrix sets it to the one that
+  /// came closer to its own solution (step_bdf2).
   bool predict_from_acceleration = true;
   /// Per segment: 1 when the line has parted there (TetherParameters::breaking_strength, see
   /// kelp/tether/failure.hpp), else 0. A parted segment carries no axial force and no bending;
