@@ -308,7 +308,8 @@ TEST_CASE("the force passes' AVX2 build gives the baseline build's bits",
       }
   CHECK(compared > 60);
 
-  // Whole steps: RK4 (the passes' accelerations) and BDF2 (forces and Jacobian terms) on a line
+  // Whole steps: RK4 (the passes' accelerations) and BDF2 (forces, Jacobian terms, the
+  // predictor and the accelerations after each step) on a line
   // swinging through the surface band from a boundary in air.
   auto p = kelp_test::benchmark_line<double>(37);
   p.internal_damping = 30.0;
@@ -334,6 +335,11 @@ TEST_CASE("the force passes' AVX2 build gives the baseline build's bits",
   const kt::TetherStated i_base = run_steps(model, s0, false, 100, bdf2);
   CHECK(same_bits(i_wide.position, i_base.position));
   CHECK(same_bits(i_wide.velocity, i_base.velocity));
+  // The implicit steps' own passes (kelp/tether/step_pass_body.hpp: predictor, accelerations)
+  // take AVX2 with the force passes: the accelerations the predictor reads agree too.
+  REQUIRE(i_wide.has_acceleration);
+  CHECK(same_bits(i_wide.acceleration, i_base.acceleration));
+  CHECK(i_wide.predict_from_acceleration == i_base.predict_from_acceleration);
   CHECK_FALSE(same_bits(i_wide.position, s0.position));
 #else
   WARN("this build does not dispatch at run time: one build of the force passes only");

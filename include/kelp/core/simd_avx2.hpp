@@ -71,6 +71,9 @@ struct Pack4d {
     r -= b.r;
     return *this;
   }
+  /// The lanes' sum, (r0 + r1) + (r2 + r3) (the implicit steps' finiteness sum,
+  /// kelp/tether/step_pass_body.hpp).
+  double sum() const { return (r[0] + r[1]) + (r[2] + r[3]); }
 };
 
 // Free functions, not friends defined in the class: GCC does not give those the region's target.

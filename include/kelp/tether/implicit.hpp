@@ -71,59 +71,38 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
   return true;
 }
 
-/// The implicit step's predictor over the flat 3 × (N+1) arrays from index j on, in packets of P
-/// (every argument by value: no reloads after the stores); returns where it stopped. mode 3:
-/// BDF2 (x̂ = (4x_n − x_{n−1})/3, v̂ likewise) from the accelerations a_n,
-/// v = v_{n−1} + 2h a_n (`two_h` = 2h); 2: BDF2 with v = 2v_n − v_{n−1}; 1: backward Euler with
-/// the velocity extrapolated; 0: backward Euler from v_n. x = x̂ + γh v in every mode.
-template <typename P, typename Scalar>
-Eigen::Index predict_pass(Eigen::Index j, Eigen::Index len, int mode, Scalar four_thirds,
-                          Scalar third, Scalar gh, Scalar two_h, const Scalar* xn, const Scalar* vn,
-                          const Scalar* xp, const Scalar* vp, const Scalar* an, Scalar* x0,
-                          Scalar* v0, Scalar* x1, Scalar* v1) {
-  const P c43 = P::all(four_thirds), c13 = P::all(third), two = P::all(Scalar(2)), g = P::all(gh),
-          h2 = P::all(two_h);
-  for (; j + P::lanes <= len; j += P::lanes) {
-    const P xnj = P::load(xn + j), vnj = P::load(vn + j);
-    if (mode >= 2) {
-      const P vpj = P::load(vp + j);
-      const P xh = c43 * xnj - c13 * P::load(xp + j);
-      const P vg = mode == 3 ? vpj + h2 * P::load(an + j) : two * vnj - vpj;
-      xh.store(x0 + j);
-      (c43 * vnj - c13 * vpj).store(v0 + j);
-      vg.store(v1 + j);
-      (xh + g * vg).store(x1 + j);
-    } else {
-      const P vg = mode == 1 ? two * vnj - P::load(vp + j) : vnj;
-      xnj.store(x0 + j);
-      vnj.store(v0 + j);
-      vg.store(v1 + j);
-      (xnj + g * vg).store(x1 + j);
-    }
-  }
-  return j;
+/// step_pass_body.hpp's predict_all on AVX2 where the force passes take it (the same bits).
+template <typename Scalar>
+void predict_all(Eigen::Index len, int mode, Scalar four_thirds, Scalar third, Scalar gh,
+                 Scalar two_h, const Scalar* xn, const Scalar* vn, const Scalar* xp,
+                 const Scalar* vp, const Scalar* an, Scalar* x0, Scalar* v0, Scalar* x1,
+                 Scalar* v1) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (force_passes_take_avx2())
+      return step_avx2::predict_all(len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an,
+                                    x0, v0, x1, v1);
+#endif
+  step_baseline::predict_all(len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0,
+                             x1, v1);
 }
 
-/// After a converged BDF2 step, over the flat 3 × (N+1) arrays from index j to len in packets of
-/// P: the new accelerations a = (v − v̂)·`inv_gh` into `a_new`, and, when `compare`, the squared
-/// distances of the solution v from the step's two predictors, 2v_n − v_{n−1} into `lin` and
-/// v_{n−1} + `two_h`·a_n into `leap` (lane-wise partial sums); returns where it stopped.
-template <typename P, typename Scalar>
-Eigen::Index acceleration_pass(Eigen::Index j, Eigen::Index len, bool compare, Scalar inv_gh,
-                               Scalar two_h, const Scalar* vn, const Scalar* vp, const Scalar* an,
-                               const Scalar* v0, const Scalar* v, Scalar* a_new, P& lin, P& leap) {
-  const P g = P::all(inv_gh), h2 = P::all(two_h), two = P::all(Scalar(2));
-  for (; j + P::lanes <= len; j += P::lanes) {
-    const P vj = P::load(v + j);
-    ((vj - P::load(v0 + j)) * g).store(a_new + j);
-    if (compare) {
-      const P vpj = P::load(vp + j);
-      const P dl = vj - (two * P::load(vn + j) - vpj), da = vj - (vpj + h2 * P::load(an + j));
-      lin += dl * dl;
-      leap += da * da;
-    }
-  }
-  return j;
+/// step_pass_body.hpp's accelerations_all: on AVX2 where the force passes take it unless it
+/// compares the predictors (its sums, on packets of another width, would round otherwise and
+/// could choose otherwise on another CPU; the comparison runs in a few steps in a hundred).
+template <typename Scalar>
+void accelerations_all(Eigen::Index len, Eigen::Index free0, Eigen::Index free1, bool compare,
+                       Scalar inv_gh, Scalar two_h, const Scalar* vn, const Scalar* vp,
+                       const Scalar* an, const Scalar* v0, const Scalar* v, Scalar* a_new,
+                       Scalar& lin, Scalar& leap) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (!compare && force_passes_take_avx2())
+      return step_avx2::accelerations_all(len, free0, free1, compare, inv_gh, two_h, vn, vp, an, v0,
+                                          v, a_new, lin, leap);
+#endif
+  step_baseline::accelerations_all(len, free0, free1, compare, inv_gh, two_h, vn, vp, an, v0, v,
+                                   a_new, lin, leap);
 }
 
 /// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
@@ -163,7 +142,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // starts closer: on the benchmark line at N = 100, 28 steps per matrix instead of 3).
   const int cols = model.nodes();
   {
-    // One pass (predict_pass), its constants and pointers passed by value.
+    // One pass (step_pass_body.hpp's predict_pass), its constants and pointers by value.
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
     const Eigen::Index len = 3 * Eigen::Index(cols);
     const int mode = use_bdf2 ? (state.has_acceleration && state.predict_from_acceleration ? 3 : 2)
@@ -173,10 +152,7 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
     const Scalar* an = state.acceleration.data();
     Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
-    const Eigen::Index j = predict_pass<simd::Pack<Scalar, true>>(
-        0, len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0, x1, v1);
-    predict_pass<simd::Pack<Scalar, false>>(j, len, mode, four_thirds, third, gh, two_h, xn, vn, xp,
-                                            vp, an, x0, v0, x1, v1);
+    predict_all(len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0, x1, v1);
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton
@@ -239,25 +215,14 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     const bool compare = use_bdf2 && state.has_acceleration && !served;
     bool from_acceleration = state.predict_from_acceleration;
     {
-      using PW = simd::Pack<Scalar, true>;
-      using P1 = simd::Pack<Scalar, false>;
-      PW lin_w = PW::all(Scalar(0)), leap_w = lin_w;
-      P1 lin_1 = P1::all(Scalar(0)), leap_1 = lin_1;
       const Scalar inv_gh = Scalar(1) / gh, two_h = Scalar(2 * dt);
       const Scalar *vn = state.velocity.data(), *vp = state.previous_velocity.data();
       const Scalar *an = state.acceleration.data(), *v0 = ws.v0.data(), *v = ws.v1.data();
-      Scalar* a_new = ws.xs.data();
       const Eigen::Index free0 = 3 * Eigen::Index(f0), free1 = 3 * Eigen::Index(f1 + 1);
-      // The kinematic ends (at most one column each side) without the comparison.
-      acceleration_pass<P1>(0, free0, false, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1,
-                            leap_1);
-      const Eigen::Index j = acceleration_pass<PW>(free0, free1, compare, inv_gh, two_h, vn, vp, an,
-                                                   v0, v, a_new, lin_w, leap_w);
-      acceleration_pass<P1>(j, free1, compare, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1,
-                            leap_1);
-      acceleration_pass<P1>(free1, 3 * Eigen::Index(cols), false, inv_gh, two_h, vn, vp, an, v0, v,
-                            a_new, lin_1, leap_1);
-      if (compare) from_acceleration = leap_w.sum() + leap_1.sum() < lin_w.sum() + lin_1.sum();
+      Scalar lin(0), leap(0);
+      accelerations_all(3 * Eigen::Index(cols), free0, free1, compare, inv_gh, two_h, vn, vp, an,
+                        v0, v, ws.xs.data(), lin, leap);
+      if (compare) from_acceleration = leap < lin;
     }
     commit(state, ws.x1, ws.v1, dt, "step_implicit");  // drops the kept matrix
     state.acceleration.swap(ws.xs);

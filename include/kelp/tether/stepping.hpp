@@ -248,23 +248,38 @@ struct StepReport {
 
 namespace detail {
 
-/// The sum of `len` scalars from `p`, in 4 packets side by side (4 independent chains of
-/// additions instead of Eigen's 2), then the rest one by one.
+// The implicit steps' array passes (kelp/tether/step_pass_body.hpp): once for the build's own
+// packets, and where kelp dispatches at run time once more for AVX2, chosen as the force passes
+// are (force_passes_take_avx2). Doxygen does not read them (their namespaces are details).
+#if !defined(KELP_DOXYGEN)
+namespace step_baseline {
+namespace vec = ::kelp::simd;
+#define KELP_STEP_PASS_BODY 1
+#include "kelp/tether/step_pass_body.hpp"  // IWYU pragma: keep
+#undef KELP_STEP_PASS_BODY
+}  // namespace step_baseline
+
+#if defined(KELP_X86_DISPATCH)
+KELP_AVX2_BEGIN
+namespace step_avx2 {
+namespace vec = ::kelp::simd::detail::avx2;
+#define KELP_STEP_PASS_BODY 1
+#include "kelp/tether/step_pass_body.hpp"  // IWYU pragma: keep
+#undef KELP_STEP_PASS_BODY
+}  // namespace step_avx2
+KELP_AVX2_END
+#endif
+#endif  // KELP_DOXYGEN
+
+/// The sum of `len` scalars from `p` (step_pass_body.hpp's flat_sum, on AVX2 where the force
+/// passes take it): only its finiteness is meaningful, its bits depend on the path.
 template <typename Scalar>
 Scalar flat_sum(const Scalar* p, Eigen::Index len) {
-  using P = simd::Pack<Scalar, simd::vectorized<Scalar>>;
-  constexpr Eigen::Index w = P::lanes;
-  P a0 = P::all(Scalar(0)), a1 = a0, a2 = a0, a3 = a0;
-  Eigen::Index j = 0;
-  for (; j + 4 * w <= len; j += 4 * w) {
-    a0 += P::load(p + j);
-    a1 += P::load(p + j + w);
-    a2 += P::load(p + j + 2 * w);
-    a3 += P::load(p + j + 3 * w);
-  }
-  Scalar s = ((a0 + a1) + (a2 + a3)).sum();
-  for (; j < len; ++j) s += p[j];
-  return s;
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (force_passes_take_avx2()) return step_avx2::flat_sum(p, len);
+#endif
+  return step_baseline::flat_sum(p, len);
 }
 
 /// True when the sum of every coordinate of x and v is finite: every one is, and their sum does

@@ -1,0 +1,120 @@
+/// \file
+/// \brief The implicit steps' passes over a tether state's flat 3 × (N+1) arrays (the predictor,
+/// the accelerations after a step, the finiteness sum), written once over a pack type and
+/// compiled twice as the force passes are (kelp/tether/force_pass_body.hpp):
+/// kelp/tether/stepping.hpp includes this file in namespace `detail::step_baseline` with `vec` =
+/// kelp::simd and, where kelp dispatches at run time (KELP_X86_DISPATCH), again in
+/// `detail::step_avx2` with `vec` = kelp::simd::detail::avx2, inside KELP_AVX2_BEGIN / END. Their
+/// element-wise results are the same bits on both. Not a header of its own: without
+/// KELP_STEP_PASS_BODY defined it is empty, and it has no include guard on purpose.
+#if defined(KELP_STEP_PASS_BODY)
+
+/// The implicit step's predictor over the flat 3 × (N+1) arrays from index j on, in packets of P
+/// (every argument by value: no reloads after the stores); returns where it stopped. mode 3:
+/// BDF2 (x̂ = (4x_n − x_{n−1})/3, v̂ likewise) from the accelerations a_n,
+/// v = v_{n−1} + 2h a_n (`two_h` = 2h); 2: BDF2 with v = 2v_n − v_{n−1}; 1: backward Euler with
+/// the velocity extrapolated; 0: backward Euler from v_n. x = x̂ + γh v in every mode.
+template <typename P, typename Scalar>
+Eigen::Index predict_pass(Eigen::Index j, Eigen::Index len, int mode, Scalar four_thirds,
+                          Scalar third, Scalar gh, Scalar two_h, const Scalar* xn, const Scalar* vn,
+                          const Scalar* xp, const Scalar* vp, const Scalar* an, Scalar* x0,
+                          Scalar* v0, Scalar* x1, Scalar* v1) {
+  const P c43 = P::all(four_thirds), c13 = P::all(third), two = P::all(Scalar(2)), g = P::all(gh),
+          h2 = P::all(two_h);
+  for (; j + P::lanes <= len; j += P::lanes) {
+    const P xnj = P::load(xn + j), vnj = P::load(vn + j);
+    if (mode >= 2) {
+      const P vpj = P::load(vp + j);
+      const P xh = c43 * xnj - c13 * P::load(xp + j);
+      const P vg = mode == 3 ? vpj + h2 * P::load(an + j) : two * vnj - vpj;
+      xh.store(x0 + j);
+      (c43 * vnj - c13 * vpj).store(v0 + j);
+      vg.store(v1 + j);
+      (xh + g * vg).store(x1 + j);
+    } else {
+      const P vg = mode == 1 ? two * vnj - P::load(vp + j) : vnj;
+      xnj.store(x0 + j);
+      vnj.store(v0 + j);
+      vg.store(v1 + j);
+      (xnj + g * vg).store(x1 + j);
+    }
+  }
+  return j;
+}
+
+/// After a converged BDF2 step, over the flat 3 × (N+1) arrays from index j to len in packets of
+/// P: the new accelerations a = (v − v̂)·`inv_gh` into `a_new`, and, when `compare`, the squared
+/// distances of the solution v from the step's two predictors, 2v_n − v_{n−1} into `lin` and
+/// v_{n−1} + `two_h`·a_n into `leap` (lane-wise partial sums); returns where it stopped.
+template <typename P, typename Scalar>
+Eigen::Index acceleration_pass(Eigen::Index j, Eigen::Index len, bool compare, Scalar inv_gh,
+                               Scalar two_h, const Scalar* vn, const Scalar* vp, const Scalar* an,
+                               const Scalar* v0, const Scalar* v, Scalar* a_new, P& lin, P& leap) {
+  const P g = P::all(inv_gh), h2 = P::all(two_h), two = P::all(Scalar(2));
+  for (; j + P::lanes <= len; j += P::lanes) {
+    const P vj = P::load(v + j);
+    ((vj - P::load(v0 + j)) * g).store(a_new + j);
+    if (compare) {
+      const P vpj = P::load(vp + j);
+      const P dl = vj - (two * P::load(vn + j) - vpj), da = vj - (vpj + h2 * P::load(an + j));
+      lin += dl * dl;
+      leap += da * da;
+    }
+  }
+  return j;
+}
+
+/// predict_pass over the whole arrays of `len` scalars: packets, then one by one.
+template <typename Scalar>
+void predict_all(Eigen::Index len, int mode, Scalar four_thirds, Scalar third, Scalar gh,
+                 Scalar two_h, const Scalar* xn, const Scalar* vn, const Scalar* xp,
+                 const Scalar* vp, const Scalar* an, Scalar* x0, Scalar* v0, Scalar* x1,
+                 Scalar* v1) {
+  const Eigen::Index j = predict_pass<vec::Pack<Scalar, true>>(
+      0, len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0, x1, v1);
+  predict_pass<vec::Pack<Scalar, false>>(j, len, mode, four_thirds, third, gh, two_h, xn, vn, xp,
+                                         vp, an, x0, v0, x1, v1);
+}
+
+/// acceleration_pass over the whole arrays of `len` scalars, comparing the predictors (when
+/// `compare`) on [free0, free1), the free nodes' entries; `lin` and `leap` get the sums.
+template <typename Scalar>
+void accelerations_all(Eigen::Index len, Eigen::Index free0, Eigen::Index free1, bool compare,
+                       Scalar inv_gh, Scalar two_h, const Scalar* vn, const Scalar* vp,
+                       const Scalar* an, const Scalar* v0, const Scalar* v, Scalar* a_new,
+                       Scalar& lin, Scalar& leap) {
+  using PW = vec::Pack<Scalar, true>;
+  using P1 = vec::Pack<Scalar, false>;
+  PW lin_w = PW::all(Scalar(0)), leap_w = lin_w;
+  P1 lin_1 = P1::all(Scalar(0)), leap_1 = lin_1;
+  // The kinematic ends (at most one column each side) without the comparison.
+  acceleration_pass<P1>(0, free0, false, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1, leap_1);
+  const Eigen::Index j = acceleration_pass<PW>(free0, free1, compare, inv_gh, two_h, vn, vp, an, v0,
+                                               v, a_new, lin_w, leap_w);
+  acceleration_pass<P1>(j, free1, compare, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1, leap_1);
+  acceleration_pass<P1>(free1, len, false, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1, leap_1);
+  lin = lin_w.sum() + lin_1.sum();
+  leap = leap_w.sum() + leap_1.sum();
+}
+
+/// The sum of `len` scalars from `p`, in 4 packets side by side (4 independent chains of
+/// additions), then the rest one by one. Its bits depend on the packets' width: only its
+/// finiteness is used (all_finite_fast).
+template <typename Scalar>
+Scalar flat_sum(const Scalar* p, Eigen::Index len) {
+  using P = vec::Pack<Scalar, vec::vectorized<Scalar>>;
+  constexpr Eigen::Index w = P::lanes;
+  P a0 = P::all(Scalar(0)), a1 = a0, a2 = a0, a3 = a0;
+  Eigen::Index j = 0;
+  for (; j + 4 * w <= len; j += 4 * w) {
+    a0 += P::load(p + j);
+    a1 += P::load(p + j + w);
+    a2 += P::load(p + j + 2 * w);
+    a3 += P::load(p + j + 3 * w);
+  }
+  Scalar s = ((a0 + a1) + (a2 + a3)).sum();
+  for (; j < len; ++j) s += p[j];
+  return s;
+}
+
+#endif  // KELP_STEP_PASS_BODY
