@@ -71,40 +71,6 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
   return true;
 }
 
-/// step_pass_body.hpp's predict_all on AVX2 where the force passes take it (the same bits).
-template <typename Scalar>
-void predict_all(Eigen::Index len, int mode, Scalar four_thirds, Scalar third, Scalar gh,
-                 Scalar two_h, const Scalar* xn, const Scalar* vn, const Scalar* xp,
-                 const Scalar* vp, const Scalar* an, Scalar* x0, Scalar* v0, Scalar* x1,
-                 Scalar* v1) {
-#if defined(KELP_X86_DISPATCH)
-  if constexpr (std::is_same_v<Scalar, double>)
-    if (force_passes_take_avx2())
-      return step_avx2::predict_all(len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an,
-                                    x0, v0, x1, v1);
-#endif
-  step_baseline::predict_all(len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0,
-                             x1, v1);
-}
-
-/// step_pass_body.hpp's accelerations_all: on AVX2 where the force passes take it unless it
-/// compares the predictors (its sums, on packets of another width, would round otherwise and
-/// could choose otherwise on another CPU; the comparison runs in a few steps in a hundred).
-template <typename Scalar>
-void accelerations_all(Eigen::Index len, Eigen::Index free0, Eigen::Index free1, bool compare,
-                       Scalar inv_gh, Scalar two_h, const Scalar* vn, const Scalar* vp,
-                       const Scalar* an, const Scalar* v0, const Scalar* v, Scalar* a_new,
-                       Scalar& lin, Scalar& leap) {
-#if defined(KELP_X86_DISPATCH)
-  if constexpr (std::is_same_v<Scalar, double>)
-    if (!compare && force_passes_take_avx2())
-      return step_avx2::accelerations_all(len, free0, free1, compare, inv_gh, two_h, vn, vp, an, v0,
-                                          v, a_new, lin, leap);
-#endif
-  step_baseline::accelerations_all(len, free0, free1, compare, inv_gh, two_h, vn, vp, an, v0, v,
-                                   a_new, lin, leap);
-}
-
 /// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
 /// new state and returns true when Newton's method converged (or options.check_convergence is
 /// false); returns false with the state untouched otherwise. Adds its work to `report`. Inputs
@@ -142,17 +108,15 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
   // starts closer: on the benchmark line at N = 100, 28 steps per matrix instead of 3).
   const int cols = model.nodes();
   {
-    // One pass (step_pass_body.hpp's predict_pass), its constants and pointers by value.
+    // One pass (step_pass_body.hpp's predict_pass).
     const Scalar third = Scalar(1) / Scalar(3), four_thirds = Scalar(4) * third;
     const Eigen::Index len = 3 * Eigen::Index(cols);
     const int mode = use_bdf2 ? (state.has_acceleration && state.predict_from_acceleration ? 3 : 2)
                               : (history ? 1 : 0);
-    const Scalar two_h = Scalar(2 * dt);
-    const Scalar *xn = state.position.data(), *vn = state.velocity.data();
-    const Scalar *xp = state.previous_position.data(), *vp = state.previous_velocity.data();
-    const Scalar* an = state.acceleration.data();
-    Scalar *x0 = ws.x0.data(), *v0 = ws.v0.data(), *x1 = ws.x1.data(), *v1 = ws.v1.data();
-    predict_all(len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0, x1, v1);
+    predict_all(PredictArrays<Scalar>{
+        len, mode, four_thirds, third, gh, Scalar(2 * dt), state.position.data(),
+        state.velocity.data(), state.previous_position.data(), state.previous_velocity.data(),
+        state.acceleration.data(), ws.x0.data(), ws.v0.data(), ws.x1.data(), ws.v1.data()});
   }
   apply_boundary(model, boundary, Scalar(dt), ws.x1, ws.v1);
   // Seabed friction limit from the normal force at the start of the step, for the whole Newton
@@ -213,17 +177,20 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     // the next steps start from that one (TetherState::predict_from_acceleration).
     const bool served = first_reused && first_residual <= options.refresh_residual * tolerance;
     const bool compare = use_bdf2 && state.has_acceleration && !served;
-    bool from_acceleration = state.predict_from_acceleration;
-    {
-      const Scalar inv_gh = Scalar(1) / gh, two_h = Scalar(2 * dt);
-      const Scalar *vn = state.velocity.data(), *vp = state.previous_velocity.data();
-      const Scalar *an = state.acceleration.data(), *v0 = ws.v0.data(), *v = ws.v1.data();
-      const Eigen::Index free0 = 3 * Eigen::Index(f0), free1 = 3 * Eigen::Index(f1 + 1);
-      Scalar lin(0), leap(0);
-      accelerations_all(3 * Eigen::Index(cols), free0, free1, compare, inv_gh, two_h, vn, vp, an,
-                        v0, v, ws.xs.data(), lin, leap);
-      if (compare) from_acceleration = leap < lin;
-    }
+    AccelerationArrays<Scalar> acc{3 * Eigen::Index(cols),
+                                   3 * Eigen::Index(f0),
+                                   3 * Eigen::Index(f1 + 1),
+                                   compare,
+                                   Scalar(1) / gh,
+                                   Scalar(2 * dt),
+                                   state.velocity.data(),
+                                   state.previous_velocity.data(),
+                                   state.acceleration.data(),
+                                   ws.v0.data(),
+                                   ws.v1.data(),
+                                   ws.xs.data()};
+    accelerations_all(acc);
+    const bool from_acceleration = compare ? acc.leap < acc.lin : state.predict_from_acceleration;
     commit(state, ws.x1, ws.v1, dt, "step_implicit");  // drops the kept matrix
     state.acceleration.swap(ws.xs);
     state.has_acceleration = true;

@@ -64,37 +64,36 @@ Eigen::Index acceleration_pass(Eigen::Index j, Eigen::Index len, bool compare, S
   return j;
 }
 
-/// predict_pass over the whole arrays of `len` scalars: packets, then one by one.
+/// predict_pass over the whole arrays: packets, then one by one.
 template <typename Scalar>
-void predict_all(Eigen::Index len, int mode, Scalar four_thirds, Scalar third, Scalar gh,
-                 Scalar two_h, const Scalar* xn, const Scalar* vn, const Scalar* xp,
-                 const Scalar* vp, const Scalar* an, Scalar* x0, Scalar* v0, Scalar* x1,
-                 Scalar* v1) {
-  const Eigen::Index j = predict_pass<vec::Pack<Scalar, true>>(
-      0, len, mode, four_thirds, third, gh, two_h, xn, vn, xp, vp, an, x0, v0, x1, v1);
-  predict_pass<vec::Pack<Scalar, false>>(j, len, mode, four_thirds, third, gh, two_h, xn, vn, xp,
-                                         vp, an, x0, v0, x1, v1);
+void predict_all(const PredictArrays<Scalar>& a) {
+  const Eigen::Index j =
+      predict_pass<vec::Pack<Scalar, true>>(0, a.len, a.mode, a.four_thirds, a.third, a.gh, a.two_h,
+                                            a.xn, a.vn, a.xp, a.vp, a.an, a.x0, a.v0, a.x1, a.v1);
+  predict_pass<vec::Pack<Scalar, false>>(j, a.len, a.mode, a.four_thirds, a.third, a.gh, a.two_h,
+                                         a.xn, a.vn, a.xp, a.vp, a.an, a.x0, a.v0, a.x1, a.v1);
 }
 
-/// acceleration_pass over the whole arrays of `len` scalars, comparing the predictors (when
-/// `compare`) on [free0, free1), the free nodes' entries; `lin` and `leap` get the sums.
+/// acceleration_pass over the whole arrays, comparing the predictors (when `a.compare`) on
+/// [free0, free1), the free nodes' entries, into `a.lin` and `a.leap`.
 template <typename Scalar>
-void accelerations_all(Eigen::Index len, Eigen::Index free0, Eigen::Index free1, bool compare,
-                       Scalar inv_gh, Scalar two_h, const Scalar* vn, const Scalar* vp,
-                       const Scalar* an, const Scalar* v0, const Scalar* v, Scalar* a_new,
-                       Scalar& lin, Scalar& leap) {
+void accelerations_all(AccelerationArrays<Scalar>& a) {
   using PW = vec::Pack<Scalar, true>;
   using P1 = vec::Pack<Scalar, false>;
   PW lin_w = PW::all(Scalar(0)), leap_w = lin_w;
   P1 lin_1 = P1::all(Scalar(0)), leap_1 = lin_1;
+  const auto pass = [&](auto& lin, auto& leap, Eigen::Index from, Eigen::Index to, bool compare) {
+    using P = std::decay_t<decltype(lin)>;
+    return acceleration_pass<P>(from, to, compare, a.inv_gh, a.two_h, a.vn, a.vp, a.an, a.v0, a.v,
+                                a.a_new, lin, leap);
+  };
   // The kinematic ends (at most one column each side) without the comparison.
-  acceleration_pass<P1>(0, free0, false, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1, leap_1);
-  const Eigen::Index j = acceleration_pass<PW>(free0, free1, compare, inv_gh, two_h, vn, vp, an, v0,
-                                               v, a_new, lin_w, leap_w);
-  acceleration_pass<P1>(j, free1, compare, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1, leap_1);
-  acceleration_pass<P1>(free1, len, false, inv_gh, two_h, vn, vp, an, v0, v, a_new, lin_1, leap_1);
-  lin = lin_w.sum() + lin_1.sum();
-  leap = leap_w.sum() + leap_1.sum();
+  pass(lin_1, leap_1, 0, a.free0, false);
+  const Eigen::Index j = pass(lin_w, leap_w, a.free0, a.free1, a.compare);
+  pass(lin_1, leap_1, j, a.free1, a.compare);
+  pass(lin_1, leap_1, a.free1, a.len, false);
+  a.lin = lin_w.sum() + lin_1.sum();
+  a.leap = leap_w.sum() + leap_1.sum();
 }
 
 /// The sum of `len` scalars from `p`, in 4 packets side by side (4 independent chains of

@@ -248,6 +248,30 @@ struct StepReport {
 
 namespace detail {
 
+/// The arrays and constants of the implicit step's predictor (step_pass_body.hpp's
+/// predict_pass: the mode and the formulas), the flat 3 × (N+1) arrays of `len` scalars.
+template <typename Scalar>
+struct PredictArrays {
+  Eigen::Index len;
+  int mode;
+  Scalar four_thirds, third, gh, two_h;
+  const Scalar *xn, *vn, *xp, *vp, *an;  ///< x_n, v_n, x_{n−1}, v_{n−1}, a_n
+  Scalar *x0, *v0, *x1, *v1;             ///< out: x̂, v̂, the predicted x and v
+};
+
+/// The arrays and constants of the accelerations after an implicit step (step_pass_body.hpp's
+/// acceleration_pass), the flat 3 × (N+1) arrays of `len` scalars, the free nodes' entries in
+/// [free0, free1).
+template <typename Scalar>
+struct AccelerationArrays {
+  Eigen::Index len, free0, free1;
+  bool compare;  ///< compare the two predictors with the solution v
+  Scalar inv_gh, two_h;
+  const Scalar *vn, *vp, *an, *v0, *v;  ///< v_n, v_{n−1}, a_n, v̂, the solution
+  Scalar* a_new;                        ///< out: the new accelerations
+  Scalar lin{}, leap{};                 ///< out (compare): the squared distances
+};
+
 // The implicit steps' array passes (kelp/tether/step_pass_body.hpp): once for the build's own
 // packets, and where kelp dispatches at run time once more for AVX2, chosen as the force passes
 // are (force_passes_take_avx2). Doxygen does not read them (their namespaces are details).
@@ -280,6 +304,28 @@ Scalar flat_sum(const Scalar* p, Eigen::Index len) {
     if (force_passes_take_avx2()) return step_avx2::flat_sum(p, len);
 #endif
   return step_baseline::flat_sum(p, len);
+}
+
+/// step_pass_body.hpp's predict_all on AVX2 where the force passes take it (the same bits).
+template <typename Scalar>
+void predict_all(const PredictArrays<Scalar>& a) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (force_passes_take_avx2()) return step_avx2::predict_all(a);
+#endif
+  step_baseline::predict_all(a);
+}
+
+/// step_pass_body.hpp's accelerations_all: on AVX2 where the force passes take it unless it
+/// compares the predictors (its sums, on packets of another width, would round otherwise and
+/// could choose otherwise on another CPU; the comparison runs in a few steps in a hundred).
+template <typename Scalar>
+void accelerations_all(AccelerationArrays<Scalar>& a) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (!a.compare && force_passes_take_avx2()) return step_avx2::accelerations_all(a);
+#endif
+  step_baseline::accelerations_all(a);
 }
 
 /// True when the sum of every coordinate of x and v is finite: every one is, and their sum does

@@ -211,9 +211,7 @@ void insert_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
   out.time_carry = in.time_carry;
   out.payout_rate = in.payout_rate;
   out.winch_length = lw - l;
-  out.previous_dt = 0.0;
-  out.newton.clear();
-  out.has_acceleration = false;
+  out.clear_history();
   // The parted flags (TetherState::parted) follow their segments: old segment 0 is new segments
   // 0 and 1, and a parting in it stays on the winch's side (new segment 0).
   out.parted.setZero(n + 1);
@@ -277,9 +275,7 @@ void remove_winch_node(const TetherModel<Scalar>& from, const TetherState<Scalar
   out.time_carry = in.time_carry;
   out.payout_rate = in.payout_rate;
   out.winch_length = lw + l;
-  out.previous_dt = 0.0;
-  out.newton.clear();
-  out.has_acceleration = false;
+  out.clear_history();
   // The parted flags follow their segments: old segments 0 and 1 are new segment 0.
   out.parted.setZero(n - 1);
   if (in.parted.size() == n) {
