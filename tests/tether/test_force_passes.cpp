@@ -347,6 +347,58 @@ TEST_CASE("the force passes' AVX2 build gives the baseline build's bits",
 #endif
 }
 
+TEST_CASE("the packed node kernels give the general path's bits, the end nodes' included",
+          "[tether][forces][simd]") {
+  // A line with one segment parted far from both ends takes the general path (node_general) at
+  // every node; the same line unparted takes the packed kernel (interior_block) at its wholly
+  // wet nodes off the seabed, the two ends included (their one-lane variant). Away from the
+  // parted segment both must give the same bits: the kernels are the general path's arithmetic
+  // for such nodes, not an approximation of it.
+  int fast_ends = 0, nodes_compared = 0;
+  for (const auto& c : cases<double>())
+    for (bool jacobian : {false, true}) {
+      const kt::TetherModeld model(c.params);
+      const int n = model.segments();
+      if (n < 8) continue;
+      const int p = n / 2;
+      kt::TetherWorkspaced a(model), b(model);
+      b.parted.setZero();
+      b.parted(p) = 1;
+      b.any_parted = true;
+      for (kt::TetherWorkspaced* ws : {&a, &b}) {
+        if (jacobian)
+          kt::compute_forces<true>(model, *ws, c.water, 1.0, c.x, c.v);
+        else
+          kt::compute_forces(model, *ws, c.water, 1.0, c.x, c.v);
+      }
+      INFO(c.name << (jacobian ? ", with Jacobian" : ""));
+      for (int i = 0; i <= n; ++i) {
+        if (i == p || i == p + 1) continue;  // the ends of the parted segment
+        INFO("node " << i);
+        CHECK(same_bits(a.tangent.col(i), b.tangent.col(i)));
+        CHECK(same_bits(a.mass_iso.row(i), b.mass_iso.row(i)));
+        CHECK(same_bits(a.mass_tan.row(i), b.mass_tan.row(i)));
+        CHECK(same_bits(a.mass_iso_inv.row(i), b.mass_iso_inv.row(i)));
+        CHECK(same_bits(a.mass_tan_ratio.row(i), b.mass_tan_ratio.row(i)));
+        CHECK(same_bits(a.submerged.row(i), b.submerged.row(i)));
+        CHECK(same_bits(a.seabed_force.row(i), b.seabed_force.row(i)));
+        if (jacobian) {
+          CHECK(same_bits(a.node_dv.col(i), b.node_dv.col(i)));
+          CHECK(same_bits(a.node_kz.row(i), b.node_kz.row(i)));
+        }
+        // The node force adds the neighbours' added-mass rate terms, which differ beside the
+        // parted segment (its ends' chords are their own segments there).
+        if (i != p - 1 && i != p + 2) CHECK(same_bits(a.force.col(i), b.force.col(i)));
+        ++nodes_compared;
+      }
+      for (int i : {0, n})
+        if (a.submerged(i) == 1.0 && a.seabed_force(i) == 0.0) ++fast_ends;
+    }
+  // Wholly wet ends off the seabed, which the one-lane end kernel computes, were among them.
+  CHECK(fast_ends >= 8);
+  CHECK(nodes_compared > 300);
+}
+
 TEST_CASE("the force passes form the implicit step's residual γh F − M (v − v̂) on the free nodes",
           "[tether][forces][implicit]") {
   // Against the residual computed here from the evaluation's own forces, masses and tangents,
