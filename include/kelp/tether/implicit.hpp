@@ -53,22 +53,26 @@ bool branches_are(const TetherModel<Scalar>& model, const TetherWorkspace<Scalar
                   const VectorX<Scalar>& branch, Scalar band) {
   const bool clamp = !model.parameters().compressive_damping;
   const int n = model.segments();
+  const bool banded = band > Scalar(0);
+  const auto code = [&](int s, Scalar l) {
+    const Scalar ls = ws.stretched_length(s);
+    if (ws.is_parted(s)) return Scalar(0);
+    if (banded && ls >= (Scalar(1) - band) * l) return Scalar(2);
+    if (clamp && !(ws.tension(s) > Scalar(0))) return Scalar(0);
+    return ls > l ? Scalar(2) : Scalar(1);
+  };
   // The segments' rest length (segment 0's own at a winch).
   const Scalar l_rest = model.segment_length();
-  for (int s = 0; s < n; ++s) {
-    const Scalar l = s == 0 ? segment_springs(model, ws, 0).l : l_rest;
-    const Scalar taut_from = band > Scalar(0) ? (Scalar(1) - band) * l : l;
-    const Scalar ls = ws.stretched_length(s);
-    const bool parted = ws.is_parted(s);
-    const bool taut = !parted && (band > Scalar(0) ? ls >= taut_from : ls > l);
-    const Scalar b = parted                     ? Scalar(0)
-                     : taut && band > Scalar(0) ? Scalar(2)
-                                                : (clamp && !(ws.tension(s) > Scalar(0))
-                                                       ? Scalar(0)
-                                                       : (ls > l ? Scalar(2) : Scalar(1)));
-    if (b != branch(s)) return false;
+  if (code(0, segment_springs(model, ws, 0).l) != branch(0)) return false;
+  if (ws.any_parted) {
+    for (int s = 1; s < n; ++s)
+      if (code(s, l_rest) != branch(s)) return false;
+    return true;
   }
-  return true;
+  // The others in packets (step_pass_body.hpp's branch_pass: the same codes).
+  return branches_all(BranchArrays<Scalar>{1, n, l_rest, (Scalar(1) - band) * l_rest, banded, clamp,
+                                           ws.stretched_length.data(), ws.tension.data(),
+                                           branch.data()});
 }
 
 /// One attempt at an implicit step of length dt (see step_implicit_euler / step_bdf2): commits the
@@ -345,6 +349,13 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
       return true;
     }
     const Eigen::Index nf = f1 - f0 + 1;
+    // The trial iterate's free nodes, v = v1 + α δ and x = x̂ + γh v (one pass; the same bits as
+    // the matrix expressions).
+    Scalar alpha(1);
+    const auto trial = [&]() {
+      trial_all(3 * Eigen::Index(f0), 3 * Eigen::Index(f1 + 1), alpha, gh, ws.v1.data(),
+                ws.delta.data(), ws.x0.data(), ws.vs.data(), ws.xs.data());
+    };
     if (whole) {
       // Line search on the merit ψ(α) = Σ_i |R_i/a_i|² along δ: with the whole Jacobian δ is a
       // descent direction of ψ (ψ'(0) = −2ψ(0)) whether or not R is a gradient (the secant
@@ -360,12 +371,9 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
         return m;
       };
       const Scalar m0 = merit();
-      Scalar alpha(1), trial_res(0);
+      Scalar trial_res(0);
       for (int ls = 0;; ++ls) {
-        ws.vs.middleCols(f0, nf).noalias() =
-            ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
-        ws.xs.middleCols(f0, nf).noalias() =
-            ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
+        trial();
         evaluate(ws.xs, ws.vs, trial_res, true);
         if (ls >= options.max_backtracks) break;
         const Scalar m = merit();
@@ -393,11 +401,9 @@ bool implicit_attempt(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>&
     };
     const Scalar g0 = slope();
     const Scalar a_lo(0), g_lo = g0;
-    Scalar alpha(1), trial_res(0);
+    Scalar trial_res(0);
     for (int ls = 0;; ++ls) {
-      ws.vs.middleCols(f0, nf).noalias() =
-          ws.v1.middleCols(f0, nf) + alpha * ws.delta.middleCols(f0, nf);
-      ws.xs.middleCols(f0, nf).noalias() = ws.x0.middleCols(f0, nf) + gh * ws.vs.middleCols(f0, nf);
+      trial();
       // Newton's method: the trial carries its Jacobian terms: when another Newton iteration
       // follows (half the steps of a line near the surface) they are needed at this point, and
       // filling them costs less than a second evaluation there (−6 % instructions per system

@@ -272,6 +272,17 @@ struct AccelerationArrays {
   Scalar lin{}, leap{};                 ///< out (compare): the squared distances
 };
 
+/// The segments of branches_are's packed check (step_pass_body.hpp's branch_pass): segments
+/// [begin, end) of rest length `l`, none parted; their stretched lengths, clamped axial forces
+/// and the branch codes to compare with (0 slack, 1 at rest, 2 taut).
+template <typename Scalar>
+struct BranchArrays {
+  Eigen::Index begin, end;
+  Scalar l, taut_from;  ///< the rest length; taut at and above `taut_from` when `banded`
+  bool banded, clamp;   ///< a slack band; no axial force in compression
+  const Scalar *stretched, *tension, *branch;
+};
+
 // The implicit steps' array passes (kelp/tether/step_pass_body.hpp): once for the build's own
 // packets, and where kelp dispatches at run time once more for AVX2, chosen as the force passes
 // are (force_passes_take_avx2). Doxygen does not read them (their namespaces are details).
@@ -295,10 +306,11 @@ KELP_AVX2_END
 #endif
 #endif  // KELP_DOXYGEN
 
-/// The sum of `len` scalars from `p` (step_pass_body.hpp's flat_sum, on AVX2 where the force
-/// passes take it): only its finiteness is meaningful, its bits depend on the path.
-template <typename Scalar>
-Scalar flat_sum(const Scalar* p, Eigen::Index len) {
+/// The sum of the `len` scalars of each of the K arrays `p` (step_pass_body.hpp's flat_sum, on
+/// AVX2 where the force passes take it): only its finiteness is meaningful, its bits depend on
+/// the path.
+template <int K, typename Scalar>
+Scalar flat_sum(const Scalar* const (&p)[K], Eigen::Index len) {
 #if defined(KELP_X86_DISPATCH)
   if constexpr (std::is_same_v<Scalar, double>)
     if (force_passes_take_avx2()) return step_avx2::flat_sum(p, len);
@@ -314,6 +326,28 @@ void predict_all(const PredictArrays<Scalar>& a) {
     if (force_passes_take_avx2()) return step_avx2::predict_all(a);
 #endif
   step_baseline::predict_all(a);
+}
+
+/// step_pass_body.hpp's trial_all on AVX2 where the force passes take it (the same bits).
+template <typename Scalar>
+void trial_all(Eigen::Index begin, Eigen::Index end, Scalar alpha, Scalar gh, const Scalar* v1,
+               const Scalar* delta, const Scalar* x0, Scalar* vs, Scalar* xs) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (force_passes_take_avx2())
+      return step_avx2::trial_all(begin, end, alpha, gh, v1, delta, x0, vs, xs);
+#endif
+  step_baseline::trial_all(begin, end, alpha, gh, v1, delta, x0, vs, xs);
+}
+
+/// step_pass_body.hpp's branches_all on AVX2 where the force passes take it (the same answer).
+template <typename Scalar>
+bool branches_all(const BranchArrays<Scalar>& a) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (force_passes_take_avx2()) return step_avx2::branches_all(a);
+#endif
+  return step_baseline::branches_all(a);
 }
 
 /// step_pass_body.hpp's accelerations_all: on AVX2 where the force passes take it unless it
@@ -333,7 +367,9 @@ void accelerations_all(AccelerationArrays<Scalar>& a) {
 template <typename Scalar>
 bool all_finite_fast(const Matrix3X<Scalar>& x, const Matrix3X<Scalar>& v) {
   using std::isfinite;
-  return isfinite(value_of(flat_sum(x.data(), x.size()) + flat_sum(v.data(), v.size())));
+  if (x.size() != v.size())
+    return isfinite(value_of(flat_sum({x.data()}, x.size()) + flat_sum({v.data()}, v.size())));
+  return isfinite(value_of(flat_sum({x.data(), v.data()}, x.size())));
 }
 
 /// Commits (x, v) as the state at t + dt if finite; the state before the step becomes the
@@ -422,7 +458,7 @@ void check_step_inputs(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>
         state.previous_dt >= 0.0 &&
         (!history_fits || !state.has_history() ||
          all_finite_fast(state.previous_position, state.previous_velocity)) &&
-        (!acceleration_used || std::isfinite(value_of(flat_sum(state.acceleration.data(),
+        (!acceleration_used || std::isfinite(value_of(flat_sum({state.acceleration.data()},
                                                                state.acceleration.size())))))) {
     check_all_finite(state.position, "state.position");
     check_all_finite(state.velocity, "state.velocity");
