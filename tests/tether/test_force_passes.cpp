@@ -347,6 +347,38 @@ TEST_CASE("the force passes' AVX2 build gives the baseline build's bits",
 #endif
 }
 
+// load3 / store3 of pack type P: the rows of P::lanes columns of a 3 × N matrix, and back.
+template <typename P, typename Scalar>
+void check_load3_store3() {
+  constexpr int lanes = P::lanes;
+  Scalar m[3 * lanes], back[3 * lanes], row[3][lanes];
+  for (int j = 0; j < 3 * lanes; ++j) m[j] = Scalar(10 * (j % 3) + j / 3 + 1);  // 10 row + col + 1
+  P x, y, z;
+  P::load3(m, x, y, z);
+  x.store(row[0]);
+  y.store(row[1]);
+  z.store(row[2]);
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < lanes; ++i) CHECK(row[k][i] == Scalar(10 * k + i + 1));
+  for (Scalar& b : back) b = Scalar(-1);
+  P::store3(back, x, y, z);
+  for (int j = 0; j < 3 * lanes; ++j) CHECK(back[j] == m[j]);
+}
+
+TEST_CASE("packs load and store the rows of 3 × N columns (load3, store3)",
+          "[tether][forces][simd]") {
+  check_load3_store3<kelp::simd::Pack<double, true>, double>();
+  check_load3_store3<kelp::simd::Pack<double, false>, double>();
+  check_load3_store3<kelp::simd::Pack<float, true>, float>();
+  check_load3_store3<kelp::simd::Pack<float, false>, float>();
+#if defined(KELP_X86_DISPATCH)
+  if (__builtin_cpu_supports("avx2"))
+    check_load3_store3<kelp::simd::detail::avx2::Pack4d, double>();
+  else
+    WARN("this CPU has no AVX2: its 4-double packs are not checked");
+#endif
+}
+
 TEST_CASE("the packed node kernels give the general path's bits, the end nodes' included",
           "[tether][forces][simd]") {
   // A line with one segment parted far from both ends takes the general path (node_general) at

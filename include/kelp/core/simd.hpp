@@ -103,6 +103,55 @@ struct Pack {
     else
       Eigen::internal::pscatter<Scalar, Raw>(p, r, stride);
   }
+  /// \brief The three rows of `lanes` consecutive columns of a column-major 3×N matrix:
+  /// x from `p[0], p[3], …`, y from `p[1], p[4], …`, z from `p[2], p[5], …` (three gathers of
+  /// stride 3; on SSE2 three loads and three shuffles).
+  /// \param p the first column; `p[3 lanes − 1]` must be readable.
+  /// \param x out: the first row's lanes.
+  /// \param y out: the second row's lanes.
+  /// \param z out: the third row's lanes.
+  static void load3(const Scalar* p, Pack& x, Pack& y, Pack& z) {
+    if constexpr (lanes == 1) {
+      x = Pack(p[0]);
+      y = Pack(p[1]);
+      z = Pack(p[2]);
+#if defined(EIGEN_VECTORIZE_SSE2)
+    } else if constexpr (std::is_same_v<Raw, Eigen::internal::Packet2d>) {
+      // [x0 y0] [z0 x1] [y1 z1] → [x0 x1] [y0 y1] [z0 z1]
+      const __m128d a = _mm_loadu_pd(p), b = _mm_loadu_pd(p + 2), c = _mm_loadu_pd(p + 4);
+      x = Pack(_mm_shuffle_pd(a, b, 2));
+      y = Pack(_mm_shuffle_pd(a, c, 1));
+      z = Pack(_mm_shuffle_pd(b, c, 2));
+#endif
+    } else {
+      x = gather(p, 3);
+      y = gather(p + 1, 3);
+      z = gather(p + 2, 3);
+    }
+  }
+  /// \brief Stores x, y, z as the three rows of `lanes` consecutive columns of a column-major
+  /// 3×N matrix (the inverse of load3()).
+  /// \param p the first column; `p[3 lanes − 1]` must be writable.
+  /// \param x the first row's lanes.
+  /// \param y the second row's lanes.
+  /// \param z the third row's lanes.
+  static void store3(Scalar* p, Pack x, Pack y, Pack z) {
+    if constexpr (lanes == 1) {
+      p[0] = x.r;
+      p[1] = y.r;
+      p[2] = z.r;
+#if defined(EIGEN_VECTORIZE_SSE2)
+    } else if constexpr (std::is_same_v<Raw, Eigen::internal::Packet2d>) {
+      _mm_storeu_pd(p, _mm_shuffle_pd(x.r, y.r, 0));
+      _mm_storeu_pd(p + 2, _mm_shuffle_pd(z.r, x.r, 2));
+      _mm_storeu_pd(p + 4, _mm_shuffle_pd(y.r, z.r, 3));
+#endif
+    } else {
+      x.scatter(p, 3);
+      y.scatter(p + 1, 3);
+      z.scatter(p + 2, 3);
+    }
+  }
   /// \brief Stores the lanes to `p[0], p[1], …` (no alignment needed).
   /// \param p the first of `lanes` consecutive writable values.
   void store(Scalar* p) const {

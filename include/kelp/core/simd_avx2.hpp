@@ -63,6 +63,29 @@ struct Pack4d {
     p[3 * stride] = r[3];
   }
   void store(double* p) const { *reinterpret_cast<V4du*>(p) = r; }
+  /// Four columns of a column-major 3×N matrix as its three rows: 3 loads, 3 lane-pair
+  /// permutes and 3 shuffles instead of 3 gathers of 4 scalars.
+  /// [x0 y0 | z0 x1] [y1 z1 | x2 y2] [z2 x3 | y3 z3] → [x0 y0 | x2 y2] [z0 x1 | z2 x3]
+  /// [y1 z1 | y3 z3] → [x0 x1 x2 x3] [y0 y1 y2 y3] [z0 z1 z2 z3].
+  static void load3(const double* p, Pack4d& x, Pack4d& y, Pack4d& z) {
+    const V4d a = *reinterpret_cast<const V4du*>(p), b = *reinterpret_cast<const V4du*>(p + 4),
+              c = *reinterpret_cast<const V4du*>(p + 8);
+    const V4d m1 = __builtin_ia32_vperm2f128_pd256(a, b, 0x30);
+    const V4d m2 = __builtin_ia32_vperm2f128_pd256(a, c, 0x21);
+    const V4d m3 = __builtin_ia32_vperm2f128_pd256(b, c, 0x30);
+    x = Pack4d(__builtin_ia32_shufpd256(m1, m2, 0xA));
+    y = Pack4d(__builtin_ia32_shufpd256(m1, m3, 0x5));
+    z = Pack4d(__builtin_ia32_shufpd256(m2, m3, 0xA));
+  }
+  /// The inverse of load3(): x, y, z as the rows of four columns, three whole stores.
+  static void store3(double* p, Pack4d x, Pack4d y, Pack4d z) {
+    const V4d m1 = __builtin_ia32_shufpd256(x.r, y.r, 0x0);  // [x0 y0 | x2 y2]
+    const V4d m2 = __builtin_ia32_shufpd256(z.r, x.r, 0xA);  // [z0 x1 | z2 x3]
+    const V4d m3 = __builtin_ia32_shufpd256(y.r, z.r, 0xF);  // [y1 z1 | y3 z3]
+    *reinterpret_cast<V4du*>(p) = __builtin_ia32_vperm2f128_pd256(m1, m2, 0x20);
+    *reinterpret_cast<V4du*>(p + 4) = __builtin_ia32_vperm2f128_pd256(m3, m1, 0x30);
+    *reinterpret_cast<V4du*>(p + 8) = __builtin_ia32_vperm2f128_pd256(m2, m3, 0x31);
+  }
   Pack4d& operator+=(Pack4d b) {
     r += b.r;
     return *this;

@@ -103,9 +103,7 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
   ls.store(&ws.stretched_length(s));
   tension.store(&ws.tension(s));
   Scalar* dir = ws.direction.data() + 3 * s;
-  u0.scatter(dir, 3);
-  u1.scatter(dir + 1, 3);
-  u2.scatter(dir + 2, 3);
+  P::store3(dir, u0, u1, u2);
   (tension * u0).store(&ws.pass_buffer(s, kSegmentForce));
   (tension * u1).store(&ws.pass_buffer(s, kSegmentForce + 1));
   (tension * u2).store(&ws.pass_buffer(s, kSegmentForce + 2));
@@ -159,9 +157,7 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   const P inv_c = sqrt(inv_c2);
   const P q0 = c0 * inv_c, q1 = c1 * inv_c, q2 = c2 * inv_c;
   Scalar* tan = ws.tangent.data() + 3 * i;
-  q0.scatter(tan, 3);
-  q1.scatter(tan + 1, 3);
-  q2.scatter(tan + 2, 3);
+  P::store3(tan, q0, q1, q2);
   const Scalar* tu = &ws.pass_buffer(i, kSegmentForce);
   // The segment forces in and out (node_general's in − out, zero on an end's missing side).
   const auto in = [&](Eigen::Index k) { return Hi == 0 ? zero : P::load(tu + k * col); };
@@ -174,8 +170,8 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   const Scalar* vi = &ws.pass_buffer(i, kVelocity);
   // Still water: the water velocity buffer holds +0 (evaluate_forces), which zero is.
   const Scalar* wi = ws.water_velocity.data() + 3 * i;
-  const P w0 = c.still ? zero : P::gather(wi, 3), w1 = c.still ? zero : P::gather(wi + 1, 3),
-          w2 = c.still ? zero : P::gather(wi + 2, 3);
+  P w0 = zero, w1 = zero, w2 = zero;
+  if (!c.still) P::load3(wi, w0, w1, w2);
   const P vr0 = w0 - P::load(vi);
   const P vr1 = w1 - P::load(vi + col);
   const P vr2 = w2 - P::load(vi + 2 * col);
@@ -192,7 +188,8 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   if (!c.still) {
     // Froude–Krylov plus added-mass forcing (zero where the water does not accelerate).
     const Scalar* ai = ws.water_acceleration.data() + 3 * i;
-    const P aw0 = P::gather(ai, 3), aw1 = P::gather(ai + 1, 3), aw2 = P::gather(ai + 2, 3);
+    P aw0, aw1, aw2;
+    P::load3(ai, aw0, aw1, aw2);
     const P qa = pc.cat_minus_can * ((q0 * aw0 + q1 * aw1) + q2 * aw2);
     const P rv = pc.rho_vol, ca = pc.one_plus_can;
     f0 += rv * (ca * aw0 + qa * q0);
@@ -256,10 +253,12 @@ EIGEN_ALWAYS_INLINE void residual_block(const ImplicitResidual<Scalar>& res,
   if constexpr (P::lanes == 1)
     if (i < res.f0 || i > res.f1) return;
   const Scalar *vh = res.v_hat + 3 * i, *tq = ws.tangent.data() + 3 * i;
-  const P d0 = P::load(&ws.pass_buffer(i, kVelocity)) - P::gather(vh, 3);
-  const P d1 = P::load(&ws.pass_buffer(i, kVelocity + 1)) - P::gather(vh + 1, 3);
-  const P d2 = P::load(&ws.pass_buffer(i, kVelocity + 2)) - P::gather(vh + 2, 3);
-  const P q0 = P::gather(tq, 3), q1 = P::gather(tq + 1, 3), q2 = P::gather(tq + 2, 3);
+  P h0, h1, h2, q0, q1, q2;
+  P::load3(vh, h0, h1, h2);
+  P::load3(tq, q0, q1, q2);
+  const P d0 = P::load(&ws.pass_buffer(i, kVelocity)) - h0;
+  const P d1 = P::load(&ws.pass_buffer(i, kVelocity + 1)) - h1;
+  const P d2 = P::load(&ws.pass_buffer(i, kVelocity + 2)) - h2;
   const P a = P::load(&ws.mass_iso(i));
   const P bqd = P::load(&ws.mass_tan(i)) * ((q0 * d0 + q1 * d1) + q2 * d2);
   const P g = P::all(res.gh);
@@ -267,9 +266,7 @@ EIGEN_ALWAYS_INLINE void residual_block(const ImplicitResidual<Scalar>& res,
   const P r1 = g * f[1] - (a * d1 + bqd * q1);
   const P r2 = g * f[2] - (a * d2 + bqd * q2);
   Scalar* out = res.rhs + 3 * i;
-  r0.scatter(out, 3);
-  r1.scatter(out + 1, 3);
-  r2.scatter(out + 2, 3);
+  P::store3(out, r0, r1, r2);
   lanes.max_scaled =
       max(lanes.max_scaled, max(max(abs(r0), abs(r1)), abs(r2)) * P::load(&ws.mass_iso_inv(i)));
   lanes.sum += (r0 + r1) + r2;
@@ -294,7 +291,8 @@ template <bool Wide, typename Scalar>
 EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws,
                                       int i, ResidualLanes<vec::Pack<Scalar, Wide>>& lanes) {
   using P = vec::Pack<Scalar, Wide>;
-  P f[3];
+  P f[3], bend[3];
+  if (c.bending) P::load3(ws.bending.data() + 3 * i, bend[0], bend[1], bend[2]);
   for (int k = 0; k < 3; ++k) {
     f[k] = P::load(&ws.pass_buffer(i, kNodeForce + k));
     if (c.mass_turns) {
@@ -310,20 +308,19 @@ EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspac
         f[k] = f[k] + (P::load(w + i - 1) - P::load(w + i + 1));
       }
     }
-    if (c.bending) f[k] += P::gather(ws.bending.data() + 3 * i + k, 3);
-    f[k].scatter(ws.force.data() + 3 * i + k, 3);
+    if (c.bending) f[k] += bend[k];
   }
+  P::store3(ws.force.data() + 3 * i, f[0], f[1], f[2]);
   if (c.residual) residual_block(*c.residual, ws, i, f, lanes);
   if (c.acc) {
     // a = M⁻¹F = (F − (b/(a+b)) q (q·F)) / a (see accelerations_from_forces).
     const Scalar* tq = ws.tangent.data() + 3 * i;
-    const P q0 = P::gather(tq, 3), q1 = P::gather(tq + 1, 3), q2 = P::gather(tq + 2, 3);
+    P q0, q1, q2;
+    P::load3(tq, q0, q1, q2);
     const P rq = P::load(&ws.mass_tan_ratio(i)) * ((q0 * f[0] + q1 * f[1]) + q2 * f[2]);
     const P ia = P::load(&ws.mass_iso_inv(i));
     Scalar* a = c.acc + 3 * i;
-    ((f[0] - rq * q0) * ia).scatter(a, 3);
-    ((f[1] - rq * q1) * ia).scatter(a + 1, 3);
-    ((f[2] - rq * q2) * ia).scatter(a + 2, 3);
+    P::store3(a, (f[0] - rq * q0) * ia, (f[1] - rq * q1) * ia, (f[2] - rq * q2) * ia);
   }
 }
 
@@ -340,11 +337,13 @@ EIGEN_ALWAYS_INLINE void soa_inputs(const ForcePass<Scalar>& c, TetherWorkspace<
   const int nodes = c.n + 1;
   int i = 0;
   if (c.xs == 3 && c.vs == 3)
-    for (; i + W::lanes <= nodes; i += W::lanes)
-      for (int k = 0; k < 3; ++k) {
-        W::gather(c.x + 3 * i + k, 3).store(px + k * col + i);
-        W::gather(c.v + 3 * i + k, 3).store(pv + k * col + i);
-      }
+    for (; i + W::lanes <= nodes; i += W::lanes) {
+      W r[3];
+      W::load3(c.x + 3 * i, r[0], r[1], r[2]);
+      for (int k = 0; k < 3; ++k) r[k].store(px + k * col + i);
+      W::load3(c.v + 3 * i, r[0], r[1], r[2]);
+      for (int k = 0; k < 3; ++k) r[k].store(pv + k * col + i);
+    }
   for (; i < nodes; ++i)
     for (int k = 0; k < 3; ++k) {
       px[k * col + i] = c.X(k, i);
