@@ -23,11 +23,11 @@
 // Per N and round r (r = 0..R-1), in this order: MoorDyn RK4 (one MoorDyn_Step per dtM),
 // MoorDyn RK4 (one MoorDyn_Step per ~10 ms coupling interval, K internal dtM steps), kelp RK4
 // at dt, kelp bare compute_forces (without and with the Jacobian terms), kelp BDF2 at 10 ms (to
-// tolerance with the default simplified Newton / W-method, to tolerance with Newton's method,
-// then one unchecked correction per step), and kelp's force evaluation and BDF2 step again on the
-// force passes' baseline build (kelp::tether::detail::wide_force_passes off: SSE2 where the AVX2
-// build is dispatched). Each measurement runs >= min_time of wall
-// clock (steady_clock); thread CPU time is recorded as well.
+// tolerance with the default simplified Newton / W-method, the same on LineModel::moordyn, to
+// tolerance with Newton's method, then one unchecked correction per step), and kelp's force
+// evaluation and BDF2 step again on the force passes' baseline build
+// (kelp::tether::detail::wide_force_passes off: SSE2 where the AVX2 build is dispatched). Each
+// measurement runs >= min_time of wall clock (steady_clock); thread CPU time is recorded as well.
 #include <fcntl.h>
 #include <moordyn/MoorDyn2.h>
 #include <unistd.h>
@@ -626,7 +626,8 @@ int main(int argc, char** argv) {
   struct Sum {
     int n;
     double dt, dt_kelp;
-    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf2x, kbdf21, krk4own, kforce_base, kbdf2_base;
+    Row md, mdc, krk4, kforce, kforcej, kbdf2, kbdf2x, kbdf21, krk4own, kforce_base, kbdf2_base,
+        kbdf2_md;
   };
   std::vector<Sum> sums;
   for (int n : sizes) {
@@ -639,6 +640,7 @@ int main(int argc, char** argv) {
     Md md(n, dt, dir);
     Md mdc(n, dt, dir);
     Kelp krk(n), kf(n), kbd(n), kbdx(n), kbd1(n), kown(n), kbd_base(n);
+    Kelp kbd_md(n, 0.0, kt::LineModel::moordyn);  // BDF2 on MoorDyn's line model
     const kt::ImplicitOptionsd once = one_newton(), exact = exact_newton();
     S.dt_kelp = kt::estimate_stable_dt(kown.model, kt::Integrator::rk4, kown.env.water_density());
     const double nodes = n + 1;
@@ -688,6 +690,8 @@ int main(int argc, char** argv) {
       long evb = 0;
       t = time_bdf2(kbd, {}, evb);
       record("kelp_bdf2_10ms", S.kbdf2, r, t, double(evb) / t.iters, 0.01, 0.01);
+      t = time_bdf2(kbd_md, {}, evb);
+      record("kelp_bdf2_10ms_moordyn_line", S.kbdf2_md, r, t, double(evb) / t.iters, 0.01, 0.01);
       t = time_bdf2(kbdx, exact, evb);
       record("kelp_bdf2_exact_10ms", S.kbdf2x, r, t, double(evb) / t.iters, 0.01, 0.01);
       t = run_for(min_time, 16, [&] { kbd1.step(0.01, kt::Integrator::bdf2, once); });
@@ -735,6 +739,8 @@ int main(int argc, char** argv) {
     std::printf("  kelp compute_forces<true>   ns/node      %s\n", ns(S.kforcej).c_str());
     std::printf("  kelp BDF2 10 ms             ns/node/eval %s  RTF %s\n", ns(S.kbdf2).c_str(),
                 rtf(S.kbdf2).c_str());
+    std::printf("  kelp BDF2 10 ms, MoorDyn's line ns/node/eval %s  RTF %s\n",
+                ns(S.kbdf2_md).c_str(), rtf(S.kbdf2_md).c_str());
     std::printf("  kelp BDF2 exact Newton 10 ms ns/node/eval %s  RTF %s\n", ns(S.kbdf2x).c_str(),
                 rtf(S.kbdf2x).c_str());
     std::printf("  kelp BDF2 one Newton 10 ms  ns/node/eval %s  RTF %s\n", ns(S.kbdf21).c_str(),
