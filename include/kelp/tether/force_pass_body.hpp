@@ -17,9 +17,8 @@ struct PackedConstants {
   P zero, one, two, three, l, l2, inv_l, ea, ea_l, ba, ba_l, inv_fade, bed, half_d, wet_weight, kn,
       kt, rho_vol, one_plus_can, cat_minus_can, mass_iso_wet, mass_tan_wet, mass_iso_inv,
       mass_tan_ratio;
-  /// The constants of the nodes of ForcePass::kinds[kind] (1: interior; 0, 2: the ends).
-  explicit PackedConstants(const ForcePass<Scalar>& c, int kind = 1) {
-    const NodeConstants<Scalar>& nc = c.kinds[kind];
+  explicit PackedConstants(const ForcePass<Scalar>& c) {
+    const NodeConstants<Scalar>& nc = c.kinds[1];
     zero = P::all(Scalar(0));
     one = P::all(Scalar(1));
     two = P::all(Scalar(2));
@@ -122,14 +121,11 @@ EIGEN_ALWAYS_INLINE void segment_block(const ForcePass<Scalar>& c,
 /// are below the surface band (at least half a diameter deep: their half segments are wholly wet)
 /// and they are off the seabed (returns false, writing nothing, otherwise): tangent, node force
 /// without the added-mass coupling to the neighbours, that coupling term w_i, masses and the
-/// Jacobian terms. The same arithmetic as node_general for such nodes. With Lo = 0 (node 0) or
-/// Hi = 0 (node N), one end node of an unparted line (`pc` of its kind; Wide false): its chord
-/// is its own segment, and the segment force on the missing side is zero (chord_nodes).
-template <bool WithJacobian, bool Wide, int Lo = -1, int Hi = 1, typename Scalar>
+/// Jacobian terms. The same arithmetic as node_general for such nodes.
+template <bool WithJacobian, bool Wide, typename Scalar>
 EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
                                         const PackedConstants<Scalar, Wide>& pc,
                                         TetherWorkspace<Scalar>& ws, int i) {
-  static_assert((Lo == -1 && Hi == 1) || (!Wide && Hi - Lo == 1 && Lo * Hi == 0));
   using P = vec::Pack<Scalar, Wide>;
   const P zero = pc.zero;
   const Eigen::Index col = ws.pass_buffer.rows();
@@ -138,19 +134,19 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   const P z = P::load(az);
   // Wholly wet (the node and its neighbours at least half a diameter under the surface: φ = 1)
   // and off the seabed.
-  const P z_lo = P::load(az + Lo), z_hi = P::load(az + Hi);
+  const P z_lo = P::load(az - 1), z_hi = P::load(az + 1);
   P d = z, d_lo = z_lo, d_hi = z_hi;
   if (!c.still) {
     const Scalar* zeta = &ws.surface_elevation(i);
     d += P::load(zeta);
-    d_lo += P::load(zeta + Lo);
-    d_hi += P::load(zeta + Hi);
+    d_lo += P::load(zeta - 1);
+    d_hi += P::load(zeta + 1);
   }
   if (vec::any(vec::less(d, pc.half_d) || vec::less(d_lo, pc.half_d) ||
                vec::less(d_hi, pc.half_d) || vec::greater(z - pc.bed, zero)))
     return false;
-  const P c0 = P::load(a + Hi) - P::load(a + Lo);
-  const P c1 = P::load(a + col + Hi) - P::load(a + col + Lo);
+  const P c0 = P::load(a + 1) - P::load(a - 1);
+  const P c1 = P::load(a + col + 1) - P::load(a + col - 1);
   const P c2 = z_hi - z_lo;
   const P cc = (c0 * c0 + c1 * c1) + c2 * c2;
   const P inv_c2 = vec::select(vec::greater(cc, zero), pc.one / cc, zero);
@@ -159,12 +155,9 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   Scalar* tan = ws.tangent.data() + 3 * i;
   P::store3(tan, q0, q1, q2);
   const Scalar* tu = &ws.pass_buffer(i, kSegmentForce);
-  // The segment forces in and out (node_general's in − out, zero on an end's missing side).
-  const auto in = [&](Eigen::Index k) { return Hi == 0 ? zero : P::load(tu + k * col); };
-  const auto out = [&](Eigen::Index k) { return Lo == 0 ? zero : P::load(tu + k * col - 1); };
-  P f0 = in(0) - out(0);
-  P f1 = in(1) - out(1);
-  P f2 = in(2) - out(2);
+  P f0 = P::load(tu) - P::load(tu - 1);
+  P f1 = P::load(tu + col) - P::load(tu + col - 1);
+  P f2 = P::load(tu + 2 * col) - P::load(tu + 2 * col - 1);
   f2 += pc.wet_weight;
   // Morison drag on the relative velocity, split along the chord.
   const Scalar* vi = &ws.pass_buffer(i, kVelocity);
@@ -203,9 +196,9 @@ EIGEN_ALWAYS_INLINE bool interior_block(const ForcePass<Scalar>& c,
   if (c.mass_turns) {
     // Added-mass rate terms (see compute_forces; zero for a zero chord, where 1/|c| = 0).
     const P k = pc.mass_tan_wet * inv_c, ks = k * vq;
-    const P dc0 = P::load(vi + Hi) - P::load(vi + Lo);
-    const P dc1 = P::load(vi + col + Hi) - P::load(vi + col + Lo);
-    const P dc2 = P::load(vi + 2 * col + Hi) - P::load(vi + 2 * col + Lo);
+    const P dc0 = P::load(vi + 1) - P::load(vi - 1);
+    const P dc1 = P::load(vi + col + 1) - P::load(vi + col - 1);
+    const P dc2 = P::load(vi + 2 * col + 1) - P::load(vi + 2 * col - 1);
     const P m = k * ((dc0 * vn0 + dc1 * vn1) + dc2 * vn2) - ks * ((q0 * dc0 + q1 * dc1) + q2 * dc2);
     f0 += ks * dc0 + m * q0;
     f1 += ks * dc1 + m * q1;
@@ -395,10 +388,7 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
     return;
   }
   if (c.bending) bending_forces(c, ws);
-  // The end nodes: in the interior kernel (one lane, their own constants) when wholly wet and off
-  // the seabed, as interior nodes are; otherwise (at the surface, on the seabed) the general path.
-  if (!interior_block<WithJacobian, false, 0, 1>(c, PackedConstants<Scalar, false>(c, 0), ws, 0))
-    node_general<WithJacobian>(c, ws, 0);
+  node_general<WithJacobian>(c, ws, 0);
   int i = 1;
   // Node 1 next to a winch segment has its own constants (kinds[3]).
   if (c.winch && n > 1) node_general<WithJacobian>(c, ws, i++);
@@ -411,9 +401,7 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   for (; i < n; ++i)
     if (!interior_block<WithJacobian, false>(c, single, ws, i))
       node_general<WithJacobian>(c, ws, i);
-  if (n > 0 &&
-      !interior_block<WithJacobian, false, -1, 0>(c, PackedConstants<Scalar, false>(c, 2), ws, n))
-    node_general<WithJacobian>(c, ws, n);
+  if (n > 0) node_general<WithJacobian>(c, ws, n);
   // Obstacles (kelp/tether/contact.hpp): none in most environments, and then no pass at all.
   if (c.obstacles) contact_pass<WithJacobian>(c, ws);
   finish_block<false>(c, ws, 0, res_one);
