@@ -105,9 +105,10 @@ enum PassColumn : int {
 
 /// Whether a double evaluation may take the force passes' AVX2 build on a CPU with AVX2 (where
 /// kelp dispatches at run time, KELP_X86_DISPATCH; true unless set otherwise), and whether the
-/// implicit steps' array passes (kelp/tether/step_pass_body.hpp) may take theirs. Both builds
-/// give the same bits: the switch is there for the tests that compare them and the benchmarks
-/// that measure the baseline, process-wide.
+/// implicit steps' array passes (kelp/tether/step_pass_body.hpp) and the kept-factor solve
+/// (kelp/tether/kept_solve_body.hpp) may take theirs. Both builds give the same bits: the switch
+/// is there for the tests that compare them and the benchmarks that measure the baseline,
+/// process-wide.
 inline std::atomic<bool>& wide_force_passes() {
   static std::atomic<bool> allowed{true};
   return allowed;
