@@ -10,10 +10,11 @@
 /// last bits (≲ 1e-15 relative per wave sum); those differences then grow through a
 /// chaotic closed loop, and a run on a CPU with AVX2 and FMA does not reproduce the same run on
 /// one without (the AVX2 and AVX-512 builds gave the same bits with GCC 12, but nothing obliges a
-/// compiler to contract both alike). The tether's force passes (kelp/tether/forces.hpp) and the
-/// implicit steps' array passes (kelp/tether/stepping.hpp) are dispatched as well, to AVX2 builds
-/// without FMA that give the same bits as the baseline's: they give the same bits on every CPU
-/// that runs the program, whatever the path.
+/// compiler to contract both alike). The tether's force passes (kelp/tether/forces.hpp), the
+/// implicit steps' array passes (kelp/tether/stepping.hpp) and the solve with a kept Newton
+/// factor (kelp/tether/block_solve.hpp) are dispatched as well, to AVX2 builds without FMA that
+/// give the same bits as the baseline's: they give the same bits on every CPU that runs the
+/// program, whatever the path.
 ///
 /// `KernelPath::portable` computes what the baseline build computes, never a fused multiply–add:
 /// with it, a program gives the same bits on every CPU that runs it (the deterministic mode). It
