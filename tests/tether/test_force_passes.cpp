@@ -494,3 +494,65 @@ TEST_CASE("the force passes form the implicit step's residual γh F − M (v −
                                      &res);
   CHECK_FALSE(std::isfinite(res.sum));
 }
+
+TEST_CASE("compute_forces refuses a non-finite position or velocity at any node, on either build",
+          "[tether][forces][bad_input]") {
+  // The input check runs in the pass that moves x and v into the pass buffer: its packets, the
+  // last packet that overlaps the one before, and the node-by-node copy of a strided input. A
+  // NaN or an Inf at any coordinate is refused and named before any output is written; finite
+  // values whose sum overflows are refused as such.
+  const double bad_values[] = {std::numeric_limits<double>::quiet_NaN(),
+                               std::numeric_limits<double>::infinity(),
+                               -std::numeric_limits<double>::infinity()};
+  int refused = 0;
+  for (int n : {9, 10, 11, 12}) {
+    const kt::TetherModeld model(kelp_test::benchmark_line<double>(n));
+    kt::TetherWorkspaced ws(model);
+    const kelp_test::TestWater<double> water;
+    const kt::TetherStated s = kt::catenary_initial_state(model, water, Vector3<double>(0, 0, 1),
+                                                          Vector3<double>(15, 0, 6));
+    for (bool wide : {false, true}) {
+      const WidePasses scope(wide);
+      kt::compute_forces(model, ws, water, 0.0, s.position, s.velocity);
+      const Matrix3X<double> good = ws.force;
+      for (bool strided : {false, true})
+        for (int i = 0; i <= n; ++i)
+          for (int k = 0; k < 3; ++k)
+            for (double bad : bad_values)
+              for (bool in_x : {true, false}) {
+                INFO("N " << n << (wide ? ", AVX2 allowed" : ", baseline")
+                          << (strided ? ", strided" : "") << ", node " << i << ", row " << k << ", "
+                          << bad << " in " << (in_x ? "x" : "v"));
+                Matrix3X<double> x = s.position, v = s.velocity;
+                (in_x ? x : v)(k, i) = bad;
+                // A strided copy: 4 rows per column, the passes read it with a column stride of 4.
+                Eigen::MatrixXd x4 = Eigen::MatrixXd::Zero(4, n + 1), v4 = x4;
+                x4.topRows(3) = x;
+                v4.topRows(3) = v;
+                const auto stride = Eigen::OuterStride<>(4);
+                const Eigen::Map<const Matrix3X<double>, 0, Eigen::OuterStride<>> xs(x4.data(), 3,
+                                                                                     n + 1, stride),
+                    vs(v4.data(), 3, n + 1, stride);
+                const auto call = [&] {
+                  if (strided)
+                    kt::compute_forces(model, ws, water, 0.0, xs, vs);
+                  else
+                    kt::compute_forces(model, ws, water, 0.0, x, v);
+                };
+                REQUIRE_THROWS_WITH(call(),
+                                    Catch::Contains(in_x ? "compute_forces: x must be finite"
+                                                         : "compute_forces: v must be finite"));
+                REQUIRE(same_bits(ws.force, good));
+                ++refused;
+              }
+      Matrix3X<double> x = s.position;
+      x(0, n) = x(1, n) = 1.5e308;
+      REQUIRE_THROWS_WITH(kt::compute_forces(model, ws, water, 0.0, x, s.velocity),
+                          Catch::Contains("compute_forces: x and v overflow"));
+      kt::compute_forces(model, ws, water, 0.0, s.position, s.velocity);
+      REQUIRE(same_bits(ws.force, good));
+    }
+  }
+  // Every node of each line, with both builds, both inputs, 3 rows and 3 values, in x and in v.
+  CHECK(refused == 2 * 2 * 3 * 3 * 2 * (10 + 11 + 12 + 13));
+}

@@ -44,7 +44,8 @@ struct NodeConstants {
 /// (finish_block) while the node forces are in registers, instead of a pass of their own that
 /// gathered the forces back: on the free nodes f0 … f1, with M_i = a_i I + b_i q_i q_iᵀ,
 ///   rhs_i = −R_i = γh F_i − M_i (v_i − v̂_i),
-/// `r_max` = max_i max_k |R_ik| / a_i and `sum` = Σ_i Σ_k R_ik, finite only when every R_ik is
+/// `r_max` = max_i max_k |R_ik| / a_i and `sum` a sum of the R_ik in which each appears once or
+/// twice (the passes' last packet may overlap the one before), finite only when every R_ik is
 /// (detail::implicit_attempt's convergence test and finiteness check).
 template <typename Scalar>
 struct ImplicitResidual {
@@ -53,7 +54,7 @@ struct ImplicitResidual {
   int f0, f1;           ///< the free nodes
   Scalar* rhs;          ///< out: −R, 3 × (N+1), column-major (free columns only)
   Scalar r_max{};       ///< out: the scaled max-norm
-  Scalar sum{};         ///< out: the sum of the residual's entries
+  Scalar sum{};         ///< out: a sum of the residual's entries (finite when they all are)
 };
 
 /// Everything compute_forces' passes share: the environment's and the model's constants of one
@@ -82,6 +83,9 @@ struct ForcePass {
   Scalar* acc = nullptr;
   /// When set: the implicit step's residual is formed as well (ImplicitResidual).
   ImplicitResidual<Scalar>* residual = nullptr;
+  /// The positions and velocities are already in TetherWorkspace::pass_buffer (compute_forces'
+  /// input check put them there).
+  bool inputs_ready = false;
   /// One flag per segment when the line has parted (TetherWorkspace::parted), else null.
   const std::uint8_t* parted = nullptr;
   /// The environment's obstacles (environment::ObstacleSet), or null: no contact pass at all.

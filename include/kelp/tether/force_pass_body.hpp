@@ -321,27 +321,52 @@ EIGEN_ALWAYS_INLINE void finish_block(const ForcePass<Scalar>& c, TetherWorkspac
 /// (kPosition, kVelocity): the segment and interior kernels then load 4 neighbouring nodes' x with
 /// one instruction, where gathering them from 3-strided columns took five and their addresses
 /// (each coordinate is read by 2–3 kernels, so it is gathered once here instead of at each use).
-template <typename Scalar>
-EIGEN_ALWAYS_INLINE void soa_inputs(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+/// With Sum, also returns a sum in which every coordinate and velocity appears, finite only when
+/// all of them are (compute_forces' input check, in the same pass); without it, 0.
+template <bool Sum, typename Scalar>
+EIGEN_ALWAYS_INLINE Scalar soa_inputs(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   using W = vec::Pack<Scalar, vec::vectorized<Scalar>>;
   const Eigen::Index col = ws.pass_buffer.rows();
   Scalar* px = &ws.pass_buffer(0, kPosition);
   Scalar* pv = &ws.pass_buffer(0, kVelocity);
   const int nodes = c.n + 1;
   int i = 0;
-  if (c.xs == 3 && c.vs == 3)
-    for (; i + W::lanes <= nodes; i += W::lanes) {
-      W r[3];
-      W::load3(c.x + 3 * i, r[0], r[1], r[2]);
-      for (int k = 0; k < 3; ++k) r[k].store(px + k * col + i);
-      W::load3(c.v + 3 * i, r[0], r[1], r[2]);
-      for (int k = 0; k < 3; ++k) r[k].store(pv + k * col + i);
+  W lanes = W::all(Scalar(0));
+  const auto packet = [&](int j) {
+    W r[3], u[3];
+    W::load3(c.x + 3 * j, r[0], r[1], r[2]);
+    for (int k = 0; k < 3; ++k) r[k].store(px + k * col + j);
+    W::load3(c.v + 3 * j, u[0], u[1], u[2]);
+    for (int k = 0; k < 3; ++k) u[k].store(pv + k * col + j);
+    if constexpr (Sum) lanes += ((r[0] + r[1]) + r[2]) + ((u[0] + u[1]) + u[2]);
+  };
+  if (c.xs == 3 && c.vs == 3 && nodes >= W::lanes) {
+    for (; i + W::lanes <= nodes; i += W::lanes) packet(i);
+    // The last nodes in one more packet that overlaps the one before (copies of the same values;
+    // the sum then counts some twice, which keeps it finite exactly when they all are).
+    if (i < nodes) {
+      packet(nodes - W::lanes);
+      i = nodes;
     }
+  }
+  Scalar rest(0);
   for (; i < nodes; ++i)
     for (int k = 0; k < 3; ++k) {
       px[k * col + i] = c.X(k, i);
       pv[k * col + i] = c.V(k, i);
+      if constexpr (Sum) rest += c.X(k, i) + c.V(k, i);
     }
+  if constexpr (Sum)
+    return lanes.sum() + rest;
+  else
+    return Scalar(0);
+}
+
+/// soa_inputs with the sum of its inputs, on its own (compute_forces runs it before anything
+/// else writes the workspace; the passes then skip theirs: ForcePass::inputs_ready).
+template <typename Scalar>
+Scalar soa_inputs_summed(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+  return soa_inputs<true>(c, ws);
 }
 
 /// The passes of compute_forces on positions and velocities stored column-major with the given
@@ -351,7 +376,7 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   constexpr bool wide = vec::vectorized<Scalar>;
   constexpr int lanes = vec::Pack<Scalar, wide>::lanes;
   const int n = c.n;
-  soa_inputs(c, ws);
+  if (!c.inputs_ready) soa_inputs<false>(c, ws);
   const PackedConstants<Scalar, wide> packed(c);
   const PackedConstants<Scalar, false> single(c);
   using PW = vec::Pack<Scalar, wide>;
@@ -373,8 +398,17 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
     segment_block<WithJacobian, false>(cw, PackedConstants<Scalar, false>(cw), ws, 0);
     s = 1;
   }
-  if constexpr (wide)
+  // The packets of the segment pass, the interior nodes' and the last pass end with one that
+  // overlaps the packet before it rather than with single lanes: their kernels write the same
+  // values again on the nodes they share.
+  if constexpr (wide) {
+    const int s0 = s;
     for (; s + lanes <= n; s += lanes) segment_block<WithJacobian, true>(c, packed, ws, s);
+    if (s < n && n - lanes >= s0) {
+      segment_block<WithJacobian, true>(c, packed, ws, n - lanes);
+      s = n;
+    }
+  }
   for (; s < n; ++s) segment_block<WithJacobian, false>(c, single, ws, s);
   if (c.parted) {
     // A parted line (TetherState::parted) takes the general path: its parted segments carry no
@@ -392,12 +426,24 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   int i = 1;
   // Node 1 next to a winch segment has its own constants (kinds[3]).
   if (c.winch && n > 1) node_general<WithJacobian>(c, ws, i++);
-  if constexpr (wide)
-    for (; i + lanes <= n; i += lanes)
-      if (!interior_block<WithJacobian, true>(c, packed, ws, i))
-        for (int j = i; j < i + lanes; ++j)
-          if (!interior_block<WithJacobian, false>(c, single, ws, j))
-            node_general<WithJacobian>(c, ws, j);
+  if constexpr (wide) {
+    // A packet with a node that the kernel does not take (in the surface band, on the seabed, or
+    // beside such a node) gives its first node to the single-lane kernel or the general path, and
+    // the next packet starts one node on: a line that dips under the surface at node 1 runs its
+    // packets from node 2.
+    const int i0 = i;
+    while (i + lanes <= n) {
+      if (interior_block<WithJacobian, true>(c, packed, ws, i)) {
+        i += lanes;
+      } else {
+        if (!interior_block<WithJacobian, false>(c, single, ws, i))
+          node_general<WithJacobian>(c, ws, i);
+        ++i;
+      }
+    }
+    if (i < n && n - lanes >= i0 && interior_block<WithJacobian, true>(c, packed, ws, n - lanes))
+      i = n;
+  }
   for (; i < n; ++i)
     if (!interior_block<WithJacobian, false>(c, single, ws, i))
       node_general<WithJacobian>(c, ws, i);
@@ -406,8 +452,16 @@ void force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   if (c.obstacles) contact_pass<WithJacobian>(c, ws);
   finish_block<false>(c, ws, 0, res_one);
   i = 1;
-  if constexpr (wide)
+  // Nodes 1 … N − 1 in packets (an overlapping last packet makes the residual's sum count the
+  // nodes it shares twice: that sum only tells whether every entry is finite,
+  // ImplicitResidual::sum), N alone.
+  if constexpr (wide) {
     for (; i + lanes <= n; i += lanes) finish_block<true>(c, ws, i, res_wide);
+    if (i < n && n - lanes >= 1) {
+      finish_block<true>(c, ws, n - lanes, res_wide);
+      i = n;
+    }
+  }
   for (; i <= n; ++i) finish_block<false>(c, ws, i, res_one);
   if (c.residual) {
     reduce_residual(res_wide, *c.residual);

@@ -595,6 +595,17 @@ void run_force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
   baseline::force_passes<WithJacobian>(c, ws);
 }
 
+/// soa_inputs_summed on the build run_force_passes takes: the inputs into the pass buffer and their
+/// sum.
+template <typename Scalar>
+Scalar run_soa_inputs_summed(const ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
+#if defined(KELP_X86_DISPATCH)
+  if constexpr (std::is_same_v<Scalar, double>)
+    if (force_passes_take_avx2()) return avx2::soa_inputs_summed(c, ws);
+#endif
+  return baseline::soa_inputs_summed(c, ws);
+}
+
 /// compute_forces, and when `acc` is not null the node accelerations M⁻¹F of every node into
 /// `acc` (3 × (N+1), column-major; the kinematic ends' entries are M⁻¹F too, not their
 /// prescribed accelerations); when `residual` is not null, the implicit step's residual
@@ -602,15 +613,31 @@ void run_force_passes(ForcePass<Scalar>& c, TetherWorkspace<Scalar>& ws) {
 template <bool WithJacobian, typename Scalar, typename Env, typename DX, typename DV>
 void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& ws, const Env& env,
                      double t, const Eigen::MatrixBase<DX>& x, const Eigen::MatrixBase<DV>& v,
-                     Scalar* acc, ImplicitResidual<Scalar>* residual = nullptr) {
+                     Scalar* acc, ImplicitResidual<Scalar>* residual = nullptr,
+                     bool check_inputs = false) {
   const TetherParameters<Scalar>& p = model.parameters();
   const int n = model.segments();
-  // Any evaluation overwrites what an explicit step kept from its end (TetherWorkspace::
-  // end_evaluated; that step sets it again after its own).
-  ws.end_evaluated = false;
   ForcePass<Scalar> c;
   c.p = &p;
   c.n = n;
+  // The passes read the coordinates through a pointer and a column stride: straight from
+  // column-major storage, or from a copy of any other expression.
+  bind_columns(x, ws.x_eval, c.x, c.xs);
+  bind_columns(v, ws.v_eval, c.v, c.vs);
+  if (check_inputs) {
+    // compute_forces' check of x and v, in the pass that moves them into the pass buffer, before
+    // anything else is written or sampled. NaN and ±Inf survive the sum (a sum that overflows is
+    // refused too, rightly: coordinates of 1e307 m are not a tether).
+    if (!is_finite(run_soa_inputs_summed(c, ws))) {
+      check_all_finite(x, "compute_forces: x");
+      check_all_finite(v, "compute_forces: v");
+      ::kelp::detail::throw_invalid_argument("compute_forces: x and v overflow");
+    }
+    c.inputs_ready = true;
+  }
+  // Any evaluation overwrites what an explicit step kept from its end (TetherWorkspace::
+  // end_evaluated; that step sets it again after its own).
+  ws.end_evaluated = false;
   c.rho = Scalar(env.water_density());
   c.g = Scalar(env.gravity());
   c.bed = Scalar(env.seabed_depth());
@@ -691,10 +718,6 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
       c.kinds[2] = winch_node(1);
   }
 
-  // The passes read the coordinates through a pointer and a column stride: straight from
-  // column-major storage, or from a copy of any other expression.
-  bind_columns(x, ws.x_eval, c.x, c.xs);
-  bind_columns(v, ws.v_eval, c.v, c.vs);
   c.acc = acc;
   c.residual = residual;
   run_force_passes<WithJacobian>(c, ws);
@@ -766,14 +789,10 @@ void compute_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& w
       x.rows() == 3 && x.cols() == model.nodes() && v.rows() == 3 && v.cols() == model.nodes(),
       "compute_forces: x and v must be 3 x (segments + 1)");
   check_finite(t, "compute_forces: t");
-  // One pass over the inputs: NaN and ±Inf survive the sum (a sum that overflows is refused
-  // too, rightly: coordinates of 1e307 m are not a tether).
-  if (!is_finite(x.sum() + v.sum())) {
-    check_all_finite(x, "compute_forces: x");
-    check_all_finite(v, "compute_forces: v");
-    ::kelp::detail::throw_invalid_argument("compute_forces: x and v overflow");
-  }
-  detail::evaluate_forces<WithJacobian>(model, ws, env, t, x, v, static_cast<Scalar*>(nullptr));
+  // x and v are checked in the evaluation's first pass (evaluate_forces' check_inputs).
+  detail::evaluate_forces<WithJacobian>(model, ws, env, t, x, v, static_cast<Scalar*>(nullptr),
+                                        static_cast<detail::ImplicitResidual<Scalar>*>(nullptr),
+                                        true);
 }
 
 /// \brief Node accelerations a_i = M_i⁻¹ F_i from the last `compute_forces` (free nodes only;

@@ -545,11 +545,13 @@ struct TetherWorkspace {
   /// \param nodes the node count N + 1 to compare with.
   /// \return whether the workspace can serve a tether of `nodes` nodes.
   bool fits(int nodes) const {
-    bool ok = nodes >= 2;
-    for_each_buffer(*this, nodes, [&ok](const auto& m, Eigen::Index rows, Eigen::Index cols) {
-      ok = ok && m.rows() == rows && m.cols() == cols;
+    // Every size compared, without a branch per buffer (the force evaluation checks this at
+    // every call): any difference leaves a bit set.
+    Eigen::Index differ = 0;
+    for_each_buffer(*this, nodes, [&differ](const auto& m, Eigen::Index rows, Eigen::Index cols) {
+      differ |= (m.rows() ^ rows) | (m.cols() ^ cols);
     });
-    return ok;
+    return nodes >= 2 && differ == 0;
   }
 
  private:
@@ -558,34 +560,18 @@ struct TetherWorkspace {
   template <typename Self, typename F>
   static void for_each_buffer(Self& w, int nodes, F&& f) {
     const Eigen::Index n = nodes, s = nodes - 1;
-    for (auto* m : {&w.force,
-                    &w.bending,
-                    &w.acceleration,
-                    &w.tangent,
-                    &w.water_velocity,
-                    &w.water_acceleration,
-                    &w.rhs,
-                    &w.rhs_true,
-                    &w.delta,
-                    &w.x0,
-                    &w.v0,
-                    &w.x1,
-                    &w.v1,
-                    &w.xs,
-                    &w.vs,
-                    &w.x_eval,
-                    &w.v_eval,
-                    &w.contact_force,
-                    &w.end_position,
-                    &w.end_velocity})
-      f(*m, 3, n);
-    for (auto* v : {&w.mass_iso, &w.mass_tan, &w.mass_iso_inv, &w.mass_tan_ratio, &w.seabed_force,
-                    &w.friction_normal, &w.submerged, &w.node_kz, &w.surface_elevation})
-      f(*v, n, 1);
+    // Buffers of one shape, unrolled (fits() runs at every force evaluation).
+    const auto each = [&f](Eigen::Index rows, Eigen::Index cols, auto&... m) {
+      (f(m, rows, cols), ...);
+    };
+    each(3, n, w.force, w.bending, w.acceleration, w.tangent, w.water_velocity,
+         w.water_acceleration, w.rhs, w.rhs_true, w.delta, w.x0, w.v0, w.x1, w.v1, w.xs, w.vs,
+         w.x_eval, w.v_eval, w.contact_force, w.end_position, w.end_velocity);
+    each(n, 1, w.mass_iso, w.mass_tan, w.mass_iso_inv, w.mass_tan_ratio, w.seabed_force,
+         w.friction_normal, w.submerged, w.node_kz, w.surface_elevation);
     f(w.direction, 3, s);
-    for (auto* v : {&w.tension, &w.stretched_length, &w.seg_k_uu, &w.seg_k_perp, &w.seg_c_uu,
-                    &w.seg_true_k_uu, &w.seg_true_c_uu, &w.seg_rate, &w.seg_branch})
-      f(*v, s, 1);
+    each(s, 1, w.tension, w.stretched_length, w.seg_k_uu, w.seg_k_perp, w.seg_c_uu, w.seg_true_k_uu,
+         w.seg_true_c_uu, w.seg_rate, w.seg_branch);
     f(w.node_dv, 6, n);
     f(w.node_kc, 6, n);
     f(w.segment_contact, s, 1);
