@@ -40,6 +40,13 @@ struct NodeConstants {
   }
 };
 
+/// What segment_wetness (kelp/tether/forces.hpp) gives for one segment: the wet shares a, b it
+/// lumps on its nodes and their derivatives in the nodes' depths.
+template <typename Scalar>
+struct SegmentWetness {
+  Scalar a, b, daa, dab, dbb;
+};
+
 /// The implicit step's momentum residual, which the force passes form in their last loop
 /// (finish_block) while the node forces are in registers, instead of a pass of their own that
 /// gathered the forces back: on the free nodes f0 … f1, with M_i = a_i I + b_i q_i q_iᵀ,
@@ -90,6 +97,10 @@ struct ForcePass {
   const std::uint8_t* parted = nullptr;
   /// The environment's obstacles (environment::ObstacleSet), or null: no contact pass at all.
   const environment::ObstacleSet* obstacles = nullptr;
+  /// The last segment whose wetness the general path computed (−1: none yet) and that wetness:
+  /// the positions do not change within an evaluation, so the node after it reuses it.
+  mutable int wet_segment = -1;
+  mutable SegmentWetness<Scalar> wet{};
   Scalar X(int k, int i) const { return x[i * xs + k]; }
   Scalar V(int k, int i) const { return v[i * vs + k]; }
   /// The positions as a 3 × (N+1) matrix.

@@ -178,11 +178,7 @@ Scalar submerged_depth_integral(Scalar z, Scalar zeta, Scalar diameter) {
 /// dbb = ∂b/∂d_b [1/m] are the integrals of φ' = 1/D over the band against (1 − s)², s (1 − s) and
 /// s² (zero in air and in the wholly wet water). Integrated in closed form over the pieces of
 /// [0, 1] where φ is 0, linear or 1.
-template <typename Scalar>
-struct SegmentWetness {
-  Scalar a, b, daa, dab, dbb;
-};
-
+/// Returns a SegmentWetness (declared in kelp/tether/force_kernels.hpp).
 template <typename Scalar>
 SegmentWetness<Scalar> segment_wetness(Scalar da, Scalar db, Scalar diameter, Scalar inv_d) {
   using std::abs;
@@ -268,32 +264,34 @@ struct NodeWetness {
   Scalar phi, d_lo, d_self, d_hi;
 };
 
-template <typename Scalar>
-NodeWetness<Scalar> node_wetness(Scalar d_lo, Scalar d, Scalar d_hi, Scalar l_before,
-                                 Scalar l_after, bool joined_before, bool joined_after,
-                                 Scalar diameter, Scalar inv_d) {
+/// node_wetness with the wetness of the segments beside the node from `segment(before)`, which
+/// returns segment_wetness of the segment before the node (before = true: depths d_lo, d) or
+/// after it (d, d_hi); the force passes keep the last one they computed (node_wetness_in_pass).
+template <typename Scalar, typename SegmentOf>
+NodeWetness<Scalar> node_wetness_with(Scalar d, Scalar l_before, Scalar l_after, bool joined_before,
+                                      bool joined_after, Scalar diameter, Scalar inv_d,
+                                      const SegmentOf& segment) {
   const Scalar zero(0), half(0.5);
   NodeWetness<Scalar> w{zero, zero, zero, zero};
-  // A half segment held at the node's own depth: φ(d)/2 of it, ∂/∂d = φ'(d)/2.
-  const Scalar phi_own = submerged_fraction(d, zero, diameter, inv_d);
-  const Scalar dphi_own = phi_own > zero && phi_own < Scalar(1) ? inv_d : zero;
   // The half segment of length l before (the node is the segment's end b) or after it (its end
-  // a), d_other the depth of the segment's other node.
-  const auto add_half = [&](Scalar l, bool joined, Scalar d_other, bool before) {
+  // a).
+  const auto add_half = [&](Scalar l, bool joined, bool before) {
     if (!(l > zero)) return;
     if (!joined) {
+      // A half segment held at the node's own depth: φ(d)/2 of it, ∂/∂d = φ'(d)/2.
+      const Scalar phi_own = submerged_fraction(d, zero, diameter, inv_d);
+      const Scalar dphi_own = phi_own > zero && phi_own < Scalar(1) ? inv_d : zero;
       w.phi += half * l * phi_own;
       w.d_self += half * l * dphi_own;
       return;
     }
-    const SegmentWetness<Scalar> s = before ? segment_wetness(d_other, d, diameter, inv_d)
-                                            : segment_wetness(d, d_other, diameter, inv_d);
+    const SegmentWetness<Scalar> s = segment(before);
     w.phi += l * (before ? s.b : s.a);
     (before ? w.d_lo : w.d_hi) += l * s.dab;
     w.d_self += l * (before ? s.dbb : s.daa);
   };
-  add_half(l_before, joined_before, d_lo, true);
-  add_half(l_after, joined_after, d_hi, false);
+  add_half(l_before, joined_before, true);
+  add_half(l_after, joined_after, false);
   const Scalar inv_h = Scalar(2) / (l_before + l_after);
   w.phi *= inv_h;
   w.d_lo *= inv_h;
@@ -302,31 +300,64 @@ NodeWetness<Scalar> node_wetness(Scalar d_lo, Scalar d, Scalar d_hi, Scalar l_be
   return w;
 }
 
+template <typename Scalar>
+NodeWetness<Scalar> node_wetness(Scalar d_lo, Scalar d, Scalar d_hi, Scalar l_before,
+                                 Scalar l_after, bool joined_before, bool joined_after,
+                                 Scalar diameter, Scalar inv_d) {
+  return node_wetness_with(d, l_before, l_after, joined_before, joined_after, diameter, inv_d,
+                           [&](bool before) {
+                             return before ? segment_wetness(d_lo, d, diameter, inv_d)
+                                           : segment_wetness(d, d_hi, diameter, inv_d);
+                           });
+}
+
 /// node_wetness of node i of a line of n segments: `depth(j)` the depth under the surface of
 /// node j, `rest(s)` the unstretched length of segment s, `parted(s)` whether segment s has
-/// parted; φ = 1 without arithmetic when the node and its neighbours are half a diameter or more
-/// below the surface.
-template <typename Scalar, typename Depth, typename Rest, typename Parted>
+/// parted, `segment_of(s, d_a, d_b)` segment_wetness of segment s between the depths d_a and d_b
+/// of its nodes; φ = 1 without arithmetic when the node and its neighbours are half a diameter
+/// or more below the surface.
+template <typename Scalar, typename Depth, typename Rest, typename Parted, typename SegmentOf>
 NodeWetness<Scalar> node_wetness_of(int i, int n, const Depth& depth, const Rest& rest,
-                                    const Parted& parted, Scalar diameter, Scalar inv_d) {
+                                    const Parted& parted, Scalar diameter, Scalar inv_d,
+                                    const SegmentOf& segment_of) {
   const bool joined_before = i > 0 && !parted(i - 1);
   const bool joined_after = i < n && !parted(i);
   const Scalar d = depth(i), half_d = Scalar(0.5) * diameter;
   const Scalar d_lo = joined_before ? depth(i - 1) : d, d_hi = joined_after ? depth(i + 1) : d;
   if (d >= half_d && d_lo >= half_d && d_hi >= half_d)
     return {Scalar(1), Scalar(0), Scalar(0), Scalar(0)};
-  return node_wetness(d_lo, d, d_hi, i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
-                      joined_before, joined_after, diameter, inv_d);
+  return node_wetness_with(d, i > 0 ? rest(i - 1) : Scalar(0), i < n ? rest(i) : Scalar(0),
+                           joined_before, joined_after, diameter, inv_d, [&](bool before) {
+                             return before ? segment_of(i - 1, d_lo, d) : segment_of(i, d, d_hi);
+                           });
+}
+
+/// node_wetness_of with each segment's wetness computed here.
+template <typename Scalar, typename Depth, typename Rest, typename Parted>
+NodeWetness<Scalar> node_wetness_of(int i, int n, const Depth& depth, const Rest& rest,
+                                    const Parted& parted, Scalar diameter, Scalar inv_d) {
+  return node_wetness_of<Scalar>(
+      i, n, depth, rest, parted, diameter, inv_d,
+      [&](int, Scalar da, Scalar db) { return segment_wetness(da, db, diameter, inv_d); });
 }
 
 /// node_wetness_of node i of a force pass (segment 0 at a winch: TetherWorkspace::winch_length).
+/// A segment crossing the surface band serves the nodes at both its ends: the pass keeps the
+/// last segment's wetness (ForcePass::wet_segment), which the node after it takes again.
 template <typename Scalar>
 NodeWetness<Scalar> node_wetness_in_pass(const ForcePass<Scalar>& c,
                                          const TetherWorkspace<Scalar>& ws, int i) {
   return node_wetness_of<Scalar>(
       i, c.n, [&](int j) { return c.still ? c.X(2, j) : c.X(2, j) + ws.surface_elevation(j); },
       [&](int s) { return c.winch && s == 0 ? ws.winch_length : c.l; },
-      [&](int s) { return c.parted && c.parted[s]; }, c.p->diameter, c.inv_d);
+      [&](int s) { return c.parted && c.parted[s]; }, c.p->diameter, c.inv_d,
+      [&](int s, Scalar da, Scalar db) {
+        if (c.wet_segment != s) {
+          c.wet = segment_wetness(da, db, c.p->diameter, c.inv_d);
+          c.wet_segment = s;
+        }
+        return c.wet;
+      });
 }
 
 /// Node i, any kind and state (end node, surface band, in air, on the seabed): tangent, node
