@@ -796,7 +796,9 @@ void evaluate_forces(const TetherModel<Scalar>& model, TetherWorkspace<Scalar>& 
 /// Evaluated in passes over SIMD packets (kelp/core/simd.hpp): the segments, then the interior
 /// nodes of the wet line a packet at a time (the ends and nodes in the surface band, in air or
 /// on the seabed one by one, with every branch), then the added-mass coupling of neighbours and
-/// bending. Also fills `ws.mass_iso_inv` and `ws.mass_tan_ratio`. No heap allocation.
+/// bending; each pass ends with a packet that overlaps the one before. x and v are checked in
+/// the first pass, which copies them, before anything else is written. Also fills
+/// `ws.mass_iso_inv` and `ws.mass_tan_ratio`. No heap allocation.
 /// \tparam WithJacobian also fill the ingredients of the symmetric block-tridiagonal Jacobian
 /// of the implicit steps (`ws.seg_*`, `ws.node_dv`, `ws.node_kz`), which leaves out the tangent's
 /// dependence on the positions in drag, forcing and added mass, the added-mass rate terms, the
